@@ -1,0 +1,150 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "CliSupport.h"
+
+#include <scandiff/core/Error.h>
+
+#include <csignal>
+#include <cstdio>
+#include <sstream>
+#include <unistd.h>
+
+namespace scandiff::cli {
+
+namespace {
+
+std::atomic<bool> interrupted{false};
+
+extern "C" void onInterrupt(int)
+{
+    interrupted = true;
+}
+
+std::vector<std::string> splitList(const std::string& text, char separator)
+{
+    std::vector<std::string> parts;
+    std::stringstream stream(text);
+    std::string part;
+    while (std::getline(stream, part, separator))
+        parts.push_back(part);
+    return parts;
+}
+
+} // namespace
+
+TerminalProgress::TerminalProgress() : draw_(::isatty(STDERR_FILENO) == 1)
+{
+    interrupted = false;
+    std::signal(SIGINT, onInterrupt);
+}
+
+TerminalProgress::~TerminalProgress()
+{
+    finishLine();
+    std::signal(SIGINT, SIG_DFL);
+}
+
+void TerminalProgress::finishLine()
+{
+    if (draw_ && lastPercent_ >= 0)
+        std::fputc('\n', stderr);
+    lastPercent_ = -1;
+}
+
+void TerminalProgress::beginStage(const std::string& title)
+{
+    finishLine();
+    stage_ = title;
+}
+
+void TerminalProgress::report(double fraction)
+{
+    if (!draw_)
+        return;
+    const int percent = static_cast<int>(fraction * 100.0 + 0.5);
+    if (percent == lastPercent_)
+        return;
+    lastPercent_ = percent;
+    constexpr int width = 30;
+    const int filled = percent * width / 100;
+    std::fprintf(stderr, "\r%-40.40s [%.*s%*s] %3d%%", stage_.c_str(), filled, "##############################",
+                 width - filled, "", percent);
+    std::fflush(stderr);
+}
+
+bool TerminalProgress::cancelRequested() const
+{
+    return interrupted.load();
+}
+
+void ReadFlags::addTo(CLI::App& command)
+{
+    command.add_option("--columns", columns,
+                       "ASCII files: column mapping, e.g. x,y,z,r,g,b,intensity (names: x y z r g b rf gf bf nx ny nz skip, "
+                       "anything else is a scalar field)");
+    command.add_option("--separator", separator, "ASCII files: column separator: , ; tab space");
+    command.add_option("--skip-lines", skipLines, "ASCII files: number of leading lines to skip");
+    command.add_option("--origin", origin, "Global shift to use, as X,Y,Z (default: chosen from the data)");
+}
+
+io::ReadOptions ReadFlags::toOptions(ProgressObserver* progress) const
+{
+    io::ReadOptions options;
+    options.progress = progress;
+    if (!columns.empty())
+        options.asciiColumns = io::AsciiColumns{splitList(columns, ',')};
+    if (!separator.empty()) {
+        if (separator == "tab" || separator == "\\t")
+            options.asciiSeparator = '\t';
+        else if (separator == "space")
+            options.asciiSeparator = ' ';
+        else if (separator.size() == 1)
+            options.asciiSeparator = separator[0];
+        else
+            throw Error(ErrorCode::InvalidArgument, "--separator: expected one character, 'tab' or 'space'");
+    }
+    if (skipLines >= 0)
+        options.asciiSkipLines = static_cast<std::size_t>(skipLines);
+    if (!origin.empty()) {
+        const auto parts = splitList(origin, ',');
+        Eigen::Vector3d o;
+        if (parts.size() != 3)
+            throw Error(ErrorCode::InvalidArgument, "--origin: expected X,Y,Z");
+        for (int a = 0; a < 3; ++a) {
+            try {
+                std::size_t used = 0;
+                o[a] = std::stod(parts[static_cast<std::size_t>(a)], &used);
+                if (used != parts[static_cast<std::size_t>(a)].size())
+                    throw std::invalid_argument("trailing text");
+            } catch (const std::exception&) {
+                throw Error(ErrorCode::InvalidArgument, "--origin: '" + parts[static_cast<std::size_t>(a)] + "' is not a number");
+            }
+        }
+        options.origin = o;
+    }
+    return options;
+}
+
+void WriteFlags::addTo(CLI::App& command)
+{
+    command.add_option("--encoding", encoding, "Output encoding: default, ascii, binary, binary-be, compressed (PCD)")
+        ->check(CLI::IsMember({"default", "ascii", "binary", "binary-be", "compressed"}));
+    command.add_option("--precision", precision, "ASCII output: decimals of the coordinates")->check(CLI::Range(0, 12));
+}
+
+io::WriteOptions WriteFlags::toOptions(ProgressObserver* progress) const
+{
+    io::WriteOptions options;
+    options.progress = progress;
+    options.asciiPrecision = precision;
+    if (encoding == "ascii")
+        options.encoding = io::Encoding::Ascii;
+    else if (encoding == "binary")
+        options.encoding = io::Encoding::BinaryLittleEndian;
+    else if (encoding == "binary-be")
+        options.encoding = io::Encoding::BinaryBigEndian;
+    else if (encoding == "compressed")
+        options.encoding = io::Encoding::BinaryCompressed;
+    return options;
+}
+
+} // namespace scandiff::cli

@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Pieces shared by the commands of scandiff-cli.
+
+#include <scandiff/core/Progress.h>
+#include <scandiff/io/FileIO.h>
+
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <string>
+
+namespace scandiff::cli {
+
+//! A progress bar on stderr, drawn only when stderr is a terminal. Ctrl-C asks
+//! the running operation to cancel (it then stops cleanly, leaving no partial file).
+class TerminalProgress : public ProgressObserver
+{
+public:
+    TerminalProgress();
+    ~TerminalProgress() override;
+    void beginStage(const std::string& title) override;
+    void report(double fraction) override;
+    bool cancelRequested() const override;
+
+private:
+    void finishLine();
+    bool draw_;
+    std::string stage_;
+    int lastPercent_ = -1;
+};
+
+//! Options of how files are read, shared by every command that reads one.
+struct ReadFlags
+{
+    std::string columns;   //!< "x,y,z,intensity"
+    std::string separator; //!< "," ";" "tab" "space"
+    int skipLines = -1;
+    std::string origin;    //!< "X,Y,Z"
+    void addTo(CLI::App& command);
+    //! Throws Error(InvalidArgument) for malformed values.
+    io::ReadOptions toOptions(ProgressObserver* progress) const;
+};
+
+struct WriteFlags
+{
+    std::string encoding = "default";
+    int precision = 6;
+    void addTo(CLI::App& command);
+    io::WriteOptions toOptions(ProgressObserver* progress) const;
+};
+
+} // namespace scandiff::cli

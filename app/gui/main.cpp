@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "MainWindow.h"
+#include "view/CloudView.h"
+
+#include <QApplication>
+#include <QCommandLineParser>
+#include <QSurfaceFormat>
+#include <QTimer>
+#include <QVTKOpenGLNativeWidget.h>
+
+int main(int argc, char** argv)
+{
+    // VTK's widget needs its OpenGL format set before the application exists.
+    QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+    QApplication app(argc, argv);
+    QApplication::setApplicationName("scandiff");
+    QApplication::setApplicationVersion("0.1.0");
+
+    QCommandLineParser parser;
+    parser.setApplicationDescription("scandiff: a workbench for comparing 3D scans");
+    parser.addHelpOption();
+    parser.addVersionOption();
+    QCommandLineOption screenshot("screenshot", "Load FILEs, save the view to PNG and quit.", "png");
+    parser.addOption(screenshot);
+    parser.addPositionalArgument("FILE", "Clouds or meshes to open", "[FILE...]");
+    parser.process(app);
+
+    const scandiff::PluginRegistry registry = scandiff::makePluginRegistry();
+    scandiff::gui::MainWindow window(registry);
+    window.show();
+    const QStringList files = parser.positionalArguments();
+    const bool quiet = parser.isSet(screenshot);
+    QTimer::singleShot(0, &window, [&] {
+        const int loaded = files.isEmpty() ? 0 : window.openFiles(files, quiet);
+        if (parser.isSet(screenshot)) {
+            const bool saved = window.view()->saveScreenshot(parser.value(screenshot));
+            QApplication::exit(saved && loaded == files.size() ? 0 : 1);
+        }
+    });
+    return app.exec();
+}

@@ -1,0 +1,16 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Builds the octree of a cloud's local positions, with the project's error
+//! policy: an empty cloud or a non-finite coordinate is an Error(InvalidData)
+//! naming the cloud. The cloud must outlive the octree and keep its points.
+
+#include <scandiff/core/PointCloud.h>
+#include <scandiff/octree/Octree.h>
+
+#include <optional>
+
+namespace scandiff {
+
+octree::Octree buildOctree(const PointCloud& cloud, std::optional<octree::CubicBox> box = std::nullopt);
+
+} // namespace scandiff

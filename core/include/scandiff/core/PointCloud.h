@@ -1,0 +1,122 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! The point cloud of scandiff.
+//!
+//! Positions are float32 *local* coordinates; the cloud's `origin` (double) is
+//! added to get the true (global) coordinates: global = origin + local. Keeping
+//! the large part of georeferenced coordinates (UTM, Lambert: 10^5..10^7 m) in
+//! the double origin keeps millimetre precision in 32-bit floats, as CloudCompare
+//! does with its "global shift".
+//!
+//! A cloud is move-only: copying millions of points must be explicit (clone()).
+
+#include <scandiff/core/ScalarField.h>
+#include <scandiff/core/SensorPose.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace scandiff {
+
+struct Rgb8
+{
+    std::uint8_t r = 0, g = 0, b = 0;
+    friend bool operator==(const Rgb8& a, const Rgb8& b) { return a.r == b.r && a.g == b.g && a.b == b.b; }
+};
+
+struct BoundingBox
+{
+    Eigen::Vector3d min = Eigen::Vector3d::Constant(0.0);
+    Eigen::Vector3d max = Eigen::Vector3d::Constant(0.0);
+    bool empty = true;
+};
+
+class PointCloud
+{
+public:
+    PointCloud() = default;
+    PointCloud(PointCloud&&) noexcept = default;
+    PointCloud& operator=(PointCloud&&) noexcept = default;
+    PointCloud(const PointCloud&) = delete;
+    PointCloud& operator=(const PointCloud&) = delete;
+    //! Explicit deep copy.
+    PointCloud clone() const;
+
+    std::string name;
+
+    std::size_t size() const { return positions_.size(); }
+    bool empty() const { return positions_.empty(); }
+
+    //! Global coordinates = origin() + local position.
+    const Eigen::Vector3d& origin() const { return origin_; }
+    //! Changes the origin while keeping global coordinates (re-expresses positions).
+    void shiftOrigin(const Eigen::Vector3d& newOrigin);
+    //! Sets the origin without touching the local positions (readers use it).
+    void setOrigin(const Eigen::Vector3d& origin) { origin_ = origin; }
+
+    const std::vector<Eigen::Vector3f>& positions() const { return positions_; }
+    std::vector<Eigen::Vector3f>& positions() { return positions_; }
+    Eigen::Vector3d globalPosition(std::size_t i) const { return origin_ + positions_[i].cast<double>(); }
+
+    //! Resizes positions and every attribute present (new entries: 0 / NaN).
+    void resize(std::size_t n);
+    void reserve(std::size_t n);
+
+    bool hasColors() const { return !colors_.empty(); }
+    const std::vector<Rgb8>& colors() const { return colors_; }
+    //! Enables colours (size() black entries) if absent and returns them.
+    std::vector<Rgb8>& enableColors();
+    void removeColors() { colors_.clear(); colors_.shrink_to_fit(); }
+
+    bool hasNormals() const { return !normals_.empty(); }
+    const std::vector<Eigen::Vector3f>& normals() const { return normals_; }
+    std::vector<Eigen::Vector3f>& enableNormals();
+    void removeNormals() { normals_.clear(); normals_.shrink_to_fit(); }
+
+    const std::vector<ScalarField>& fields() const { return fields_; }
+    //! Null if there is no field of that name.
+    const ScalarField* field(const std::string& name) const;
+    ScalarField* field(const std::string& name);
+    //! Returns the named field, creating it (all NaN) if absent.
+    ScalarField& addField(const std::string& name);
+    //! Adds a field built elsewhere; its size must equal size(). Replaces a field of the same name.
+    ScalarField& addField(ScalarField field);
+    bool removeField(const std::string& name);
+
+    //! Scanner poses this cloud was acquired from (visibility needs them).
+    std::vector<SensorPose>& sensors() { return sensors_; }
+    const std::vector<SensorPose>& sensors() const { return sensors_; }
+
+    //! Bounding box of the global coordinates, ignoring non-finite positions.
+    BoundingBox bounds() const;
+
+    //! A new cloud made of the listed points, in that order, with every attribute.
+    PointCloud subset(const std::vector<std::size_t>& indices) const;
+
+    //! Drops the points whose position is NaN or infinite (with their attributes);
+    //! returns how many were dropped. Readers call it and log a warning: the
+    //! documented policy for non-finite coordinates in point clouds.
+    std::size_t removeNonFinitePoints();
+
+    //! Throws Error(InvalidData) if the attribute arrays disagree with the point count.
+    void checkConsistency() const;
+
+private:
+    Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
+    std::vector<Eigen::Vector3f> positions_;
+    std::vector<Rgb8> colors_;
+    std::vector<Eigen::Vector3f> normals_;
+    std::vector<ScalarField> fields_;
+    std::vector<SensorPose> sensors_;
+};
+
+//! Chooses an origin for global coordinates spanning `bounds`: zero when float32
+//! keeps sub-millimetre precision (all |coordinates| < 1e4 m), otherwise the box
+//! minimum rounded down to a multiple of 1000 m, as a survey user would expect.
+Eigen::Vector3d suggestOrigin(const BoundingBox& bounds);
+
+} // namespace scandiff

@@ -1,0 +1,110 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Tools contributed by plugins, described once for every front end.
+//!
+//! A tool declares its parameters (name, label, help, unit, default, valid range
+//! or choices) and a run function. The CLI turns the declarations into options
+//! (`scandiff-cli run TOOL --name value`), the GUI into a dialog: there is no
+//! second copy of any default. Values are checked against their declaration
+//! before the tool runs, so a run function only sees valid parameters.
+
+#include <scandiff/core/PointCloud.h>
+#include <scandiff/core/Progress.h>
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <map>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace scandiff {
+
+enum class ParameterType { Integer, Real, Boolean, Choice };
+
+using ParameterValue = std::variant<std::int64_t, double, bool, std::string>;
+
+struct ParameterSpec
+{
+    std::string name;        //!< identifier, CLI option "--name"
+    std::string label;       //!< short GUI label
+    std::string description; //!< one sentence of help
+    std::string unit;        //!< "m", "points", "" ...
+    ParameterType type = ParameterType::Real;
+    ParameterValue defaultValue = 0.0;
+    double minimum = -std::numeric_limits<double>::infinity(); //!< Integer/Real: inclusive
+    double maximum = std::numeric_limits<double>::infinity();  //!< Integer/Real: inclusive
+    std::vector<std::string> choices;                            //!< Choice only
+
+    static ParameterSpec integer(std::string name, std::string label, std::string description, std::int64_t defaultValue,
+                                 std::int64_t minimum, std::int64_t maximum, std::string unit = {});
+    static ParameterSpec real(std::string name, std::string label, std::string description, double defaultValue,
+                              double minimum, double maximum, std::string unit = {});
+    static ParameterSpec boolean(std::string name, std::string label, std::string description, bool defaultValue);
+    static ParameterSpec choice(std::string name, std::string label, std::string description,
+                                std::vector<std::string> choices, std::string defaultValue);
+
+    //! Parses user text ("12", "0.5", "true", "plane") into a valid value.
+    //! Throws Error(InvalidArgument) naming the parameter and its valid range.
+    ParameterValue parse(const std::string& text) const;
+    //! Throws Error(InvalidArgument) if `value` has the wrong type or lies outside the range.
+    void validate(const ParameterValue& value) const;
+    //! "8", "0.5", "true", "plane": the inverse of parse().
+    static std::string format(const ParameterValue& value);
+};
+
+//! Validated parameter values of one tool run.
+class ParameterValues
+{
+public:
+    void set(const std::string& name, ParameterValue value) { values_[name] = std::move(value); }
+    bool has(const std::string& name) const { return values_.count(name) != 0; }
+    std::int64_t integer(const std::string& name) const;
+    double real(const std::string& name) const;
+    bool boolean(const std::string& name) const;
+    const std::string& text(const std::string& name) const;
+    const std::map<std::string, ParameterValue>& all() const { return values_; }
+
+private:
+    const ParameterValue& get(const std::string& name) const;
+    std::map<std::string, ParameterValue> values_;
+};
+
+struct ToolResult
+{
+    PointCloud cloud;    //!< the tool's output cloud (input untouched)
+    std::string summary; //!< one line for the log: what was done, counts
+};
+
+struct ToolSpec
+{
+    std::string name;        //!< CLI name, e.g. "sor-filter"
+    std::string title;       //!< menu text, e.g. "Statistical outlier filter"
+    std::string description; //!< a paragraph of help, with the method's source
+    std::string category;    //!< menu group, e.g. "Filters"
+    std::vector<ParameterSpec> parameters;
+    std::function<ToolResult(const PointCloud&, const ParameterValues&, ProgressObserver*)> run;
+
+    const ParameterSpec* parameter(const std::string& name) const;
+    //! The declared defaults.
+    ParameterValues defaults() const;
+    //! Defaults overridden by user text, every value parsed and checked.
+    //! Throws Error(InvalidArgument) for an unknown name or a bad value.
+    ParameterValues resolve(const std::map<std::string, std::string>& userText) const;
+};
+
+class ToolRegistry
+{
+public:
+    //! Throws Error(Internal) if a tool of that name exists already.
+    void add(ToolSpec tool);
+    //! Null when unknown.
+    const ToolSpec* find(const std::string& name) const;
+    const std::vector<ToolSpec>& tools() const { return tools_; }
+
+private:
+    std::vector<ToolSpec> tools_;
+};
+
+} // namespace scandiff

@@ -1,0 +1,18 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/core/CloudOctree.h>
+#include <scandiff/core/Error.h>
+
+#include <stdexcept>
+
+namespace scandiff {
+
+octree::Octree buildOctree(const PointCloud& cloud, std::optional<octree::CubicBox> box)
+{
+    try {
+        return octree::Octree(cloud.positions().data(), cloud.size(), box);
+    } catch (const std::invalid_argument& e) {
+        throw Error(ErrorCode::InvalidData, "cloud '" + cloud.name + "': " + e.what());
+    }
+}
+
+} // namespace scandiff

@@ -1,0 +1,221 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/core/Error.h>
+#include <scandiff/core/PointCloud.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace scandiff {
+
+PointCloud PointCloud::clone() const
+{
+    PointCloud copy;
+    copy.name = name;
+    copy.origin_ = origin_;
+    copy.positions_ = positions_;
+    copy.colors_ = colors_;
+    copy.normals_ = normals_;
+    copy.fields_ = fields_;
+    copy.sensors_ = sensors_;
+    return copy;
+}
+
+void PointCloud::shiftOrigin(const Eigen::Vector3d& newOrigin)
+{
+    const Eigen::Vector3d delta = origin_ - newOrigin;
+    for (auto& p : positions_)
+        p = (p.cast<double>() + delta).cast<float>();
+    origin_ = newOrigin;
+}
+
+void PointCloud::resize(std::size_t n)
+{
+    positions_.resize(n, Eigen::Vector3f::Zero());
+    if (!colors_.empty())
+        colors_.resize(n);
+    if (!normals_.empty())
+        normals_.resize(n, Eigen::Vector3f::Zero());
+    for (auto& f : fields_)
+        f.values().resize(n, std::numeric_limits<float>::quiet_NaN());
+}
+
+void PointCloud::reserve(std::size_t n)
+{
+    positions_.reserve(n);
+}
+
+std::vector<Rgb8>& PointCloud::enableColors()
+{
+    if (colors_.size() != positions_.size())
+        colors_.assign(positions_.size(), Rgb8{});
+    return colors_;
+}
+
+std::vector<Eigen::Vector3f>& PointCloud::enableNormals()
+{
+    if (normals_.size() != positions_.size())
+        normals_.assign(positions_.size(), Eigen::Vector3f::Zero());
+    return normals_;
+}
+
+const ScalarField* PointCloud::field(const std::string& fieldName) const
+{
+    for (const auto& f : fields_)
+        if (f.name() == fieldName)
+            return &f;
+    return nullptr;
+}
+
+ScalarField* PointCloud::field(const std::string& fieldName)
+{
+    for (auto& f : fields_)
+        if (f.name() == fieldName)
+            return &f;
+    return nullptr;
+}
+
+ScalarField& PointCloud::addField(const std::string& fieldName)
+{
+    if (ScalarField* existing = field(fieldName))
+        return *existing;
+    fields_.emplace_back(fieldName, positions_.size());
+    return fields_.back();
+}
+
+ScalarField& PointCloud::addField(ScalarField newField)
+{
+    if (newField.size() != positions_.size())
+        throw Error(ErrorCode::InvalidArgument, "scalar field '" + newField.name() + "' has " +
+                                                    std::to_string(newField.size()) + " values for " +
+                                                    std::to_string(positions_.size()) + " points");
+    if (ScalarField* existing = field(newField.name())) {
+        *existing = std::move(newField);
+        return *existing;
+    }
+    fields_.push_back(std::move(newField));
+    return fields_.back();
+}
+
+bool PointCloud::removeField(const std::string& fieldName)
+{
+    auto it = std::find_if(fields_.begin(), fields_.end(), [&](const ScalarField& f) { return f.name() == fieldName; });
+    if (it == fields_.end())
+        return false;
+    fields_.erase(it);
+    return true;
+}
+
+BoundingBox PointCloud::bounds() const
+{
+    BoundingBox box;
+    Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
+    Eigen::Vector3f hi = -lo;
+    for (const auto& p : positions_) {
+        if (!p.allFinite())
+            continue;
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+        box.empty = false;
+    }
+    if (!box.empty) {
+        box.min = origin_ + lo.cast<double>();
+        box.max = origin_ + hi.cast<double>();
+    }
+    return box;
+}
+
+PointCloud PointCloud::subset(const std::vector<std::size_t>& indices) const
+{
+    PointCloud out;
+    out.name = name;
+    out.origin_ = origin_;
+    out.sensors_ = sensors_;
+    out.positions_.reserve(indices.size());
+    for (std::size_t i : indices) {
+        if (i >= positions_.size())
+            throw Error(ErrorCode::InvalidArgument, "subset index " + std::to_string(i) + " beyond the " +
+                                                        std::to_string(positions_.size()) + " points of '" + name + "'");
+        out.positions_.push_back(positions_[i]);
+    }
+    if (hasColors()) {
+        out.colors_.reserve(indices.size());
+        for (std::size_t i : indices)
+            out.colors_.push_back(colors_[i]);
+    }
+    if (hasNormals()) {
+        out.normals_.reserve(indices.size());
+        for (std::size_t i : indices)
+            out.normals_.push_back(normals_[i]);
+    }
+    for (const auto& f : fields_) {
+        ScalarField g(f.name(), 0);
+        g.setOffset(f.offset());
+        g.values().reserve(indices.size());
+        for (std::size_t i : indices)
+            g.values().push_back(f.values()[i]);
+        out.fields_.push_back(std::move(g));
+    }
+    return out;
+}
+
+std::size_t PointCloud::removeNonFinitePoints()
+{
+    const std::size_t n = positions_.size();
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!positions_[i].allFinite())
+            continue;
+        if (kept != i) {
+            positions_[kept] = positions_[i];
+            if (!colors_.empty())
+                colors_[kept] = colors_[i];
+            if (!normals_.empty())
+                normals_[kept] = normals_[i];
+            for (auto& f : fields_)
+                f.values()[kept] = f.values()[i];
+        }
+        ++kept;
+    }
+    if (kept != n) {
+        positions_.resize(kept);
+        if (!colors_.empty())
+            colors_.resize(kept);
+        if (!normals_.empty())
+            normals_.resize(kept);
+        for (auto& f : fields_)
+            f.values().resize(kept);
+    }
+    return n - kept;
+}
+
+void PointCloud::checkConsistency() const
+{
+    const std::size_t n = positions_.size();
+    auto complain = [&](const std::string& what, std::size_t count) {
+        throw Error(ErrorCode::InvalidData, "cloud '" + name + "': " + what + " has " + std::to_string(count) +
+                                                " entries for " + std::to_string(n) + " points");
+    };
+    if (!colors_.empty() && colors_.size() != n)
+        complain("colours", colors_.size());
+    if (!normals_.empty() && normals_.size() != n)
+        complain("normals", normals_.size());
+    for (const auto& f : fields_)
+        if (f.size() != n)
+            complain("scalar field '" + f.name() + "'", f.size());
+}
+
+Eigen::Vector3d suggestOrigin(const BoundingBox& bounds)
+{
+    if (bounds.empty)
+        return Eigen::Vector3d::Zero();
+    const double largest = std::max(bounds.min.cwiseAbs().maxCoeff(), bounds.max.cwiseAbs().maxCoeff());
+    // float32 has a 24-bit mantissa: below 1e4 m its step is under 1 mm.
+    if (largest < 1e4)
+        return Eigen::Vector3d::Zero();
+    Eigen::Vector3d origin;
+    for (int a = 0; a < 3; ++a)
+        origin[a] = std::floor(bounds.min[a] / 1000.0) * 1000.0;
+    return origin;
+}
+
+} // namespace scandiff

@@ -1,0 +1,103 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Reading and writing clouds and meshes, by file extension.
+//!
+//! A FormatRegistry maps extensions to format handlers. The built-in formats
+//! (PLY, ASCII XYZ/TXT/CSV/PTS/ASC, LAS, OBJ/STL/OFF via assimp, DXF export) are
+//! registered by registerBuiltinFormats(); plugins add more (PCD comes from the
+//! PCL plugin). Every writer goes through AtomicFile: an existing output file is
+//! never left half-written.
+
+#include <scandiff/core/Mesh.h>
+#include <scandiff/core/PointCloud.h>
+#include <scandiff/core/Progress.h>
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace scandiff::io {
+
+//! Column mapping of an ASCII point file. Names are case-insensitive:
+//! x y z, r g b (0-255) or rf gf bf (0-1), nx ny nz, skip (ignored column), and
+//! anything else becomes a scalar field of that name.
+struct AsciiColumns
+{
+    std::vector<std::string> names;
+};
+
+struct ReadOptions
+{
+    ProgressObserver* progress = nullptr;
+    //! Force this origin (global shift) instead of choosing one (suggestOrigin()).
+    std::optional<Eigen::Vector3d> origin;
+    //! ASCII only: overrides the detected column mapping.
+    std::optional<AsciiColumns> asciiColumns;
+    //! ASCII only: overrides the detected separator (' ', ',', ';' or '\t').
+    std::optional<char> asciiSeparator;
+    //! ASCII only: number of leading lines to skip (overrides header detection).
+    std::optional<std::size_t> asciiSkipLines;
+};
+
+enum class Encoding
+{
+    Default,            //!< the format's usual choice (binary when it exists)
+    Ascii,
+    BinaryLittleEndian,
+    BinaryBigEndian,
+    BinaryCompressed    //!< PCD binary_compressed
+};
+
+struct WriteOptions
+{
+    ProgressObserver* progress = nullptr;
+    Encoding encoding = Encoding::Default;
+    //! Significant digits after the decimal point for ASCII coordinates (mm at 3).
+    int asciiPrecision = 6;
+};
+
+using Entity = std::variant<PointCloud, Mesh>;
+
+struct FormatHandler
+{
+    std::string name;                    //!< "PLY", "LAS"...
+    std::vector<std::string> extensions; //!< lower case, without dot
+    //! Reads a file as a cloud or a mesh. Null if the format cannot be read.
+    std::function<Entity(const std::filesystem::path&, const ReadOptions&)> read;
+    std::function<void(const PointCloud&, const std::filesystem::path&, const WriteOptions&)> writeCloud;
+    std::function<void(const Mesh&, const std::filesystem::path&, const WriteOptions&)> writeMesh;
+};
+
+class FormatRegistry
+{
+public:
+    //! Adds a handler; a later handler for the same extension takes precedence.
+    void add(FormatHandler handler);
+    //! Throws Error(Unsupported) naming the extension when nothing handles it.
+    const FormatHandler& forPath(const std::filesystem::path& path) const;
+    const std::vector<FormatHandler>& handlers() const { return handlers_; }
+
+private:
+    std::vector<FormatHandler> handlers_;
+};
+
+//! Registers PLY, ASCII, LAS, OBJ/STL/OFF and DXF.
+void registerBuiltinFormats(FormatRegistry& registry);
+
+//! Reads any supported file. Throws Error naming the file on failure.
+Entity readFile(const FormatRegistry& registry, const std::filesystem::path& path, const ReadOptions& options = {});
+//! Reads a point cloud; a mesh file yields its vertices.
+PointCloud readPointCloud(const FormatRegistry& registry, const std::filesystem::path& path, const ReadOptions& options = {});
+//! Reads a mesh; throws Error(InvalidData) if the file holds no triangles.
+Mesh readMesh(const FormatRegistry& registry, const std::filesystem::path& path, const ReadOptions& options = {});
+void writePointCloud(const FormatRegistry& registry, const PointCloud& cloud, const std::filesystem::path& path, const WriteOptions& options = {});
+void writeMesh(const FormatRegistry& registry, const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options = {});
+void writeFile(const FormatRegistry& registry, const Entity& entity, const std::filesystem::path& path, const WriteOptions& options = {});
+
+//! Lower-case extension without the dot ("PLY" -> "ply").
+std::string lowerExtension(const std::filesystem::path& path);
+
+} // namespace scandiff::io

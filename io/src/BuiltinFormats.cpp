@@ -1,0 +1,15 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "internal/Formats.h"
+
+namespace scandiff::io {
+
+void registerBuiltinFormats(FormatRegistry& registry)
+{
+    registry.add(detail::plyFormat());
+    registry.add(detail::asciiFormat());
+    registry.add(detail::lasFormat());
+    registry.add(detail::assimpMeshFormat());
+    registry.add(detail::dxfFormat());
+}
+
+} // namespace scandiff::io

@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/io/FileIO.h>
+
+#include <scandiff/core/Error.h>
+
+#include <algorithm>
+#include <cctype>
+
+namespace scandiff::io {
+
+namespace fs = std::filesystem;
+
+std::string lowerExtension(const fs::path& path)
+{
+    std::string ext = path.extension().string();
+    if (!ext.empty() && ext.front() == '.')
+        ext.erase(0, 1);
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext;
+}
+
+void FormatRegistry::add(FormatHandler handler)
+{
+    handlers_.push_back(std::move(handler));
+}
+
+const FormatHandler& FormatRegistry::forPath(const fs::path& path) const
+{
+    const std::string ext = lowerExtension(path);
+    for (auto it = handlers_.rbegin(); it != handlers_.rend(); ++it)
+        if (std::find(it->extensions.begin(), it->extensions.end(), ext) != it->extensions.end())
+            return *it;
+    std::string known;
+    for (const auto& h : handlers_)
+        for (const auto& e : h.extensions)
+            known += (known.empty() ? "" : ", ") + e;
+    if (ext == "laz")
+        throw Error(ErrorCode::Unsupported, path.string() + ": compressed LAS (LAZ) is not supported; decompress it to .las first (e.g. with laszip or pdal translate)");
+    throw Error(ErrorCode::Unsupported, path.string() + ": unknown file extension '" + ext + "' (supported: " + known + ")");
+}
+
+Entity readFile(const FormatRegistry& registry, const fs::path& path, const ReadOptions& options)
+{
+    const FormatHandler& handler = registry.forPath(path);
+    if (!handler.read)
+        throw Error(ErrorCode::Unsupported, path.string() + ": " + handler.name + " files can be written but not read");
+    std::error_code ec;
+    if (!fs::exists(path, ec))
+        throw Error(ErrorCode::Io, path.string() + ": no such file");
+    Entity entity = handler.read(path, options);
+    const std::string stem = path.stem().string();
+    std::visit([&](auto& e) {
+        if (e.name.empty())
+            e.name = stem;
+    }, entity);
+    return entity;
+}
+
+PointCloud readPointCloud(const FormatRegistry& registry, const fs::path& path, const ReadOptions& options)
+{
+    Entity entity = readFile(registry, path, options);
+    if (auto* mesh = std::get_if<Mesh>(&entity)) {
+        PointCloud vertices = std::move(mesh->vertices);
+        vertices.name = mesh->name;
+        return vertices;
+    }
+    return std::move(std::get<PointCloud>(entity));
+}
+
+Mesh readMesh(const FormatRegistry& registry, const fs::path& path, const ReadOptions& options)
+{
+    Entity entity = readFile(registry, path, options);
+    if (auto* mesh = std::get_if<Mesh>(&entity))
+        return std::move(*mesh);
+    throw Error(ErrorCode::InvalidData, path.string() + ": holds points but no triangles; a mesh was expected");
+}
+
+void writePointCloud(const FormatRegistry& registry, const PointCloud& cloud, const fs::path& path, const WriteOptions& options)
+{
+    const FormatHandler& handler = registry.forPath(path);
+    if (!handler.writeCloud)
+        throw Error(ErrorCode::Unsupported, path.string() + ": " + handler.name + " cannot store point clouds");
+    cloud.checkConsistency();
+    handler.writeCloud(cloud, path, options);
+}
+
+void writeMesh(const FormatRegistry& registry, const Mesh& mesh, const fs::path& path, const WriteOptions& options)
+{
+    const FormatHandler& handler = registry.forPath(path);
+    if (!handler.writeMesh)
+        throw Error(ErrorCode::Unsupported, path.string() + ": " + handler.name + " cannot store meshes");
+    mesh.checkConsistency();
+    handler.writeMesh(mesh, path, options);
+}
+
+void writeFile(const FormatRegistry& registry, const Entity& entity, const fs::path& path, const WriteOptions& options)
+{
+    if (const auto* mesh = std::get_if<Mesh>(&entity))
+        writeMesh(registry, *mesh, path, options);
+    else
+        writePointCloud(registry, std::get<PointCloud>(entity), path, options);
+}
+
+} // namespace scandiff::io

@@ -1,0 +1,1041 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+//! LAS: reads LAS 1.0-1.4 (point data record formats 0-10, uncompressed) straight
+//! from a memory map, and writes LAS 1.4 with point format 6, 7 or 8.
+//!
+//! Layout facts quoted below come from the ASPRS LAS 1.4 specification, R15
+//! ("LAS 1.4 R15"), which also describes the older versions this reader accepts.
+
+#include "internal/Formats.h"
+#include "internal/MappedFile.h"
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/Log.h>
+#include <scandiff/core/Progress.h>
+#include <scandiff/io/AtomicFile.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <ctime>
+#include <limits>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+// LAS is little endian (LAS 1.4 R15, "LAS Format Definition"): fields are loaded with
+// memcpy, which is only right on a little-endian host.
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "LasFormat.cpp assumes a little-endian host"
+#endif
+
+namespace scandiff::io::detail {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// Points decoded between two progress steps: large enough that the ticker costs
+// nothing, small enough for a responsive Cancel.
+constexpr std::size_t kChunkPoints = 1u << 16;
+
+template <class T>
+T load(const char* p)
+{
+    T value;
+    std::memcpy(&value, p, sizeof value);
+    return value;
+}
+
+template <class T>
+void store(char* p, T value)
+{
+    std::memcpy(p, &value, sizeof value);
+}
+
+std::string fixedString(const char* p, std::size_t maxLength)
+{
+    std::size_t n = 0;
+    while (n < maxLength && p[n] != '\0')
+        ++n;
+    return std::string(p, n);
+}
+
+// ---------------------------------------------------------------------------
+// Public Header Block (LAS 1.4 R15). Offsets are the same in every version:
+// 1.0-1.2 have 227 bytes, 1.3 appends the waveform start (235 bytes), 1.4 the
+// EVLR fields and the 64-bit counts (375 bytes).
+
+constexpr std::size_t kHeaderSize12 = 227;
+constexpr std::size_t kHeaderSize14 = 375;
+
+namespace hdr {
+constexpr std::size_t globalEncoding = 6;
+constexpr std::size_t versionMajor = 24;
+constexpr std::size_t versionMinor = 25;
+constexpr std::size_t systemIdentifier = 26;
+constexpr std::size_t generatingSoftware = 58;
+constexpr std::size_t creationDay = 90;
+constexpr std::size_t creationYear = 92;
+constexpr std::size_t headerSize = 94;
+constexpr std::size_t offsetToPoints = 96;
+constexpr std::size_t vlrCount = 100;
+constexpr std::size_t pointFormat = 104;
+constexpr std::size_t recordLength = 105;
+constexpr std::size_t legacyPointCount = 107;
+constexpr std::size_t scale = 131;      // x, y, z doubles
+constexpr std::size_t offset = 155;     // x, y, z doubles
+constexpr std::size_t bounds = 179;     // max x, min x, max y, min y, max z, min z
+constexpr std::size_t evlrStart = 235;  // 1.4
+constexpr std::size_t evlrCount = 243;  // 1.4
+constexpr std::size_t pointCount = 247; // 1.4, uint64
+constexpr std::size_t pointsByReturn = 255; // 1.4, uint64[15]
+} // namespace hdr
+
+// Variable length record header: 54 bytes; the extended one (EVLR, 1.4) has a
+// 64-bit payload length and is 60 bytes (LAS 1.4 R15, "Variable Length Records"
+// and "Extended Variable Length Records").
+constexpr std::size_t kVlrHeaderSize = 54;
+constexpr std::size_t kEvlrHeaderSize = 60;
+
+// Size of the standard part of each point data record format (LAS 1.4 R15,
+// "Point Data Record Format 0" to "10"). Formats 4, 5, 9 and 10 end with 29
+// bytes of wave packet descriptor, which this reader skips.
+constexpr std::array<std::size_t, 11> kBaseRecordSize = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+
+struct LasHeader
+{
+    int versionMajor = 0;
+    int versionMinor = 0;
+    std::uint16_t globalEncoding = 0;
+    std::size_t headerSize = 0;
+    std::uint64_t offsetToPoints = 0;
+    std::uint32_t vlrCount = 0;
+    int pointFormat = 0;
+    std::size_t recordLength = 0;
+    std::uint64_t pointCount = 0;
+    std::uint64_t evlrStart = 0;
+    std::uint32_t evlrCount = 0;
+    Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+    Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+    Eigen::Vector3d min = Eigen::Vector3d::Zero();
+    Eigen::Vector3d max = Eigen::Vector3d::Zero();
+};
+
+[[noreturn]] void invalid(const fs::path& path, const std::string& what)
+{
+    throw Error(ErrorCode::InvalidData, path.string() + ": " + what);
+}
+
+LasHeader parseHeader(const MappedFile& file)
+{
+    const fs::path& path = file.path();
+    const char* data = file.data();
+    const std::size_t size = file.size();
+    if (size == 0)
+        invalid(path, "empty file (0 bytes), not a LAS file");
+    if (size < 4 || std::memcmp(data, "LASF", 4) != 0)
+        invalid(path, "not a LAS file (the signature at byte 0 is not 'LASF')");
+    if (size < kHeaderSize12)
+        invalid(path, "LAS header too short: the file has " + std::to_string(size) +
+                          " bytes, a header needs at least " + std::to_string(kHeaderSize12));
+
+    LasHeader h;
+    h.versionMajor = static_cast<unsigned char>(data[hdr::versionMajor]);
+    h.versionMinor = static_cast<unsigned char>(data[hdr::versionMinor]);
+    if (h.versionMajor != 1 || h.versionMinor > 4)
+        invalid(path, "unknown LAS version " + std::to_string(h.versionMajor) + "." + std::to_string(h.versionMinor) +
+                          " at byte 24 (1.0 to 1.4 are supported)");
+
+    h.globalEncoding = load<std::uint16_t>(data + hdr::globalEncoding);
+    h.headerSize = load<std::uint16_t>(data + hdr::headerSize);
+    // 1.3 headers written with the 1.2 size exist in the wild; only 1.4 needs the
+    // longer header, for the 64-bit point count.
+    const std::size_t minimumHeader = h.versionMinor >= 4 ? kHeaderSize14 : kHeaderSize12;
+    if (h.headerSize < minimumHeader)
+        invalid(path, "LAS header too short: header size (byte 94) is " + std::to_string(h.headerSize) + ", LAS 1." +
+                          std::to_string(h.versionMinor) + " needs at least " + std::to_string(minimumHeader));
+    if (h.headerSize > size)
+        invalid(path, "LAS header too short: header size (byte 94) is " + std::to_string(h.headerSize) +
+                          " but the file has only " + std::to_string(size) + " bytes");
+
+    const auto formatByte = static_cast<unsigned char>(data[hdr::pointFormat]);
+    // LASzip marks compressed points by setting bit 7 of the format id (bit 6 in
+    // some older writers); the points are then unreadable without LASzip.
+    if (formatByte & 0xC0)
+        throw Error(ErrorCode::Unsupported, path.string() +
+                                                ": compressed LAS (LAZ) is not supported; decompress it to .las first "
+                                                "(e.g. with laszip or pdal translate)");
+    h.pointFormat = formatByte;
+    if (h.pointFormat > 10)
+        invalid(path, "unknown point data record format " + std::to_string(h.pointFormat) +
+                          " at byte 104 (0 to 10 are defined)");
+
+    h.recordLength = load<std::uint16_t>(data + hdr::recordLength);
+    if (h.recordLength < kBaseRecordSize[static_cast<std::size_t>(h.pointFormat)])
+        invalid(path, "point record length (byte 105) is " + std::to_string(h.recordLength) +
+                          " bytes, smaller than the " +
+                          std::to_string(kBaseRecordSize[static_cast<std::size_t>(h.pointFormat)]) +
+                          " bytes of point format " + std::to_string(h.pointFormat));
+
+    h.offsetToPoints = load<std::uint32_t>(data + hdr::offsetToPoints);
+    if (h.offsetToPoints > size)
+        invalid(path, "offset to point data (byte 96) is " + std::to_string(h.offsetToPoints) +
+                          ", beyond the end of the file (" + std::to_string(size) + " bytes)");
+    if (h.offsetToPoints < h.headerSize)
+        invalid(path, "offset to point data (byte 96) is " + std::to_string(h.offsetToPoints) +
+                          ", inside the " + std::to_string(h.headerSize) + "-byte header");
+    h.vlrCount = load<std::uint32_t>(data + hdr::vlrCount);
+
+    for (int a = 0; a < 3; ++a) {
+        h.scale[a] = load<double>(data + hdr::scale + 8 * static_cast<std::size_t>(a));
+        h.offset[a] = load<double>(data + hdr::offset + 8 * static_cast<std::size_t>(a));
+        h.max[a] = load<double>(data + hdr::bounds + 16 * static_cast<std::size_t>(a));
+        h.min[a] = load<double>(data + hdr::bounds + 16 * static_cast<std::size_t>(a) + 8);
+    }
+    static const char* const axisName[3] = {"X", "Y", "Z"};
+    for (int a = 0; a < 3; ++a) {
+        if (!std::isfinite(h.scale[a]) || h.scale[a] == 0.0)
+            invalid(path, std::string(axisName[a]) + " scale factor (byte " + std::to_string(hdr::scale + 8 * a) +
+                              ") is " + std::to_string(h.scale[a]) + "; it must be a finite non-zero number");
+        if (!std::isfinite(h.offset[a]))
+            invalid(path, std::string(axisName[a]) + " offset (byte " + std::to_string(hdr::offset + 8 * a) +
+                              ") is not a finite number");
+    }
+
+    // LAS 1.4 R15: the 64-bit "Number of Point Records" must always be filled;
+    // the legacy 32-bit one is zero for formats 6-10 or beyond 2^32 points.
+    const std::uint64_t legacyCount = load<std::uint32_t>(data + hdr::legacyPointCount);
+    h.pointCount = legacyCount;
+    if (h.versionMinor >= 4) {
+        h.evlrStart = load<std::uint64_t>(data + hdr::evlrStart);
+        h.evlrCount = load<std::uint32_t>(data + hdr::evlrCount);
+        const std::uint64_t count64 = load<std::uint64_t>(data + hdr::pointCount);
+        // A few writers fill only the legacy count of a 1.4 file.
+        if (count64 != 0)
+            h.pointCount = count64;
+    }
+
+    const std::uint64_t available = size - h.offsetToPoints;
+    if (h.pointCount > available / h.recordLength)
+        invalid(path, "truncated: " + std::to_string(h.pointCount) + " points of " + std::to_string(h.recordLength) +
+                          " bytes need " +
+                          (h.pointCount > std::numeric_limits<std::uint64_t>::max() / h.recordLength
+                               ? std::string("more than 2^64")
+                               : std::to_string(h.pointCount * h.recordLength)) +
+                          " bytes from byte " + std::to_string(h.offsetToPoints) + ", but only " +
+                          std::to_string(available) + " bytes follow");
+    return h;
+}
+
+// ---------------------------------------------------------------------------
+// Extra Bytes (LAS 1.4 R15, "Extra Bytes" VLR): user id "LASF_Spec",
+// record id 4, an array of 192-byte descriptors, one per extra dimension, in
+// the order the dimensions follow the standard part of each point record.
+
+constexpr std::size_t kExtraBytesDescriptorSize = 192;
+
+namespace eb {
+constexpr std::size_t dataType = 2;
+constexpr std::size_t options = 3;
+constexpr std::size_t name = 4;
+constexpr std::size_t noData = 40;
+constexpr std::size_t scale = 112;
+constexpr std::size_t offset = 136;
+constexpr std::size_t description = 160;
+constexpr unsigned optNoData = 1u << 0;
+constexpr unsigned optScale = 1u << 3;
+constexpr unsigned optOffset = 1u << 4;
+constexpr unsigned char typeFloat = 9;
+constexpr unsigned char typeDouble = 10;
+} // namespace eb
+
+struct ExtraDimension
+{
+    std::string name;
+    unsigned char type = 0; // 1..10: the scalar types this reader decodes
+    std::size_t recordOffset = 0;
+    bool hasNoData = false;
+    std::uint64_t noDataBits = 0; // upcast no_data, compared with the upcast raw value
+    double scale = 1.0;
+    double offset = 0.0;
+};
+
+// Byte size of an extra-bytes data type; 0 for an unknown type. Types 11-30 are
+// the deprecated 2- and 3-element arrays of types 1-10 (LAS 1.4 R15, Extra Bytes data_type).
+std::size_t extraTypeSize(unsigned char type, unsigned char options)
+{
+    static constexpr std::size_t scalarSize[11] = {0, 1, 1, 2, 2, 4, 4, 8, 8, 4, 8};
+    if (type == 0)
+        return options; // "undocumented extra bytes": options holds the byte count
+    if (type <= 10)
+        return scalarSize[type];
+    if (type <= 20)
+        return 2 * scalarSize[type - 10];
+    if (type <= 30)
+        return 3 * scalarSize[type - 20];
+    return 0;
+}
+
+std::vector<ExtraDimension> parseExtraBytes(const fs::path& path, const char* payload, std::size_t length,
+                                            std::size_t baseSize, std::size_t recordLength)
+{
+    std::vector<ExtraDimension> dims;
+    std::size_t position = baseSize;
+    for (std::size_t d = 0; d + kExtraBytesDescriptorSize <= length; d += kExtraBytesDescriptorSize) {
+        const char* p = payload + d;
+        const auto type = static_cast<unsigned char>(p[eb::dataType]);
+        const auto options = static_cast<unsigned char>(p[eb::options]);
+        std::string name = fixedString(p + eb::name, 32);
+        const std::size_t size = extraTypeSize(type, options);
+        if (size == 0 && type != 0) {
+            logWarning(path.string() + ": extra bytes dimension '" + name + "' has unknown data type " +
+                       std::to_string(type) + "; it and the extra dimensions after it are skipped");
+            break;
+        }
+        if (position + size > recordLength) {
+            logWarning(path.string() + ": extra bytes dimension '" + name + "' does not fit in the " +
+                       std::to_string(recordLength) + "-byte point record; it and the ones after it are skipped");
+            break;
+        }
+        if (type >= 1 && type <= 10) {
+            ExtraDimension dim;
+            dim.name = std::move(name);
+            dim.type = type;
+            dim.recordOffset = position;
+            dim.hasNoData = (options & eb::optNoData) != 0;
+            dim.noDataBits = load<std::uint64_t>(p + eb::noData);
+            if (options & eb::optScale)
+                dim.scale = load<double>(p + eb::scale);
+            if (options & eb::optOffset)
+                dim.offset = load<double>(p + eb::offset);
+            dims.push_back(std::move(dim));
+        } else if (type != 0) {
+            logWarning(path.string() + ": extra bytes dimension '" + name + "' (array type " + std::to_string(type) +
+                       ") is not supported and was skipped");
+        }
+        position += size;
+    }
+    return dims;
+}
+
+// Finds the Extra Bytes record among the VLRs (and, in 1.4, the EVLRs).
+std::vector<ExtraDimension> findExtraDimensions(const MappedFile& file, const LasHeader& h)
+{
+    const fs::path& path = file.path();
+    const char* data = file.data();
+    const std::size_t baseSize = kBaseRecordSize[static_cast<std::size_t>(h.pointFormat)];
+    if (h.recordLength == baseSize)
+        return {};
+    auto isExtraBytes = [](const char* recordHeader) {
+        return fixedString(recordHeader + 2, 16) == "LASF_Spec" && load<std::uint16_t>(recordHeader + 18) == 4;
+    };
+
+    std::size_t position = h.headerSize;
+    for (std::uint32_t v = 0; v < h.vlrCount; ++v) {
+        if (position + kVlrHeaderSize > h.offsetToPoints) {
+            logWarning(path.string() + ": variable length record " + std::to_string(v) + " at byte " +
+                       std::to_string(position) + " runs into the point data; the remaining records are ignored");
+            break;
+        }
+        const std::size_t length = load<std::uint16_t>(data + position + 20);
+        if (position + kVlrHeaderSize + length > h.offsetToPoints) {
+            logWarning(path.string() + ": variable length record " + std::to_string(v) + " at byte " +
+                       std::to_string(position) + " runs into the point data; the remaining records are ignored");
+            break;
+        }
+        if (isExtraBytes(data + position))
+            return parseExtraBytes(path, data + position + kVlrHeaderSize, length, baseSize, h.recordLength);
+        position += kVlrHeaderSize + length;
+    }
+
+    std::uint64_t evlr = h.evlrStart;
+    for (std::uint32_t v = 0; v < h.evlrCount && evlr != 0; ++v) {
+        if (evlr > file.size() || file.size() - evlr < kEvlrHeaderSize)
+            break;
+        const std::uint64_t length = load<std::uint64_t>(data + evlr + 20);
+        if (length > file.size() - evlr - kEvlrHeaderSize)
+            break;
+        if (isExtraBytes(data + evlr))
+            return parseExtraBytes(path, data + evlr + kEvlrHeaderSize, static_cast<std::size_t>(length), baseSize,
+                                   h.recordLength);
+        evlr += kEvlrHeaderSize + length;
+    }
+
+    logInfo(path.string() + ": " + std::to_string(h.recordLength - baseSize) +
+            " undescribed extra bytes per point were ignored");
+    return {};
+}
+
+// ---------------------------------------------------------------------------
+// Point decoding.
+
+//! Where the decoder puts each attribute; null when the format lacks it.
+struct PointOutputs
+{
+    Eigen::Vector3f* positions = nullptr;
+    Rgb8* colors = nullptr;
+    float* intensity = nullptr;
+    float* returnNumber = nullptr;
+    float* numberOfReturns = nullptr;
+    float* classification = nullptr;
+    float* classificationFlags = nullptr;
+    float* scannerChannel = nullptr;
+    float* scanDirectionFlag = nullptr;
+    float* edgeOfFlightLine = nullptr;
+    float* scanAngle = nullptr;
+    float* userData = nullptr;
+    float* pointSourceId = nullptr;
+    float* gpsTime = nullptr;
+    double gpsTimeOffset = 0.0;
+    float* nir = nullptr;
+    //! Bitwise OR of every colour channel: tells whether any exceeds 255.
+    unsigned colorBits = 0;
+};
+
+struct CoordinateTransform
+{
+    Eigen::Vector3d scale;
+    Eigen::Vector3d shift; // header offset - cloud origin
+};
+
+// One instantiation per family of formats, so the per-point loop has no
+// branches on the format and all field offsets are constants.
+//   Extended: formats 6-10; otherwise the legacy formats 0-5 (LAS 1.4 R15,
+//   "Point Data Record Format 0" to "10").
+template <bool Extended, bool HasGpsTime, bool HasRgb, bool HasNir>
+unsigned decodeRange(const char* records, std::size_t recordLength, std::size_t begin, std::size_t end,
+                     const CoordinateTransform& transform, const PointOutputs& out)
+{
+    constexpr std::size_t gpsOffset = Extended ? 22 : 20;
+    constexpr std::size_t rgbOffset = Extended ? 30 : (HasGpsTime ? 28 : 20);
+    constexpr std::size_t nirOffset = 36;
+    const double sx = transform.scale.x(), sy = transform.scale.y(), sz = transform.scale.z();
+    const double tx = transform.shift.x(), ty = transform.shift.y(), tz = transform.shift.z();
+    unsigned colorBits = 0;
+    const char* p = records + begin * recordLength;
+    for (std::size_t i = begin; i < end; ++i, p += recordLength) {
+        out.positions[i] = Eigen::Vector3f(static_cast<float>(load<std::int32_t>(p) * sx + tx),
+                                           static_cast<float>(load<std::int32_t>(p + 4) * sy + ty),
+                                           static_cast<float>(load<std::int32_t>(p + 8) * sz + tz));
+        out.intensity[i] = load<std::uint16_t>(p + 12);
+        const auto returns = static_cast<unsigned char>(p[14]);
+        if constexpr (Extended) {
+            // Byte 14: return number (bits 0-3), number of returns (4-7).
+            // Byte 15: classification flags (0-3: synthetic, key-point, withheld,
+            // overlap), scanner channel (4-5), scan direction (6), edge of flight line (7).
+            const auto flags = static_cast<unsigned char>(p[15]);
+            out.returnNumber[i] = returns & 0x0F;
+            out.numberOfReturns[i] = returns >> 4;
+            out.classificationFlags[i] = flags & 0x0F;
+            out.scannerChannel[i] = (flags >> 4) & 0x03;
+            out.scanDirectionFlag[i] = (flags >> 6) & 0x01;
+            out.edgeOfFlightLine[i] = flags >> 7;
+            out.classification[i] = static_cast<unsigned char>(p[16]);
+            out.userData[i] = static_cast<unsigned char>(p[17]);
+            // Scan angle: int16 in units of 0.006 degree.
+            out.scanAngle[i] = static_cast<float>(load<std::int16_t>(p + 18) * 0.006);
+            out.pointSourceId[i] = load<std::uint16_t>(p + 20);
+        } else {
+            // Byte 14: return number (bits 0-2), number of returns (3-5), scan
+            // direction (6), edge of flight line (7). Byte 15: classification
+            // (bits 0-4), synthetic (5), key-point (6), withheld (7); the flags are
+            // stored as bits 0-2 of classification_flags, as in formats 6-10.
+            const auto classByte = static_cast<unsigned char>(p[15]);
+            out.returnNumber[i] = returns & 0x07;
+            out.numberOfReturns[i] = (returns >> 3) & 0x07;
+            out.scanDirectionFlag[i] = (returns >> 6) & 0x01;
+            out.edgeOfFlightLine[i] = returns >> 7;
+            out.classification[i] = classByte & 0x1F;
+            out.classificationFlags[i] = classByte >> 5;
+            // Scan angle rank: int8, whole degrees.
+            out.scanAngle[i] = static_cast<signed char>(p[16]);
+            out.userData[i] = static_cast<unsigned char>(p[17]);
+            out.pointSourceId[i] = load<std::uint16_t>(p + 18);
+        }
+        if constexpr (HasGpsTime)
+            out.gpsTime[i] = static_cast<float>(load<double>(p + gpsOffset) - out.gpsTimeOffset);
+        if constexpr (HasRgb) {
+            const unsigned r = load<std::uint16_t>(p + rgbOffset);
+            const unsigned g = load<std::uint16_t>(p + rgbOffset + 2);
+            const unsigned b = load<std::uint16_t>(p + rgbOffset + 4);
+            colorBits |= r | g | b;
+            // 65535 / 257 = 255: the exact inverse of the x257 scaling of the writer.
+            out.colors[i] = Rgb8{static_cast<std::uint8_t>((r + 128) / 257), static_cast<std::uint8_t>((g + 128) / 257),
+                                 static_cast<std::uint8_t>((b + 128) / 257)};
+        }
+        if constexpr (HasNir)
+            out.nir[i] = load<std::uint16_t>(p + nirOffset);
+    }
+    return colorBits;
+}
+
+using DecodeFunction = unsigned (*)(const char*, std::size_t, std::size_t, std::size_t, const CoordinateTransform&,
+                                    const PointOutputs&);
+
+DecodeFunction decoderFor(int format)
+{
+    switch (format) {
+    case 0: return &decodeRange<false, false, false, false>;
+    case 1: case 4: return &decodeRange<false, true, false, false>;
+    case 2: return &decodeRange<false, false, true, false>;
+    case 3: case 5: return &decodeRange<false, true, true, false>;
+    case 6: case 9: return &decodeRange<true, true, false, false>;
+    case 7: return &decodeRange<true, true, true, false>;
+    case 8: case 10: return &decodeRange<true, true, true, true>;
+    default: return nullptr;
+    }
+}
+
+bool formatHasGpsTime(int format) { return format != 0 && format != 2; }
+bool formatHasRgb(int format)
+{
+    return format == 2 || format == 3 || format == 5 || format == 7 || format == 8 || format == 10;
+}
+bool formatHasNir(int format) { return format == 8 || format == 10; }
+std::size_t rgbOffsetOf(int format) { return format >= 6 ? 30 : (formatHasGpsTime(format) ? 28 : 20); }
+
+// A field offset that keeps float32 precision for values far from zero (large
+// integers, times, anything scaled): the first finite value, rounded down.
+double offsetForValues(double firstValue)
+{
+    if (!std::isfinite(firstValue) || std::abs(firstValue) < 1e4)
+        return 0.0;
+    return std::floor(firstValue);
+}
+
+template <class T>
+void decodeExtraTyped(const char* records, std::size_t recordLength, std::size_t count, const ExtraDimension& dim,
+                      ScalarField& field)
+{
+    const char* p = records + dim.recordOffset;
+    // The no_data value is stored upcast to 8 bytes: double for floats, 64-bit
+    // integers otherwise (LAS 1.4 R15, Extra Bytes).
+    using Upcast = std::conditional_t<std::is_floating_point_v<T>, double,
+                                      std::conditional_t<std::is_signed_v<T>, std::int64_t, std::uint64_t>>;
+    Upcast noData{};
+    std::memcpy(&noData, &dim.noDataBits, sizeof noData);
+    const bool plain = dim.scale == 1.0 && dim.offset == 0.0;
+    double first = std::numeric_limits<double>::quiet_NaN();
+    for (std::size_t i = 0; i < count && !std::isfinite(first); ++i) {
+        const auto raw = load<T>(p + i * recordLength);
+        if (!(dim.hasNoData && static_cast<Upcast>(raw) == noData))
+            first = static_cast<double>(raw) * dim.scale + dim.offset;
+    }
+    const bool exactInFloat = plain && (sizeof(T) <= 2 || std::is_same_v<T, float>);
+    const double fieldOffset = exactInFloat ? 0.0 : offsetForValues(first);
+    field.setOffset(fieldOffset);
+    float* values = field.values().data();
+    for (std::size_t i = 0; i < count; ++i, p += recordLength) {
+        const auto raw = load<T>(p);
+        if (dim.hasNoData && static_cast<Upcast>(raw) == noData)
+            values[i] = kNaN;
+        else
+            values[i] = static_cast<float>(static_cast<double>(raw) * dim.scale + dim.offset - fieldOffset);
+    }
+}
+
+void decodeExtra(const char* records, std::size_t recordLength, std::size_t count, const ExtraDimension& dim,
+                 ScalarField& field)
+{
+    switch (dim.type) {
+    case 1: decodeExtraTyped<std::uint8_t>(records, recordLength, count, dim, field); break;
+    case 2: decodeExtraTyped<std::int8_t>(records, recordLength, count, dim, field); break;
+    case 3: decodeExtraTyped<std::uint16_t>(records, recordLength, count, dim, field); break;
+    case 4: decodeExtraTyped<std::int16_t>(records, recordLength, count, dim, field); break;
+    case 5: decodeExtraTyped<std::uint32_t>(records, recordLength, count, dim, field); break;
+    case 6: decodeExtraTyped<std::int32_t>(records, recordLength, count, dim, field); break;
+    case 7: decodeExtraTyped<std::uint64_t>(records, recordLength, count, dim, field); break;
+    case 8: decodeExtraTyped<std::int64_t>(records, recordLength, count, dim, field); break;
+    case 9: decodeExtraTyped<float>(records, recordLength, count, dim, field); break;
+    case 10: decodeExtraTyped<double>(records, recordLength, count, dim, field); break;
+    default: break;
+    }
+}
+
+// The cloud origin: the caller's, else the header offset (the "global shift"
+// the producer chose) unless the data lie far from it, where float32 would
+// lose millimetres (e.g. an offset of 0 for UTM coordinates).
+Eigen::Vector3d chooseOrigin(const LasHeader& h, const char* records, const ReadOptions& options)
+{
+    if (options.origin)
+        return *options.origin;
+    BoundingBox box;
+    const bool headerBoundsUsable = h.min.allFinite() && h.max.allFinite() && (h.min.array() <= h.max.array()).all() &&
+                                    !(h.min.isZero() && h.max.isZero());
+    if (headerBoundsUsable) {
+        box.min = h.min;
+        box.max = h.max;
+        box.empty = false;
+    } else if (h.pointCount > 0) {
+        // Bounds missing: the first point stands for the data.
+        Eigen::Vector3d first;
+        for (int a = 0; a < 3; ++a)
+            first[a] = load<std::int32_t>(records + 4 * a) * h.scale[a] + h.offset[a];
+        box.min = box.max = first;
+        box.empty = false;
+    }
+    if (box.empty)
+        return h.offset;
+    const double reach =
+        std::max((box.min - h.offset).cwiseAbs().maxCoeff(), (box.max - h.offset).cwiseAbs().maxCoeff());
+    // Same threshold as suggestOrigin(): below 1e4 m float32 keeps sub-millimetre steps.
+    if (reach < 1e4)
+        return h.offset;
+    return suggestOrigin(box);
+}
+
+std::string uniqueFieldName(const PointCloud& cloud, std::string name)
+{
+    if (name.empty())
+        name = "extra";
+    if (!cloud.field(name))
+        return name;
+    for (int k = 2;; ++k) {
+        std::string candidate = name + "_" + std::to_string(k);
+        if (!cloud.field(candidate))
+            return candidate;
+    }
+}
+
+Entity readLas(const fs::path& path, const ReadOptions& options)
+{
+    MappedFile file(path);
+    const LasHeader h = parseHeader(file);
+    const std::size_t count = static_cast<std::size_t>(h.pointCount);
+    const char* records = file.data() + h.offsetToPoints;
+    const int format = h.pointFormat;
+    std::vector<ExtraDimension> extras = findExtraDimensions(file, h);
+
+    PointCloud cloud;
+    cloud.setOrigin(chooseOrigin(h, records, options));
+    double gpsTimeOffset = 0.0;
+    if (formatHasGpsTime(format) && count > 0) {
+        // Relative to the first time, float32 keeps 1 µs over ±8 s and 61 µs over
+        // ±17 minutes of a ~1e9 s GPS time, which on its own would keep only 64 s.
+        gpsTimeOffset = std::floor(load<double>(records + (format >= 6 ? 22 : 20)));
+        if (!std::isfinite(gpsTimeOffset))
+            gpsTimeOffset = 0.0;
+    }
+    std::vector<std::string> extraNames;
+    try {
+        cloud.resize(count);
+        for (const char* name : {"intensity", "return_number", "number_of_returns", "classification",
+                                 "classification_flags", "scan_direction_flag", "edge_of_flight_line", "scan_angle",
+                                 "user_data", "point_source_id"})
+            cloud.addField(ScalarField(name, count));
+        if (format >= 6)
+            cloud.addField(ScalarField("scanner_channel", count));
+        if (formatHasGpsTime(format))
+            cloud.addField(ScalarField("gps_time", count)).setOffset(gpsTimeOffset);
+        if (formatHasNir(format))
+            cloud.addField(ScalarField("nir", count));
+        for (const ExtraDimension& dim : extras) {
+            extraNames.push_back(uniqueFieldName(cloud, dim.name));
+            cloud.addField(ScalarField(extraNames.back(), count));
+        }
+        if (formatHasRgb(format))
+            cloud.enableColors();
+    } catch (const std::bad_alloc&) {
+        throw Error(ErrorCode::Io, path.string() + ": not enough memory to load " + std::to_string(count) + " points");
+    } catch (const std::length_error&) {
+        throw Error(ErrorCode::Io, path.string() + ": not enough memory to load " + std::to_string(count) + " points");
+    }
+
+    // Pointers are taken once every field exists: adding fields moves them.
+    auto values = [&](const char* name) {
+        ScalarField* f = cloud.field(name);
+        return f ? f->values().data() : nullptr;
+    };
+    PointOutputs out;
+    out.positions = cloud.positions().data();
+    out.colors = cloud.hasColors() ? cloud.enableColors().data() : nullptr;
+    out.intensity = values("intensity");
+    out.returnNumber = values("return_number");
+    out.numberOfReturns = values("number_of_returns");
+    out.classification = values("classification");
+    out.classificationFlags = values("classification_flags");
+    out.scannerChannel = values("scanner_channel");
+    out.scanDirectionFlag = values("scan_direction_flag");
+    out.edgeOfFlightLine = values("edge_of_flight_line");
+    out.scanAngle = values("scan_angle");
+    out.userData = values("user_data");
+    out.pointSourceId = values("point_source_id");
+    out.gpsTime = values("gps_time");
+    out.gpsTimeOffset = gpsTimeOffset;
+    out.nir = values("nir");
+
+    const CoordinateTransform transform{h.scale, h.offset - cloud.origin()};
+    const DecodeFunction decode = decoderFor(format);
+    const std::size_t extraSteps = extras.size() * count;
+    ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), count + extraSteps);
+    unsigned colorBits = 0;
+    for (std::size_t begin = 0; begin < count; begin += kChunkPoints) {
+        const std::size_t end = std::min(count, begin + kChunkPoints);
+        colorBits |= decode(records, h.recordLength, begin, end, transform, out);
+        ticker.step(end - begin);
+    }
+
+    // LAS 1.4 R15 says colours are normalised to 16 bits, but several tools write
+    // 8-bit values unscaled. If no channel exceeds 255 the file is of that kind
+    // (genuine 16-bit colours that low would all be black), so take them as is.
+    if (out.colors && colorBits <= 255) {
+        const std::size_t rgb = rgbOffsetOf(format);
+        const char* p = records + rgb;
+        for (std::size_t i = 0; i < count; ++i, p += h.recordLength)
+            out.colors[i] = Rgb8{static_cast<std::uint8_t>(p[0]), static_cast<std::uint8_t>(p[2]),
+                                 static_cast<std::uint8_t>(p[4])};
+    }
+
+    for (std::size_t d = 0; d < extras.size(); ++d) {
+        decodeExtra(records, h.recordLength, count, extras[d], *cloud.field(extraNames[d]));
+        ticker.step(count);
+    }
+
+    const std::size_t dropped = cloud.removeNonFinitePoints();
+    if (dropped > 0)
+        logWarning(path.string() + ": " + std::to_string(dropped) + " points with non-finite coordinates were skipped");
+    return cloud;
+}
+
+// ---------------------------------------------------------------------------
+// Writing: LAS 1.4, point format 6 (no colour), 7 (colour) or 8 (colour and a
+// "nir" field), so every standard attribute has its full 1.4 range.
+
+// Where a standard scalar field goes in a format 6-8 record.
+enum class Slot {
+    Intensity,
+    ReturnNumber,
+    NumberOfReturns,
+    ClassificationFlags,
+    ScannerChannel,
+    ScanDirectionFlag,
+    EdgeOfFlightLine,
+    Classification,
+    UserData,
+    ScanAngle,
+    PointSourceId,
+    GpsTime,
+    Nir,
+    Count
+};
+
+// The field names of the slots, in the order of Slot; the reader uses the same names.
+constexpr std::array<const char*, static_cast<std::size_t>(Slot::Count)> kSlotNames = {
+    "intensity",           "return_number",       "number_of_returns", "classification_flags",
+    "scanner_channel",     "scan_direction_flag", "edge_of_flight_line", "classification",
+    "user_data",           "scan_angle",          "point_source_id",   "gps_time",
+    "nir"};
+
+struct SlotSource
+{
+    const float* values = nullptr;
+    double offset = 0.0;
+
+    // The field value of point i, or `fallback` when there is no field; NaN -> 0.
+    double get(std::size_t i, double fallback) const
+    {
+        if (!values)
+            return fallback;
+        const float v = values[i];
+        return std::isnan(v) ? 0.0 : offset + static_cast<double>(v);
+    }
+};
+
+template <class T>
+T clampRound(double v)
+{
+    const double r = std::round(v);
+    if (!(r >= static_cast<double>(std::numeric_limits<T>::lowest())))
+        return std::numeric_limits<T>::lowest();
+    if (r > static_cast<double>(std::numeric_limits<T>::max()))
+        return std::numeric_limits<T>::max();
+    return static_cast<T>(r);
+}
+
+unsigned clampBits(double v, unsigned maxValue)
+{
+    const double r = std::round(v);
+    if (!(r >= 0.0))
+        return 0;
+    return r > maxValue ? maxValue : static_cast<unsigned>(r);
+}
+
+struct ExtraOutput
+{
+    const ScalarField* field = nullptr;
+    std::string lasName;
+    bool asDouble = false;
+    std::size_t recordOffset = 0;
+};
+
+// Quantisation of one axis. LAS stores int32 = (coordinate - offset) / scale.
+// 0.1 mm is a usual scanner resolution and close to the step of a float32 local
+// coordinate 1-2 km from the origin (61 µm at 1 km, 122 µm at 2 km), so it
+// changes a coordinate by at most 50 µm. It overflows int32 only beyond ±214 km
+// from the offset; there the scale is coarsened by decades (1 mm: ±2147 km)
+// rather than losing points.
+void chooseQuantization(const fs::path& path, double origin, double lo, double hi, bool empty, double& offset,
+                        double& scale)
+{
+    static constexpr double kScales[] = {1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0, 1000.0};
+    // Keep a margin below 2^31 for the rounding of the extreme points.
+    constexpr double kLimit = 2147483000.0;
+    offset = std::isfinite(origin) ? std::round(origin) : 0.0;
+    scale = kScales[0];
+    if (empty)
+        return;
+    auto reach = [&](double o) { return std::max(std::abs(lo - o), std::abs(hi - o)); };
+    if (reach(offset) / kScales[0] > kLimit) {
+        const double centre = std::round(0.5 * (lo + hi));
+        if (reach(centre) < reach(offset))
+            offset = centre;
+    }
+    for (double s : kScales) {
+        scale = s;
+        if (reach(offset) / s <= kLimit)
+            return;
+    }
+    throw Error(ErrorCode::InvalidData, path.string() + ": coordinates span " + std::to_string(hi - lo) +
+                                            " m, too large for LAS even at a 1 km resolution");
+}
+
+void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions& options)
+{
+    const std::size_t n = cloud.size();
+    const auto& positions = cloud.positions();
+
+    std::size_t finiteCount = 0;
+    for (const auto& p : positions)
+        finiteCount += p.allFinite() ? 1 : 0;
+    if (finiteCount != n)
+        logWarning(path.string() + ": " + std::to_string(n - finiteCount) +
+                   " points with non-finite coordinates were not written");
+
+    // Standard attributes into their slots, everything else as extra bytes.
+    std::array<SlotSource, static_cast<std::size_t>(Slot::Count)> slots{};
+    std::vector<const ScalarField*> others;
+    for (const ScalarField& f : cloud.fields()) {
+        const auto it =
+            std::find_if(kSlotNames.begin(), kSlotNames.end(), [&](const char* s) { return f.name() == s; });
+        if (it == kSlotNames.end()) {
+            others.push_back(&f);
+            continue;
+        }
+        slots[static_cast<std::size_t>(it - kSlotNames.begin())] = SlotSource{f.values().data(), f.offset()};
+    }
+    const SlotSource& nirSlot = slots[static_cast<std::size_t>(Slot::Nir)];
+    // Format 8 adds near infrared to the colours of format 7; without colours a
+    // "nir" field goes to the extra bytes rather than forcing black colours.
+    const int format = cloud.hasColors() ? (nirSlot.values ? 8 : 7) : 6;
+    if (format != 8 && nirSlot.values) {
+        others.push_back(cloud.field("nir"));
+        slots[static_cast<std::size_t>(Slot::Nir)] = SlotSource{};
+    }
+    const std::size_t baseSize = kBaseRecordSize[static_cast<std::size_t>(format)];
+
+    // Extra bytes: float (type 9) keeps a field exactly; a field with an offset
+    // (times, large values) needs double (type 10) to keep its precision.
+    std::vector<ExtraOutput> extras;
+    std::size_t recordLength = baseSize;
+    for (const ScalarField* f : others) {
+        ExtraOutput e;
+        e.field = f;
+        e.asDouble = f->offset() != 0.0;
+        e.recordOffset = recordLength;
+        // The descriptor's name is char[32]: longer names are cut to 32 bytes,
+        // and a cut name that repeats an earlier one ends with "~2", "~3"...
+        e.lasName = f->name().substr(0, 32);
+        if (e.lasName.empty())
+            e.lasName = "field";
+        auto taken = [&](const std::string& name) {
+            return std::any_of(extras.begin(), extras.end(), [&](const ExtraOutput& x) { return x.lasName == name; });
+        };
+        for (int k = 2; taken(e.lasName); ++k) {
+            const std::string suffix = "~" + std::to_string(k);
+            e.lasName = f->name().substr(0, 32 - suffix.size()) + suffix;
+        }
+        if (e.lasName != f->name())
+            logWarning(path.string() + ": scalar field '" + f->name() + "' is stored as '" + e.lasName +
+                       "' (LAS extra dimension names are limited to 32 characters)");
+        recordLength += e.asDouble ? 8 : 4;
+        extras.push_back(std::move(e));
+    }
+    // Both the point record length and the VLR payload (192 bytes per extra
+    // dimension) are 16-bit numbers.
+    if (recordLength > std::numeric_limits<std::uint16_t>::max() ||
+        extras.size() * kExtraBytesDescriptorSize > std::numeric_limits<std::uint16_t>::max())
+        throw Error(ErrorCode::InvalidArgument, path.string() + ": too many scalar fields for LAS (" +
+                                                    std::to_string(extras.size()) +
+                                                    " extra dimensions; at most 341 fit in the Extra Bytes record)");
+
+    // Extra Bytes VLR.
+    std::string vlr;
+    if (!extras.empty()) {
+        vlr.assign(kVlrHeaderSize + kExtraBytesDescriptorSize * extras.size(), '\0');
+        std::memcpy(&vlr[2], "LASF_Spec", 9);
+        store<std::uint16_t>(&vlr[18], 4);
+        store<std::uint16_t>(&vlr[20], static_cast<std::uint16_t>(kExtraBytesDescriptorSize * extras.size()));
+        std::memcpy(&vlr[22], "Extra Bytes Record", 18);
+        for (std::size_t d = 0; d < extras.size(); ++d) {
+            char* p = &vlr[kVlrHeaderSize + kExtraBytesDescriptorSize * d];
+            p[eb::dataType] = static_cast<char>(extras[d].asDouble ? eb::typeDouble : eb::typeFloat);
+            // NaN means "no value" in scandiff; declaring it as no_data tells other
+            // readers so (stored as a double, the upcast of float and double).
+            p[eb::options] = static_cast<char>(eb::optNoData);
+            store<double>(p + eb::noData, std::numeric_limits<double>::quiet_NaN());
+            std::memcpy(p + eb::name, extras[d].lasName.data(), extras[d].lasName.size());
+            const char description[] = "scandiff scalar field";
+            std::memcpy(p + eb::description, description, sizeof description - 1);
+        }
+    }
+
+    const BoundingBox bounds = cloud.bounds();
+    Eigen::Vector3d lasOffset, lasScale;
+    for (int a = 0; a < 3; ++a)
+        chooseQuantization(path, cloud.origin()[a], bounds.min[a], bounds.max[a], bounds.empty, lasOffset[a],
+                           lasScale[a]);
+    const Eigen::Vector3d inverseScale = lasScale.cwiseInverse();
+    const Eigen::Vector3d shift = cloud.origin() - lasOffset;
+
+    AtomicFile output(path);
+    std::ofstream& stream = output.stream();
+    const std::uint64_t offsetToPoints = kHeaderSize14 + vlr.size();
+    // The header is written again at the end, with the extents and return counts.
+    std::array<char, kHeaderSize14> header{};
+    stream.write(header.data(), header.size());
+    stream.write(vlr.data(), static_cast<std::streamsize>(vlr.size()));
+
+    std::array<std::uint64_t, 15> pointsByReturn{};
+    constexpr std::int32_t kInt32Max = std::numeric_limits<std::int32_t>::max();
+    constexpr std::int32_t kInt32Min = std::numeric_limits<std::int32_t>::lowest();
+    std::array<std::int32_t, 3> rawMin{kInt32Max, kInt32Max, kInt32Max};
+    std::array<std::int32_t, 3> rawMax{kInt32Min, kInt32Min, kInt32Min};
+    double gpsMax = -std::numeric_limits<double>::infinity();
+    auto slot = [&](Slot s) -> const SlotSource& { return slots[static_cast<std::size_t>(s)]; };
+
+    ProgressTicker ticker(options.progress, "Writing " + path.filename().string(), n);
+    std::vector<char> buffer(kChunkPoints * recordLength);
+    for (std::size_t begin = 0; begin < n; begin += kChunkPoints) {
+        const std::size_t end = std::min(n, begin + kChunkPoints);
+        std::fill(buffer.begin(), buffer.end(), '\0');
+        char* p = buffer.data();
+        for (std::size_t i = begin; i < end; ++i) {
+            const Eigen::Vector3f& local = positions[i];
+            if (!local.allFinite())
+                continue;
+            for (int a = 0; a < 3; ++a) {
+                const std::int32_t raw = clampRound<std::int32_t>((shift[a] + local[a]) * inverseScale[a]);
+                store<std::int32_t>(p + 4 * a, raw);
+                rawMin[a] = std::min(rawMin[a], raw);
+                rawMax[a] = std::max(rawMax[a], raw);
+            }
+            store<std::uint16_t>(p + 12, clampRound<std::uint16_t>(slot(Slot::Intensity).get(i, 0.0)));
+            // Return number and count default to 1: "1 of 1" is what a single-return
+            // scanner produces, and 0 is not a valid return number.
+            const unsigned returnNumber = clampBits(slot(Slot::ReturnNumber).get(i, 1.0), 15);
+            const unsigned numberOfReturns = clampBits(slot(Slot::NumberOfReturns).get(i, 1.0), 15);
+            p[14] = static_cast<char>(returnNumber | (numberOfReturns << 4));
+            p[15] = static_cast<char>(clampBits(slot(Slot::ClassificationFlags).get(i, 0.0), 15) |
+                                      (clampBits(slot(Slot::ScannerChannel).get(i, 0.0), 3) << 4) |
+                                      (clampBits(slot(Slot::ScanDirectionFlag).get(i, 0.0), 1) << 6) |
+                                      (clampBits(slot(Slot::EdgeOfFlightLine).get(i, 0.0), 1) << 7));
+            p[16] = static_cast<char>(clampRound<std::uint8_t>(slot(Slot::Classification).get(i, 0.0)));
+            p[17] = static_cast<char>(clampRound<std::uint8_t>(slot(Slot::UserData).get(i, 0.0)));
+            // Scan angle in 0.006 degree units; LAS 1.4 R15 limits it to ±30000 (±180°).
+            const double angle = std::clamp(slot(Slot::ScanAngle).get(i, 0.0) / 0.006, -30000.0, 30000.0);
+            store<std::int16_t>(p + 18, clampRound<std::int16_t>(angle));
+            store<std::uint16_t>(p + 20, clampRound<std::uint16_t>(slot(Slot::PointSourceId).get(i, 0.0)));
+            const double gps = slot(Slot::GpsTime).get(i, 0.0);
+            gpsMax = std::max(gpsMax, gps);
+            store<double>(p + 22, gps);
+            if (format >= 7) {
+                // 8-bit to 16-bit: x257 maps 0..255 onto the full 0..65535 range.
+                const Rgb8& c = cloud.colors()[i];
+                store<std::uint16_t>(p + 30, static_cast<std::uint16_t>(c.r * 257));
+                store<std::uint16_t>(p + 32, static_cast<std::uint16_t>(c.g * 257));
+                store<std::uint16_t>(p + 34, static_cast<std::uint16_t>(c.b * 257));
+            }
+            if (format == 8)
+                store<std::uint16_t>(p + 36, clampRound<std::uint16_t>(slot(Slot::Nir).get(i, 0.0)));
+            for (const ExtraOutput& e : extras) {
+                const float v = e.field->values()[i];
+                if (e.asDouble)
+                    store<double>(p + e.recordOffset, e.field->offset() + static_cast<double>(v));
+                else
+                    store<float>(p + e.recordOffset, v);
+            }
+            if (returnNumber >= 1)
+                ++pointsByReturn[returnNumber - 1];
+            p += recordLength;
+        }
+        stream.write(buffer.data(), p - buffer.data());
+        ticker.step(end - begin);
+    }
+
+    // Public header block, LAS 1.4.
+    char* h = header.data();
+    std::memcpy(h, "LASF", 4);
+    // Global encoding: bit 4 (WKT) is required for point formats 6-10 (LAS 1.4 R15,
+    // "Coordinate Reference System Representation": GeoTIFF with them is an error).
+    // Bit 0: the cloud does not record the GPS time type, but times beyond one week
+    // (604800 s) cannot be GPS week time, so they are adjusted standard GPS time.
+    std::uint16_t globalEncoding = 1u << 4;
+    if (gpsMax > 604800.0)
+        globalEncoding |= 1u;
+    store<std::uint16_t>(h + hdr::globalEncoding, globalEncoding);
+    h[hdr::versionMajor] = 1;
+    h[hdr::versionMinor] = 4;
+    const char systemIdentifier[] = "OTHER";
+    std::memcpy(h + hdr::systemIdentifier, systemIdentifier, sizeof systemIdentifier - 1);
+    const char software[] = "scandiff";
+    std::memcpy(h + hdr::generatingSoftware, software, sizeof software - 1);
+    const std::time_t now = std::time(nullptr);
+    std::tm utc{};
+    if (gmtime_r(&now, &utc)) {
+        store<std::uint16_t>(h + hdr::creationDay, static_cast<std::uint16_t>(utc.tm_yday + 1));
+        store<std::uint16_t>(h + hdr::creationYear, static_cast<std::uint16_t>(utc.tm_year + 1900));
+    }
+    store<std::uint16_t>(h + hdr::headerSize, static_cast<std::uint16_t>(kHeaderSize14));
+    store<std::uint32_t>(h + hdr::offsetToPoints, static_cast<std::uint32_t>(offsetToPoints));
+    store<std::uint32_t>(h + hdr::vlrCount, extras.empty() ? 0u : 1u);
+    h[hdr::pointFormat] = static_cast<char>(format);
+    store<std::uint16_t>(h + hdr::recordLength, static_cast<std::uint16_t>(recordLength));
+    // Legacy point counts stay 0: LAS 1.4 R15 requires it for point formats 6 and above.
+    for (int a = 0; a < 3; ++a) {
+        store<double>(h + hdr::scale + 8 * a, lasScale[a]);
+        store<double>(h + hdr::offset + 8 * a, lasOffset[a]);
+        // The extents of the stored (quantised) coordinates; zero without points.
+        const double lo = finiteCount ? rawMin[a] * lasScale[a] + lasOffset[a] : 0.0;
+        const double hi = finiteCount ? rawMax[a] * lasScale[a] + lasOffset[a] : 0.0;
+        store<double>(h + hdr::bounds + 16 * a, hi);
+        store<double>(h + hdr::bounds + 16 * a + 8, lo);
+    }
+    store<std::uint64_t>(h + hdr::pointCount, finiteCount);
+    for (std::size_t r = 0; r < pointsByReturn.size(); ++r)
+        store<std::uint64_t>(h + hdr::pointsByReturn + 8 * r, pointsByReturn[r]);
+    stream.seekp(0);
+    stream.write(header.data(), header.size());
+    output.commit();
+}
+
+} // namespace
+
+FormatHandler lasFormat()
+{
+    FormatHandler handler;
+    handler.name = "LAS";
+    handler.extensions = {"las"};
+    handler.read = [](const fs::path& path, const ReadOptions& options) { return readLas(path, options); };
+    handler.writeCloud = [](const PointCloud& cloud, const fs::path& path, const WriteOptions& options) {
+        writeLas(cloud, path, options);
+    };
+    return handler;
+}
+
+} // namespace scandiff::io::detail

@@ -1,0 +1,1477 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+//! PLY (Stanford polygon format): ascii, binary_little_endian and binary_big_endian.
+//!
+//! Reading maps the vertex element's properties to the cloud: x y z (any numeric
+//! type), red green blue (or diffuse_*; integers 0-255, 16-bit integers scaled,
+//! floats 0-1 scaled), nx ny nz (or normal_*), alpha ignored, list properties
+//! skipped, and every other scalar property becomes a scalar field (a leading
+//! "scalar_", as CloudCompare writes it, is removed). A "face" element with a
+//! vertex_indices (or vertex_index) list gives triangles, polygons being fan
+//! triangulated; the file is then a Mesh. Every other element is skipped.
+//!
+//! Writing uses float x y z when the origin is zero and double global
+//! coordinates otherwise, uchar colours, float normals, and one float property
+//! per scalar field (double when the field has an offset, so GPS times survive).
+
+#include "internal/Formats.h"
+#include "internal/MappedFile.h"
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/Log.h>
+#include <scandiff/io/AtomicFile.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace scandiff::io::detail {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+#if defined(__BYTE_ORDER__)
+constexpr bool kHostLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
+#else
+constexpr bool kHostLittleEndian = true; // compilers without __BYTE_ORDER__ (MSVC) only target little-endian CPUs
+#endif
+
+//! Records per progress step: frequent enough for a smooth bar, rare enough to cost nothing.
+constexpr std::uint64_t kChunk = 1u << 16;
+
+enum class PlyType : std::uint8_t { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
+
+std::size_t typeSize(PlyType type)
+{
+    switch (type) {
+    case PlyType::Int8:
+    case PlyType::UInt8: return 1;
+    case PlyType::Int16:
+    case PlyType::UInt16: return 2;
+    case PlyType::Int32:
+    case PlyType::UInt32:
+    case PlyType::Float32: return 4;
+    case PlyType::Float64: return 8;
+    }
+    return 1;
+}
+
+bool parseType(std::string_view name, PlyType& type)
+{
+    struct Entry
+    {
+        const char* name;
+        PlyType type;
+    };
+    static const Entry entries[] = {
+        {"char", PlyType::Int8},     {"int8", PlyType::Int8},       {"uchar", PlyType::UInt8},
+        {"uint8", PlyType::UInt8},   {"short", PlyType::Int16},     {"int16", PlyType::Int16},
+        {"ushort", PlyType::UInt16}, {"uint16", PlyType::UInt16},   {"int", PlyType::Int32},
+        {"int32", PlyType::Int32},   {"uint", PlyType::UInt32},     {"uint32", PlyType::UInt32},
+        {"float", PlyType::Float32}, {"float32", PlyType::Float32}, {"double", PlyType::Float64},
+        {"float64", PlyType::Float64},
+    };
+    for (const Entry& e : entries)
+        if (name == e.name) {
+            type = e.type;
+            return true;
+        }
+    return false;
+}
+
+bool isFloatType(PlyType type)
+{
+    return type == PlyType::Float32 || type == PlyType::Float64;
+}
+
+enum class PlyEncoding { Ascii, BinaryLittleEndian, BinaryBigEndian };
+
+struct PlyProperty
+{
+    std::string name;
+    PlyType type = PlyType::Float32; //!< the item type for a list
+    bool isList = false;
+    PlyType countType = PlyType::UInt8;
+};
+
+struct PlyElement
+{
+    std::string name;
+    std::uint64_t count = 0;
+    std::vector<PlyProperty> properties;
+
+    bool fixedSize() const
+    {
+        return std::none_of(properties.begin(), properties.end(), [](const PlyProperty& p) { return p.isList; });
+    }
+    //! Exact size of a fixed-size record; the smallest possible one otherwise (empty lists).
+    std::size_t minRecordSize() const
+    {
+        std::size_t size = 0;
+        for (const auto& p : properties)
+            size += typeSize(p.isList ? p.countType : p.type);
+        return size;
+    }
+};
+
+struct PlyHeader
+{
+    PlyEncoding encoding = PlyEncoding::Ascii;
+    std::vector<PlyElement> elements;
+    std::size_t dataOffset = 0; //!< first byte after end_header's line
+    std::size_t lineCount = 0;  //!< lines in the header, for ASCII line numbers
+};
+
+std::string lower(std::string_view s)
+{
+    std::string out(s);
+    for (char& c : out)
+        if (c >= 'A' && c <= 'Z')
+            c = static_cast<char>(c - 'A' + 'a');
+    return out;
+}
+
+bool isBlank(char c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+}
+
+//! Splits off the next whitespace-separated token of `rest`; false at the end.
+bool nextToken(std::string_view& rest, std::string_view& token)
+{
+    std::size_t i = 0;
+    while (i < rest.size() && isBlank(rest[i]))
+        ++i;
+    if (i == rest.size()) {
+        rest = {};
+        return false;
+    }
+    std::size_t j = i;
+    while (j < rest.size() && !isBlank(rest[j]))
+        ++j;
+    token = rest.substr(i, j - i);
+    rest.remove_prefix(j);
+    return true;
+}
+
+std::vector<std::string_view> tokenize(std::string_view line)
+{
+    std::vector<std::string_view> tokens;
+    std::string_view token;
+    while (nextToken(line, token))
+        tokens.push_back(token);
+    return tokens;
+}
+
+bool parseDouble(std::string_view token, double& value)
+{
+    const char* first = token.data();
+    const char* last = first + token.size();
+    // from_chars rejects the '+' sign that some writers emit.
+    if (first != last && *first == '+')
+        ++first;
+    const auto [ptr, ec] = std::from_chars(first, last, value);
+    return ec == std::errc() && ptr == last && first != last;
+}
+
+bool parseInteger(std::string_view token, std::int64_t& value)
+{
+    const char* first = token.data();
+    const char* last = first + token.size();
+    if (first != last && *first == '+')
+        ++first;
+    const auto [ptr, ec] = std::from_chars(first, last, value);
+    return ec == std::errc() && ptr == last && first != last;
+}
+
+std::string quoted(std::string_view s)
+{
+    constexpr std::size_t kMax = 40; // a binary blob must not flood the message
+    std::string out = "'";
+    for (char c : s.substr(0, kMax))
+        out += (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) >= 127) ? '?' : c;
+    if (s.size() > kMax)
+        out += "...";
+    return out + "'";
+}
+
+class Context
+{
+public:
+    explicit Context(const fs::path& path) : fileName_(path.string()) {}
+    const std::string& fileName() const { return fileName_; }
+
+    [[noreturn]] void fail(const std::string& message) const
+    {
+        throw Error(ErrorCode::InvalidData, fileName_ + ": " + message);
+    }
+    [[noreturn]] void failAtLine(std::size_t line, const std::string& message) const
+    {
+        throw Error(ErrorCode::InvalidData, fileName_ + ":" + std::to_string(line) + ": " + message);
+    }
+    [[noreturn]] void truncated(const PlyElement& e, std::uint64_t index) const
+    {
+        fail("truncated: " + e.name + " " + std::to_string(index + 1) + " of " + std::to_string(e.count) +
+             " ends beyond the end of the file");
+    }
+
+private:
+    std::string fileName_;
+};
+
+PlyHeader parseHeader(const MappedFile& file, const Context& ctx)
+{
+    const char* data = file.data();
+    const std::size_t size = file.size();
+    if (size == 0)
+        ctx.fail("empty file");
+
+    PlyHeader header;
+    std::size_t pos = 0;
+    std::size_t lineNo = 0;
+    auto nextLine = [&](std::string_view& line) {
+        if (pos >= size)
+            return false;
+        const void* nl = std::memchr(data + pos, '\n', size - pos);
+        const std::size_t stop = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - data) : size;
+        line = std::string_view(data + pos, stop - pos);
+        if (!line.empty() && line.back() == '\r')
+            line.remove_suffix(1);
+        pos = nl ? stop + 1 : size;
+        ++lineNo;
+        return true;
+    };
+
+    std::string_view line;
+    nextLine(line);
+    if (line != "ply" && tokenize(line) != std::vector<std::string_view>{"ply"})
+        ctx.fail("not a PLY file (the first line is not 'ply')");
+
+    bool sawFormat = false;
+    while (true) {
+        if (!nextLine(line))
+            ctx.fail("missing end_header: the header ends with the file");
+        const auto tokens = tokenize(line);
+        if (tokens.empty())
+            continue;
+        const std::string_view keyword = tokens[0];
+        if (keyword == "end_header") {
+            break;
+        } else if (keyword == "comment" || keyword == "obj_info") {
+            continue;
+        } else if (keyword == "format") {
+            if (tokens.size() != 3)
+                ctx.failAtLine(lineNo, "malformed format line (expected 'format <encoding> 1.0')");
+            if (tokens[1] == "ascii")
+                header.encoding = PlyEncoding::Ascii;
+            else if (tokens[1] == "binary_little_endian")
+                header.encoding = PlyEncoding::BinaryLittleEndian;
+            else if (tokens[1] == "binary_big_endian")
+                header.encoding = PlyEncoding::BinaryBigEndian;
+            else
+                ctx.failAtLine(lineNo, "unknown format " + quoted(tokens[1]) +
+                                           " (expected ascii, binary_little_endian or binary_big_endian)");
+            if (tokens[2].substr(0, 1) != "1")
+                ctx.failAtLine(lineNo, "unsupported PLY version " + quoted(tokens[2]));
+            sawFormat = true;
+        } else if (keyword == "element") {
+            std::int64_t count = 0;
+            if (tokens.size() != 3 || !parseInteger(tokens[2], count) || count < 0)
+                ctx.failAtLine(lineNo, "malformed element line (expected 'element <name> <count>')");
+            PlyElement e;
+            e.name = std::string(tokens[1]);
+            e.count = static_cast<std::uint64_t>(count);
+            header.elements.push_back(std::move(e));
+        } else if (keyword == "property") {
+            if (header.elements.empty())
+                ctx.failAtLine(lineNo, "property before any element");
+            PlyProperty p;
+            if (tokens.size() >= 2 && tokens[1] == "list") {
+                if (tokens.size() != 5)
+                    ctx.failAtLine(lineNo, "malformed list property (expected 'property list <count type> <item type> <name>')");
+                if (!parseType(tokens[2], p.countType))
+                    ctx.failAtLine(lineNo, "unknown property type " + quoted(tokens[2]));
+                if (isFloatType(p.countType))
+                    ctx.failAtLine(lineNo, "a list count must have an integer type, not " + quoted(tokens[2]));
+                if (!parseType(tokens[3], p.type))
+                    ctx.failAtLine(lineNo, "unknown property type " + quoted(tokens[3]));
+                p.isList = true;
+                p.name = std::string(tokens[4]);
+            } else {
+                if (tokens.size() != 3)
+                    ctx.failAtLine(lineNo, "malformed property line (expected 'property <type> <name>')");
+                if (!parseType(tokens[1], p.type))
+                    ctx.failAtLine(lineNo, "unknown property type " + quoted(tokens[1]));
+                p.name = std::string(tokens[2]);
+            }
+            header.elements.back().properties.push_back(std::move(p));
+        } else {
+            ctx.failAtLine(lineNo, "unexpected " + quoted(keyword) + " in the PLY header");
+        }
+    }
+    if (!sawFormat)
+        ctx.fail("the PLY header has no format line");
+    header.dataOffset = pos;
+    header.lineCount = lineNo;
+    return header;
+}
+
+// ---------------------------------------------------------------- binary values
+
+template <typename T, bool Swap>
+inline T load(const char* p)
+{
+    T value;
+    if constexpr (!Swap) {
+        std::memcpy(&value, p, sizeof(T));
+    } else {
+        char bytes[sizeof(T)];
+        for (std::size_t i = 0; i < sizeof(T); ++i)
+            bytes[i] = p[sizeof(T) - 1 - i];
+        std::memcpy(&value, bytes, sizeof(T));
+    }
+    return value;
+}
+
+template <bool Swap>
+inline double loadDouble(const char* p, PlyType type)
+{
+    switch (type) {
+    case PlyType::Int8: return load<std::int8_t, Swap>(p);
+    case PlyType::UInt8: return load<std::uint8_t, Swap>(p);
+    case PlyType::Int16: return load<std::int16_t, Swap>(p);
+    case PlyType::UInt16: return load<std::uint16_t, Swap>(p);
+    case PlyType::Int32: return load<std::int32_t, Swap>(p);
+    case PlyType::UInt32: return load<std::uint32_t, Swap>(p);
+    case PlyType::Float32: return load<float, Swap>(p);
+    case PlyType::Float64: return load<double, Swap>(p);
+    }
+    return 0.0;
+}
+
+//! Integer value of a list count or index; floating-point indices (seen in the
+//! wild) are truncated, NaN maps to -1 so that it is rejected as out of range.
+template <bool Swap>
+inline std::int64_t loadInteger(const char* p, PlyType type)
+{
+    switch (type) {
+    case PlyType::Int8: return load<std::int8_t, Swap>(p);
+    case PlyType::UInt8: return load<std::uint8_t, Swap>(p);
+    case PlyType::Int16: return load<std::int16_t, Swap>(p);
+    case PlyType::UInt16: return load<std::uint16_t, Swap>(p);
+    case PlyType::Int32: return load<std::int32_t, Swap>(p);
+    case PlyType::UInt32: return load<std::uint32_t, Swap>(p);
+    case PlyType::Float32:
+    case PlyType::Float64: {
+        const double v = loadDouble<Swap>(p, type);
+        return (v >= 0.0 && v < 9e18) ? static_cast<std::int64_t>(v) : -1;
+    }
+    }
+    return -1;
+}
+
+// ---------------------------------------------------------------- vertex layout
+
+enum class Role : std::uint8_t { Ignore, X, Y, Z, Red, Green, Blue, Nx, Ny, Nz, Field };
+
+struct Slot
+{
+    Role role = Role::Ignore;
+    PlyType type = PlyType::Float32;
+    std::uint32_t index = 0;  //!< position in VertexLayout::slots
+    std::uint32_t field = 0;  //!< index among the layout's fields for Role::Field
+    std::size_t offset = 0;   //!< byte offset inside a fixed-size binary record
+    double colorScale = 1.0;  //!< brings the stored colour to 0-255
+};
+
+struct VertexLayout
+{
+    std::vector<Slot> slots;          //!< the properties that carry data, in file order
+    std::vector<int> slotOfProperty;  //!< per property of the element, -1 when skipped
+    std::vector<std::string> fieldNames;
+    //! Fields whose values may not fit a float around zero (double, 32-bit integers):
+    //! their offset is chosen from their range before conversion.
+    std::vector<bool> fieldIsWide;
+    bool hasColors = false;
+    bool hasNormals = false;
+    bool coordinatesAreDouble = false;
+};
+
+VertexLayout makeVertexLayout(const PlyElement& e, const Context& ctx)
+{
+    VertexLayout layout;
+    layout.slotOfProperty.assign(e.properties.size(), -1);
+    bool hasAxis[3] = {false, false, false};
+    std::size_t offset = 0;
+    for (std::size_t i = 0; i < e.properties.size(); ++i) {
+        const PlyProperty& p = e.properties[i];
+        const std::size_t size = typeSize(p.isList ? p.countType : p.type);
+        const std::size_t propertyOffset = offset;
+        offset += size;
+        if (p.isList)
+            continue;
+        const std::string name = lower(p.name);
+        Slot slot;
+        slot.type = p.type;
+        slot.offset = propertyOffset;
+        if (name == "x" || name == "y" || name == "z") {
+            const int axis = name[0] - 'x';
+            slot.role = static_cast<Role>(static_cast<int>(Role::X) + axis);
+            hasAxis[axis] = true;
+            if (p.type == PlyType::Float64)
+                layout.coordinatesAreDouble = true;
+        } else if (name == "red" || name == "diffuse_red" || name == "green" || name == "diffuse_green" ||
+                   name == "blue" || name == "diffuse_blue") {
+            const std::string base = name.rfind("diffuse_", 0) == 0 ? name.substr(8) : name;
+            slot.role = base == "red" ? Role::Red : base == "green" ? Role::Green : Role::Blue;
+            if (isFloatType(p.type))
+                slot.colorScale = 255.0;
+            else if (p.type == PlyType::UInt16 || p.type == PlyType::Int16)
+                slot.colorScale = 255.0 / 65535.0;
+            layout.hasColors = true;
+        } else if (name == "alpha" || name == "diffuse_alpha") {
+            continue;
+        } else if (name == "nx" || name == "ny" || name == "nz" || name == "normal_x" || name == "normal_y" ||
+                   name == "normal_z") {
+            const int axis = name.back() - 'x';
+            slot.role = static_cast<Role>(static_cast<int>(Role::Nx) + axis);
+            layout.hasNormals = true;
+        } else {
+            std::string fieldName = p.name;
+            if (name.rfind("scalar_", 0) == 0 && fieldName.size() > 7)
+                fieldName.erase(0, 7);
+            // Two properties may map to one name ("scalar_a" and "a"): keep both.
+            const std::string base = fieldName;
+            for (int k = 2; std::find(layout.fieldNames.begin(), layout.fieldNames.end(), fieldName) !=
+                            layout.fieldNames.end();
+                 ++k)
+                fieldName = base + "_" + std::to_string(k);
+            slot.role = Role::Field;
+            slot.field = static_cast<std::uint32_t>(layout.fieldNames.size());
+            layout.fieldNames.push_back(fieldName);
+            layout.fieldIsWide.push_back(p.type == PlyType::Float64 || p.type == PlyType::Int32 ||
+                                         p.type == PlyType::UInt32);
+        }
+        slot.index = static_cast<std::uint32_t>(layout.slots.size());
+        layout.slotOfProperty[i] = static_cast<int>(slot.index);
+        layout.slots.push_back(slot);
+    }
+    if (!hasAxis[0] || !hasAxis[1] || !hasAxis[2])
+        ctx.fail("the " + e.name + " element has no x, y and z properties");
+    return layout;
+}
+
+//! Where decoded vertex values go. Coordinates and wide fields go to double
+//! staging buffers when their origin/offset can only be chosen after reading.
+//! Set the members, call compile(), then put() every value.
+struct VertexSink
+{
+    Eigen::Vector3f* positions = nullptr;
+    Rgb8* colors = nullptr;
+    Eigen::Vector3f* normals = nullptr;
+    std::vector<float*> fieldValues;
+    std::vector<double> fieldOffsets;
+    std::vector<double*> stagedFields; //!< per field, null when written directly
+    double* stagedXyz = nullptr;
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+
+    static std::uint8_t colorByte(double v, double scale)
+    {
+        v *= scale;
+        if (!(v > 0.0))
+            return 0;
+        if (v >= 255.0)
+            return 255;
+        return static_cast<std::uint8_t>(std::lround(v));
+    }
+
+    //! Turns every slot into a strided destination, so that put() is a small
+    //! switch the compiler inlines in the per-value loop.
+    void compile(const VertexLayout& layout)
+    {
+        static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "positions must be packed xyz floats");
+        static_assert(sizeof(Rgb8) == 3, "colours must be packed rgb bytes");
+        targets_.clear();
+        for (const Slot& s : layout.slots) {
+            Target t;
+            switch (s.role) {
+            case Role::X:
+            case Role::Y:
+            case Role::Z: {
+                const int axis = static_cast<int>(s.role) - static_cast<int>(Role::X);
+                t.stride = 3;
+                if (stagedXyz) {
+                    t.kind = Target::Staged;
+                    t.doubles = stagedXyz + axis;
+                } else {
+                    t.kind = Target::Float;
+                    t.floats = reinterpret_cast<float*>(positions) + axis;
+                    t.offset = origin[axis];
+                }
+                break;
+            }
+            case Role::Red:
+            case Role::Green:
+            case Role::Blue:
+                t.kind = Target::Color;
+                t.stride = 3;
+                t.bytes = reinterpret_cast<std::uint8_t*>(colors) + (static_cast<int>(s.role) - static_cast<int>(Role::Red));
+                t.colorScale = s.colorScale;
+                break;
+            case Role::Nx:
+            case Role::Ny:
+            case Role::Nz:
+                t.kind = Target::Float;
+                t.stride = 3;
+                t.floats = reinterpret_cast<float*>(normals) + (static_cast<int>(s.role) - static_cast<int>(Role::Nx));
+                break;
+            case Role::Field:
+                if (stagedFields[s.field]) {
+                    t.kind = Target::Staged;
+                    t.doubles = stagedFields[s.field];
+                } else {
+                    t.kind = Target::Float;
+                    t.floats = fieldValues[s.field];
+                    t.offset = fieldOffsets[s.field];
+                }
+                break;
+            case Role::Ignore: break;
+            }
+            targets_.push_back(t);
+        }
+    }
+
+    void put(std::size_t i, const Slot& s, double v) const
+    {
+        const Target& t = targets_[s.index];
+        switch (t.kind) {
+        case Target::Float: t.floats[i * t.stride] = static_cast<float>(v - t.offset); break;
+        case Target::Color: t.bytes[i * t.stride] = colorByte(v, t.colorScale); break;
+        case Target::Staged: t.doubles[i * t.stride] = v; break;
+        case Target::None: break;
+        }
+    }
+
+private:
+    struct Target
+    {
+        enum Kind : std::uint8_t { None, Float, Color, Staged } kind = None;
+        std::size_t stride = 1;
+        float* floats = nullptr;
+        std::uint8_t* bytes = nullptr;
+        double* doubles = nullptr;
+        double offset = 0.0;
+        double colorScale = 1.0;
+    };
+    std::vector<Target> targets_;
+};
+
+//! Keeps float precision for large values (GPS time ~1e9 s, 32-bit ids): values
+//! are stored relative to their rounded-down minimum.
+double chooseFieldOffset(double lo, double hi)
+{
+    if (!(lo <= hi))
+        return 0.0;
+    if (std::max(std::abs(lo), std::abs(hi)) < 1e5)
+        return 0.0;
+    return std::floor(lo);
+}
+
+struct RangeAccumulator
+{
+    double lo[3] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                    std::numeric_limits<double>::infinity()};
+    double hi[3] = {-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                    -std::numeric_limits<double>::infinity()};
+    std::vector<double> fieldLo, fieldHi;
+
+    explicit RangeAccumulator(std::size_t fieldCount)
+        : fieldLo(fieldCount, std::numeric_limits<double>::infinity()),
+          fieldHi(fieldCount, -std::numeric_limits<double>::infinity())
+    {
+    }
+
+    void add(const Slot& s, double v)
+    {
+        if (s.role >= Role::X && s.role <= Role::Z) {
+            if (std::isfinite(v)) {
+                const int axis = static_cast<int>(s.role) - static_cast<int>(Role::X);
+                lo[axis] = std::min(lo[axis], v);
+                hi[axis] = std::max(hi[axis], v);
+            }
+        } else if (s.role == Role::Field && std::isfinite(v)) {
+            fieldLo[s.field] = std::min(fieldLo[s.field], v);
+            fieldHi[s.field] = std::max(fieldHi[s.field], v);
+        }
+    }
+
+    BoundingBox box() const
+    {
+        BoundingBox b;
+        b.empty = !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]);
+        if (!b.empty) {
+            b.min = Eigen::Vector3d(lo[0], lo[1], lo[2]);
+            b.max = Eigen::Vector3d(hi[0], hi[1], hi[2]);
+        }
+        return b;
+    }
+};
+
+// ---------------------------------------------------------------- binary elements
+
+template <bool Swap>
+const char* skipBinaryList(const PlyElement& e, const PlyProperty& p, std::uint64_t record, const char* ptr,
+                           const char* end, const Context& ctx)
+{
+    const std::size_t countSize = typeSize(p.countType);
+    if (static_cast<std::size_t>(end - ptr) < countSize)
+        ctx.truncated(e, record);
+    const std::int64_t count = loadInteger<Swap>(ptr, p.countType);
+    if (count < 0)
+        ctx.fail(e.name + " " + std::to_string(record + 1) + ": negative length " + std::to_string(count) +
+                 " for list '" + p.name + "'");
+    ptr += countSize;
+    const std::size_t itemSize = typeSize(p.type);
+    if (static_cast<std::uint64_t>(end - ptr) / itemSize < static_cast<std::uint64_t>(count))
+        ctx.truncated(e, record);
+    return ptr + static_cast<std::size_t>(count) * itemSize;
+}
+
+//! Calls visit(index, slot, value) for every used vertex property, in file order.
+template <bool Swap, class Visit>
+const char* visitBinaryVertices(const PlyElement& e, const VertexLayout& layout, const char* ptr, const char* end,
+                                const Context& ctx, ProgressTicker& ticker, Visit&& visit)
+{
+    const std::uint64_t n = e.count;
+    if (e.fixedSize()) {
+        const std::size_t recordSize = e.minRecordSize();
+        const std::uint64_t available = static_cast<std::uint64_t>(end - ptr) / recordSize;
+        if (available < n)
+            ctx.truncated(e, available);
+        const Slot* slotsBegin = layout.slots.data();
+        const Slot* slotsEnd = slotsBegin + layout.slots.size();
+        for (std::uint64_t start = 0; start < n; start += kChunk) {
+            const std::uint64_t stop = std::min(n, start + kChunk);
+            const char* record = ptr + start * recordSize;
+            for (std::uint64_t i = start; i < stop; ++i, record += recordSize)
+                for (const Slot* s = slotsBegin; s != slotsEnd; ++s)
+                    visit(i, *s, loadDouble<Swap>(record + s->offset, s->type));
+            ticker.step(stop - start);
+        }
+        return ptr + n * recordSize;
+    }
+    for (std::uint64_t i = 0; i < n; ++i) {
+        for (std::size_t j = 0; j < e.properties.size(); ++j) {
+            const PlyProperty& p = e.properties[j];
+            if (p.isList) {
+                ptr = skipBinaryList<Swap>(e, p, i, ptr, end, ctx);
+                continue;
+            }
+            const std::size_t size = typeSize(p.type);
+            if (static_cast<std::size_t>(end - ptr) < size)
+                ctx.truncated(e, i);
+            if (const int slot = layout.slotOfProperty[j]; slot >= 0)
+                visit(i, layout.slots[static_cast<std::size_t>(slot)], loadDouble<Swap>(ptr, p.type));
+            ptr += size;
+        }
+        if ((i + 1) % kChunk == 0)
+            ticker.step(kChunk);
+    }
+    ticker.step(n % kChunk);
+    return ptr;
+}
+
+template <bool Swap>
+const char* skipBinaryElement(const PlyElement& e, const char* ptr, const char* end, const Context& ctx)
+{
+    if (e.fixedSize()) {
+        const std::size_t recordSize = e.minRecordSize();
+        if (recordSize == 0)
+            return ptr;
+        const std::uint64_t available = static_cast<std::uint64_t>(end - ptr) / recordSize;
+        if (available < e.count)
+            ctx.truncated(e, available);
+        return ptr + e.count * recordSize;
+    }
+    for (std::uint64_t i = 0; i < e.count; ++i)
+        for (const PlyProperty& p : e.properties) {
+            if (p.isList) {
+                ptr = skipBinaryList<Swap>(e, p, i, ptr, end, ctx);
+            } else {
+                const std::size_t size = typeSize(p.type);
+                if (static_cast<std::size_t>(end - ptr) < size)
+                    ctx.truncated(e, i);
+                ptr += size;
+            }
+        }
+    return ptr;
+}
+
+//! Adds the fan triangulation of one polygon, checking every index.
+class FaceBuilder
+{
+public:
+    FaceBuilder(const PlyElement& faces, std::uint64_t vertexCount, const Context& ctx, std::vector<Triangle>& out)
+        : faces_(faces), vertexCount_(vertexCount), ctx_(ctx), out_(out)
+    {
+    }
+
+    void begin(std::uint64_t face)
+    {
+        face_ = face;
+        corners_ = 0;
+    }
+    void add(std::int64_t index)
+    {
+        if (index < 0 || static_cast<std::uint64_t>(index) >= vertexCount_)
+            ctx_.fail("face " + std::to_string(face_ + 1) + " of " + std::to_string(faces_.count) + " uses vertex " +
+                      std::to_string(index) + ", but there are only " + std::to_string(vertexCount_) + " vertices");
+        const auto v = static_cast<std::uint32_t>(index);
+        if (corners_ == 0)
+            first_ = v;
+        else if (corners_ >= 2)
+            out_.push_back({first_, previous_, v});
+        previous_ = v;
+        ++corners_;
+    }
+
+private:
+    const PlyElement& faces_;
+    std::uint64_t vertexCount_;
+    const Context& ctx_;
+    std::vector<Triangle>& out_;
+    std::uint64_t face_ = 0;
+    std::size_t corners_ = 0;
+    std::uint32_t first_ = 0;
+    std::uint32_t previous_ = 0;
+};
+
+template <bool Swap>
+const char* readBinaryFaces(const PlyElement& e, std::size_t indexProperty, FaceBuilder& builder, const char* ptr,
+                            const char* end, const Context& ctx, ProgressTicker& ticker)
+{
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+        for (std::size_t j = 0; j < e.properties.size(); ++j) {
+            const PlyProperty& p = e.properties[j];
+            if (!p.isList) {
+                const std::size_t size = typeSize(p.type);
+                if (static_cast<std::size_t>(end - ptr) < size)
+                    ctx.truncated(e, i);
+                ptr += size;
+                continue;
+            }
+            const char* next = skipBinaryList<Swap>(e, p, i, ptr, end, ctx);
+            const char* items = ptr + typeSize(p.countType);
+            if (j == indexProperty) {
+                builder.begin(i);
+                const std::size_t itemSize = typeSize(p.type);
+                for (const char* item = items; item < next; item += itemSize)
+                    builder.add(loadInteger<Swap>(item, p.type));
+            }
+            ptr = next;
+        }
+        if ((i + 1) % kChunk == 0)
+            ticker.step(kChunk);
+    }
+    ticker.step(e.count % kChunk);
+    return ptr;
+}
+
+// ---------------------------------------------------------------- ASCII elements
+
+//! Walks the data section line by line (one record per line, as every writer
+//! does), skipping blank lines and keeping the line number for messages.
+class AsciiLines
+{
+public:
+    AsciiLines(const char* begin, const char* end, std::size_t firstLine)
+        : ptr_(begin), end_(end), nextLineNumber_(firstLine)
+    {
+    }
+
+    bool next(std::string_view& line)
+    {
+        while (ptr_ < end_) {
+            const void* nl = std::memchr(ptr_, '\n', static_cast<std::size_t>(end_ - ptr_));
+            const char* stop = nl ? static_cast<const char*>(nl) : end_;
+            line = std::string_view(ptr_, static_cast<std::size_t>(stop - ptr_));
+            ptr_ = nl ? stop + 1 : end_;
+            lineNumber_ = nextLineNumber_++;
+            for (char c : line)
+                if (!isBlank(c))
+                    return true;
+        }
+        return false;
+    }
+    std::size_t lineNumber() const { return lineNumber_; }
+    //! The line the file ends on, for "the file ends at line N".
+    std::size_t lastLine() const { return nextLineNumber_ - 1; }
+    std::size_t remainingBytes() const { return static_cast<std::size_t>(end_ - ptr_); }
+
+private:
+    const char* ptr_;
+    const char* end_;
+    std::size_t nextLineNumber_;
+    std::size_t lineNumber_ = 0;
+};
+
+class AsciiRecordReader
+{
+public:
+    AsciiRecordReader(AsciiLines& lines, const PlyElement& e, const Context& ctx) : lines_(lines), e_(e), ctx_(ctx)
+    {
+        // A record holds at least one character and one separator or newline per
+        // property: an upper bound on the records left, so that a corrupt count
+        // cannot trigger a huge allocation.
+        const std::size_t tokens = std::max<std::size_t>(e.properties.size(), 1);
+        maxRecords_ = (lines.remainingBytes() + 1) / (2 * tokens);
+    }
+
+    //! Records that can be parsed before the data must run out (with a precise message).
+    std::uint64_t capacity() const { return std::min<std::uint64_t>(e_.count, maxRecords_ + 1); }
+
+    void beginRecord(std::uint64_t index)
+    {
+        index_ = index;
+        if (!lines_.next(rest_))
+            ctx_.fail("truncated: " + e_.name + " " + std::to_string(index + 1) + " of " + std::to_string(e_.count) +
+                      " is missing (the file ends at line " + std::to_string(lines_.lastLine()) + ")");
+    }
+    std::string_view token(const PlyProperty& p)
+    {
+        std::string_view t;
+        if (!nextToken(rest_, t))
+            ctx_.failAtLine(lines_.lineNumber(), e_.name + " " + std::to_string(index_ + 1) + " has fewer values than the " +
+                                                     std::to_string(e_.properties.size()) +
+                                                     " properties of the header (no value for '" + p.name + "')");
+        return t;
+    }
+    double number(const PlyProperty& p)
+    {
+        const std::string_view t = token(p);
+        double v = 0.0;
+        if (!parseDouble(t, v))
+            ctx_.failAtLine(lines_.lineNumber(), quoted(t) + " is not a number (property '" + p.name + "' of " + e_.name +
+                                                     " " + std::to_string(index_ + 1) + ")");
+        return v;
+    }
+    std::int64_t integer(const PlyProperty& p)
+    {
+        const std::string_view t = token(p);
+        std::int64_t v = 0;
+        if (!parseInteger(t, v))
+            ctx_.failAtLine(lines_.lineNumber(), quoted(t) + " is not an integer (property '" + p.name + "' of " +
+                                                     e_.name + " " + std::to_string(index_ + 1) + ")");
+        return v;
+    }
+    std::int64_t listCount(const PlyProperty& p)
+    {
+        const std::int64_t count = integer(p);
+        if (count < 0)
+            ctx_.failAtLine(lines_.lineNumber(), "negative length for list '" + p.name + "'");
+        return count;
+    }
+    void endRecord()
+    {
+        std::string_view t;
+        if (nextToken(rest_, t))
+            ctx_.failAtLine(lines_.lineNumber(), e_.name + " " + std::to_string(index_ + 1) + " has more values than the " +
+                                                     std::to_string(e_.properties.size()) + " properties of the header");
+    }
+
+private:
+    AsciiLines& lines_;
+    const PlyElement& e_;
+    const Context& ctx_;
+    std::string_view rest_;
+    std::uint64_t index_ = 0;
+    std::uint64_t maxRecords_ = 0;
+};
+
+void readAsciiVertices(const PlyElement& e, const VertexLayout& layout, AsciiRecordReader& reader, const VertexSink& sink,
+                       ProgressTicker& ticker)
+{
+    const std::uint64_t capacity = reader.capacity();
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+        if (i == capacity) // cannot happen (see capacity()), but the arrays end here
+            throw Error(ErrorCode::Internal, "PLY reader: ASCII record bound exceeded");
+        reader.beginRecord(i);
+        for (std::size_t j = 0; j < e.properties.size(); ++j) {
+            const PlyProperty& p = e.properties[j];
+            if (p.isList) {
+                for (std::int64_t k = reader.listCount(p); k > 0; --k)
+                    reader.token(p);
+            } else if (const int slot = layout.slotOfProperty[j]; slot >= 0) {
+                sink.put(i, layout.slots[static_cast<std::size_t>(slot)], reader.number(p));
+            } else {
+                reader.token(p);
+            }
+        }
+        reader.endRecord();
+        if ((i + 1) % kChunk == 0)
+            ticker.step(kChunk);
+    }
+    ticker.step(e.count % kChunk);
+}
+
+void readAsciiFaces(const PlyElement& e, std::size_t indexProperty, FaceBuilder& builder, AsciiLines& lines,
+                    const Context& ctx, ProgressTicker& ticker)
+{
+    AsciiRecordReader reader(lines, e, ctx);
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+        reader.beginRecord(i);
+        for (std::size_t j = 0; j < e.properties.size(); ++j) {
+            const PlyProperty& p = e.properties[j];
+            if (!p.isList) {
+                reader.token(p);
+                continue;
+            }
+            const std::int64_t count = reader.listCount(p);
+            if (j == indexProperty)
+                builder.begin(i);
+            for (std::int64_t k = 0; k < count; ++k) {
+                if (j == indexProperty)
+                    builder.add(reader.integer(p));
+                else
+                    reader.token(p);
+            }
+        }
+        reader.endRecord();
+        if ((i + 1) % kChunk == 0)
+            ticker.step(kChunk);
+    }
+    ticker.step(e.count % kChunk);
+}
+
+void skipAsciiElement(const PlyElement& e, AsciiLines& lines, const Context& ctx)
+{
+    AsciiRecordReader reader(lines, e, ctx);
+    for (std::uint64_t i = 0; i < e.count; ++i)
+        reader.beginRecord(i);
+}
+
+// ---------------------------------------------------------------- reading
+
+bool isVertexElement(const PlyElement& e)
+{
+    return e.name == "vertex";
+}
+
+//! Index of the face element's vertex list, or -1 when the element gives no triangles.
+int faceIndexProperty(const PlyElement& e)
+{
+    if (e.name != "face")
+        return -1;
+    for (std::size_t j = 0; j < e.properties.size(); ++j)
+        if (e.properties[j].isList && (e.properties[j].name == "vertex_indices" || e.properties[j].name == "vertex_index"))
+            return static_cast<int>(j);
+    return -1;
+}
+
+class PlyReader
+{
+public:
+    PlyReader(const fs::path& path, const ReadOptions& options)
+        : path_(path), options_(options), ctx_(path), file_(path), header_(parseHeader(file_, ctx_))
+    {
+    }
+
+    Entity read()
+    {
+        const PlyElement* vertexElement = nullptr;
+        for (const auto& e : header_.elements)
+            if (isVertexElement(e) && !vertexElement)
+                vertexElement = &e;
+        if (!vertexElement)
+            ctx_.fail("no vertex element in the PLY header");
+        layout_ = makeVertexLayout(*vertexElement, ctx_);
+
+        const bool binary = header_.encoding != PlyEncoding::Ascii;
+        const bool needsRanges =
+            binary && ((layout_.coordinatesAreDouble && !options_.origin) ||
+                       std::find(layout_.fieldIsWide.begin(), layout_.fieldIsWide.end(), true) != layout_.fieldIsWide.end());
+        std::uint64_t totalSteps = vertexElement->count * (needsRanges ? 2 : 1);
+        for (const auto& e : header_.elements)
+            if (faceIndexProperty(e) >= 0)
+                totalSteps += e.count;
+        ProgressTicker ticker(options_.progress, "Reading " + path_.filename().string(), totalSteps);
+
+        const bool swap = binary && ((header_.encoding == PlyEncoding::BinaryBigEndian) == kHostLittleEndian);
+        if (!binary)
+            readAll(ticker, false);
+        else if (swap)
+            readAll<true>(ticker, needsRanges);
+        else
+            readAll<false>(ticker, needsRanges);
+        return finish();
+    }
+
+private:
+    template <bool Swap = false>
+    void readAll(ProgressTicker& ticker, bool needsRanges)
+    {
+        const bool binary = header_.encoding != PlyEncoding::Ascii;
+        const char* ptr = file_.data() + header_.dataOffset;
+        const char* end = file_.data() + file_.size();
+        AsciiLines lines(ptr, end, header_.lineCount + 1);
+        bool vertexDone = false;
+        bool facesDone = false;
+        for (const auto& e : header_.elements) {
+            const int indexProperty = faceIndexProperty(e);
+            if (isVertexElement(e) && !vertexDone) {
+                vertexDone = true;
+                if (binary)
+                    ptr = readBinaryVertexElement<Swap>(e, ptr, end, ticker, needsRanges);
+                else
+                    readAsciiVertexElement(e, lines, ticker);
+            } else if (indexProperty >= 0 && !facesDone) {
+                facesDone = true;
+                const std::uint64_t vertexCount = vertexCountFromHeader();
+                reserveTriangles(e, binary ? static_cast<std::size_t>(end - ptr) : lines.remainingBytes());
+                FaceBuilder builder(e, vertexCount, ctx_, triangles_);
+                if (binary)
+                    ptr = readBinaryFaces<Swap>(e, static_cast<std::size_t>(indexProperty), builder, ptr, end, ctx_, ticker);
+                else
+                    readAsciiFaces(e, static_cast<std::size_t>(indexProperty), builder, lines, ctx_, ticker);
+            } else {
+                if (binary)
+                    ptr = skipBinaryElement<Swap>(e, ptr, end, ctx_);
+                else
+                    skipAsciiElement(e, lines, ctx_);
+            }
+        }
+    }
+
+    std::uint64_t vertexCountFromHeader() const
+    {
+        for (const auto& e : header_.elements)
+            if (isVertexElement(e))
+                return e.count;
+        return 0;
+    }
+
+    void reserveTriangles(const PlyElement& e, std::size_t remainingBytes)
+    {
+        // Most faces are triangles; the bound keeps a lying count from allocating wildly.
+        const std::size_t bound = remainingBytes / std::max<std::size_t>(e.minRecordSize(), 2);
+        triangles_.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(e.count, bound)));
+    }
+
+    //! Allocates the cloud and points the sink at its arrays.
+    VertexSink prepareCloud(std::uint64_t count)
+    {
+        const auto n = static_cast<std::size_t>(count);
+        cloud_.resize(n);
+        VertexSink sink;
+        sink.positions = cloud_.positions().data();
+        sink.colors = layout_.hasColors ? cloud_.enableColors().data() : nullptr;
+        sink.normals = layout_.hasNormals ? cloud_.enableNormals().data() : nullptr;
+        for (const auto& name : layout_.fieldNames)
+            cloud_.addField(name);
+        // Pointers are taken once every field exists: addField may reallocate the field vector.
+        for (const auto& name : layout_.fieldNames)
+            sink.fieldValues.push_back(cloud_.field(name)->values().data());
+        sink.fieldOffsets.assign(layout_.fieldNames.size(), 0.0);
+        sink.stagedFields.assign(layout_.fieldNames.size(), nullptr);
+        return sink;
+    }
+
+    template <bool Swap>
+    const char* readBinaryVertexElement(const PlyElement& e, const char* ptr, const char* end, ProgressTicker& ticker,
+                                        bool needsRanges)
+    {
+        // Check the size before allocating: a corrupt count must not allocate gigabytes.
+        const std::size_t minSize = std::max<std::size_t>(e.minRecordSize(), 1);
+        if (static_cast<std::uint64_t>(end - ptr) / minSize < e.count) {
+            if (e.fixedSize())
+                ctx_.truncated(e, static_cast<std::uint64_t>(end - ptr) / minSize);
+            ctx_.fail("truncated: the header announces " + std::to_string(e.count) + " vertices but only " +
+                      std::to_string(end - ptr) + " bytes of data remain");
+        }
+        RangeAccumulator ranges(layout_.fieldNames.size());
+        if (needsRanges)
+            visitBinaryVertices<Swap>(e, layout_, ptr, end, ctx_, ticker,
+                                      [&ranges](std::uint64_t, const Slot& s, double v) { ranges.add(s, v); });
+        VertexSink sink = prepareCloud(e.count);
+        if (options_.origin)
+            sink.origin = *options_.origin;
+        else if (layout_.coordinatesAreDouble)
+            sink.origin = suggestOrigin(ranges.box());
+        cloud_.setOrigin(sink.origin);
+        for (std::size_t f = 0; f < layout_.fieldNames.size(); ++f)
+            if (layout_.fieldIsWide[f])
+                sink.fieldOffsets[f] = chooseFieldOffset(ranges.fieldLo[f], ranges.fieldHi[f]);
+        applyFieldOffsets(sink);
+        sink.compile(layout_);
+        return visitBinaryVertices<Swap>(e, layout_, ptr, end, ctx_, ticker,
+                                          [&sink](std::uint64_t i, const Slot& s, double v) { sink.put(i, s, v); });
+    }
+
+    void readAsciiVertexElement(const PlyElement& e, AsciiLines& lines, ProgressTicker& ticker)
+    {
+        // The text gives every coordinate in full: keep them in double until the
+        // bounding box, hence the origin, is known.
+        AsciiRecordReader reader(lines, e, ctx_);
+        // Allocating for the records the data can hold: the count may lie, and
+        // parsing then stops with a precise message before the arrays end.
+        const auto n = static_cast<std::size_t>(reader.capacity());
+        VertexSink sink = prepareCloud(n);
+        std::vector<double> stagedXyz;
+        if (options_.origin) {
+            sink.origin = *options_.origin;
+        } else {
+            stagedXyz.resize(3 * n);
+            sink.stagedXyz = stagedXyz.data();
+        }
+        std::vector<std::vector<double>> stagedFields(layout_.fieldNames.size());
+        for (std::size_t f = 0; f < layout_.fieldNames.size(); ++f)
+            if (layout_.fieldIsWide[f]) {
+                stagedFields[f].assign(n, std::numeric_limits<double>::quiet_NaN());
+                sink.stagedFields[f] = stagedFields[f].data();
+            }
+        sink.compile(layout_);
+        readAsciiVertices(e, layout_, reader, sink, ticker);
+
+        if (!options_.origin) {
+            RangeAccumulator ranges(0);
+            Slot axis[3];
+            for (int a = 0; a < 3; ++a)
+                axis[a].role = static_cast<Role>(static_cast<int>(Role::X) + a);
+            for (std::size_t i = 0; i < n; ++i)
+                for (int a = 0; a < 3; ++a)
+                    ranges.add(axis[a], stagedXyz[3 * i + static_cast<std::size_t>(a)]);
+            const Eigen::Vector3d origin = suggestOrigin(ranges.box());
+            auto& positions = cloud_.positions();
+            for (std::size_t i = 0; i < n; ++i)
+                for (int a = 0; a < 3; ++a)
+                    positions[i][a] = static_cast<float>(stagedXyz[3 * i + static_cast<std::size_t>(a)] - origin[a]);
+            sink.origin = origin;
+        }
+        cloud_.setOrigin(sink.origin);
+        for (std::size_t f = 0; f < layout_.fieldNames.size(); ++f) {
+            if (!layout_.fieldIsWide[f])
+                continue;
+            const auto& staged = stagedFields[f];
+            double lo = std::numeric_limits<double>::infinity();
+            double hi = -lo;
+            for (double v : staged)
+                if (std::isfinite(v)) {
+                    lo = std::min(lo, v);
+                    hi = std::max(hi, v);
+                }
+            sink.fieldOffsets[f] = chooseFieldOffset(lo, hi);
+            float* values = sink.fieldValues[f];
+            for (std::size_t i = 0; i < n; ++i)
+                values[i] = static_cast<float>(staged[i] - sink.fieldOffsets[f]);
+        }
+        applyFieldOffsets(sink);
+    }
+
+    void applyFieldOffsets(const VertexSink& sink)
+    {
+        for (std::size_t f = 0; f < layout_.fieldNames.size(); ++f)
+            cloud_.field(layout_.fieldNames[f])->setOffset(sink.fieldOffsets[f]);
+    }
+
+    Entity finish()
+    {
+        if (!triangles_.empty()) {
+            const auto& positions = cloud_.positions();
+            for (std::size_t i = 0; i < positions.size(); ++i)
+                if (!positions[i].allFinite())
+                    ctx_.fail("vertex " + std::to_string(i + 1) + " of " + std::to_string(positions.size()) +
+                              " has a non-finite coordinate; a mesh cannot have one");
+            Mesh mesh;
+            mesh.vertices = std::move(cloud_);
+            mesh.triangles = std::move(triangles_);
+            return mesh;
+        }
+        if (const std::size_t dropped = cloud_.removeNonFinitePoints(); dropped > 0)
+            logWarning(ctx_.fileName() + ": " + std::to_string(dropped) +
+                       " points with non-finite coordinates were skipped");
+        return std::move(cloud_);
+    }
+
+    fs::path path_;
+    const ReadOptions& options_;
+    Context ctx_;
+    MappedFile file_;
+    PlyHeader header_;
+    VertexLayout layout_;
+    PointCloud cloud_;
+    std::vector<Triangle> triangles_;
+};
+
+// ---------------------------------------------------------------- writing
+
+enum class ColumnKind : std::uint8_t { Coordinate, Color, Normal, Field };
+
+struct Column
+{
+    std::string name;
+    PlyType type;
+    ColumnKind kind;
+    int index; //!< axis, channel or field index
+};
+
+std::string plyPropertyName(const std::string& fieldName)
+{
+    std::string name = fieldName.empty() ? std::string("field") : fieldName;
+    for (char& c : name)
+        if (static_cast<unsigned char>(c) <= 32 || static_cast<unsigned char>(c) >= 127)
+            c = '_';
+    // Names the reader would take for something else get the prefix it strips.
+    static const char* reserved[] = {"x",     "y",           "z",             "red",          "green",
+                                     "blue",  "diffuse_red", "diffuse_green", "diffuse_blue", "alpha",
+                                     "diffuse_alpha", "nx",  "ny",            "nz",           "normal_x",
+                                     "normal_y",      "normal_z"};
+    const std::string key = lower(name);
+    const bool clashes = key.rfind("scalar_", 0) == 0 ||
+                         std::any_of(std::begin(reserved), std::end(reserved), [&](const char* r) { return key == r; });
+    return clashes ? "scalar_" + name : name;
+}
+
+const char* plyTypeName(PlyType type)
+{
+    switch (type) {
+    case PlyType::Int8: return "char";
+    case PlyType::UInt8: return "uchar";
+    case PlyType::Int16: return "short";
+    case PlyType::UInt16: return "ushort";
+    case PlyType::Int32: return "int";
+    case PlyType::UInt32: return "uint";
+    case PlyType::Float32: return "float";
+    case PlyType::Float64: return "double";
+    }
+    return "float";
+}
+
+template <typename T, bool Swap>
+inline char* store(char* out, T value)
+{
+    if constexpr (!Swap) {
+        std::memcpy(out, &value, sizeof(T));
+    } else {
+        char bytes[sizeof(T)];
+        std::memcpy(bytes, &value, sizeof(T));
+        for (std::size_t i = 0; i < sizeof(T); ++i)
+            out[i] = bytes[sizeof(T) - 1 - i];
+    }
+    return out + sizeof(T);
+}
+
+class PlyWriter
+{
+public:
+    PlyWriter(const PointCloud& cloud, const std::vector<Triangle>* triangles, const fs::path& path,
+              const WriteOptions& options)
+        : cloud_(cloud), triangles_(triangles), path_(path), options_(options)
+    {
+        switch (options.encoding) {
+        case Encoding::Default:
+        case Encoding::BinaryLittleEndian: encoding_ = PlyEncoding::BinaryLittleEndian; break;
+        case Encoding::BinaryBigEndian: encoding_ = PlyEncoding::BinaryBigEndian; break;
+        case Encoding::Ascii: encoding_ = PlyEncoding::Ascii; break;
+        case Encoding::BinaryCompressed:
+            throw Error(ErrorCode::InvalidArgument, path.string() + ": PLY has no compressed encoding");
+        }
+        const bool globalDoubles = cloud.origin() != Eigen::Vector3d::Zero();
+        for (int a = 0; a < 3; ++a)
+            columns_.push_back({std::string(1, static_cast<char>('x' + a)),
+                                globalDoubles ? PlyType::Float64 : PlyType::Float32, ColumnKind::Coordinate, a});
+        if (cloud.hasColors())
+            for (int c = 0; c < 3; ++c)
+                columns_.push_back({c == 0 ? "red" : c == 1 ? "green" : "blue", PlyType::UInt8, ColumnKind::Color, c});
+        if (cloud.hasNormals())
+            for (int a = 0; a < 3; ++a)
+                columns_.push_back({"n" + std::string(1, static_cast<char>('x' + a)), PlyType::Float32,
+                                    ColumnKind::Normal, a});
+        for (std::size_t f = 0; f < cloud.fields().size(); ++f) {
+            const ScalarField& field = cloud.fields()[f];
+            columns_.push_back({plyPropertyName(field.name()),
+                                field.offset() != 0.0 ? PlyType::Float64 : PlyType::Float32, ColumnKind::Field,
+                                static_cast<int>(f)});
+        }
+    }
+
+    void write()
+    {
+        AtomicFile file(path_);
+        std::ofstream& out = file.stream();
+        const std::string header = makeHeader();
+        out.write(header.data(), static_cast<std::streamsize>(header.size()));
+        const std::uint64_t faceCount = triangles_ ? triangles_->size() : 0;
+        ProgressTicker ticker(options_.progress, "Writing " + path_.filename().string(), cloud_.size() + faceCount);
+        if (encoding_ == PlyEncoding::Ascii)
+            writeAscii(out, ticker);
+        else if ((encoding_ == PlyEncoding::BinaryBigEndian) == kHostLittleEndian)
+            writeBinary<true>(out, ticker);
+        else
+            writeBinary<false>(out, ticker);
+        file.commit();
+    }
+
+private:
+    std::string makeHeader() const
+    {
+        std::string h = "ply\nformat ";
+        h += encoding_ == PlyEncoding::Ascii                ? "ascii"
+             : encoding_ == PlyEncoding::BinaryLittleEndian ? "binary_little_endian"
+                                                            : "binary_big_endian";
+        h += " 1.0\ncomment Written by scandiff\n";
+        h += "element vertex " + std::to_string(cloud_.size()) + "\n";
+        for (const Column& c : columns_)
+            h += std::string("property ") + plyTypeName(c.type) + " " + c.name + "\n";
+        if (triangles_) {
+            h += "element face " + std::to_string(triangles_->size()) + "\n";
+            h += "property list uchar int vertex_indices\n";
+        }
+        h += "end_header\n";
+        return h;
+    }
+
+    double value(const Column& c, std::size_t i) const
+    {
+        switch (c.kind) {
+        case ColumnKind::Coordinate:
+            return c.type == PlyType::Float64 ? cloud_.origin()[c.index] + static_cast<double>(cloud_.positions()[i][c.index])
+                                              : static_cast<double>(cloud_.positions()[i][c.index]);
+        case ColumnKind::Color: {
+            const Rgb8& rgb = cloud_.colors()[i];
+            return c.index == 0 ? rgb.r : c.index == 1 ? rgb.g : rgb.b;
+        }
+        case ColumnKind::Normal: return cloud_.normals()[i][c.index];
+        case ColumnKind::Field: return cloud_.fields()[static_cast<std::size_t>(c.index)].value(i);
+        }
+        return 0.0;
+    }
+
+    template <bool Swap>
+    void writeBinary(std::ofstream& out, ProgressTicker& ticker)
+    {
+        std::size_t recordSize = 0;
+        for (const Column& c : columns_)
+            recordSize += typeSize(c.type);
+        const std::size_t n = cloud_.size();
+        std::vector<char> buffer(static_cast<std::size_t>(kChunk) * std::max<std::size_t>(recordSize, 13));
+        for (std::size_t start = 0; start < n; start += kChunk) {
+            const std::size_t stop = std::min<std::size_t>(n, start + kChunk);
+            char* o = buffer.data();
+            for (std::size_t i = start; i < stop; ++i)
+                for (const Column& c : columns_) {
+                    const double v = value(c, i);
+                    switch (c.type) {
+                    case PlyType::UInt8: o = store<std::uint8_t, Swap>(o, static_cast<std::uint8_t>(v)); break;
+                    case PlyType::Float64: o = store<double, Swap>(o, v); break;
+                    default: o = store<float, Swap>(o, static_cast<float>(v)); break;
+                    }
+                }
+            out.write(buffer.data(), o - buffer.data());
+            ticker.step(stop - start);
+        }
+        if (!triangles_)
+            return;
+        const std::size_t m = triangles_->size();
+        for (std::size_t start = 0; start < m; start += kChunk) {
+            const std::size_t stop = std::min<std::size_t>(m, start + kChunk);
+            char* o = buffer.data();
+            for (std::size_t t = start; t < stop; ++t) {
+                *o++ = 3;
+                for (std::uint32_t v : (*triangles_)[t])
+                    o = store<std::int32_t, Swap>(o, static_cast<std::int32_t>(v));
+            }
+            out.write(buffer.data(), o - buffer.data());
+            ticker.step(stop - start);
+        }
+    }
+
+    void writeAscii(std::ofstream& out, ProgressTicker& ticker)
+    {
+        std::string text;
+        char number[64];
+        auto append = [&](auto v) {
+            const auto result = std::to_chars(number, number + sizeof(number), v);
+            // Keep "nan" unsigned: some readers reject "-nan".
+            if (number[0] == '-' && result.ptr - number == 4 && number[1] == 'n')
+                text.append(number + 1, 3);
+            else
+                text.append(number, result.ptr);
+        };
+        auto flushIfLarge = [&]() {
+            if (text.size() > (1u << 20)) {
+                out.write(text.data(), static_cast<std::streamsize>(text.size()));
+                text.clear();
+            }
+        };
+        const std::size_t n = cloud_.size();
+        for (std::size_t i = 0; i < n; ++i) {
+            for (std::size_t k = 0; k < columns_.size(); ++k) {
+                const Column& c = columns_[k];
+                if (k > 0)
+                    text += ' ';
+                const double v = value(c, i);
+                if (c.type == PlyType::UInt8)
+                    append(static_cast<int>(v));
+                else if (c.type == PlyType::Float64)
+                    append(v);
+                else
+                    append(static_cast<float>(v));
+            }
+            text += '\n';
+            flushIfLarge();
+            if ((i + 1) % kChunk == 0)
+                ticker.step(kChunk);
+        }
+        ticker.step(n % kChunk);
+        if (triangles_) {
+            for (std::size_t t = 0; t < triangles_->size(); ++t) {
+                const Triangle& tri = (*triangles_)[t];
+                text += '3';
+                for (std::uint32_t v : tri) {
+                    text += ' ';
+                    append(v);
+                }
+                text += '\n';
+                flushIfLarge();
+                if ((t + 1) % kChunk == 0)
+                    ticker.step(kChunk);
+            }
+            ticker.step(triangles_->size() % kChunk);
+        }
+        out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    }
+
+    const PointCloud& cloud_;
+    const std::vector<Triangle>* triangles_;
+    fs::path path_;
+    const WriteOptions& options_;
+    PlyEncoding encoding_ = PlyEncoding::BinaryLittleEndian;
+    std::vector<Column> columns_;
+};
+
+} // namespace
+
+FormatHandler plyFormat()
+{
+    FormatHandler handler;
+    handler.name = "PLY";
+    handler.extensions = {"ply"};
+    handler.read = [](const fs::path& path, const ReadOptions& options) -> Entity {
+        return PlyReader(path, options).read();
+    };
+    handler.writeCloud = [](const PointCloud& cloud, const fs::path& path, const WriteOptions& options) {
+        PlyWriter(cloud, nullptr, path, options).write();
+    };
+    handler.writeMesh = [](const Mesh& mesh, const fs::path& path, const WriteOptions& options) {
+        PlyWriter(mesh.vertices, &mesh.triangles, path, options).write();
+    };
+    return handler;
+}
+
+} // namespace scandiff::io::detail

@@ -1,0 +1,15 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! The built-in format handlers, one per source file of io/src/.
+
+#include <scandiff/io/FileIO.h>
+
+namespace scandiff::io::detail {
+
+FormatHandler plyFormat();        // PlyFormat.cpp
+FormatHandler asciiFormat();      // AsciiFormat.cpp
+FormatHandler lasFormat();        // LasFormat.cpp
+FormatHandler assimpMeshFormat(); // AssimpMeshFormat.cpp
+FormatHandler dxfFormat();        // DxfWriter.cpp (export only)
+
+} // namespace scandiff::io::detail

@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! The numeric-coded octree of thesis 000, chapter 4: one Morton code per point,
+//! points ordered by code, so every cell of every level is a contiguous range
+//! found by binary search. The octree never copies the points: it reads the
+//! caller's contiguous float array (which must outlive it) and keeps 12 bytes per
+//! point (a 64-bit code and a 32-bit point index).
+//!
+//! Queries run at one level chosen by the caller (or bestLevelFor()); the level
+//! changes the speed, never the result: every query is exact, equal to brute
+//! force with ties broken by the smaller point index.
+
+#include <scandiff/octree/MortonCode.h>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace scandiff::octree {
+
+//! An axis-aligned cube: the root cell. Two octrees built on the same cube have
+//! equal codes for homologous cells (needed for cloud/cloud work).
+struct CubicBox
+{
+    Eigen::Vector3d min = Eigen::Vector3d::Zero();
+    double size = 1.0;
+
+    //! The smallest cube holding every point (a tiny margin keeps the maximum inside).
+    static CubicBox enclosing(const Eigen::Vector3f* points, std::size_t count);
+    //! The smallest cube holding both boxes' points.
+    static CubicBox enclosingBoth(const CubicBox& a, const CubicBox& b);
+};
+
+struct LevelStatistics
+{
+    std::size_t nonEmptyCells = 0;
+    double meanPointsPerCell = 0.0;
+    std::size_t maxPointsPerCell = 0;
+};
+
+struct Neighbour
+{
+    std::uint32_t index = 0;     //!< point index in the caller's array
+    float squaredDistance = 0.0f;
+    friend bool operator<(const Neighbour& a, const Neighbour& b)
+    {
+        return a.squaredDistance < b.squaredDistance ||
+               (a.squaredDistance == b.squaredDistance && a.index < b.index);
+    }
+};
+
+class Octree
+{
+public:
+    //! Throws std::invalid_argument for an empty array, more than 2^32-1 points,
+    //! or a non-finite coordinate (naming the point index).
+    Octree(const Eigen::Vector3f* points, std::size_t count, std::optional<CubicBox> box = std::nullopt);
+
+    std::size_t size() const { return codes_.size(); }
+    const CubicBox& box() const { return box_; }
+    const Eigen::Vector3f* points() const { return points_; }
+
+    //! Full-depth codes in increasing order, and the point index of each.
+    const std::vector<MortonCode>& sortedCodes() const { return codes_; }
+    const std::vector<std::uint32_t>& sortedIndices() const { return indices_; }
+
+    //! Statistics of levels 1..kMaxLevel (index 0 is the root: one cell).
+    const LevelStatistics& levelStatistics(int level) const { return stats_.at(static_cast<std::size_t>(level)); }
+    double cellSize(int level) const { return box_.size / static_cast<double>(1u << level); }
+
+    //! Range [first, last) in sorted order of the cell `cellCode` (3*level bits); empty if no point.
+    std::pair<std::size_t, std::size_t> cellRange(MortonCode cellCode, int level) const;
+
+    //! The k nearest points to q, closest first. Fewer than k if the octree is smaller.
+    void nearest(const Eigen::Vector3f& q, std::size_t k, int level, std::vector<Neighbour>& out) const;
+    //! Every point within `radius` of q (distance <= radius), closest first.
+    void withinRadius(const Eigen::Vector3f& q, float radius, int level, std::vector<Neighbour>& out) const;
+
+    //! The ISPRS 2005 rule (thesis 000 §4.5): the shallowest level whose mean
+    //! number of points per non-empty cell is at most `maxMeanPointsPerCell`.
+    int levelForMeanPopulation(double maxMeanPointsPerCell) const;
+
+private:
+    std::array<std::int64_t, 3> cellOf(const Eigen::Vector3f& q, int level) const;
+    double squaredGap(MortonCode cell, int level, const Eigen::Vector3f& q) const;
+    //! Best-first traversal of the cells down to `leafLevel`; `visitRange` scans
+    //! sorted ranges, `prune(gap2)` ends the search once nothing closer remains.
+    template <typename Visit, typename Prune>
+    void descend(const Eigen::Vector3f& q, int leafLevel, Visit&& visitRange, Prune&& prune) const;
+    void descendNearest(const Eigen::Vector3f& q, std::size_t k, int leafLevel, std::vector<Neighbour>& heap) const;
+    void scanCell(std::int64_t x, std::int64_t y, std::int64_t z, int level, const Eigen::Vector3f& q, std::size_t k,
+                  std::vector<Neighbour>& heap) const;
+
+    const Eigen::Vector3f* points_;
+    CubicBox box_;
+    std::vector<MortonCode> codes_;
+    std::vector<std::uint32_t> indices_;
+    std::vector<LevelStatistics> stats_;
+};
+
+} // namespace scandiff::octree

@@ -1,0 +1,390 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/octree/Octree.h>
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <stdexcept>
+#include <string>
+
+namespace scandiff::octree {
+
+namespace {
+
+// Float distances are compared against double geometric bounds; this relative
+// slack makes the pruning and stopping tests conservative so that rounding can
+// never drop a point that brute force would return.
+constexpr double kSlack = 1e-5;
+
+//! Cells the constant-level search may visit (5 x 5 x 5: two rings around an
+//! inner cell) before switching to the descent.
+constexpr std::int64_t kMaxRingCells = 125;
+
+//! Cells of at most this many points are scanned whole during a descent.
+constexpr std::size_t kDescentLeafSize = 32;
+
+//! Cells in a radius query's box beyond which the descent is cheaper.
+constexpr std::int64_t kMaxRadiusCells = 512;
+
+bool heapFull(const std::vector<Neighbour>& heap, std::size_t k) { return heap.size() >= k; }
+
+void offer(std::vector<Neighbour>& heap, std::size_t k, const Neighbour& candidate)
+{
+    if (heap.size() < k) {
+        heap.push_back(candidate);
+        std::push_heap(heap.begin(), heap.end());
+    } else if (candidate < heap.front()) {
+        std::pop_heap(heap.begin(), heap.end());
+        heap.back() = candidate;
+        std::push_heap(heap.begin(), heap.end());
+    }
+}
+
+} // namespace
+
+CubicBox CubicBox::enclosing(const Eigen::Vector3f* points, std::size_t count)
+{
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
+    for (std::size_t i = 0; i < count; ++i) {
+        lo = lo.cwiseMin(points[i].cast<double>());
+        hi = hi.cwiseMax(points[i].cast<double>());
+    }
+    CubicBox box;
+    box.min = lo;
+    const double extent = (hi - lo).maxCoeff();
+    // A cloud of one point (or all duplicates) still needs a non-zero cube.
+    box.size = extent > 0 ? extent * (1.0 + 1e-6) : 1.0;
+    return box;
+}
+
+CubicBox CubicBox::enclosingBoth(const CubicBox& a, const CubicBox& b)
+{
+    CubicBox box;
+    box.min = a.min.cwiseMin(b.min);
+    const Eigen::Vector3d hi = (a.min.array() + a.size).matrix().cwiseMax((b.min.array() + b.size).matrix());
+    box.size = (hi - box.min).maxCoeff();
+    return box;
+}
+
+Octree::Octree(const Eigen::Vector3f* points, std::size_t count, std::optional<CubicBox> box)
+    : points_(points)
+{
+    if (count == 0)
+        throw std::invalid_argument("cannot build an octree on an empty cloud");
+    if (count > std::numeric_limits<std::uint32_t>::max())
+        throw std::invalid_argument("an octree holds at most 4,294,967,295 points");
+    for (std::size_t i = 0; i < count; ++i)
+        if (!points[i].allFinite())
+            throw std::invalid_argument("point " + std::to_string(i) + " has a non-finite coordinate; remove such points first");
+    box_ = box ? *box : CubicBox::enclosing(points, count);
+    if (!(box_.size > 0) || !std::isfinite(box_.size))
+        throw std::invalid_argument("the octree's bounding cube must have a finite, positive size");
+
+    const double scale = static_cast<double>(kCellsPerAxisAtMaxLevel) / box_.size;
+    const auto maxCell = static_cast<std::int64_t>(kCellsPerAxisAtMaxLevel - 1);
+    std::vector<std::pair<MortonCode, std::uint32_t>> keyed(count);
+    std::atomic<bool> outside{false};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            std::uint32_t c[3];
+            for (int a = 0; a < 3; ++a) {
+                const auto v = static_cast<std::int64_t>(std::floor((points[i][a] - box_.min[a]) * scale));
+                // The far face itself belongs to the last cell; beyond it, the
+                // geometric pruning of the queries would no longer hold.
+                if (v < 0 || v > maxCell + 1)
+                    outside = true;
+                c[a] = static_cast<std::uint32_t>(std::clamp<std::int64_t>(v, 0, maxCell));
+            }
+            keyed[i] = {encodeCell(c[0], c[1], c[2]), static_cast<std::uint32_t>(i)};
+        }
+    });
+    if (outside)
+        throw std::invalid_argument("some points lie outside the octree's bounding cube");
+    tbb::parallel_sort(keyed.begin(), keyed.end());
+    codes_.resize(count);
+    indices_.resize(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        codes_[i] = keyed[i].first;
+        indices_[i] = keyed[i].second;
+    }
+    keyed.clear();
+    keyed.shrink_to_fit();
+
+    // Per-level statistics in one pass: two consecutive codes first differ at the
+    // level of their highest differing bit triplet; a new cell starts there and at
+    // every deeper level.
+    stats_.assign(kMaxLevel + 1, LevelStatistics{});
+    std::vector<std::size_t> cellStart(kMaxLevel + 1, 0);
+    for (int level = 0; level <= kMaxLevel; ++level)
+        stats_[static_cast<std::size_t>(level)].nonEmptyCells = 1;
+    auto closeCell = [&](int level, std::size_t end) {
+        auto& s = stats_[static_cast<std::size_t>(level)];
+        s.maxPointsPerCell = std::max(s.maxPointsPerCell, end - cellStart[static_cast<std::size_t>(level)]);
+        cellStart[static_cast<std::size_t>(level)] = end;
+    };
+    for (std::size_t i = 1; i < count; ++i) {
+        const MortonCode diff = codes_[i] ^ codes_[i - 1];
+        if (diff == 0)
+            continue;
+        const int highestBit = 63 - __builtin_clzll(diff);
+        const int firstLevel = kMaxLevel - highestBit / 3;
+        for (int level = firstLevel; level <= kMaxLevel; ++level) {
+            ++stats_[static_cast<std::size_t>(level)].nonEmptyCells;
+            closeCell(level, i);
+        }
+    }
+    for (int level = 0; level <= kMaxLevel; ++level) {
+        closeCell(level, count);
+        auto& s = stats_[static_cast<std::size_t>(level)];
+        s.meanPointsPerCell = static_cast<double>(count) / static_cast<double>(s.nonEmptyCells);
+    }
+}
+
+std::pair<std::size_t, std::size_t> Octree::cellRange(MortonCode cellCode, int level) const
+{
+    const int shift = 3 * (kMaxLevel - level);
+    const MortonCode first = cellCode << shift;
+    const MortonCode last = (cellCode + 1) << shift; // exclusive; level >= 1 keeps it within 63 bits
+    const auto begin = std::lower_bound(codes_.begin(), codes_.end(), first);
+    if (begin == codes_.end() || *begin >= last)
+        return {0, 0};
+    const auto end = std::lower_bound(begin, codes_.end(), last);
+    return {static_cast<std::size_t>(begin - codes_.begin()), static_cast<std::size_t>(end - codes_.begin())};
+}
+
+std::array<std::int64_t, 3> Octree::cellOf(const Eigen::Vector3f& q, int level) const
+{
+    const double l = cellSize(level);
+    std::array<std::int64_t, 3> c{};
+    for (int a = 0; a < 3; ++a)
+        c[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(std::floor((q[a] - box_.min[a]) / l));
+    return c;
+}
+
+void Octree::scanCell(std::int64_t x, std::int64_t y, std::int64_t z, int level, const Eigen::Vector3f& q,
+                      std::size_t k, std::vector<Neighbour>& heap) const
+{
+    if (heapFull(heap, k)) {
+        // Skip a cell that cannot hold anything closer than the current k-th.
+        const double l = cellSize(level);
+        const std::int64_t cell[3] = {x, y, z};
+        double gap2 = 0;
+        for (int a = 0; a < 3; ++a) {
+            const double lo = box_.min[a] + static_cast<double>(cell[a]) * l;
+            const double d = std::max({lo - q[a], q[a] - (lo + l), 0.0});
+            gap2 += d * d;
+        }
+        if (gap2 > static_cast<double>(heap.front().squaredDistance) * (1 + kSlack))
+            return;
+    }
+    const auto [first, last] = cellRange(encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                                                     static_cast<std::uint32_t>(z)), level);
+    for (std::size_t i = first; i < last; ++i) {
+        const std::uint32_t index = indices_[i];
+        offer(heap, k, Neighbour{index, (points_[index] - q).squaredNorm()});
+    }
+}
+
+double Octree::squaredGap(MortonCode cell, int level, const Eigen::Vector3f& q) const
+{
+    const CellCoordinates c = decodeCell(cell);
+    const double l = cellSize(level);
+    const double coords[3] = {static_cast<double>(c.x), static_cast<double>(c.y), static_cast<double>(c.z)};
+    double gap2 = 0;
+    for (int a = 0; a < 3; ++a) {
+        const double lo = box_.min[a] + coords[a] * l;
+        const double d = std::max({lo - q[a], q[a] - (lo + l), 0.0});
+        gap2 += d * d;
+    }
+    return gap2;
+}
+
+template <typename Visit, typename Prune>
+void Octree::descend(const Eigen::Vector3f& q, int leafLevel, Visit&& visitRange, Prune&& prune) const
+{
+    struct Node
+    {
+        double gap2;
+        int level;
+        MortonCode cell;
+        std::size_t first, last;
+        bool operator>(const Node& other) const { return gap2 > other.gap2; }
+    };
+    // Closest cells first, so the k-th distance shrinks early and prunes the most.
+    std::priority_queue<Node, std::vector<Node>, std::greater<Node>> queue;
+    queue.push({0.0, 0, 0, 0, codes_.size()});
+    while (!queue.empty()) {
+        const Node node = queue.top();
+        queue.pop();
+        if (prune(node.gap2))
+            break;
+        if (node.level >= leafLevel || node.last - node.first <= kDescentLeafSize) {
+            visitRange(node.first, node.last);
+            continue;
+        }
+        const int childLevel = node.level + 1;
+        const int shift = 3 * (kMaxLevel - childLevel);
+        std::size_t begin = node.first;
+        for (MortonCode c = 0; c < 8 && begin < node.last; ++c) {
+            const MortonCode child = (node.cell << 3) | c;
+            const auto end = static_cast<std::size_t>(
+                std::lower_bound(codes_.begin() + static_cast<std::ptrdiff_t>(begin),
+                                 codes_.begin() + static_cast<std::ptrdiff_t>(node.last), (child + 1) << shift) -
+                codes_.begin());
+            if (end > begin)
+                queue.push({squaredGap(child, childLevel, q), childLevel, child, begin, end});
+            begin = end;
+        }
+    }
+}
+
+void Octree::descendNearest(const Eigen::Vector3f& q, std::size_t k, int leafLevel, std::vector<Neighbour>& heap) const
+{
+    descend(
+        q, leafLevel,
+        [&](std::size_t first, std::size_t last) {
+            for (std::size_t i = first; i < last; ++i) {
+                const std::uint32_t index = indices_[i];
+                offer(heap, k, Neighbour{index, (points_[index] - q).squaredNorm()});
+            }
+        },
+        [&](double gap2) { return heapFull(heap, k) && gap2 > static_cast<double>(heap.front().squaredDistance) * (1 + kSlack); });
+}
+
+void Octree::nearest(const Eigen::Vector3f& q, std::size_t k, int level, std::vector<Neighbour>& out) const
+{
+    out.clear();
+    if (k == 0)
+        return;
+    if (level < 1 || level > kMaxLevel)
+        throw std::invalid_argument("octree level must be in 1.." + std::to_string(kMaxLevel));
+    const std::int64_t n = std::int64_t(1) << level;
+    const auto c = cellOf(q, level);
+    const double l = cellSize(level);
+    // Distance from q to the faces of its own cell: the inscribed radius of eq. 4.1 is j*l plus this.
+    double inner = std::numeric_limits<double>::infinity();
+    std::int64_t firstRing = 0, lastRing = 0;
+    for (int a = 0; a < 3; ++a) {
+        const auto ca = c[static_cast<std::size_t>(a)];
+        const double centre = box_.min[a] + (static_cast<double>(ca) + 0.5) * l;
+        inner = std::min(inner, 0.5 * l - std::abs(q[a] - centre));
+        // Rings closer than the grid are empty; rings beyond covering it are pointless.
+        firstRing = std::max(firstRing, std::max(-ca, ca - (n - 1)));
+        lastRing = std::max(lastRing, std::max(ca, n - 1 - ca));
+    }
+    out.reserve(k);
+    // The thesis's constant-level search (§4.4) is fast when the level suits the
+    // data, and very slow when the nearest points lie many cells away (a deep
+    // level, or a query far from the cloud). Once the rings would cover more
+    // than a few cells without meeting the stopping rule, we start again with a
+    // best-first descent of the hierarchy, which costs about log(n) whatever
+    // the level.
+    for (std::int64_t j = firstRing; j <= lastRing; ++j) {
+        std::int64_t coveredCells = 1;
+        for (int a = 0; a < 3; ++a)
+            coveredCells *= std::min<std::int64_t>(c[static_cast<std::size_t>(a)] + j, n - 1) -
+                            std::max<std::int64_t>(c[static_cast<std::size_t>(a)] - j, 0) + 1;
+        if (coveredCells > kMaxRingCells) {
+            out.clear();
+            descendNearest(q, k, level, out);
+            break;
+        }
+        const std::int64_t x0 = std::max<std::int64_t>(c[0] - j, 0), x1 = std::min<std::int64_t>(c[0] + j, n - 1);
+        const std::int64_t y0 = std::max<std::int64_t>(c[1] - j, 0), y1 = std::min<std::int64_t>(c[1] + j, n - 1);
+        for (std::int64_t x = x0; x <= x1; ++x) {
+            for (std::int64_t y = y0; y <= y1; ++y) {
+                const bool onShell = std::abs(x - c[0]) == j || std::abs(y - c[1]) == j;
+                if (onShell) {
+                    const std::int64_t z0 = std::max<std::int64_t>(c[2] - j, 0), z1 = std::min<std::int64_t>(c[2] + j, n - 1);
+                    for (std::int64_t z = z0; z <= z1; ++z)
+                        scanCell(x, y, z, level, q, k, out);
+                } else {
+                    if (c[2] - j >= 0 && c[2] - j < n)
+                        scanCell(x, y, c[2] - j, level, q, k, out);
+                    if (j > 0 && c[2] + j >= 0 && c[2] + j < n)
+                        scanCell(x, y, c[2] + j, level, q, k, out);
+                }
+            }
+        }
+        // Stopping rule of thesis 000 eq. 4.1: every unvisited point lies outside
+        // the cube of rings 0..j, hence farther than its inscribed sphere.
+        if (heapFull(out, k)) {
+            const double inscribed = static_cast<double>(j) * l + inner;
+            if (static_cast<double>(out.front().squaredDistance) * (1 + kSlack) < inscribed * inscribed)
+                break;
+        }
+    }
+    std::sort_heap(out.begin(), out.end());
+}
+
+void Octree::withinRadius(const Eigen::Vector3f& q, float radius, int level, std::vector<Neighbour>& out) const
+{
+    out.clear();
+    if (!(radius >= 0))
+        return;
+    if (level < 1 || level > kMaxLevel)
+        throw std::invalid_argument("octree level must be in 1.." + std::to_string(kMaxLevel));
+    const std::int64_t n = std::int64_t(1) << level;
+    const double l = cellSize(level);
+    const float r2 = radius * radius;
+    std::int64_t lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor((q[a] - radius - box_.min[a]) / l)) - 1);
+        hi[a] = std::min<std::int64_t>(n - 1, static_cast<std::int64_t>(std::floor((q[a] + radius - box_.min[a]) / l)) + 1);
+    }
+    const std::int64_t boxCells = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+    if (boxCells > kMaxRadiusCells) {
+        descend(
+            q, level,
+            [&](std::size_t first, std::size_t last) {
+                for (std::size_t i = first; i < last; ++i) {
+                    const std::uint32_t index = indices_[i];
+                    const float d2 = (points_[index] - q).squaredNorm();
+                    if (d2 <= r2)
+                        out.push_back({index, d2});
+                }
+            },
+            // Nodes come out by increasing gap: the first beyond the radius ends the search.
+            [&](double gap2) { return gap2 > static_cast<double>(r2) * (1 + kSlack); });
+        std::sort(out.begin(), out.end());
+        return;
+    }
+    for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+            for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
+                const std::int64_t cell[3] = {x, y, z};
+                double gap2 = 0;
+                for (int a = 0; a < 3; ++a) {
+                    const double cmin = box_.min[a] + static_cast<double>(cell[a]) * l;
+                    const double d = std::max({cmin - q[a], q[a] - (cmin + l), 0.0});
+                    gap2 += d * d;
+                }
+                if (gap2 > static_cast<double>(r2) * (1 + kSlack))
+                    continue;
+                const auto [first, last] = cellRange(encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                                                                 static_cast<std::uint32_t>(z)), level);
+                for (std::size_t i = first; i < last; ++i) {
+                    const std::uint32_t index = indices_[i];
+                    const float d2 = (points_[index] - q).squaredNorm();
+                    if (d2 <= r2)
+                        out.push_back({index, d2});
+                }
+            }
+    std::sort(out.begin(), out.end());
+}
+
+int Octree::levelForMeanPopulation(double maxMeanPointsPerCell) const
+{
+    for (int level = 1; level <= kMaxLevel; ++level)
+        if (stats_[static_cast<std::size_t>(level)].meanPointsPerCell <= maxMeanPointsPerCell)
+            return level;
+    return kMaxLevel;
+}
+
+} // namespace scandiff::octree

@@ -1,0 +1,142 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/core/Error.h>
+#include <scandiff/core/Mesh.h>
+#include <scandiff/core/PointCloud.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <type_traits>
+
+using namespace scandiff;
+
+static_assert(!std::is_copy_constructible_v<PointCloud>, "a cloud is never copied by accident");
+static_assert(std::is_nothrow_move_constructible_v<PointCloud>, "a cloud moves cheaply");
+static_assert(!std::is_copy_constructible_v<Mesh>, "a mesh is never copied by accident");
+
+namespace {
+
+PointCloud threePoints()
+{
+    PointCloud c;
+    c.name = "three";
+    c.resize(3);
+    c.positions()[0] = {0, 0, 0};
+    c.positions()[1] = {1, 2, 3};
+    c.positions()[2] = {-1, 5, 2};
+    c.enableColors()[1] = Rgb8{10, 20, 30};
+    c.enableNormals()[2] = {0, 0, 1};
+    ScalarField& f = c.addField("intensity");
+    f.values() = {1.0f, std::nanf(""), 3.0f};
+    return c;
+}
+
+} // namespace
+
+TEST(PointCloud, GlobalCoordinatesKeepMillimetresWithAnOrigin)
+{
+    PointCloud c;
+    c.setOrigin({512000.0, 5423000.0, 0.0});
+    c.resize(1);
+    c.positions()[0] = {345.678f, 456.789f, 123.456f};
+    const Eigen::Vector3d g = c.globalPosition(0);
+    EXPECT_NEAR(g.x(), 512345.678, 1e-4);
+    EXPECT_NEAR(g.y(), 5423456.789, 1e-4);
+    c.shiftOrigin({512300.0, 5423400.0, 100.0});
+    EXPECT_NEAR(c.globalPosition(0).x(), 512345.678, 1e-4);
+    EXPECT_NEAR(c.globalPosition(0).z(), 123.456, 1e-4);
+}
+
+TEST(PointCloud, SuggestedOriginForGeoreferencedBounds)
+{
+    BoundingBox local;
+    local.min = {-10, -10, 0};
+    local.max = {100, 100, 5};
+    local.empty = false;
+    EXPECT_TRUE(suggestOrigin(local).isZero());
+    BoundingBox utm;
+    utm.min = {512345.6, 5423456.7, 80};
+    utm.max = {513000, 5424000, 120};
+    utm.empty = false;
+    EXPECT_EQ(suggestOrigin(utm), Eigen::Vector3d(512000, 5423000, 0));
+}
+
+TEST(PointCloud, BoundsIgnoreNonFinitePoints)
+{
+    PointCloud c = threePoints();
+    c.positions()[0] = {std::nanf(""), 0, 0};
+    const BoundingBox b = c.bounds();
+    ASSERT_FALSE(b.empty);
+    EXPECT_EQ(b.min, Eigen::Vector3d(-1, 2, 2));
+    EXPECT_EQ(b.max, Eigen::Vector3d(1, 5, 3));
+    EXPECT_TRUE(PointCloud().bounds().empty);
+}
+
+TEST(PointCloud, RemoveNonFinitePointsKeepsAttributesAligned)
+{
+    PointCloud c = threePoints();
+    c.positions()[1] = {INFINITY, 0, 0};
+    EXPECT_EQ(c.removeNonFinitePoints(), 1u);
+    ASSERT_EQ(c.size(), 2u);
+    EXPECT_EQ(c.positions()[1], Eigen::Vector3f(-1, 5, 2));
+    EXPECT_EQ(c.normals()[1], Eigen::Vector3f(0, 0, 1));
+    EXPECT_EQ(c.field("intensity")->values()[1], 3.0f);
+    EXPECT_EQ(c.colors().size(), 2u);
+    c.checkConsistency();
+}
+
+TEST(PointCloud, SubsetAndCloneCopyEverything)
+{
+    const PointCloud c = threePoints();
+    const PointCloud s = c.subset({2, 1});
+    ASSERT_EQ(s.size(), 2u);
+    EXPECT_EQ(s.positions()[0], c.positions()[2]);
+    EXPECT_EQ(s.colors()[1], (Rgb8{10, 20, 30}));
+    EXPECT_EQ(s.normals()[0], Eigen::Vector3f(0, 0, 1));
+    EXPECT_TRUE(std::isnan(s.field("intensity")->values()[1]));
+    EXPECT_THROW(c.subset({3}), Error);
+    const PointCloud copy = c.clone();
+    EXPECT_EQ(copy.positions(), c.positions());
+    EXPECT_EQ(copy.fields().size(), 1u);
+}
+
+TEST(PointCloud, FieldsByName)
+{
+    PointCloud c = threePoints();
+    EXPECT_EQ(c.field("missing"), nullptr);
+    ScalarField& d = c.addField("distance");
+    EXPECT_EQ(d.size(), 3u);
+    EXPECT_TRUE(std::isnan(d.values()[0]));
+    EXPECT_EQ(&c.addField("distance"), c.field("distance"));
+    EXPECT_THROW(c.addField(ScalarField("wrong", 2)), Error);
+    EXPECT_TRUE(c.removeField("distance"));
+    EXPECT_FALSE(c.removeField("distance"));
+    c.resize(5);
+    EXPECT_EQ(c.field("intensity")->size(), 5u);
+    EXPECT_EQ(c.colors().size(), 5u);
+}
+
+TEST(ScalarField, RangeWithOffsetKeepsLargeValuesPrecise)
+{
+    ScalarField gps("gps_time", 3);
+    gps.setOffset(1.2e9);
+    gps.setValue(0, 1.2e9 + 0.25);
+    gps.setValue(2, 1.2e9 + 10.5);
+    const ValueRange r = gps.range();
+    EXPECT_EQ(r.validCount, 2u);
+    EXPECT_DOUBLE_EQ(r.min, 1.2e9 + 0.25);
+    EXPECT_DOUBLE_EQ(r.max, 1.2e9 + 10.5);
+    EXPECT_TRUE(std::isnan(ScalarField("empty", 4).range().min));
+}
+
+TEST(Mesh, ConsistencyAndDegenerateTriangles)
+{
+    Mesh m;
+    m.vertices.resize(4);
+    m.vertices.positions() = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {2, 0, 0}};
+    m.triangles = {{0, 1, 2}, {0, 0, 1}, {0, 1, 3}};
+    EXPECT_EQ(m.countDegenerateTriangles(), 2u); // a repeated vertex, and three collinear ones
+    m.checkConsistency();
+    m.triangles.push_back({0, 1, 9});
+    EXPECT_THROW(m.checkConsistency(), Error);
+}

@@ -1,0 +1,248 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/octree/Octree.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+using namespace scandiff::octree;
+
+namespace {
+
+using Cloud = std::vector<Eigen::Vector3f>;
+
+std::vector<Neighbour> bruteForceNearest(const Cloud& cloud, const Eigen::Vector3f& q, std::size_t k)
+{
+    std::vector<Neighbour> all;
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        all.push_back({static_cast<std::uint32_t>(i), (cloud[i] - q).squaredNorm()});
+    std::sort(all.begin(), all.end());
+    all.resize(std::min(k, all.size()));
+    return all;
+}
+
+std::vector<Neighbour> bruteForceRadius(const Cloud& cloud, const Eigen::Vector3f& q, float r)
+{
+    std::vector<Neighbour> all;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const float d2 = (cloud[i] - q).squaredNorm();
+        if (d2 <= r * r)
+            all.push_back({static_cast<std::uint32_t>(i), d2});
+    }
+    std::sort(all.begin(), all.end());
+    return all;
+}
+
+Cloud randomCloud(std::size_t n, std::mt19937& rng)
+{
+    std::uniform_real_distribution<float> u(-5.0f, 5.0f);
+    Cloud c(n);
+    for (auto& p : c)
+        p = {u(rng), u(rng), u(rng)};
+    return c;
+}
+
+Cloud clusteredCloud(std::size_t n, std::mt19937& rng)
+{
+    std::normal_distribution<float> g(0.0f, 0.05f);
+    std::uniform_real_distribution<float> u(-10.0f, 10.0f);
+    Cloud centres(5);
+    for (auto& c : centres)
+        c = {u(rng), u(rng), u(rng)};
+    Cloud c(n);
+    for (std::size_t i = 0; i < n; ++i)
+        c[i] = centres[i % centres.size()] + Eigen::Vector3f(g(rng), g(rng), g(rng));
+    return c;
+}
+
+Cloud planarCloud(std::size_t n, std::mt19937& rng)
+{
+    std::uniform_real_distribution<float> u(0.0f, 3.0f);
+    Cloud c(n);
+    for (auto& p : c)
+        p = {u(rng), u(rng), 1.5f};
+    return c;
+}
+
+Cloud duplicateCloud(std::size_t n, std::mt19937& rng)
+{
+    Cloud base = randomCloud(n / 4, rng);
+    Cloud c;
+    for (int copy = 0; copy < 4; ++copy)
+        c.insert(c.end(), base.begin(), base.end());
+    return c;
+}
+
+void expectSame(const std::vector<Neighbour>& got, const std::vector<Neighbour>& expected, const std::string& where)
+{
+    ASSERT_EQ(got.size(), expected.size()) << where;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+        EXPECT_EQ(got[i].index, expected[i].index) << where << " rank " << i;
+        EXPECT_EQ(got[i].squaredDistance, expected[i].squaredDistance) << where << " rank " << i;
+    }
+}
+
+struct Shape
+{
+    const char* name;
+    Cloud (*make)(std::size_t, std::mt19937&);
+};
+
+const Shape kShapes[] = {{"random", randomCloud}, {"clustered", clusteredCloud}, {"planar", planarCloud}, {"duplicates", duplicateCloud}};
+
+} // namespace
+
+TEST(Octree, NearestEqualsBruteForceOnEveryShapeAndLevel)
+{
+    std::mt19937 rng(7);
+    for (const Shape& shape : kShapes) {
+        const Cloud cloud = shape.make(800, rng);
+        const Octree tree(cloud.data(), cloud.size());
+        const Cloud queries = randomCloud(40, rng);
+        for (int level = 1; level <= kMaxLevel; level += (level < 10 ? 1 : 5)) {
+            for (std::size_t k : {1u, 5u, 17u}) {
+                std::vector<Neighbour> got;
+                for (std::size_t qi = 0; qi < queries.size(); ++qi) {
+                    // Queries both off the cloud and on its own points.
+                    for (const Eigen::Vector3f& q : {queries[qi], cloud[qi * 7]}) {
+                        tree.nearest(q, k, level, got);
+                        expectSame(got, bruteForceNearest(cloud, q, k),
+                                   std::string(shape.name) + " level " + std::to_string(level) + " k " + std::to_string(k));
+                    }
+                }
+            }
+        }
+    }
+}
+
+TEST(Octree, RadiusEqualsBruteForceOnEveryShapeAndLevel)
+{
+    std::mt19937 rng(11);
+    for (const Shape& shape : kShapes) {
+        const Cloud cloud = shape.make(600, rng);
+        const Octree tree(cloud.data(), cloud.size());
+        const Cloud queries = randomCloud(30, rng);
+        for (int level = 1; level <= 12; ++level) {
+            for (float r : {0.05f, 0.7f, 3.0f}) {
+                std::vector<Neighbour> got;
+                for (const auto& q : queries) {
+                    tree.withinRadius(q, r, level, got);
+                    expectSame(got, bruteForceRadius(cloud, q, r), std::string(shape.name) + " level " + std::to_string(level));
+                }
+            }
+        }
+    }
+}
+
+TEST(Octree, SinglePointCloud)
+{
+    const Cloud cloud = {{1.0f, 2.0f, 3.0f}};
+    const Octree tree(cloud.data(), cloud.size());
+    std::vector<Neighbour> got;
+    for (int level = 1; level <= kMaxLevel; ++level) {
+        tree.nearest({10.0f, -4.0f, 0.0f}, 3, level, got);
+        ASSERT_EQ(got.size(), 1u);
+        EXPECT_EQ(got[0].index, 0u);
+        EXPECT_FLOAT_EQ(got[0].squaredDistance, 81.0f + 36.0f + 9.0f);
+    }
+}
+
+TEST(Octree, QueriesFarOutsideTheCubeAreExact)
+{
+    std::mt19937 rng(3);
+    const Cloud cloud = randomCloud(300, rng);
+    const Octree tree(cloud.data(), cloud.size());
+    std::vector<Neighbour> got;
+    for (const Eigen::Vector3f& q : {Eigen::Vector3f(100, 0, 0), Eigen::Vector3f(-50, 60, 7), Eigen::Vector3f(0, 0, -1e4f)}) {
+        tree.nearest(q, 4, 8, got);
+        expectSame(got, bruteForceNearest(cloud, q, 4), "far query");
+    }
+}
+
+TEST(Octree, CellsAreContiguousAndStatisticsAgree)
+{
+    std::mt19937 rng(5);
+    const Cloud cloud = clusteredCloud(2000, rng);
+    const Octree tree(cloud.data(), cloud.size());
+    const auto& codes = tree.sortedCodes();
+    ASSERT_TRUE(std::is_sorted(codes.begin(), codes.end()));
+    for (int level = 1; level <= kMaxLevel; ++level) {
+        std::size_t cells = 0, largest = 0;
+        std::size_t i = 0;
+        while (i < codes.size()) {
+            const MortonCode cell = cellCodeAtLevel(codes[i], level);
+            const auto [first, last] = tree.cellRange(cell, level);
+            EXPECT_EQ(first, i);
+            std::size_t j = i;
+            while (j < codes.size() && cellCodeAtLevel(codes[j], level) == cell)
+                ++j;
+            EXPECT_EQ(last, j);
+            largest = std::max(largest, j - i);
+            ++cells;
+            i = j;
+        }
+        EXPECT_EQ(tree.levelStatistics(level).nonEmptyCells, cells) << "level " << level;
+        EXPECT_EQ(tree.levelStatistics(level).maxPointsPerCell, largest) << "level " << level;
+        EXPECT_DOUBLE_EQ(tree.levelStatistics(level).meanPointsPerCell, 2000.0 / static_cast<double>(cells));
+    }
+}
+
+TEST(Octree, EveryPointLiesInItsCell)
+{
+    std::mt19937 rng(9);
+    const Cloud cloud = randomCloud(500, rng);
+    const Octree tree(cloud.data(), cloud.size());
+    const int level = 6;
+    const double l = tree.cellSize(level);
+    for (std::size_t s = 0; s < tree.size(); ++s) {
+        const CellCoordinates c = decodeCell(cellCodeAtLevel(tree.sortedCodes()[s], level));
+        const Eigen::Vector3f& p = cloud[tree.sortedIndices()[s]];
+        const std::uint32_t coords[3] = {c.x, c.y, c.z};
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_GE(p[a], tree.box().min[a] + coords[a] * l - 1e-9);
+            EXPECT_LE(p[a], tree.box().min[a] + (coords[a] + 1) * l + 1e-9);
+        }
+    }
+}
+
+TEST(Octree, SharedCubeGivesHomologousCodes)
+{
+    const Cloud a = {{0, 0, 0}, {1, 1, 1}};
+    const Cloud b = {{0.001f, 0.001f, 0.001f}, {4, 4, 4}};
+    const CubicBox both = CubicBox::enclosingBoth(CubicBox::enclosing(a.data(), a.size()), CubicBox::enclosing(b.data(), b.size()));
+    const Octree ta(a.data(), a.size(), both), tb(b.data(), b.size(), both);
+    // The two points near the origin share their cell down to a deep level.
+    EXPECT_EQ(cellCodeAtLevel(ta.sortedCodes()[0], 10), cellCodeAtLevel(tb.sortedCodes()[0], 10));
+}
+
+TEST(Octree, RejectsEmptyNonFiniteAndOutsidePoints)
+{
+    const Cloud empty;
+    EXPECT_THROW(Octree(empty.data(), 0), std::invalid_argument);
+    const Cloud withNan = {{0, 0, 0}, {std::nanf(""), 1, 1}};
+    try {
+        Octree tree(withNan.data(), withNan.size());
+        FAIL() << "NaN accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("point 1"), std::string::npos);
+    }
+    const Cloud withInf = {{0, 0, 0}, {INFINITY, 1, 1}};
+    EXPECT_THROW(Octree(withInf.data(), withInf.size()), std::invalid_argument);
+    const Cloud far = {{0, 0, 0}, {10, 10, 10}};
+    CubicBox small;
+    small.size = 1.0;
+    EXPECT_THROW(Octree(far.data(), far.size(), small), std::invalid_argument);
+}
+
+TEST(Octree, LevelRuleOfIsprs2005)
+{
+    std::mt19937 rng(1);
+    const Cloud cloud = randomCloud(4096, rng);
+    const Octree tree(cloud.data(), cloud.size());
+    const int level = tree.levelForMeanPopulation(10.0);
+    EXPECT_LE(tree.levelStatistics(level).meanPointsPerCell, 10.0);
+    EXPECT_GT(tree.levelStatistics(level - 1).meanPointsPerCell, 10.0);
+}

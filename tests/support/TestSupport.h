@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Helpers shared by the test suites: data paths (configured by CMake), a
+//! per-test temporary folder, and small file utilities.
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#ifndef SCANDIFF_TEST_DATA_DIR
+#error "SCANDIFF_TEST_DATA_DIR must be defined by CMake"
+#endif
+
+namespace scandiff::test {
+
+//! A file of tests/data.
+inline std::filesystem::path dataPath(const std::string& name)
+{
+    return std::filesystem::path(SCANDIFF_TEST_DATA_DIR) / name;
+}
+
+//! A fresh folder for the current test, removed at the start of the next run.
+inline std::filesystem::path tempDir()
+{
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = info ? std::string(info->test_suite_name()) + "_" + info->name() : "scandiff";
+    for (char& c : name)
+        if (c == '/')
+            c = '_';
+    const auto dir = std::filesystem::temp_directory_path() / "scandiff-tests" / name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+inline void writeText(const std::filesystem::path& path, const std::string& text)
+{
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+}
+
+inline std::string readBytes(const std::filesystem::path& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+} // namespace scandiff::test
