@@ -36,7 +36,12 @@ Entity readWithAssimp(const fs::path& path, const ReadOptions& options)
     Assimp::Importer importer;
     // Triangulate polygons, merge the per-face vertices of STL, keep everything
     // else as stored (no normals invented, no vertices reordered beyond merging).
-    const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+    unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices;
+    // STL stores one normal per facet; copied to the corners they would keep
+    // every shared vertex apart, so they are dropped before merging.
+    if (lowerExtension(path) == "stl")
+        flags |= aiProcess_DropNormals;
+    const aiScene* scene = importer.ReadFile(path.string(), flags);
     if (!scene || !scene->mRootNode)
         throw Error(ErrorCode::InvalidData, path.string() + ": cannot read mesh: " + importer.GetErrorString());
 

@@ -21,6 +21,8 @@
 #include <pcl/io/pcd_io.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <cstring>
 
 namespace {
@@ -48,8 +50,112 @@ double fieldValue(const std::uint8_t* p, std::uint8_t datatype, bool bigEndian)
     }
 }
 
+//! PCL's reader trusts the header: an empty file or one without FIELDS makes it
+//! crash (PCL 1.13). So the header is checked here first, and the data size
+//! against it, before PCL sees the file.
+void checkPcdHeader(const fs::path& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+        throw Error(ErrorCode::Io, path.string() + ": cannot open");
+    in.seekg(0, std::ios::end);
+    const auto fileSize = static_cast<std::uint64_t>(in.tellg());
+    in.seekg(0);
+    auto fail = [&](const std::string& why) { throw Error(ErrorCode::InvalidData, path.string() + ": not a valid PCD file: " + why); };
+    if (fileSize == 0)
+        fail("the file is empty");
+    std::vector<std::string> fields;
+    std::vector<std::uint64_t> sizes, counts;
+    std::uint64_t width = 0, height = 0, points = 0;
+    bool haveWidth = false, haveHeight = false, havePoints = false;
+    std::string data;
+    std::string line;
+    int lineNumber = 0;
+    while (data.empty() && std::getline(in, line)) {
+        ++lineNumber;
+        if (lineNumber > 64)
+            fail("no DATA line in the first 64 lines");
+        if (!line.empty() && line.back() == '\r')
+            line.pop_back();
+        if (line.empty() || line[0] == '#')
+            continue;
+        std::istringstream words(line);
+        std::string key;
+        words >> key;
+        auto numbers = [&](std::vector<std::uint64_t>& into) {
+            std::string w;
+            while (words >> w) {
+                try {
+                    into.push_back(std::stoull(w));
+                } catch (const std::exception&) {
+                    fail("line " + std::to_string(lineNumber) + ": '" + w + "' is not a number");
+                }
+            }
+        };
+        auto one = [&](std::uint64_t& into, bool& flag) {
+            std::vector<std::uint64_t> v;
+            numbers(v);
+            if (v.size() != 1)
+                fail("line " + std::to_string(lineNumber) + ": " + key + " needs one number");
+            into = v[0];
+            flag = true;
+        };
+        if (key == "VERSION" || key == "VIEWPOINT" || key == "TYPE")
+            continue;
+        if (key == "FIELDS") {
+            std::string w;
+            while (words >> w)
+                fields.push_back(w);
+        } else if (key == "SIZE")
+            numbers(sizes);
+        else if (key == "COUNT")
+            numbers(counts);
+        else if (key == "WIDTH")
+            one(width, haveWidth);
+        else if (key == "HEIGHT")
+            one(height, haveHeight);
+        else if (key == "POINTS")
+            one(points, havePoints);
+        else if (key == "DATA")
+            words >> data;
+        else
+            fail("line " + std::to_string(lineNumber) + ": unknown header keyword '" + key.substr(0, 32) + "'");
+    }
+    if (data.empty())
+        fail("the header has no DATA line");
+    if (fields.empty() || sizes.size() != fields.size() || (!counts.empty() && counts.size() != fields.size()))
+        fail("FIELDS, SIZE and COUNT do not describe the same fields");
+    if (!haveWidth || !haveHeight || !havePoints || width * height != points)
+        fail("WIDTH x HEIGHT must equal POINTS");
+    std::uint64_t pointStep = 0;
+    for (std::size_t f = 0; f < fields.size(); ++f) {
+        if (sizes[f] != 1 && sizes[f] != 2 && sizes[f] != 4 && sizes[f] != 8)
+            fail("field '" + fields[f] + "' has size " + std::to_string(sizes[f]));
+        pointStep += sizes[f] * (counts.empty() ? 1 : counts[f]);
+    }
+    const auto headerEnd = static_cast<std::uint64_t>(in.tellg());
+    const std::uint64_t remaining = fileSize >= headerEnd ? fileSize - headerEnd : 0;
+    if (data == "binary") {
+        if (remaining < points * pointStep)
+            fail("truncated: " + std::to_string(points) + " points need " + std::to_string(points * pointStep) +
+                 " bytes of data, the file has " + std::to_string(remaining));
+    } else if (data == "binary_compressed") {
+        std::uint32_t sizesOfBlock[2] = {0, 0};
+        if (remaining < 8 || !in.read(reinterpret_cast<char*>(sizesOfBlock), 8))
+            fail("truncated compressed data");
+        if (sizesOfBlock[0] > remaining - 8)
+            fail("truncated: the compressed block is " + std::to_string(sizesOfBlock[0]) + " bytes, the file has " +
+                 std::to_string(remaining - 8));
+        if (sizesOfBlock[1] != points * pointStep)
+            fail("the uncompressed size disagrees with POINTS");
+    } else if (data != "ascii") {
+        fail("unknown DATA encoding '" + data.substr(0, 32) + "'");
+    }
+}
+
 io::Entity readPcd(const fs::path& path, const io::ReadOptions& options)
 {
+    checkPcdHeader(path);
     ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), 2);
     pcl::PCLPointCloud2 blob;
     Eigen::Vector4f viewOrigin;
