@@ -678,6 +678,7 @@ Entity readLas(const fs::path& path, const ReadOptions& options)
     for (std::size_t begin = 0; begin < count; begin += kChunkPoints) {
         const std::size_t end = std::min(count, begin + kChunkPoints);
         colorBits |= decode(records, h.recordLength, begin, end, transform, out);
+        MappedFile::releaseConsumed(records + begin * h.recordLength, records + end * h.recordLength);
         ticker.step(end - begin);
     }
 
@@ -696,6 +697,21 @@ Entity readLas(const fs::path& path, const ReadOptions& options)
         decodeExtra(records, h.recordLength, count, extras[d], *cloud.field(extraNames[d]));
         ticker.step(count);
     }
+
+    // A standard attribute that is 0 for every point (user_data, scanner_channel,
+    // flags... in most files) carries nothing: dropping it saves 4 bytes per point
+    // each, and writing LAS again puts 0 in its slot all the same. Extra Bytes
+    // are the user's own dimensions and always kept.
+    std::vector<std::string> emptyStandardFields;
+    for (const ScalarField& f : cloud.fields()) {
+        if (std::find(extraNames.begin(), extraNames.end(), f.name()) != extraNames.end())
+            continue;
+        const ValueRange r = f.range();
+        if (r.validCount == f.size() && r.min == 0.0 && r.max == 0.0)
+            emptyStandardFields.push_back(f.name());
+    }
+    for (const std::string& name : emptyStandardFields)
+        cloud.removeField(name);
 
     const std::size_t dropped = cloud.removeNonFinitePoints();
     if (dropped > 0)

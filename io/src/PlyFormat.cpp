@@ -659,9 +659,11 @@ const char* visitBinaryVertices(const PlyElement& e, const VertexLayout& layout,
         for (std::uint64_t start = 0; start < n; start += kChunk) {
             const std::uint64_t stop = std::min(n, start + kChunk);
             const char* record = ptr + start * recordSize;
+            const char* chunkBegin = record;
             for (std::uint64_t i = start; i < stop; ++i, record += recordSize)
                 for (const Slot* s = slotsBegin; s != slotsEnd; ++s)
                     visit(i, *s, loadDouble<Swap>(record + s->offset, s->type));
+            MappedFile::releaseConsumed(chunkBegin, record);
             ticker.step(stop - start);
         }
         return ptr + n * recordSize;

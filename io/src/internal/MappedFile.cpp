@@ -4,6 +4,7 @@
 #include <scandiff/core/Error.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -35,6 +36,15 @@ MappedFile::MappedFile(const std::filesystem::path& path) : path_(path)
         data_ = static_cast<const char*>(p);
     }
     ::close(fd);
+}
+
+void MappedFile::releaseConsumed(const char* begin, const char* end)
+{
+    static const auto pageSize = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+    const auto first = reinterpret_cast<std::uintptr_t>(begin) & ~(pageSize - 1);
+    const auto last = reinterpret_cast<std::uintptr_t>(end) & ~(pageSize - 1);
+    if (last > first)
+        ::madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
 }
 
 MappedFile::~MappedFile()
