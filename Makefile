@@ -4,7 +4,7 @@
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc)
-DEMO_FILES ?= data/pcl-data/region_growing_tutorial.pcd
+DEMO_FILES ?= data/pcl-data/samp11-utm.pcd
 
 .PHONY: all deps configure build run test bench clean
 
