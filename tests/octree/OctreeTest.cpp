@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 #include <stdexcept>
 
 using namespace scandiff::octree;
@@ -245,4 +246,132 @@ TEST(Octree, LevelRuleOfIsprs2005)
     const int level = tree.levelForMeanPopulation(10.0);
     EXPECT_LE(tree.levelStatistics(level).meanPointsPerCell, 10.0);
     EXPECT_GT(tree.levelStatistics(level - 1).meanPointsPerCell, 10.0);
+}
+
+TEST(Octree, BatchNearestEqualsBruteForceAtEveryLevel)
+{
+    std::mt19937 rng(17);
+    for (const Shape& shape : kShapes) {
+        const Cloud cloud = shape.make(700, rng);
+        const Octree tree(cloud.data(), cloud.size());
+        Cloud queries = randomCloud(150, rng);
+        queries.insert(queries.end(), cloud.begin(), cloud.begin() + 150); // on the cloud, and duplicates
+        queries.push_back({1e3f, 0, 0});                                      // far outside the cube
+        for (int level = 1; level <= kMaxLevel; ++level) {
+            for (std::size_t k : {1u, 6u}) {
+                std::vector<Neighbour> got;
+                tree.nearestBatch(queries.data(), queries.size(), k, level, got);
+                ASSERT_EQ(got.size(), queries.size() * k);
+                for (std::size_t qi = 0; qi < queries.size(); ++qi) {
+                    const auto expected = bruteForceNearest(cloud, queries[qi], k);
+                    const std::vector<Neighbour> mine(got.begin() + static_cast<std::ptrdiff_t>(qi * k),
+                                                      got.begin() + static_cast<std::ptrdiff_t>((qi + 1) * k));
+                    expectSame(mine, expected, std::string(shape.name) + " level " + std::to_string(level) + " k " +
+                                                   std::to_string(k) + " query " + std::to_string(qi));
+                }
+            }
+        }
+    }
+}
+
+TEST(Octree, BatchPadsMissingNeighboursAndSkipsNaNQueries)
+{
+    const Cloud cloud = {{0, 0, 0}, {1, 0, 0}};
+    const Octree tree(cloud.data(), cloud.size());
+    const Cloud queries = {{0.2f, 0, 0}, {std::nanf(""), 0, 0}};
+    std::vector<Neighbour> got;
+    tree.nearestBatch(queries.data(), queries.size(), 3, 4, got);
+    ASSERT_EQ(got.size(), 6u);
+    EXPECT_EQ(got[0].index, 0u);
+    EXPECT_EQ(got[1].index, 1u);
+    EXPECT_EQ(got[2].index, std::numeric_limits<std::uint32_t>::max());
+    EXPECT_TRUE(std::isinf(got[2].squaredDistance));
+    for (int r = 3; r < 6; ++r)
+        EXPECT_EQ(got[static_cast<std::size_t>(r)].index, std::numeric_limits<std::uint32_t>::max());
+}
+
+TEST(Octree, EqualCodesKeepTheirIndexOrder)
+{
+    std::mt19937 rng(2);
+    const Cloud cloud = duplicateCloud(4000, rng);
+    const Octree tree(cloud.data(), cloud.size());
+    for (std::size_t i = 1; i < tree.size(); ++i) {
+        if (tree.sortedCodes()[i] == tree.sortedCodes()[i - 1]) {
+            EXPECT_LT(tree.sortedIndices()[i - 1], tree.sortedIndices()[i]);
+        }
+    }
+    std::vector<std::uint32_t> all(tree.sortedIndices());
+    std::sort(all.begin(), all.end());
+    for (std::size_t i = 0; i < all.size(); ++i)
+        ASSERT_EQ(all[i], i);
+}
+
+TEST(Octree, NeighbourCellsMatchDecodeAndEncode)
+{
+    std::mt19937 rng(23);
+    const Cloud cloud = randomCloud(3000, rng);
+    const Octree tree(cloud.data(), cloud.size());
+    for (int level : {1, 3, 5}) {
+        std::set<MortonCode> existing;
+        tree.forEachCell(level, [&](MortonCode cell, std::size_t first, std::size_t last) {
+            EXPECT_LT(first, last);
+            existing.insert(cell);
+        });
+        EXPECT_EQ(existing.size(), tree.levelStatistics(level).nonEmptyCells);
+        for (const MortonCode cell : existing) {
+            const CellCoordinates c = decodeCell(cell);
+            for (const auto connectivity : {Connectivity::Faces6, Connectivity::Edges18, Connectivity::Corners26}) {
+                std::vector<MortonCode> expected;
+                for (const MortonCode other : existing) {
+                    const CellCoordinates o = decodeCell(other);
+                    const long dx = std::labs(long(o.x) - long(c.x)), dy = std::labs(long(o.y) - long(c.y)),
+                               dz = std::labs(long(o.z) - long(c.z));
+                    if (std::max({dx, dy, dz}) != 1)
+                        continue;
+                    const long nonZero = (dx != 0) + (dy != 0) + (dz != 0);
+                    if (nonZero <= static_cast<long>(connectivity == Connectivity::Faces6 ? 1 : connectivity == Connectivity::Edges18 ? 2 : 3))
+                        expected.push_back(other);
+                }
+                EXPECT_EQ(tree.neighbourCells(cell, level, connectivity), expected) << "level " << level;
+            }
+        }
+    }
+}
+
+TEST(Octree, BestLevelIsNearTheCheapestMeasuredLevel)
+{
+    // The thesis's setting (§4.5, Fig. 4.4) scaled down: two samplings of the
+    // same surface, k = 1. "Cheapest" is measured with the work counters of the
+    // batch query (a deterministic stand-in for time; wall times are in
+    // docs/benchmarks.md).
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<float> u(0.0f, 10.0f);
+    auto surface = [&](std::size_t count) {
+        Cloud c(count);
+        for (auto& p : c) {
+            const float x = u(rng), y = u(rng);
+            p = {x, y, std::sin(x) * std::cos(y)};
+        }
+        return c;
+    };
+    const Cloud reference = surface(60000), compared = surface(60000);
+    const CubicBox cube = CubicBox::enclosingBoth(CubicBox::enclosing(reference.data(), reference.size()),
+                                                  CubicBox::enclosing(compared.data(), compared.size()));
+    const Octree referenceTree(reference.data(), reference.size(), cube);
+    const Octree comparedTree(compared.data(), compared.size(), cube);
+    const int chosen = referenceTree.bestLevelFor(comparedTree, 1);
+    double cheapestCost = std::numeric_limits<double>::infinity();
+    int cheapest = 0;
+    std::vector<Neighbour> out;
+    for (int level = 1; level <= 12; ++level) {
+        QueryStatistics work;
+        referenceTree.nearestBatch(compared.data(), compared.size(), 1, level, out, &work);
+        const double cost = static_cast<double>(work.distances) + 20.0 * static_cast<double>(work.cellLookups) +
+                            1000.0 * static_cast<double>(work.fullSearches);
+        if (cost < cheapestCost) {
+            cheapestCost = cost;
+            cheapest = level;
+        }
+    }
+    EXPECT_LE(std::abs(chosen - cheapest), 2) << "chosen " << chosen << ", cheapest " << cheapest;
 }

@@ -52,6 +52,17 @@ struct Neighbour
     }
 };
 
+//! Cell adjacency: faces (6), faces and edges (18), faces, edges and corners (26).
+enum class Connectivity { Faces6 = 6, Edges18 = 18, Corners26 = 26 };
+
+//! Work counters of batch queries, for the level heuristic's tests and benchmarks.
+struct QueryStatistics
+{
+    std::uint64_t distances = 0;    //!< point distances computed
+    std::uint64_t cellLookups = 0;  //!< binary searches for a cell
+    std::uint64_t fullSearches = 0; //!< queries the cached neighbourhood did not settle
+};
+
 class Octree
 {
 public:
@@ -78,6 +89,43 @@ public:
     void nearest(const Eigen::Vector3f& q, std::size_t k, int level, std::vector<Neighbour>& out) const;
     //! Every point within `radius` of q (distance <= radius), closest first.
     void withinRadius(const Eigen::Vector3f& q, float radius, int level, std::vector<Neighbour>& out) const;
+
+    //! Calls visit(cellCode, first, last) for every non-empty cell of `level`,
+    //! in Morton order; [first, last) is the cell's range in sorted order.
+    template <typename Visit>
+    void forEachCell(int level, Visit&& visit) const
+    {
+        const int shift = 3 * (kMaxLevel - level);
+        std::size_t first = 0;
+        while (first < codes_.size()) {
+            const MortonCode cell = codes_[first] >> shift;
+            std::size_t last = first + 1;
+            while (last < codes_.size() && (codes_[last] >> shift) == cell)
+                ++last;
+            visit(cell, first, last);
+            first = last;
+        }
+    }
+
+    //! Codes of the non-empty cells adjacent to `cellCode` at `level` (the cell
+    //! itself excluded), in increasing order. Cells outside the root cube do not exist.
+    std::vector<MortonCode> neighbourCells(MortonCode cellCode, int level, Connectivity connectivity) const;
+
+    //! The k nearest points of every query, in parallel (TBB) with per-thread
+    //! scratch and no lock. out[i * k + r] is the r-th neighbour of query i;
+    //! missing ones (a cloud smaller than k) are {UINT32_MAX, +inf}. Queries are
+    //! visited in Morton order and grouped by cell: the candidates of a cell's
+    //! 27-neighbourhood are gathered once for all its queries (thesis 000 §4.4,
+    //! "same-cell optimisation"), and a query they do not settle by the
+    //! inscribed-sphere rule gets a full search. Exact at every level.
+    void nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std::size_t k, int level,
+                      std::vector<Neighbour>& out, QueryStatistics* statistics = nullptr) const;
+
+    //! The level of thesis 000 §4.5 (eq. 4.2) for k-nearest queries of the
+    //! points of `queries`, an octree built on the same cube: the level that
+    //! minimises the estimated cost of distances (candidates per query) plus
+    //! cell searches, the cells with no homologue counting as full searches.
+    int bestLevelFor(const Octree& queries, std::size_t k) const;
 
     //! The ISPRS 2005 rule (thesis 000 §4.5): the shallowest level whose mean
     //! number of points per non-empty cell is at most `maxMeanPointsPerCell`.
