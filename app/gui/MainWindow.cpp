@@ -2,6 +2,7 @@
 #include "MainWindow.h"
 
 #include "TaskRunner.h"
+#include "tools/ToolController.h"
 #include "view/CloudView.h"
 
 #include <scandiff/io/FileIO.h>
@@ -35,9 +36,49 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
 
     QMenu* viewMenu = menuBar()->addMenu(tr("&View"));
     viewMenu->addAction(tr("&Reset camera"), view_, &CloudView::resetCamera);
-    viewMenu->addAction(tr("&Clear"), view_, &CloudView::clear);
+    viewMenu->addAction(tr("&Clear"), &document_, &Document::clear);
+
+    connect(&document_, &Document::added, this, &MainWindow::showEntity);
+    connect(&document_, &Document::cleared, view_, &CloudView::clear);
+    buildToolsMenu();
 
     statusBar()->showMessage(tr("Open a cloud or a mesh (File > Open)"));
+}
+
+void MainWindow::buildToolsMenu()
+{
+    QMenu* toolsMenu = menuBar()->addMenu(tr("&Tools"));
+    std::map<std::string, QMenu*> categories;
+    for (const ToolSpec& tool : registry_.tools.tools()) {
+        QMenu*& menu = categories[tool.category];
+        if (!menu)
+            menu = tool.category.empty() ? toolsMenu : toolsMenu->addMenu(QString::fromStdString(tool.category));
+        auto* controller = new ToolController(tool, document_, this);
+        tools_[tool.name] = controller;
+        QAction* action = menu->addAction(QString::fromStdString(tool.title) + "...", controller, &ToolController::runInteractively);
+        action->setStatusTip(QString::fromStdString(tool.description));
+        connect(controller, &ToolController::finished, this, [this](const QString& summary) { statusBar()->showMessage(summary); });
+        connect(controller, &ToolController::failed, this, [this](const QString& message) {
+            statusBar()->showMessage(message);
+            std::cerr << "error: " << message.toStdString() << '\n';
+        });
+    }
+}
+
+ToolController* MainWindow::toolController(const std::string& toolName) const
+{
+    const auto it = tools_.find(toolName);
+    return it == tools_.end() ? nullptr : it->second;
+}
+
+void MainWindow::showEntity(std::size_t index)
+{
+    const Document::Item& item = document_.item(index);
+    if (const auto* mesh = std::get_if<Mesh>(&item.entity))
+        view_->addMesh(*mesh);
+    else
+        view_->addCloud(std::get<PointCloud>(item.entity));
+    view_->resetCamera();
 }
 
 QString MainWindow::fileDialogFilter() const
@@ -81,18 +122,12 @@ int MainWindow::openFiles(const QStringList& paths, bool quiet)
                 QMessageBox::warning(this, tr("Cannot open file"), message);
             continue;
         }
-        std::size_t points = 0;
-        if (auto* mesh = std::get_if<Mesh>(&*entity)) {
-            view_->addMesh(*mesh);
-            points = mesh->vertices.size();
-        } else {
-            view_->addCloud(std::get<PointCloud>(*entity));
-            points = std::get<PointCloud>(*entity).size();
-        }
+        const std::size_t points = std::holds_alternative<Mesh>(*entity) ? std::get<Mesh>(*entity).vertices.size()
+                                                                          : std::get<PointCloud>(*entity).size();
+        document_.add(QFileInfo(path).completeBaseName(), std::move(*entity));
         statusBar()->showMessage(tr("%1: %2 points").arg(QFileInfo(path).fileName()).arg(points));
         ++loaded;
     }
-    view_->resetCamera();
     return loaded;
 }
 

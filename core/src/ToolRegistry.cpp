@@ -5,17 +5,17 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <sstream>
 
 namespace scandiff {
 
 namespace {
 
+//! The shortest text that parses back to the same double.
 std::string formatNumber(double v)
 {
-    std::ostringstream s;
-    s << v;
-    return s.str();
+    char buffer[32];
+    const auto result = std::to_chars(buffer, buffer + sizeof buffer, v);
+    return std::string(buffer, result.ptr);
 }
 
 std::string rangeText(const ParameterSpec& spec)
