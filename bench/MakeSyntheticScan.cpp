@@ -3,6 +3,8 @@
 //! undulating terrain with a wall, georeferenced (UTM-like coordinates), with
 //! colours, intensity, classification and gps_time, like a real LAS/PLY scan.
 //! Usage: scandiff-make-scan POINTS OUTPUT [SEED]
+//!        scandiff-make-scan --mesh N OUTPUT   (the terrain as an N x N vertex grid:
+//!                                              2 (N-1)^2 triangles, 300 -> 178,802)
 
 #include <scandiff/core/Error.h>
 #include <scandiff/io/FileIO.h>
@@ -12,8 +14,49 @@
 #include <random>
 #include <string>
 
+namespace {
+
+float terrainHeight(float x, float y)
+{
+    return 2.0f * std::sin(x * 0.05f) * std::cos(y * 0.03f);
+}
+
+int writeTerrainMesh(int n, const char* output)
+{
+    scandiff::Mesh mesh;
+    mesh.vertices.setOrigin({512000.0, 5423000.0, 100.0});
+    mesh.vertices.resize(static_cast<std::size_t>(n) * static_cast<std::size_t>(n));
+    const float step = 200.0f / static_cast<float>(n - 1);
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const float x = static_cast<float>(i) * step, y = static_cast<float>(j) * step;
+            mesh.vertices.positions()[static_cast<std::size_t>(j * n + i)] = {x, y, terrainHeight(x, y)};
+        }
+    for (int j = 0; j + 1 < n; ++j)
+        for (int i = 0; i + 1 < n; ++i) {
+            const auto a = static_cast<std::uint32_t>(j * n + i), b = a + 1, c = a + static_cast<std::uint32_t>(n), d = c + 1;
+            mesh.triangles.push_back({a, b, d});
+            mesh.triangles.push_back({a, d, c});
+        }
+    scandiff::io::FormatRegistry registry;
+    scandiff::io::registerBuiltinFormats(registry);
+    scandiff::io::writeMesh(registry, mesh, output);
+    std::cout << "wrote " << output << " (" << mesh.triangles.size() << " triangles)\n";
+    return 0;
+}
+
+} // namespace
+
 int main(int argc, char** argv)
 {
+    if (argc == 4 && std::string(argv[1]) == "--mesh") {
+        try {
+            return writeTerrainMesh(std::stoi(argv[2]), argv[3]);
+        } catch (const std::exception& e) {
+            std::cerr << "error: " << e.what() << '\n';
+            return 1;
+        }
+    }
     if (argc < 3) {
         std::cerr << "usage: scandiff-make-scan POINTS OUTPUT [SEED]\n";
         return 2;
@@ -35,7 +78,7 @@ int main(int argc, char** argv)
         for (std::size_t i = 0; i < n; ++i) {
             const float x = u(rng), y = u(rng);
             const bool wall = i % 5 == 0;
-            const float z = wall ? u(rng) * 0.05f : 2.0f * std::sin(x * 0.05f) * std::cos(y * 0.03f);
+            const float z = wall ? u(rng) * 0.05f : terrainHeight(x, y);
             cloud.positions()[i] = {wall ? 100.0f + noise(rng) : x, y, z + noise(rng)};
             colours[i] = {static_cast<std::uint8_t>(x), static_cast<std::uint8_t>(y), static_cast<std::uint8_t>(128 + 50 * z)};
             intensity.values()[i] = static_cast<float>(i % 4096);

@@ -4,6 +4,7 @@
 #include <scandiff/core/Error.h>
 
 #include <csignal>
+#include <iomanip>
 #include <cstdio>
 #include <sstream>
 #include <unistd.h>
@@ -74,6 +75,19 @@ void TerminalProgress::report(double fraction)
 bool TerminalProgress::cancelRequested() const
 {
     return interrupted.load();
+}
+
+void printStatistics(std::ostream& out, const std::string& label, const DistanceStatistics& s)
+{
+    const auto flags = out.flags();
+    const auto precision = out.precision();
+    out << label << ": " << s.count << " values";
+    if (s.count > 0)
+        out << std::setprecision(6) << ", mean " << s.mean << ", std " << s.standardDeviation << ", min " << s.min
+            << ", max " << s.max << ", RMS " << s.rms;
+    out << '\n';
+    out.flags(flags);
+    out.precision(precision);
 }
 
 void ReadFlags::addTo(CLI::App& command)

@@ -3,6 +3,7 @@
 //! Pieces shared by the commands of scandiff-cli.
 
 #include <scandiff/core/Progress.h>
+#include <scandiff/core/distance/DistanceStatistics.h>
 #include <scandiff/io/FileIO.h>
 
 #include <CLI/CLI.hpp>
@@ -49,5 +50,8 @@ struct WriteFlags
     void addTo(CLI::App& command);
     io::WriteOptions toOptions(ProgressObserver* progress) const;
 };
+
+//! "label: N values, mean ..., std ..., min ..., max ..., RMS ..." on one line.
+void printStatistics(std::ostream& out, const std::string& label, const DistanceStatistics& statistics);
 
 } // namespace scandiff::cli

@@ -21,6 +21,10 @@ struct Streams
 
 void addInfoCommand(CLI::App& app, const PluginRegistry& registry, Streams streams);
 void addConvertCommand(CLI::App& app, const PluginRegistry& registry, Streams streams);
+//! `c2c`: cloud-to-cloud distances (CloudToCloudCommand.cpp).
+void addCloudToCloudCommand(CLI::App& app, const PluginRegistry& registry, Streams streams);
+//! `c2m`: cloud-to-mesh distances (CloudToMeshCommand.cpp).
+void addCloudToMeshCommand(CLI::App& app, const PluginRegistry& registry, Streams streams);
 //! `formats`, `tools`, and one subcommand per registered tool.
 void addToolCommands(CLI::App& app, const PluginRegistry& registry, Streams streams);
 

@@ -101,6 +101,8 @@ int runCli(int argc, const char* const* argv, const PluginRegistry& registry, St
     app.set_version_flag("--version", "scandiff 0.1.0");
     addInfoCommand(app, registry, streams);
     addConvertCommand(app, registry, streams);
+    addCloudToCloudCommand(app, registry, streams);
+    addCloudToMeshCommand(app, registry, streams);
     addToolCommands(app, registry, streams);
     try {
         app.parse(argc, argv);

@@ -1,0 +1,194 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "LocalModels.h"
+
+#include <scandiff/core/geometry/PointTriangleDistance.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+
+namespace scandiff::detail {
+
+namespace {
+
+struct PlaneFrame
+{
+    Eigen::Vector3d centroid;
+    Eigen::Vector3d u, v, normal;
+};
+
+//! Least-squares plane through the points; false if they are (nearly) collinear.
+bool fitPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& orientation, PlaneFrame& frame)
+{
+    if (points.size() < 3)
+        return false;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const auto& p : points)
+        centroid += p;
+    centroid /= static_cast<double>(points.size());
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (const auto& p : points) {
+        const Eigen::Vector3d d = p - centroid;
+        covariance += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(covariance);
+    const Eigen::Vector3d values = solver.eigenvalues(); // increasing
+    // A line (second eigenvalue ~ 0 relative to the largest) fixes no plane.
+    if (!(values[2] > 0) || values[1] <= 1e-12 * values[2])
+        return false;
+    frame.centroid = centroid;
+    frame.normal = solver.eigenvectors().col(0).normalized();
+    if (frame.normal.dot(orientation) < 0)
+        frame.normal = -frame.normal;
+    frame.u = solver.eigenvectors().col(2).normalized();
+    frame.v = frame.normal.cross(frame.u);
+    return true;
+}
+
+bool quadricDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q, const PlaneFrame& f, double& out)
+{
+    // h = a u^2 + b uv + c v^2 + d u + e v + f0 over the plane, by linear least
+    // squares (the thesis used gradient descent; the closed form is exact).
+    const auto n = static_cast<Eigen::Index>(points.size());
+    if (n < 6)
+        return false;
+    Eigen::MatrixXd A(n, 6);
+    Eigen::VectorXd h(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+        const Eigen::Vector3d d = points[static_cast<std::size_t>(i)] - f.centroid;
+        const double u = d.dot(f.u), v = d.dot(f.v);
+        A.row(i) << u * u, u * v, v * v, u, v, 1.0;
+        h[i] = d.dot(f.normal);
+    }
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+    if (qr.rank() < 6)
+        return false;
+    const Eigen::VectorXd c = qr.solve(h);
+    const Eigen::Vector3d d = q - f.centroid;
+    const double u = d.dot(f.u), v = d.dot(f.v), hq = d.dot(f.normal);
+    const double surface = c[0] * u * u + c[1] * u * v + c[2] * v * v + c[3] * u + c[4] * v + c[5];
+    const double du = 2 * c[0] * u + c[1] * v + c[3], dv = c[1] * u + 2 * c[2] * v + c[4];
+    // Height difference brought to the surface normal (first order).
+    out = (hq - surface) / std::sqrt(1.0 + du * du + dv * dv);
+    return std::isfinite(out);
+}
+
+bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q, const PlaneFrame& f,
+                      double& out, ModelScratch& scratch)
+{
+    scratch.planar.clear();
+    for (const auto& p : points) {
+        const Eigen::Vector3d d = p - f.centroid;
+        scratch.planar.emplace_back(d.dot(f.u), d.dot(f.v));
+    }
+    std::vector<std::array<int, 3>>& triangles = scratch.keep;
+    delaunay2d(scratch.planar, triangles, scratch);
+    if (triangles.empty())
+        return false;
+    double best = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d closest = Eigen::Vector3d::Zero();
+    for (const auto& t : triangles) {
+        const geometry::PointTriangleResult r = geometry::pointTriangleDistance(q, points[static_cast<std::size_t>(t[0])],
+                                                            points[static_cast<std::size_t>(t[1])],
+                                                            points[static_cast<std::size_t>(t[2])]);
+        if (r.squaredDistance < best) {
+            best = r.squaredDistance;
+            closest = r.closestPoint;
+        }
+    }
+    const double side = (q - closest).dot(f.normal);
+    out = std::sqrt(best) * (side < 0 ? -1.0 : 1.0);
+    return true;
+}
+
+} // namespace
+
+void delaunay2d(const std::vector<Eigen::Vector2d>& input, std::vector<std::array<int, 3>>& triangles, ModelScratch& scratch)
+{
+    triangles.clear();
+    const int n = static_cast<int>(input.size());
+    if (n < 3)
+        return;
+    // Work on a copy with three far vertices of a super-triangle appended.
+    std::vector<Eigen::Vector2d>& p = scratch.planar;
+    if (&p != &input)
+        p = input;
+    Eigen::Vector2d lo = p[0], hi = p[0];
+    for (int i = 0; i < n; ++i) {
+        lo = lo.cwiseMin(p[static_cast<std::size_t>(i)]);
+        hi = hi.cwiseMax(p[static_cast<std::size_t>(i)]);
+    }
+    const double span = std::max((hi - lo).maxCoeff(), 1e-12);
+    const Eigen::Vector2d mid = 0.5 * (lo + hi);
+    p.emplace_back(mid.x() - 20 * span, mid.y() - span);
+    p.emplace_back(mid.x(), mid.y() + 20 * span);
+    p.emplace_back(mid.x() + 20 * span, mid.y() - span);
+    std::vector<std::array<int, 3>>& work = scratch.triangles;
+    work.assign(1, {n, n + 1, n + 2});
+    auto inCircumcircle = [&](const std::array<int, 3>& t, const Eigen::Vector2d& d) {
+        const Eigen::Vector2d a = p[static_cast<std::size_t>(t[0])] - d, b = p[static_cast<std::size_t>(t[1])] - d,
+                              c = p[static_cast<std::size_t>(t[2])] - d;
+        const double det = (a.squaredNorm()) * (b.x() * c.y() - c.x() * b.y()) -
+                           (b.squaredNorm()) * (a.x() * c.y() - c.x() * a.y()) +
+                           (c.squaredNorm()) * (a.x() * b.y() - b.x() * a.y());
+        const double orientation = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+        return orientation > 0 ? det > 0 : det < 0;
+    };
+    std::vector<std::array<int, 2>>& edges = scratch.edges;
+    for (int i = 0; i < n; ++i) {
+        const Eigen::Vector2d& d = p[static_cast<std::size_t>(i)];
+        // Coincident points add nothing to a triangulation.
+        bool duplicate = false;
+        for (int j = 0; j < i && !duplicate; ++j)
+            duplicate = (p[static_cast<std::size_t>(j)] - d).squaredNorm() <= 1e-24 * span * span;
+        if (duplicate)
+            continue;
+        edges.clear();
+        std::size_t kept = 0;
+        for (std::size_t t = 0; t < work.size(); ++t) {
+            if (inCircumcircle(work[t], d)) {
+                for (int e = 0; e < 3; ++e)
+                    edges.push_back({work[t][static_cast<std::size_t>(e)], work[t][static_cast<std::size_t>((e + 1) % 3)]});
+            } else {
+                work[kept++] = work[t];
+            }
+        }
+        work.resize(kept);
+        // Edges seen once bound the cavity; re-triangulate it around the new point.
+        for (std::size_t e = 0; e < edges.size(); ++e) {
+            bool shared = false;
+            for (std::size_t f = 0; f < edges.size() && !shared; ++f)
+                shared = f != e && edges[f][0] == edges[e][1] && edges[f][1] == edges[e][0];
+            if (!shared)
+                work.push_back({edges[e][0], edges[e][1], i});
+        }
+    }
+    for (const auto& t : work)
+        if (t[0] < n && t[1] < n && t[2] < n)
+            triangles.push_back(t);
+    p.resize(static_cast<std::size_t>(n));
+}
+
+bool modelDistance(LocalModel model, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q,
+                   const Eigen::Vector3d& orientation, double& signedDistance, ModelScratch& scratch)
+{
+    PlaneFrame frame;
+    if (!fitPlane(points, orientation, frame))
+        return false;
+    switch (model) {
+    case LocalModel::Plane:
+        signedDistance = (q - frame.centroid).dot(frame.normal);
+        return true;
+    case LocalModel::Quadric:
+        return quadricDistance(points, q, frame, signedDistance);
+    case LocalModel::Delaunay:
+        return delaunayDistance(points, q, frame, signedDistance, scratch);
+    case LocalModel::None:
+        break;
+    }
+    return false;
+}
+
+} // namespace scandiff::detail

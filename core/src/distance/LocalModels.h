@@ -1,0 +1,35 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! The local surface models of thesis 000 §2.3.2, fitted on a few reference
+//! points around a nearest neighbour (internal to core/).
+
+#include <scandiff/core/distance/CloudToCloud.h>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <vector>
+
+namespace scandiff::detail {
+
+struct ModelScratch
+{
+    std::vector<Eigen::Vector2d> planar;
+    std::vector<std::array<int, 3>> triangles;
+    std::vector<std::array<int, 3>> keep;
+    std::vector<std::array<int, 2>> edges;
+};
+
+//! Signed distance from q to the model of `points` (positive on the side of the
+//! model normal, oriented to agree with `orientation`). Returns false when the
+//! neighbourhood is too small or degenerate (collinear, coincident) for the model.
+bool modelDistance(LocalModel model, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q,
+                   const Eigen::Vector3d& orientation, double& signedDistance, ModelScratch& scratch);
+
+//! 2D Delaunay triangulation (Bowyer-Watson) of up to a few hundred points, the
+//! size of a local neighbourhood. Written here because core may not use CGAL
+//! (it lives in the GPL plugins), and for so few points a direct O(n^2)
+//! insertion is faster than setting up a general-purpose triangulation.
+void delaunay2d(const std::vector<Eigen::Vector2d>& points, std::vector<std::array<int, 3>>& triangles, ModelScratch& scratch);
+
+} // namespace scandiff::detail

@@ -1,0 +1,323 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/core/Error.h>
+#include <scandiff/core/distance/CloudToCloud.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace scandiff;
+
+namespace {
+
+PointCloud randomCloud(std::size_t n, std::mt19937& rng, float extent = 10.0f, const Eigen::Vector3d& origin = Eigen::Vector3d::Zero())
+{
+    PointCloud c;
+    c.setOrigin(origin);
+    c.resize(n);
+    std::uniform_real_distribution<float> u(0.0f, extent);
+    for (auto& p : c.positions())
+        p = {u(rng), u(rng), u(rng)};
+    return c;
+}
+
+//! Uniform (Poisson) samples of the square [0, side]^2 at height z.
+PointCloud planeSamples(std::size_t n, double side, float z, std::mt19937& rng)
+{
+    PointCloud c;
+    c.resize(n);
+    std::uniform_real_distribution<float> u(0.0f, static_cast<float>(side));
+    for (auto& p : c.positions())
+        p = {u(rng), u(rng), z};
+    return c;
+}
+
+PointCloud sphereSamples(std::size_t n, double radius, std::mt19937& rng)
+{
+    PointCloud c;
+    c.resize(n);
+    std::normal_distribution<double> g(0.0, 1.0);
+    for (auto& p : c.positions()) {
+        Eigen::Vector3d d(g(rng), g(rng), g(rng));
+        p = (d.normalized() * radius).cast<float>();
+    }
+    return c;
+}
+
+double rms(const ScalarField& f)
+{
+    double sum = 0;
+    std::size_t count = 0;
+    for (float v : f.values())
+        if (!std::isnan(v)) {
+            sum += static_cast<double>(v) * v;
+            ++count;
+        }
+    return std::sqrt(sum / static_cast<double>(count));
+}
+
+ErrorCode errorOf(const std::function<void()>& f)
+{
+    try {
+        f();
+    } catch (const Error& e) {
+        return e.code();
+    }
+    return ErrorCode::Internal;
+}
+
+} // namespace
+
+TEST(CloudToCloud, NearestNeighbourEqualsBruteForceAcrossOrigins)
+{
+    std::mt19937 rng(1);
+    const PointCloud reference = randomCloud(3000, rng, 10.0f, {512000, 5423000, 100});
+    PointCloud compared = randomCloud(500, rng, 12.0f, {511999, 5422999, 101});
+    compared.positions()[7] = {std::nanf(""), 0, 0};
+    CloudToCloudParams params;
+    params.splitComponents = true;
+    params.closestPoints = true;
+    for (int level : {0, 2, 5, 9, 14}) {
+        params.octreeLevel = level;
+        const CloudToCloudResult r = cloudToCloud(compared, reference, params);
+        ASSERT_EQ(r.distance.size(), compared.size());
+        EXPECT_TRUE(std::isnan(r.distance.values()[7]));
+        for (std::size_t i = 0; i < compared.size(); ++i) {
+            if (i == 7)
+                continue;
+            const Eigen::Vector3d q = compared.globalPosition(i);
+            double best = std::numeric_limits<double>::infinity();
+            Eigen::Vector3d bestPoint;
+            for (std::size_t j = 0; j < reference.size(); ++j) {
+                const double d = (reference.globalPosition(j) - q).norm();
+                if (d < best) {
+                    best = d;
+                    bestPoint = reference.globalPosition(j);
+                }
+            }
+            ASSERT_NEAR(r.distance.values()[i], best, 2e-5) << "level " << level << " point " << i;
+            EXPECT_NEAR(r.dx->values()[i], q.x() - bestPoint.x(), 2e-5);
+            EXPECT_NEAR(r.dz->values()[i], q.z() - bestPoint.z(), 2e-5);
+        }
+        ASSERT_TRUE(r.closest);
+        EXPECT_EQ(r.closest->size(), compared.size() - 1);
+        EXPECT_EQ(r.statistics.count, compared.size() - 1);
+    }
+}
+
+TEST(CloudToCloud, PlaneOffsetByHWithEveryModel)
+{
+    std::mt19937 rng(2);
+    const PointCloud reference = planeSamples(20000, 1.0, 0.0f, rng);
+    PointCloud compared = planeSamples(2000, 1.0, 0.0f, rng);
+    const float h = 0.05f;
+    for (auto& p : compared.positions())
+        p.z() = h;
+    CloudToCloudParams params;
+    const CloudToCloudResult plain = cloudToCloud(compared, reference, params);
+    for (float v : plain.distance.values())
+        EXPECT_GE(v, h - 1e-6f); // the NN distance can only be larger
+    for (LocalModel model : {LocalModel::Plane, LocalModel::Delaunay, LocalModel::Quadric}) {
+        params.model = model;
+        const CloudToCloudResult r = cloudToCloud(compared, reference, params);
+        for (std::size_t i = 0; i < compared.size(); ++i) {
+            if (model == LocalModel::Delaunay) {
+                // The triangles cover the neighbours of the nearest point; a query
+                // projecting just outside them meets an edge: between h and the NN distance.
+                ASSERT_GE(r.distance.values()[i], h - 1e-6f) << "point " << i;
+                ASSERT_LE(r.distance.values()[i], plain.distance.values()[i] + 1e-6f) << "point " << i;
+            } else {
+                ASSERT_NEAR(r.distance.values()[i], h, 1e-5) << localModelName(model) << " point " << i;
+            }
+        }
+        EXPECT_NEAR(r.statistics.mean, h, 1e-4) << localModelName(model);
+        EXPECT_EQ(r.modelFallbacks, 0u);
+    }
+}
+
+TEST(CloudToCloud, SphereOfRadiusRWithAQuadric)
+{
+    std::mt19937 rng(3);
+    const double r = 2.0, h = 0.1;
+    const PointCloud reference = sphereSamples(60000, r, rng);
+    PointCloud compared = sphereSamples(1000, r + h, rng);
+    CloudToCloudParams params;
+    params.model = LocalModel::Quadric;
+    params.neighbours = 20;
+    const CloudToCloudResult quadric = cloudToCloud(compared, reference, params);
+    params.model = LocalModel::None;
+    const CloudToCloudResult plain = cloudToCloud(compared, reference, params);
+    // The quadric follows the curvature: distances within 2 mm of h; plain NN is
+    // biased upwards by the sampling.
+    for (float v : quadric.distance.values())
+        ASSERT_NEAR(v, h, 2e-3);
+    EXPECT_GT(plain.statistics.mean, quadric.statistics.mean);
+}
+
+TEST(CloudToCloud, SamplingBiasOfTwoSamplingsOfOnePlane)
+{
+    // Thesis 000 §2.3.1, Fig. 2.5: a 100 mm square, N reference points, K = 10,000
+    // queries on the same plane. The NN distance has RMS 1/sqrt(pi * lambda)
+    // (eq. 2.5; lambda = N / area) and mean 1/(2 sqrt(lambda)) (the digest's
+    // corrected Rayleigh mean); a local plane removes the bias.
+    std::mt19937 rng(4);
+    const double side = 0.1;
+    for (std::size_t N : {20000u, 200000u}) {
+        const PointCloud reference = planeSamples(N, side, 0.0f, rng);
+        const PointCloud compared = planeSamples(10000, side, 0.0f, rng);
+        const double lambda = static_cast<double>(N) / (side * side);
+        CloudToCloudParams params;
+        const CloudToCloudResult plain = cloudToCloud(compared, reference, params);
+        EXPECT_NEAR(rms(plain.distance), 1.0 / std::sqrt(M_PI * lambda), 0.03 / std::sqrt(M_PI * lambda)) << "N " << N;
+        EXPECT_NEAR(plain.statistics.mean, 0.5 / std::sqrt(lambda), 0.03 * 0.5 / std::sqrt(lambda)) << "N " << N;
+        params.model = LocalModel::Plane;
+        const CloudToCloudResult modelled = cloudToCloud(compared, reference, params);
+        EXPECT_LT(rms(modelled.distance), 1e-7) << "N " << N;
+    }
+}
+
+TEST(CloudToCloud, MaximumDistanceGivesNaNOrTheMaximum)
+{
+    std::mt19937 rng(5);
+    const PointCloud reference = planeSamples(5000, 1.0, 0.0f, rng);
+    PointCloud compared = planeSamples(100, 1.0, 0.0f, rng);
+    for (std::size_t i = 0; i < compared.size(); ++i)
+        compared.positions()[i].z() = i % 2 ? 0.5f : 0.01f;
+    CloudToCloudParams params;
+    params.model = LocalModel::Plane;
+    params.maxDistance = 0.1;
+    CloudToCloudResult r = cloudToCloud(compared, reference, params);
+    for (std::size_t i = 0; i < compared.size(); ++i) {
+        if (i % 2)
+            EXPECT_TRUE(std::isnan(r.distance.values()[i]));
+        else
+            EXPECT_NEAR(r.distance.values()[i], 0.01, 1e-5);
+    }
+    params.clampBeyondMax = true;
+    r = cloudToCloud(compared, reference, params);
+    for (std::size_t i = 1; i < compared.size(); i += 2)
+        EXPECT_FLOAT_EQ(r.distance.values()[i], 0.1f);
+}
+
+TEST(CloudToCloud, SignedByReferenceNormalsOrModel)
+{
+    std::mt19937 rng(6);
+    PointCloud reference = planeSamples(5000, 1.0, 0.0f, rng);
+    for (auto& n : reference.enableNormals())
+        n = {0, 0, 1};
+    PointCloud compared = planeSamples(200, 1.0, 0.0f, rng);
+    for (std::size_t i = 0; i < compared.size(); ++i)
+        compared.positions()[i].z() = i % 2 ? 0.02f : -0.03f;
+    CloudToCloudParams params;
+    params.signedDistances = true;
+    for (LocalModel model : {LocalModel::None, LocalModel::Plane, LocalModel::Delaunay, LocalModel::Quadric}) {
+        params.model = model;
+        const CloudToCloudResult r = cloudToCloud(compared, reference, params);
+        for (std::size_t i = 0; i < compared.size(); ++i) {
+            if (i % 2)
+                EXPECT_GT(r.distance.values()[i], 0.0f) << localModelName(model);
+            else
+                EXPECT_LT(r.distance.values()[i], 0.0f) << localModelName(model);
+        }
+    }
+    reference.removeNormals();
+    params.model = LocalModel::None;
+    EXPECT_EQ(errorOf([&] { cloudToCloud(compared, reference, params); }), ErrorCode::InvalidArgument);
+}
+
+TEST(CloudToCloud, VisibilityOnTheWallScenario)
+{
+    // Thesis 000 Fig. 2.8: a scanner at the origin looks at a wall 10 m away
+    // (x = 10, y and z in [-2, 2]); the reference never saw what is behind it.
+    PointCloud reference;
+    for (int i = -40; i <= 40; ++i)
+        for (int j = -40; j <= 40; ++j) {
+            reference.resize(reference.size() + 1);
+            reference.positions().back() = {10.0f, i * 0.05f, j * 0.05f};
+        }
+    SensorPose scanner;
+    scanner.maxRange = 30.0;
+    PointCloud compared;
+    compared.resize(5);
+    compared.positions() = {
+        {10.0f, 0.3f, 0.2f},   // on the wall: visible
+        {12.0f, 0.5f, -0.4f},  // behind the wall: hidden
+        {10.0f, 6.0f, 0.0f},   // beside the wall, outside the scanned angles: out of field
+        {40.0f, 0.1f, 0.1f},   // behind, and beyond the scanner's range: out of range
+        {9.0f, -1.0f, 1.0f},   // in front of the wall: visible (something appeared)
+    };
+    CloudToCloudParams params;
+    params.viewpoints = {scanner};
+    const CloudToCloudResult r = cloudToCloud(compared, reference, params);
+    ASSERT_TRUE(r.visibility);
+    const std::vector<float> expected = {0, 1, 3, 2, 0};
+    for (std::size_t i = 0; i < 5; ++i)
+        EXPECT_EQ(r.visibility->values()[i], expected[i]) << "point " << i;
+    EXPECT_FALSE(std::isnan(r.distance.values()[0]));
+    EXPECT_TRUE(std::isnan(r.distance.values()[1]));
+    EXPECT_TRUE(std::isnan(r.distance.values()[2]));
+    EXPECT_TRUE(std::isnan(r.distance.values()[3]));
+    EXPECT_NEAR(r.distance.values()[4], 1.0, 1e-5);
+
+    // A second scanner, beyond the wall and looking back at it, scanned a surface
+    // at x = 11.5: the point at x = 12 lies in front of that surface, so the
+    // second viewpoint sees it, and "visible in any map" wins.
+    PointCloud behind;
+    behind.resize(1);
+    behind.positions()[0] = {12.0f, 0.5f, -0.4f};
+    SensorPose second;
+    second.position = {20, 0, 0};
+    second.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+    PointCloud both = reference.clone();
+    ScalarField& scan = both.addField("scan_index");
+    std::fill(scan.values().begin(), scan.values().end(), 0.0f);
+    const std::size_t base = both.size();
+    for (int i = -40; i <= 40; ++i)
+        for (int j = -40; j <= 40; ++j) {
+            both.resize(both.size() + 1);
+            both.positions().back() = {11.5f, i * 0.05f, j * 0.05f};
+            both.field("scan_index")->values().back() = 1.0f;
+        }
+    ASSERT_GT(both.size(), base);
+    params.viewpoints = {scanner, second};
+    const CloudToCloudResult twoViews = cloudToCloud(behind, both, params);
+    EXPECT_EQ(twoViews.visibility->values()[0], 0.0f);
+}
+
+TEST(CloudToCloud, BadInputs)
+{
+    std::mt19937 rng(7);
+    const PointCloud cloud = randomCloud(10, rng);
+    PointCloud empty;
+    CloudToCloudParams params;
+    EXPECT_EQ(errorOf([&] { cloudToCloud(cloud, empty, params); }), ErrorCode::InvalidData);
+    PointCloud withNan = cloud.clone();
+    withNan.positions()[3] = {std::nanf(""), 0, 0};
+    EXPECT_EQ(errorOf([&] { cloudToCloud(cloud, withNan, params); }), ErrorCode::InvalidData);
+    const CloudToCloudResult none = cloudToCloud(empty, cloud, params);
+    EXPECT_EQ(none.distance.size(), 0u);
+    EXPECT_EQ(none.statistics.count, 0u);
+    params.maxDistance = -1.0;
+    EXPECT_EQ(errorOf([&] { cloudToCloud(cloud, cloud, params); }), ErrorCode::InvalidArgument);
+    params.maxDistance.reset();
+    params.neighbours = 2;
+    EXPECT_EQ(errorOf([&] { cloudToCloud(cloud, cloud, params); }), ErrorCode::InvalidArgument);
+}
+
+TEST(CloudToCloud, CancellationLeavesInputsUntouched)
+{
+    struct CancelAtOnce : ProgressObserver
+    {
+        void beginStage(const std::string&) override {}
+        void report(double) override {}
+        bool cancelRequested() const override { return true; }
+    } cancel;
+    std::mt19937 rng(8);
+    const PointCloud reference = randomCloud(1000, rng);
+    PointCloud compared = randomCloud(1000, rng);
+    const auto before = compared.positions();
+    EXPECT_EQ(errorOf([&] { cloudToCloud(compared, reference, {}, &cancel); }), ErrorCode::Cancelled);
+    EXPECT_EQ(compared.positions(), before);
+    EXPECT_TRUE(compared.fields().empty());
+}
