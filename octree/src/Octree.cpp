@@ -105,6 +105,32 @@ void radixSort(std::vector<KeyedIndex>& keys)
 
 } // namespace
 
+std::vector<std::uint32_t> mortonOrder(const Eigen::Vector3f* points, std::size_t count, const CubicBox& box)
+{
+    const double scale = static_cast<double>(kCellsPerAxisAtMaxLevel) / box.size;
+    const auto maxCell = static_cast<std::int64_t>(kCellsPerAxisAtMaxLevel - 1);
+    std::vector<KeyedIndex> keyed(count);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            if (!points[i].allFinite()) {
+                keyed[i] = {std::numeric_limits<MortonCode>::max(), static_cast<std::uint32_t>(i)};
+                continue;
+            }
+            std::uint32_t c[3];
+            for (int a = 0; a < 3; ++a) {
+                const auto v = static_cast<std::int64_t>(std::floor((points[i][a] - box.min[a]) * scale));
+                c[a] = static_cast<std::uint32_t>(std::clamp<std::int64_t>(v, 0, maxCell));
+            }
+            keyed[i] = {encodeCell(c[0], c[1], c[2]), static_cast<std::uint32_t>(i)};
+        }
+    });
+    radixSort(keyed);
+    std::vector<std::uint32_t> order(count);
+    for (std::size_t i = 0; i < count; ++i)
+        order[i] = keyed[i].index;
+    return order;
+}
+
 CubicBox CubicBox::enclosing(const Eigen::Vector3f* points, std::size_t count)
 {
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
@@ -545,12 +571,14 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                 continue;
             }
             // Gather the 27-neighbourhood once for every query of the cell.
-            const CellCoordinates c = decodeCell(cell);
+            const CellCoordinates cellCoordinates = decodeCell(cell);
+            // Signed copies: the neighbourhood of a cell on the cube's low faces starts at -1.
+            const std::int64_t cx = cellCoordinates.x, cy = cellCoordinates.y, cz = cellCoordinates.z;
             s.positions.clear();
             s.indices.clear();
-            for (std::int64_t x = std::max<std::int64_t>(c.x - 1, 0); x <= std::min<std::int64_t>(c.x + 1, n - 1); ++x)
-                for (std::int64_t y = std::max<std::int64_t>(c.y - 1, 0); y <= std::min<std::int64_t>(c.y + 1, n - 1); ++y)
-                    for (std::int64_t z = std::max<std::int64_t>(c.z - 1, 0); z <= std::min<std::int64_t>(c.z + 1, n - 1); ++z) {
+            for (std::int64_t x = std::max<std::int64_t>(cx - 1, 0); x <= std::min<std::int64_t>(cx + 1, n - 1); ++x)
+                for (std::int64_t y = std::max<std::int64_t>(cy - 1, 0); y <= std::min<std::int64_t>(cy + 1, n - 1); ++y)
+                    for (std::int64_t z = std::max<std::int64_t>(cz - 1, 0); z <= std::min<std::int64_t>(cz + 1, n - 1); ++z) {
                         const auto [b, e] = cellRange(encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
                                                                  static_cast<std::uint32_t>(z)), level);
                         ++s.statistics.cellLookups;
@@ -559,7 +587,8 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                             s.positions.push_back(points_[indices_[i]]);
                         }
                     }
-            const Eigen::Vector3d centre = box_.min + (Eigen::Vector3d(c.x, c.y, c.z).array() + 0.5).matrix() * l;
+            const Eigen::Vector3d centre =
+                box_.min + (Eigen::Vector3d(double(cx), double(cy), double(cz)).array() + 0.5).matrix() * l;
             for (std::size_t i = first; i < last; ++i) {
                 const std::uint32_t qi = order[i].index;
                 const Eigen::Vector3f& q = queries[qi];
@@ -576,8 +605,16 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                     if (m > 0)
                         s.heap.push_back(best);
                 } else {
+                    // All candidate distances, then a selection: linear in the
+                    // candidates, cheaper than a heap update per candidate.
+                    s.heap.resize(m);
                     for (std::size_t j = 0; j < m; ++j)
-                        offer(s.heap, k, Neighbour{s.indices[j], (s.positions[j] - q).squaredNorm()});
+                        s.heap[j] = Neighbour{s.indices[j], (s.positions[j] - q).squaredNorm()};
+                    if (m > k) {
+                        std::nth_element(s.heap.begin(), s.heap.begin() + static_cast<std::ptrdiff_t>(k - 1), s.heap.end());
+                        s.heap.resize(k);
+                    }
+                    std::make_heap(s.heap.begin(), s.heap.end());
                 }
                 s.statistics.distances += m;
                 // Inscribed sphere of the 27 cells around q (eq. 4.1 with j = 1).

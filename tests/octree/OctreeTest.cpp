@@ -375,3 +375,23 @@ TEST(Octree, BestLevelIsNearTheCheapestMeasuredLevel)
     }
     EXPECT_LE(std::abs(chosen - cheapest), 2) << "chosen " << chosen << ", cheapest " << cheapest;
 }
+
+TEST(Octree, BatchSettlesQueriesInCellsOnTheCubesLowFaces)
+{
+    // A flat cloud lies in the first layer of cells: their neighbourhoods start
+    // at coordinate -1, which must be clipped, not wrapped around.
+    std::mt19937 rng(41);
+    const Cloud reference = planarCloud(20000, rng);
+    Cloud queries = planarCloud(2000, rng);
+    for (auto& q : queries)
+        q = Eigen::Vector3f::Constant(0.1f) + q * 0.9f; // away from the x and y borders
+    for (auto& q : queries)
+        q.z() = 1.5f;
+    const Octree tree(reference.data(), reference.size());
+    std::vector<Neighbour> got;
+    QueryStatistics work;
+    tree.nearestBatch(queries.data(), queries.size(), 1, 6, got, &work);
+    EXPECT_LT(work.fullSearches, queries.size() / 100);
+    for (std::size_t i = 0; i < queries.size(); i += 50)
+        EXPECT_EQ(got[i].squaredDistance, bruteForceNearest(reference, queries[i], 1)[0].squaredDistance);
+}

@@ -115,17 +115,27 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
         result.visibility = std::move(field);
     }
 
-    ProgressTicker ticker(progress, "Nearest neighbours", 1);
+    // With a k-neighbourhood model, the k nearest reference points of each
+    // compared point (§2.3.2: "its k nearest neighbours instead of only the
+    // nearest one") come from one batch query per chunk, and the first of them
+    // is the nearest neighbour: no separate NN pass.
+    const bool useModel = params.model != LocalModel::None;
+    const bool batchNeighbourhoods = useModel && !params.radius;
+    const auto k = static_cast<std::size_t>(params.neighbours);
     std::vector<octree::Neighbour> nearest;
-    tree.nearestBatch(queries, n, 1, result.level, nearest);
-    ticker.step();
+    if (!batchNeighbourhoods) {
+        ProgressTicker ticker(progress, "Nearest neighbours", 1);
+        tree.nearestBatch(queries, n, 1, result.level, nearest);
+        ticker.step();
+    } else {
+        nearest.assign(n, octree::Neighbour{std::numeric_limits<std::uint32_t>::max(), 0.0f});
+    }
 
     if (params.splitComponents) {
         result.dx = ScalarField("c2c_dx", n);
         result.dy = ScalarField("c2c_dy", n);
         result.dz = ScalarField("c2c_dz", n);
     }
-    const bool useModel = params.model != LocalModel::None;
     const auto& refPoints = reference.positions();
     Eigen::Vector3d sensorDirectionOrigin = Eigen::Vector3d::Zero();
     const bool haveSensor = !reference.sensors().empty();
@@ -134,58 +144,89 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
     std::atomic<std::size_t> fallbacks{0};
     tbb::enumerable_thread_specific<Scratch> scratch;
     ProgressTicker modelTicker(progress, useModel ? "Local models" : "Distances", n);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 2048), [&](const tbb::blocked_range<std::size_t>& range) {
-        Scratch& s = scratch.local();
-        std::size_t localFallbacks = 0;
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-            const octree::Neighbour nb = nearest[i];
-            const bool hidden = !labels.empty() && labels[i] != VisibilityLabel::Visible;
-            if (nb.index == std::numeric_limits<std::uint32_t>::max() || hidden)
-                continue; // NaN query, or not comparable: the value stays NaN
-            const Eigen::Vector3f& q = queries[i];
-            const Eigen::Vector3f& p = refPoints[nb.index];
-            double d = std::sqrt(static_cast<double>(nb.squaredDistance));
-            if (params.signedDistances && !useModel) {
-                // Sign by the reference normal at the nearest neighbour.
-                if (reference.normals()[nb.index].dot(q - p) < 0)
-                    d = -d;
+    // The batch's level for k neighbours: at most about 1.5 k reference points per
+    // cell, so the 27 cells around a query almost always settle its k nearest.
+    const int modelLevel = params.octreeLevel > 0 ? params.octreeLevel
+                                                  : tree.levelForMeanPopulation(std::max(4.0, 1.5 * static_cast<double>(k)));
+    // Chunks keep the k-neighbour lists small (k x 8 bytes per point).
+    // Chunks follow the Morton order of the compared points, so the points of
+    // one cell fall in the same chunk and share their candidates in the batch.
+    constexpr std::size_t kChunk = 1 << 16;
+    std::vector<std::uint32_t> order;
+    if (batchNeighbourhoods)
+        order = octree::mortonOrder(queries, n, cube);
+    std::vector<Eigen::Vector3f> chunkQueries;
+    std::vector<octree::Neighbour> chunkNeighbours;
+    std::vector<std::uint32_t> slotOf(batchNeighbourhoods ? n : 0);
+    for (std::size_t chunkBegin = 0; chunkBegin < n; chunkBegin += kChunk) {
+        const std::size_t chunkEnd = std::min(n, chunkBegin + kChunk);
+        if (batchNeighbourhoods) {
+            chunkQueries.resize(chunkEnd - chunkBegin);
+            for (std::size_t j = chunkBegin; j < chunkEnd; ++j) {
+                chunkQueries[j - chunkBegin] = queries[order[j]];
+                slotOf[order[j]] = static_cast<std::uint32_t>(j - chunkBegin);
             }
-            if (useModel) {
-                if (params.radius)
-                    tree.withinRadius(p, static_cast<float>(*params.radius), result.level, s.neighbours);
-                else
-                    tree.nearest(p, static_cast<std::size_t>(params.neighbours), result.level, s.neighbours);
-                s.points.clear();
-                for (const auto& m : s.neighbours)
-                    s.points.push_back(refPoints[m.index].cast<double>());
-                // Which side is "positive": the reference normal, else the scanner, else up.
-                Eigen::Vector3d orientation = Eigen::Vector3d::UnitZ();
-                if (reference.hasNormals())
-                    orientation = reference.normals()[nb.index].cast<double>();
-                else if (haveSensor)
-                    orientation = sensorDirectionOrigin - p.cast<double>();
-                double modelSigned = 0;
-                if (detail::modelDistance(params.model, s.points, q.cast<double>(), orientation, modelSigned, s.model))
-                    d = params.signedDistances ? modelSigned : std::abs(modelSigned);
-                else
-                    ++localFallbacks; // thesis: a degenerate neighbourhood is no worse than plain NN
-            }
-            if (params.maxDistance && std::abs(d) > *params.maxDistance) {
-                if (!params.clampBeyondMax)
-                    continue;
-                d = d < 0 ? -*params.maxDistance : *params.maxDistance;
-            }
-            result.distance.values()[i] = static_cast<float>(d);
-            if (params.splitComponents) {
-                const Eigen::Vector3f v = q - p;
-                result.dx->values()[i] = v.x();
-                result.dy->values()[i] = v.y();
-                result.dz->values()[i] = v.z();
-            }
+            tree.nearestBatch(chunkQueries.data(), chunkQueries.size(), k, modelLevel, chunkNeighbours);
+            for (std::size_t j = chunkBegin; j < chunkEnd; ++j)
+                nearest[order[j]] = chunkNeighbours[(j - chunkBegin) * k];
         }
-        fallbacks += localFallbacks;
-        modelTicker.step(range.size());
-    });
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(chunkBegin, chunkEnd, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+            Scratch& s = scratch.local();
+            std::size_t localFallbacks = 0;
+            for (std::size_t position = range.begin(); position != range.end(); ++position) {
+                const std::size_t i = batchNeighbourhoods ? order[position] : position;
+                const octree::Neighbour nb = nearest[i];
+                const bool hidden = !labels.empty() && labels[i] != VisibilityLabel::Visible;
+                if (nb.index == std::numeric_limits<std::uint32_t>::max() || hidden)
+                    continue; // NaN query, or not comparable: the value stays NaN
+                const Eigen::Vector3f& q = queries[i];
+                const Eigen::Vector3f& p = refPoints[nb.index];
+                double d = std::sqrt(static_cast<double>(nb.squaredDistance));
+                if (params.signedDistances && !useModel) {
+                    // Sign by the reference normal at the nearest neighbour.
+                    if (reference.normals()[nb.index].dot(q - p) < 0)
+                        d = -d;
+                }
+                if (useModel) {
+                    s.points.clear();
+                    if (batchNeighbourhoods) {
+                        const octree::Neighbour* list = chunkNeighbours.data() + static_cast<std::size_t>(slotOf[i]) * k;
+                        for (std::size_t r = 0; r < k && list[r].index != std::numeric_limits<std::uint32_t>::max(); ++r)
+                            s.points.push_back(refPoints[list[r].index].cast<double>());
+                    } else {
+                        tree.withinRadius(p, static_cast<float>(*params.radius), modelLevel, s.neighbours);
+                        for (const auto& m : s.neighbours)
+                            s.points.push_back(refPoints[m.index].cast<double>());
+                    }
+                    // Which side is "positive": the reference normal, else the scanner, else up.
+                    Eigen::Vector3d orientation = Eigen::Vector3d::UnitZ();
+                    if (reference.hasNormals())
+                        orientation = reference.normals()[nb.index].cast<double>();
+                    else if (haveSensor)
+                        orientation = sensorDirectionOrigin - p.cast<double>();
+                    double modelSigned = 0;
+                    if (detail::modelDistance(params.model, s.points, q.cast<double>(), orientation, modelSigned, s.model))
+                        d = params.signedDistances ? modelSigned : std::abs(modelSigned);
+                    else
+                        ++localFallbacks; // thesis: a degenerate neighbourhood is no worse than plain NN
+                }
+                if (params.maxDistance && std::abs(d) > *params.maxDistance) {
+                    if (!params.clampBeyondMax)
+                        continue;
+                    d = d < 0 ? -*params.maxDistance : *params.maxDistance;
+                }
+                result.distance.values()[i] = static_cast<float>(d);
+                if (params.splitComponents) {
+                    const Eigen::Vector3f v = q - p;
+                    result.dx->values()[i] = v.x();
+                    result.dy->values()[i] = v.y();
+                    result.dz->values()[i] = v.z();
+                }
+            }
+            fallbacks += localFallbacks;
+            modelTicker.step(range.size());
+        });
+    }
     result.modelFallbacks = fallbacks;
 
     if (params.closestPoints) {

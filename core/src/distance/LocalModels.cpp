@@ -51,27 +51,37 @@ bool quadricDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::Ve
 {
     // h = a u^2 + b uv + c v^2 + d u + e v + f0 over the plane, by linear least
     // squares (the thesis used gradient descent; the closed form is exact).
-    const auto n = static_cast<Eigen::Index>(points.size());
-    if (n < 6)
+    // Normal equations in fixed 6x6 size: no allocation per point; u and v are
+    // scaled by the neighbourhood's extent so the system stays well conditioned.
+    if (points.size() < 6)
         return false;
-    Eigen::MatrixXd A(n, 6);
-    Eigen::VectorXd h(n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-        const Eigen::Vector3d d = points[static_cast<std::size_t>(i)] - f.centroid;
-        const double u = d.dot(f.u), v = d.dot(f.v);
-        A.row(i) << u * u, u * v, v * v, u, v, 1.0;
-        h[i] = d.dot(f.normal);
+    double extent = 0;
+    for (const auto& p : points)
+        extent = std::max(extent, (p - f.centroid).norm());
+    if (!(extent > 0))
+        return false;
+    const double scale = 1.0 / extent;
+    Eigen::Matrix<double, 6, 6> normal = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
+    for (const auto& p : points) {
+        const Eigen::Vector3d d = p - f.centroid;
+        const double u = d.dot(f.u) * scale, v = d.dot(f.v) * scale;
+        Eigen::Matrix<double, 6, 1> row;
+        row << u * u, u * v, v * v, u, v, 1.0;
+        normal.noalias() += row * row.transpose();
+        rhs += row * (d.dot(f.normal) * scale);
     }
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
-    if (qr.rank() < 6)
-        return false;
-    const Eigen::VectorXd c = qr.solve(h);
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
+    if (solver.info() != Eigen::Success || !solver.isPositive() ||
+        solver.vectorD().minCoeff() <= 1e-12 * solver.vectorD().maxCoeff())
+        return false; // the points do not determine a quadric (e.g. all on a line)
+    const Eigen::Matrix<double, 6, 1> c = solver.solve(rhs);
     const Eigen::Vector3d d = q - f.centroid;
-    const double u = d.dot(f.u), v = d.dot(f.v), hq = d.dot(f.normal);
+    const double u = d.dot(f.u) * scale, v = d.dot(f.v) * scale, hq = d.dot(f.normal) * scale;
     const double surface = c[0] * u * u + c[1] * u * v + c[2] * v * v + c[3] * u + c[4] * v + c[5];
     const double du = 2 * c[0] * u + c[1] * v + c[3], dv = c[1] * u + 2 * c[2] * v + c[4];
-    // Height difference brought to the surface normal (first order).
-    out = (hq - surface) / std::sqrt(1.0 + du * du + dv * dv);
+    // Height difference brought to the surface normal (first order), back in metres.
+    out = (hq - surface) / std::sqrt(1.0 + du * du + dv * dv) * extent;
     return std::isfinite(out);
 }
 

@@ -63,6 +63,12 @@ struct QueryStatistics
     std::uint64_t fullSearches = 0; //!< queries the cached neighbourhood did not settle
 };
 
+//! The indices 0..count-1 ordered by the Morton code of their point in `box`
+//! (points outside the box are clamped to its faces; non-finite ones come
+//! last). Processing queries in this order keeps neighbours together in cache
+//! and lets batch queries share work between points of one cell.
+std::vector<std::uint32_t> mortonOrder(const Eigen::Vector3f* points, std::size_t count, const CubicBox& box);
+
 class Octree
 {
 public:

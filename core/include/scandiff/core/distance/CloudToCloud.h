@@ -5,9 +5,11 @@
 //!
 //! - Nearest-neighbour distance (§2.3.1), exact, through the octree's batch
 //!   query on a cube shared by both clouds.
-//! - Optional local model of the reference around each nearest neighbour
-//!   (§2.3.2): least-squares plane, 2.5D Delaunay triangulation on that plane,
-//!   or a quadric height function over it. Two samplings of one surface are at
+//! - Optional local model of the reference near each compared point (§2.3.2):
+//!   least-squares plane, 2.5D Delaunay triangulation on that plane, or a
+//!   quadric height function over it, fitted on the point's k nearest reference
+//!   points (the first being its nearest neighbour) or on the reference points
+//!   within a radius of its nearest neighbour. Two samplings of one surface are at
 //!   NN distance ~1/sqrt(pi*lambda) RMS (eq. 2.5); a local model removes that bias.
 //! - Optional visibility (§2.3.3, Algorithm 3): with reference viewpoints, each
 //!   compared point is labelled visible / hidden / out of range / out of field,
@@ -36,11 +38,11 @@ struct CloudToCloudParams
     //! Metres, > 0. Points farther than this get NaN, or maxDistance itself with clampBeyondMax.
     std::optional<double> maxDistance;
     bool clampBeyondMax = false;
-    //! Local model of the reference around each nearest neighbour. Default: none.
+    //! Local model of the reference near each compared point. Default: none.
     LocalModel model = LocalModel::None;
-    //! Neighbours of the nearest neighbour used by the model, in [3, 500]. Default 12.
+    //! k, in [3, 500]: the model is fitted on the compared point's k nearest reference points. Default 12.
     int neighbours = 12;
-    //! Metres, > 0: take the neighbours within this radius instead of the k nearest.
+    //! Metres, > 0: fit on the reference points within this radius of the nearest neighbour instead.
     std::optional<double> radius;
     //! Also output the X, Y, Z components of the vector to the nearest neighbour.
     bool splitComponents = false;
