@@ -22,13 +22,13 @@ timed() { # label command...
   local label=$1; shift
   /usr/bin/time -f "$label %e s %M KB" "$@" > /dev/null 2> >(tail -n 1 >&2)
 }
-cc() { QT_QPA_PLATFORM=offscreen CloudCompare -SILENT -NO_TIMESTAMP -AUTO_SAVE OFF "$@"; }
+cloudcompare=(env QT_QPA_PLATFORM=offscreen CloudCompare -SILENT -NO_TIMESTAMP -AUTO_SAVE OFF)
 
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
 cat "$reference" "$compared" "$mesh" > /dev/null
 for i in $(seq "$runs"); do
   timed "scandiff c2c" "$cli" c2c --reference "$reference" --compared "$compared"
-  timed "CloudCompare c2c" cc -O "$compared" -O "$reference" -C2C_DIST
+  timed "CloudCompare c2c" "${cloudcompare[@]}" -O "$compared" -O "$reference" -C2C_DIST
 done
 for model in plane quadric delaunay; do
   timed "scandiff c2c --model $model" "$cli" c2c --reference "$reference" --compared "$compared" --model "$model"
@@ -36,6 +36,6 @@ done
 if "$cli" c2m --help > /dev/null 2>&1; then
   for i in $(seq "$runs"); do
     timed "scandiff c2m" "$cli" c2m --reference "$mesh" --compared "$compared"
-    timed "CloudCompare c2m" cc -O "$compared" -O "$mesh" -C2M_DIST
+    timed "CloudCompare c2m" "${cloudcompare[@]}" -O "$compared" -O "$mesh" -C2M_DIST
   done
 fi

@@ -146,3 +146,93 @@ TEST(Cli, TheInstalledBinaryReportsErrorsThroughItsExitStatus)
     ASSERT_TRUE(WIFEXITED(status));
     EXPECT_EQ(WEXITSTATUS(status), static_cast<int>(ErrorCode::Io));
 }
+
+namespace {
+
+//! A 21 x 21 grid on z = 0 (spacing 0.1 m) as a cloud, and the same grid as a mesh.
+void writePlane(const PluginRegistry& registry, const std::filesystem::path& cloudPath, const std::filesystem::path& meshPath)
+{
+    Mesh mesh;
+    mesh.vertices.resize(21 * 21);
+    for (int j = 0; j < 21; ++j)
+        for (int i = 0; i < 21; ++i)
+            mesh.vertices.positions()[static_cast<std::size_t>(j * 21 + i)] = {i * 0.1f, j * 0.1f, 0.0f};
+    for (std::uint32_t j = 0; j < 20; ++j)
+        for (std::uint32_t i = 0; i < 20; ++i) {
+            const std::uint32_t a = j * 21 + i;
+            mesh.triangles.push_back({a, a + 1, a + 22});
+            mesh.triangles.push_back({a, a + 22, a + 21});
+        }
+    io::writePointCloud(registry.formats, mesh.vertices, cloudPath);
+    io::writeMesh(registry.formats, mesh, meshPath);
+}
+
+} // namespace
+
+TEST(Cli, CloudToCloudAndCloudToMeshWriteTheirFields)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    writePlane(registry, dir / "reference.ply", dir / "mesh.ply");
+    PointCloud compared;
+    compared.resize(3);
+    compared.positions() = {{0.55f, 0.55f, 0.2f}, {1.0f, 1.0f, -0.1f}, {1.23f, 0.47f, 0.05f}};
+    io::writePointCloud(registry.formats, compared, dir / "compared.ply");
+
+    CliRun run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared",
+                                   (dir / "compared.ply").string(), "--model", "plane", "--split-xyz", "-o",
+                                   (dir / "c2c.ply").string(), "--both-ways"});
+    ASSERT_EQ(run.status, 0) << run.err;
+    EXPECT_NE(run.out.find("3 values"), std::string::npos) << run.out;
+    PointCloud out = io::readPointCloud(registry.formats, dir / "c2c.ply");
+    ASSERT_EQ(out.size(), 3u);
+    ASSERT_NE(out.field("c2c_distance"), nullptr);
+    EXPECT_NEAR(out.field("c2c_distance")->values()[0], 0.2, 1e-5);
+    EXPECT_NEAR(out.field("c2c_distance")->values()[1], 0.1, 1e-5);
+    EXPECT_NEAR(out.field("c2c_distance")->values()[2], 0.05, 1e-5);
+    EXPECT_NE(out.field("c2c_dz"), nullptr);
+    EXPECT_TRUE(std::filesystem::exists(dir / "c2c_reference.ply"));
+
+    run = runCli(registry, {"c2m", "--reference", (dir / "mesh.ply").string(), "--compared", (dir / "compared.ply").string(),
+                            "--signed", "-o", (dir / "c2m.ply").string()});
+    ASSERT_EQ(run.status, 0) << run.err;
+    out = io::readPointCloud(registry.formats, dir / "c2m.ply");
+    ASSERT_NE(out.field("c2m_distance"), nullptr);
+    EXPECT_NEAR(out.field("c2m_distance")->values()[0], 0.2, 1e-6);
+    EXPECT_NEAR(out.field("c2m_distance")->values()[1], -0.1, 1e-6);
+
+    // Without -o nothing is written; bad options are refused with a message.
+    run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string()});
+    EXPECT_EQ(run.status, 0);
+    run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
+                            "--signed"});
+    EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
+    EXPECT_NE(run.err.find("normals"), std::string::npos) << run.err;
+    run = runCli(registry, {"c2m", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string()});
+    EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidData)) << run.err;
+}
+
+TEST(Cli, CloudToCloudVisibilityFromTheCommandLine)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    PointCloud wall;
+    for (int i = -20; i <= 20; ++i)
+        for (int j = -20; j <= 20; ++j) {
+            wall.resize(wall.size() + 1);
+            wall.positions().back() = {10.0f, i * 0.1f, j * 0.1f};
+        }
+    io::writePointCloud(registry.formats, wall, dir / "wall.ply");
+    PointCloud compared;
+    compared.resize(2);
+    compared.positions() = {{10.0f, 0.3f, 0.2f}, {12.0f, 0.5f, -0.4f}};
+    io::writePointCloud(registry.formats, compared, dir / "compared.ply");
+    const CliRun run = runCli(registry, {"c2c", "--reference", (dir / "wall.ply").string(), "--compared",
+                                         (dir / "compared.ply").string(), "--sensor", "0,0,0", "-o", (dir / "out.ply").string()});
+    ASSERT_EQ(run.status, 0) << run.err;
+    const PointCloud out = io::readPointCloud(registry.formats, dir / "out.ply");
+    ASSERT_NE(out.field("visibility"), nullptr);
+    EXPECT_EQ(out.field("visibility")->values()[0], 0.0f);
+    EXPECT_EQ(out.field("visibility")->values()[1], 1.0f);
+    EXPECT_TRUE(std::isnan(out.field("c2c_distance")->values()[1]));
+}
