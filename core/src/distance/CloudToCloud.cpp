@@ -87,7 +87,6 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
     }
     octree::CubicBox cube = octree::CubicBox::enclosing(reference.positions().data(), reference.size());
     {
-        std::vector<Eigen::Vector3f> finite;
         Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
         bool any = false;
         for (std::size_t i = 0; i < n; ++i)
@@ -101,10 +100,35 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
             cube = octree::CubicBox::enclosingBoth(cube, octree::CubicBox::enclosing(corners, 2));
         }
     }
+    // The compared points are visited in Morton order, in chunks: the points of
+    // one cell share their candidates in the batch query, memory stays local,
+    // and the batch's own sorting buffers stay chunk-sized. The order is computed
+    // before the octree so their temporary buffers never coexist.
+    const std::vector<std::uint32_t> order = octree::mortonOrder(queries, n, cube);
     const octree::Octree tree = buildOctree(reference, cube);
-    // About 4 reference points per cell: the batch's 27-cell candidate sets stay
-    // near a hundred points (docs/benchmarks.md, level sweep).
-    result.level = params.octreeLevel > 0 ? params.octreeLevel : tree.levelForMeanPopulation(4.0);
+
+    // With a k-neighbourhood model, the k nearest reference points of each
+    // compared point (§2.3.2: "its k nearest neighbours instead of only the
+    // nearest one") come from the same batch query; the first is the nearest
+    // neighbour, so there is no separate NN pass.
+    const bool useModel = params.model != LocalModel::None;
+    const bool batchNeighbourhoods = useModel && !params.radius;
+    const std::size_t k = batchNeighbourhoods ? static_cast<std::size_t>(params.neighbours) : 1;
+    // Levels whose cells hold about 8 reference points for NN (the level sweep of
+    // docs/benchmarks.md) and about 1.5 k for k neighbours, so that the 27 cells
+    // around a query almost always settle it.
+    const double targetPopulation = batchNeighbourhoods ? std::max(8.0, 1.5 * static_cast<double>(k)) : 8.0;
+    result.level = params.octreeLevel;
+    if (result.level == 0) {
+        double bestGap = std::numeric_limits<double>::infinity();
+        for (int level = 1; level <= octree::kMaxLevel; ++level) {
+            const double gap = std::abs(std::log(tree.levelStatistics(level).meanPointsPerCell / targetPopulation));
+            if (gap < bestGap) {
+                bestGap = gap;
+                result.level = level;
+            }
+        }
+    }
 
     std::vector<VisibilityLabel> labels;
     if (!params.viewpoints.empty()) {
@@ -114,87 +138,55 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
             field.values()[i] = static_cast<float>(labels[i]);
         result.visibility = std::move(field);
     }
-
-    // With a k-neighbourhood model, the k nearest reference points of each
-    // compared point (§2.3.2: "its k nearest neighbours instead of only the
-    // nearest one") come from one batch query per chunk, and the first of them
-    // is the nearest neighbour: no separate NN pass.
-    const bool useModel = params.model != LocalModel::None;
-    const bool batchNeighbourhoods = useModel && !params.radius;
-    const auto k = static_cast<std::size_t>(params.neighbours);
-    std::vector<octree::Neighbour> nearest;
-    if (!batchNeighbourhoods) {
-        ProgressTicker ticker(progress, "Nearest neighbours", 1);
-        tree.nearestBatch(queries, n, 1, result.level, nearest);
-        ticker.step();
-    } else {
-        nearest.assign(n, octree::Neighbour{std::numeric_limits<std::uint32_t>::max(), 0.0f});
-    }
-
     if (params.splitComponents) {
         result.dx = ScalarField("c2c_dx", n);
         result.dy = ScalarField("c2c_dy", n);
         result.dz = ScalarField("c2c_dz", n);
     }
+    constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::uint32_t> closestIndex(params.closestPoints ? n : 0, kNone);
+
     const auto& refPoints = reference.positions();
-    Eigen::Vector3d sensorDirectionOrigin = Eigen::Vector3d::Zero();
     const bool haveSensor = !reference.sensors().empty();
-    if (haveSensor)
-        sensorDirectionOrigin = reference.sensors().front().position - reference.origin();
+    const Eigen::Vector3d sensorPosition = haveSensor ? Eigen::Vector3d(reference.sensors().front().position - reference.origin())
+                                                      : Eigen::Vector3d::Zero();
     std::atomic<std::size_t> fallbacks{0};
     tbb::enumerable_thread_specific<Scratch> scratch;
-    ProgressTicker modelTicker(progress, useModel ? "Local models" : "Distances", n);
-    // The batch's level for k neighbours: at most about 1.5 k reference points per
-    // cell, so the 27 cells around a query almost always settle its k nearest.
-    const int modelLevel = params.octreeLevel > 0 ? params.octreeLevel
-                                                  : tree.levelForMeanPopulation(std::max(4.0, 1.5 * static_cast<double>(k)));
-    // Chunks keep the k-neighbour lists small (k x 8 bytes per point).
-    // Chunks follow the Morton order of the compared points, so the points of
-    // one cell fall in the same chunk and share their candidates in the batch.
+    ProgressTicker ticker(progress, useModel ? "Distances with local models" : "Nearest-neighbour distances", n);
     constexpr std::size_t kChunk = 1 << 16;
-    std::vector<std::uint32_t> order;
-    if (batchNeighbourhoods)
-        order = octree::mortonOrder(queries, n, cube);
     std::vector<Eigen::Vector3f> chunkQueries;
     std::vector<octree::Neighbour> chunkNeighbours;
-    std::vector<std::uint32_t> slotOf(batchNeighbourhoods ? n : 0);
     for (std::size_t chunkBegin = 0; chunkBegin < n; chunkBegin += kChunk) {
         const std::size_t chunkEnd = std::min(n, chunkBegin + kChunk);
-        if (batchNeighbourhoods) {
-            chunkQueries.resize(chunkEnd - chunkBegin);
-            for (std::size_t j = chunkBegin; j < chunkEnd; ++j) {
-                chunkQueries[j - chunkBegin] = queries[order[j]];
-                slotOf[order[j]] = static_cast<std::uint32_t>(j - chunkBegin);
-            }
-            tree.nearestBatch(chunkQueries.data(), chunkQueries.size(), k, modelLevel, chunkNeighbours);
-            for (std::size_t j = chunkBegin; j < chunkEnd; ++j)
-                nearest[order[j]] = chunkNeighbours[(j - chunkBegin) * k];
+        chunkQueries.resize(chunkEnd - chunkBegin);
+        for (std::size_t j = chunkBegin; j < chunkEnd; ++j) {
+            const std::uint32_t i = order[j];
+            const bool hidden = !labels.empty() && labels[i] != VisibilityLabel::Visible;
+            // A NaN query gets no neighbour: how hidden points are skipped cheaply.
+            chunkQueries[j - chunkBegin] = hidden ? Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()) : queries[i];
         }
+        tree.nearestBatch(chunkQueries.data(), chunkQueries.size(), k, result.level, chunkNeighbours);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(chunkBegin, chunkEnd, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
             Scratch& s = scratch.local();
             std::size_t localFallbacks = 0;
-            for (std::size_t position = range.begin(); position != range.end(); ++position) {
-                const std::size_t i = batchNeighbourhoods ? order[position] : position;
-                const octree::Neighbour nb = nearest[i];
-                const bool hidden = !labels.empty() && labels[i] != VisibilityLabel::Visible;
-                if (nb.index == std::numeric_limits<std::uint32_t>::max() || hidden)
+            for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                const std::uint32_t i = order[j];
+                const octree::Neighbour* list = chunkNeighbours.data() + (j - chunkBegin) * k;
+                const octree::Neighbour nb = list[0];
+                if (nb.index == kNone)
                     continue; // NaN query, or not comparable: the value stays NaN
-                const Eigen::Vector3f& q = queries[i];
+                const Eigen::Vector3f& q = chunkQueries[j - chunkBegin];
                 const Eigen::Vector3f& p = refPoints[nb.index];
                 double d = std::sqrt(static_cast<double>(nb.squaredDistance));
-                if (params.signedDistances && !useModel) {
-                    // Sign by the reference normal at the nearest neighbour.
-                    if (reference.normals()[nb.index].dot(q - p) < 0)
-                        d = -d;
-                }
+                if (params.signedDistances && !useModel && reference.normals()[nb.index].dot(q - p) < 0)
+                    d = -d; // sign by the reference normal at the nearest neighbour
                 if (useModel) {
                     s.points.clear();
                     if (batchNeighbourhoods) {
-                        const octree::Neighbour* list = chunkNeighbours.data() + static_cast<std::size_t>(slotOf[i]) * k;
-                        for (std::size_t r = 0; r < k && list[r].index != std::numeric_limits<std::uint32_t>::max(); ++r)
+                        for (std::size_t r = 0; r < k && list[r].index != kNone; ++r)
                             s.points.push_back(refPoints[list[r].index].cast<double>());
                     } else {
-                        tree.withinRadius(p, static_cast<float>(*params.radius), modelLevel, s.neighbours);
+                        tree.withinRadius(p, static_cast<float>(*params.radius), result.level, s.neighbours);
                         for (const auto& m : s.neighbours)
                             s.points.push_back(refPoints[m.index].cast<double>());
                     }
@@ -203,13 +195,15 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
                     if (reference.hasNormals())
                         orientation = reference.normals()[nb.index].cast<double>();
                     else if (haveSensor)
-                        orientation = sensorDirectionOrigin - p.cast<double>();
+                        orientation = sensorPosition - p.cast<double>();
                     double modelSigned = 0;
                     if (detail::modelDistance(params.model, s.points, q.cast<double>(), orientation, modelSigned, s.model))
                         d = params.signedDistances ? modelSigned : std::abs(modelSigned);
                     else
                         ++localFallbacks; // thesis: a degenerate neighbourhood is no worse than plain NN
                 }
+                if (params.closestPoints)
+                    closestIndex[i] = nb.index;
                 if (params.maxDistance && std::abs(d) > *params.maxDistance) {
                     if (!params.clampBeyondMax)
                         continue;
@@ -224,7 +218,7 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
                 }
             }
             fallbacks += localFallbacks;
-            modelTicker.step(range.size());
+            ticker.step(range.size());
         });
     }
     result.modelFallbacks = fallbacks;
@@ -232,9 +226,9 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
     if (params.closestPoints) {
         std::vector<std::size_t> matched;
         matched.reserve(n);
-        for (const auto& nb : nearest)
-            if (nb.index != std::numeric_limits<std::uint32_t>::max())
-                matched.push_back(nb.index);
+        for (const std::uint32_t index : closestIndex)
+            if (index != kNone)
+                matched.push_back(index);
         result.closest = reference.subset(matched);
         result.closest->name = reference.name + "_closest";
     }
