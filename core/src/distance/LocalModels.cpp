@@ -99,7 +99,18 @@ bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::V
         return false;
     double best = std::numeric_limits<double>::infinity();
     Eigen::Vector3d closest = Eigen::Vector3d::Zero();
+    const Eigen::Vector3d dq = q - f.centroid;
+    const Eigen::Vector2d qPlanar(dq.dot(f.u), dq.dot(f.v));
     for (const auto& t : triangles) {
+        // Projection onto the plane shortens distances, so the in-plane gap to
+        // the triangle's box is a lower bound: skip triangles that cannot win.
+        const Eigen::Vector2d& a = scratch.planar[static_cast<std::size_t>(t[0])];
+        const Eigen::Vector2d& b = scratch.planar[static_cast<std::size_t>(t[1])];
+        const Eigen::Vector2d& c = scratch.planar[static_cast<std::size_t>(t[2])];
+        const Eigen::Vector2d lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
+        const Eigen::Vector2d gap = (lo - qPlanar).cwiseMax(qPlanar - hi).cwiseMax(Eigen::Vector2d::Zero());
+        if (gap.squaredNorm() > best)
+            continue;
         const geometry::PointTriangleResult r = geometry::pointTriangleDistance(q, points[static_cast<std::size_t>(t[0])],
                                                             points[static_cast<std::size_t>(t[1])],
                                                             points[static_cast<std::size_t>(t[2])]);
