@@ -3,6 +3,8 @@
 
 #include <scandiff/core/Error.h>
 
+#include <tbb/global_control.h>
+
 #include <csignal>
 #include <iomanip>
 #include <cstdio>
@@ -76,6 +78,19 @@ bool TerminalProgress::cancelRequested() const
 {
     return interrupted.load();
 }
+
+void ThreadLimit::addOption(CLI::App& command, int& threads)
+{
+    command.add_option("--threads", threads, "Number of threads (default: all cores)")->check(CLI::Range(1, 1024));
+}
+
+ThreadLimit::ThreadLimit(int threads)
+{
+    if (threads > 0)
+        control_ = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+}
+
+ThreadLimit::~ThreadLimit() = default;
 
 void printStatistics(std::ostream& out, const std::string& label, const DistanceStatistics& s)
 {

@@ -7,8 +7,10 @@
 #include <scandiff/io/FileIO.h>
 
 #include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
 
 #include <atomic>
+#include <memory>
 #include <string>
 
 namespace scandiff::cli {
@@ -49,6 +51,19 @@ struct WriteFlags
     int precision = 6;
     void addTo(CLI::App& command);
     io::WriteOptions toOptions(ProgressObserver* progress) const;
+};
+
+//! --threads N: limits TBB's worker threads for the lifetime of the object.
+class ThreadLimit
+{
+public:
+    //! Adds the --threads option to a command; 0 (the default) means all cores.
+    static void addOption(CLI::App& command, int& threads);
+    explicit ThreadLimit(int threads);
+    ~ThreadLimit();
+
+private:
+    std::unique_ptr<tbb::global_control> control_;
 };
 
 //! "label: N values, mean ..., std ..., min ..., max ..., RMS ..." on one line.

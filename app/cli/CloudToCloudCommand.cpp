@@ -5,7 +5,6 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/distance/CloudToCloud.h>
 
-#include <tbb/global_control.h>
 
 #include <chrono>
 #include <cmath>
@@ -100,8 +99,9 @@ void addCloudToCloudCommand(CLI::App& app, const PluginRegistry& registry, Strea
     c->add_option("--reference", args->reference, "Reference cloud")->required();
     c->add_option("--compared", args->compared, "Compared cloud (the output keeps its points, in order)")->required();
     c->add_option("-o,--output", args->output, "Output: the compared cloud with c2c_distance (nothing is written without it)");
-    c->add_option("--max-dist", args->maxDistance, "Points farther than this (m) get NaN, or the maximum with --clamp")->check(CLI::PositiveNumber);
-    c->add_flag("--clamp", args->clamp, "With --max-dist: give farther points the maximum instead of NaN");
+    auto* maxDistance = c->add_option("--max-dist", args->maxDistance, "Points farther than this (m) get NaN, or the maximum with --clamp")
+                            ->check(CLI::PositiveNumber);
+    c->add_flag("--clamp", args->clamp, "With --max-dist: give farther points the maximum instead of NaN")->needs(maxDistance);
     c->add_option("--model", args->model, "Local model of the reference: none, plane, delaunay, quadric")
         ->check(CLI::IsMember({"none", "plane", "delaunay", "quadric"}));
     auto* knn = c->add_option("--knn", args->knn, "Local model neighbourhood: k nearest (default 12)")->check(CLI::Range(3, 500));
@@ -118,13 +118,11 @@ void addCloudToCloudCommand(CLI::App& app, const PluginRegistry& registry, Strea
     c->add_option("--visibility-tolerance", args->tolerance, "Depth-map tolerance (m), default 0.05")->check(CLI::NonNegativeNumber);
     c->add_flag("--both-ways", args->bothWays, "Also compute reference -> compared (written beside OUT as <name>_reference.<ext>)");
     c->add_option("--octree-level", args->level, "Octree level 1..21 (default: automatic)")->check(CLI::Range(0, 21));
-    c->add_option("--threads", args->threads, "Number of threads (default: all cores)")->check(CLI::Range(1, 1024));
+    ThreadLimit::addOption(*c, args->threads);
     args->read.addTo(*c);
     args->write.addTo(*c);
     c->callback([args, &registry, streams] {
-        std::optional<tbb::global_control> threadLimit;
-        if (args->threads > 0)
-            threadLimit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(args->threads));
+        const ThreadLimit threadLimit(args->threads);
         CloudToCloudParams params;
         params.maxDistance = args->maxDistance;
         params.clampBeyondMax = args->clamp;

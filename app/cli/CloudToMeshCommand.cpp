@@ -5,7 +5,6 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/distance/CloudToMesh.h>
 
-#include <tbb/global_control.h>
 
 #include <chrono>
 #include <iomanip>
@@ -40,16 +39,14 @@ void addCloudToMeshCommand(CLI::App& app, const PluginRegistry& registry, Stream
     c->add_flag("--clamp", args->clamp, "With --max-dist: give farther points the maximum instead of NaN");
     c->add_option("--octree-level", args->level, "Grid level 1..21 (default: automatic, from the mean triangle size)")
         ->check(CLI::Range(0, 21));
-    c->add_option("--threads", args->threads, "Number of threads (default: all cores)")->check(CLI::Range(1, 1024));
+    ThreadLimit::addOption(*c, args->threads);
     args->read.addTo(*c);
     args->write.addTo(*c);
     c->callback([args, &registry, streams] {
         // Parameters are checked before the (possibly long) reads.
         if (args->clamp && !args->maxDistance)
             throw Error(ErrorCode::InvalidArgument, "--clamp needs --max-dist");
-        std::optional<tbb::global_control> threadLimit;
-        if (args->threads > 0)
-            threadLimit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(args->threads));
+        const ThreadLimit threadLimit(args->threads);
         CloudToMeshParams params;
         params.signedDistances = args->signedDistances;
         params.maxDistance = args->maxDistance;

@@ -40,6 +40,7 @@
 
 #include "internal/Formats.h"
 #include "internal/MappedFile.h"
+#include "internal/TextUtil.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
@@ -111,17 +112,6 @@ bool isInteger(std::string_view token)
     std::int64_t value = 0;
     const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
     return ec == std::errc() && ptr == token.data() + token.size() && !token.empty();
-}
-
-std::string quoted(std::string_view s)
-{
-    constexpr std::size_t kMax = 40; // a binary blob must not flood the message
-    std::string out = "'";
-    for (char c : s.substr(0, kMax))
-        out += (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) >= 127) ? '?' : c;
-    if (s.size() > kMax)
-        out += "...";
-    return out + "'";
 }
 
 //! Lines of the mapped file with their 1-based numbers; copyable to look ahead.

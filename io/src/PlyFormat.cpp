@@ -15,6 +15,7 @@
 
 #include "internal/Formats.h"
 #include "internal/MappedFile.h"
+#include "internal/TextUtil.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
@@ -188,17 +189,6 @@ bool parseInteger(std::string_view token, std::int64_t& value)
         ++first;
     const auto [ptr, ec] = std::from_chars(first, last, value);
     return ec == std::errc() && ptr == last && first != last;
-}
-
-std::string quoted(std::string_view s)
-{
-    constexpr std::size_t kMax = 40; // a binary blob must not flood the message
-    std::string out = "'";
-    for (char c : s.substr(0, kMax))
-        out += (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) >= 127) ? '?' : c;
-    if (s.size() > kMax)
-        out += "...";
-    return out + "'";
 }
 
 class Context

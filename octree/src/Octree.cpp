@@ -254,21 +254,11 @@ std::array<std::int64_t, 3> Octree::cellOf(const Eigen::Vector3f& q, int level) 
 void Octree::scanCell(std::int64_t x, std::int64_t y, std::int64_t z, int level, const Eigen::Vector3f& q,
                       std::size_t k, std::vector<Neighbour>& heap) const
 {
-    if (heapFull(heap, k)) {
-        // Skip a cell that cannot hold anything closer than the current k-th.
-        const double l = cellSize(level);
-        const std::int64_t cell[3] = {x, y, z};
-        double gap2 = 0;
-        for (int a = 0; a < 3; ++a) {
-            const double lo = box_.min[a] + static_cast<double>(cell[a]) * l;
-            const double d = std::max({lo - q[a], q[a] - (lo + l), 0.0});
-            gap2 += d * d;
-        }
-        if (gap2 > static_cast<double>(heap.front().squaredDistance) * (1 + kSlack))
-            return;
-    }
-    const auto [first, last] = cellRange(encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                                                     static_cast<std::uint32_t>(z)), level);
+    const MortonCode cell = encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(z));
+    // Skip a cell that cannot hold anything closer than the current k-th.
+    if (heapFull(heap, k) && squaredGap(cell, level, q) > static_cast<double>(heap.front().squaredDistance) * (1 + kSlack))
+        return;
+    const auto [first, last] = cellRange(cell, level);
     for (std::size_t i = first; i < last; ++i) {
         const std::uint32_t index = indices_[i];
         offer(heap, k, Neighbour{index, (points_[index] - q).squaredNorm()});
@@ -442,17 +432,11 @@ void Octree::withinRadius(const Eigen::Vector3f& q, float radius, int level, std
     for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
         for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
             for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-                const std::int64_t cell[3] = {x, y, z};
-                double gap2 = 0;
-                for (int a = 0; a < 3; ++a) {
-                    const double cmin = box_.min[a] + static_cast<double>(cell[a]) * l;
-                    const double d = std::max({cmin - q[a], q[a] - (cmin + l), 0.0});
-                    gap2 += d * d;
-                }
-                if (gap2 > static_cast<double>(r2) * (1 + kSlack))
+                const MortonCode cell = encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                                                   static_cast<std::uint32_t>(z));
+                if (squaredGap(cell, level, q) > static_cast<double>(r2) * (1 + kSlack))
                     continue;
-                const auto [first, last] = cellRange(encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                                                                 static_cast<std::uint32_t>(z)), level);
+                const auto [first, last] = cellRange(cell, level);
                 for (std::size_t i = first; i < last; ++i) {
                     const std::uint32_t index = indices_[i];
                     const float d2 = (points_[index] - q).squaredNorm();
