@@ -492,8 +492,31 @@ struct BatchScratch
     std::vector<Eigen::Vector3f> positions;
     std::vector<std::uint32_t> indices;
     std::vector<Neighbour> heap;
+    //! Where each gathered cell's points start in positions/indices, and its
+    //! offset from the query cell: the queries skip the cells they cannot need.
+    std::array<std::uint32_t, 28> cellStart{};
+    std::array<std::array<int, 3>, 27> cellOffset{};
+    int cellCount = 0;
     QueryStatistics statistics;
 };
+
+//! The 27 cell offsets, the own cell first, then faces, edges and corners, so
+//! that the closest candidates come first and the later cells are often pruned.
+const std::array<std::array<int, 3>, 27>& neighbourhoodOffsets()
+{
+    static const std::array<std::array<int, 3>, 27> offsets = [] {
+        std::array<std::array<int, 3>, 27> o{};
+        int i = 0;
+        for (int nonZero = 0; nonZero <= 3; ++nonZero)
+            for (int dx = -1; dx <= 1; ++dx)
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dz = -1; dz <= 1; ++dz)
+                        if ((dx != 0) + (dy != 0) + (dz != 0) == nonZero)
+                            o[static_cast<std::size_t>(i++)] = {dx, dy, dz};
+        return o;
+    }();
+    return offsets;
+}
 
 } // namespace
 
@@ -537,6 +560,25 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
             groupStart.push_back(i);
     groupStart.push_back(count);
 
+    // A directory of the level's non-empty cells: one binary search over the
+    // cells (small enough to stay in cache) instead of two over every code.
+    std::vector<MortonCode> directoryCodes;
+    std::vector<std::uint32_t> directoryStart;
+    directoryCodes.reserve(stats_[static_cast<std::size_t>(level)].nonEmptyCells);
+    directoryStart.reserve(stats_[static_cast<std::size_t>(level)].nonEmptyCells + 1);
+    forEachCell(level, [&](MortonCode code, std::size_t begin, std::size_t) {
+        directoryCodes.push_back(code);
+        directoryStart.push_back(static_cast<std::uint32_t>(begin));
+    });
+    directoryStart.push_back(static_cast<std::uint32_t>(codes_.size()));
+    auto lookup = [&](MortonCode code) -> std::pair<std::size_t, std::size_t> {
+        const auto it = std::lower_bound(directoryCodes.begin(), directoryCodes.end(), code);
+        if (it == directoryCodes.end() || *it != code)
+            return {0, 0};
+        const auto d = static_cast<std::size_t>(it - directoryCodes.begin());
+        return {directoryStart[d], directoryStart[d + 1]};
+    };
+
     tbb::enumerable_thread_specific<BatchScratch> scratch;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groupStart.size() - 1, 16), [&](const tbb::blocked_range<std::size_t>& range) {
         BatchScratch& s = scratch.local();
@@ -560,17 +602,25 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
             const std::int64_t cx = cellCoordinates.x, cy = cellCoordinates.y, cz = cellCoordinates.z;
             s.positions.clear();
             s.indices.clear();
-            for (std::int64_t x = std::max<std::int64_t>(cx - 1, 0); x <= std::min<std::int64_t>(cx + 1, n - 1); ++x)
-                for (std::int64_t y = std::max<std::int64_t>(cy - 1, 0); y <= std::min<std::int64_t>(cy + 1, n - 1); ++y)
-                    for (std::int64_t z = std::max<std::int64_t>(cz - 1, 0); z <= std::min<std::int64_t>(cz + 1, n - 1); ++z) {
-                        const auto [b, e] = cellRange(encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                                                                 static_cast<std::uint32_t>(z)), level);
-                        ++s.statistics.cellLookups;
-                        for (std::size_t i = b; i < e; ++i) {
-                            s.indices.push_back(indices_[i]);
-                            s.positions.push_back(points_[indices_[i]]);
-                        }
-                    }
+            s.cellCount = 0;
+            for (const auto& offset : neighbourhoodOffsets()) {
+                const std::int64_t x = cx + offset[0], y = cy + offset[1], z = cz + offset[2];
+                if (x < 0 || y < 0 || z < 0 || x >= n || y >= n || z >= n)
+                    continue;
+                const auto [b, e] = lookup(encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                                                      static_cast<std::uint32_t>(z)));
+                ++s.statistics.cellLookups;
+                if (b == e)
+                    continue;
+                s.cellStart[static_cast<std::size_t>(s.cellCount)] = static_cast<std::uint32_t>(s.positions.size());
+                s.cellOffset[static_cast<std::size_t>(s.cellCount)] = offset;
+                ++s.cellCount;
+                for (std::size_t i = b; i < e; ++i) {
+                    s.indices.push_back(indices_[i]);
+                    s.positions.push_back(points_[indices_[i]]);
+                }
+            }
+            s.cellStart[static_cast<std::size_t>(s.cellCount)] = static_cast<std::uint32_t>(s.positions.size());
             const Eigen::Vector3d centre =
                 box_.min + (Eigen::Vector3d(double(cx), double(cy), double(cz)).array() + 0.5).matrix() * l;
             for (std::size_t i = first; i < last; ++i) {
@@ -579,15 +629,35 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                 s.heap.clear();
                 const std::size_t m = s.positions.size();
                 if (k == 1) {
-                    // The common case (cloud/cloud distance): a running minimum, no heap.
+                    // The common case (cloud/cloud distance): a running minimum, no
+                    // heap, and a cell is skipped when its box is already farther
+                    // than the best distance (ties are still scanned).
+                    const Eigen::Vector3d local = q.cast<double>() - centre;
+                    double faceGap2[3][3];
+                    for (int a = 0; a < 3; ++a) {
+                        const double below = 0.5 * l + local[a], above = 0.5 * l - local[a];
+                        faceGap2[a][0] = below * below;
+                        faceGap2[a][1] = 0.0;
+                        faceGap2[a][2] = above * above;
+                    }
                     Neighbour best{0, std::numeric_limits<float>::infinity()};
-                    for (std::size_t j = 0; j < m; ++j) {
-                        const Neighbour candidate{s.indices[j], (s.positions[j] - q).squaredNorm()};
-                        if (candidate < best)
-                            best = candidate;
+                    std::size_t scanned = 0;
+                    for (int c = 0; c < s.cellCount; ++c) {
+                        const auto& o = s.cellOffset[static_cast<std::size_t>(c)];
+                        const double gap2 = faceGap2[0][o[0] + 1] + faceGap2[1][o[1] + 1] + faceGap2[2][o[2] + 1];
+                        if (gap2 > static_cast<double>(best.squaredDistance) * (1 + kSlack))
+                            continue;
+                        const std::uint32_t end = s.cellStart[static_cast<std::size_t>(c) + 1];
+                        for (std::uint32_t j = s.cellStart[static_cast<std::size_t>(c)]; j < end; ++j) {
+                            const Neighbour candidate{s.indices[j], (s.positions[j] - q).squaredNorm()};
+                            if (candidate < best)
+                                best = candidate;
+                        }
+                        scanned += end - s.cellStart[static_cast<std::size_t>(c)];
                     }
                     if (m > 0)
                         s.heap.push_back(best);
+                    s.statistics.distances += scanned;
                 } else {
                     // All candidate distances, then a selection: linear in the
                     // candidates, cheaper than a heap update per candidate.
@@ -599,8 +669,8 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                         s.heap.resize(k);
                     }
                     std::make_heap(s.heap.begin(), s.heap.end());
+                    s.statistics.distances += m;
                 }
-                s.statistics.distances += m;
                 // Inscribed sphere of the 27 cells around q (eq. 4.1 with j = 1).
                 const double inner = 0.5 * l - (q.cast<double>() - centre).cwiseAbs().maxCoeff();
                 const double inscribed = l + inner;
@@ -629,21 +699,23 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
 int Octree::bestLevelFor(const Octree& queries, std::size_t k) const
 {
     // Cost model of thesis 000 eq. 4.2, adapted to nearestBatch:
-    //   distances: every query compares itself with the points of 27 cells,
-    //              about 27 * mean reference points per cell;
-    //   lookups:   27 binary searches (log2 of the reference size) per query cell;
-    //   misses:    a query cell with no homologue (or fewer than k points in it)
-    //              usually needs a full search, weighted like the thesis's
+    //   distances: a query scans its own cell and the few neighbours the
+    //              pruning keeps, about 2.5 mean cells (27 for k > 1, unpruned);
+    //   lookups:   27 searches in the directory of non-empty cells per query
+    //              cell, each step weighted 4 distances (a dependent, often
+    //              mispredicted load; measured in docs/benchmarks.md);
+    //   misses:    a query cell whose homologue holds fewer than k points usually
+    //              needs a full search, weighted like the thesis's
     //              t_vois / t_dist ~ 10^3.
+    // Levels are tried from the root down and the search stops once the cost has
+    // risen for two levels in a row.
     const double queryCount = static_cast<double>(queries.size());
-    const double searchSteps = std::log2(static_cast<double>(size()) + 1.0);
+    const double cellsScanned = k == 1 ? 2.5 : 27.0;
     double bestCost = std::numeric_limits<double>::infinity();
-    int bestLevel = 1;
-    for (int level = 1; level <= kMaxLevel; ++level) {
-        const double meanReference = stats_[static_cast<std::size_t>(level)].meanPointsPerCell;
-        // Deeper levels only add cost once cells are nearly empty.
-        if (meanReference < 0.25)
-            break;
+    int bestLevel = 1, rises = 0;
+    double previous = std::numeric_limits<double>::infinity();
+    for (int level = 1; level <= kMaxLevel && rises < 2; ++level) {
+        const LevelStatistics& reference = stats_[static_cast<std::size_t>(level)];
         const int shift = 3 * (kMaxLevel - level);
         std::size_t queryCells = 0, misses = 0, r = 0;
         queries.forEachCell(level, [&](MortonCode cell, std::size_t, std::size_t) {
@@ -656,8 +728,11 @@ int Octree::bestLevelFor(const Octree& queries, std::size_t k) const
             if (e - r < k)
                 ++misses;
         });
-        const double cost = queryCount * 27.0 * meanReference + static_cast<double>(queryCells) * 27.0 * searchSteps +
-                            1000.0 * static_cast<double>(misses);
+        const double searchSteps = std::log2(static_cast<double>(reference.nonEmptyCells) + 1.0);
+        const double cost = queryCount * cellsScanned * reference.meanPointsPerCell +
+                            static_cast<double>(queryCells) * 27.0 * 4.0 * searchSteps + 1000.0 * static_cast<double>(misses);
+        rises = cost > previous ? rises + 1 : 0;
+        previous = cost;
         if (cost < bestCost) {
             bestCost = cost;
             bestLevel = level;

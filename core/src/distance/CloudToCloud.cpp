@@ -114,10 +114,11 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
     const bool useModel = params.model != LocalModel::None;
     const bool batchNeighbourhoods = useModel && !params.radius;
     const std::size_t k = batchNeighbourhoods ? static_cast<std::size_t>(params.neighbours) : 1;
-    // Levels whose cells hold about 8 reference points for NN (the level sweep of
-    // docs/benchmarks.md) and about 1.5 k for k neighbours, so that the 27 cells
-    // around a query almost always settle it.
-    const double targetPopulation = batchNeighbourhoods ? std::max(8.0, 1.5 * static_cast<double>(k)) : 8.0;
+    // Levels whose cells hold about 30 reference points for NN (the batch prunes
+    // the neighbour cells a query cannot need; level sweep in docs/benchmarks.md)
+    // and about 1.5 k for k neighbours, so that the 27 cells around a query
+    // almost always settle it.
+    const double targetPopulation = batchNeighbourhoods ? std::max(8.0, 1.5 * static_cast<double>(k)) : 30.0;
     result.level = params.octreeLevel;
     if (result.level == 0) {
         double bestGap = std::numeric_limits<double>::infinity();
