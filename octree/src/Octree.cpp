@@ -491,6 +491,7 @@ struct BatchScratch
 {
     std::vector<Eigen::Vector3f> positions;
     std::vector<std::uint32_t> indices;
+    std::vector<float> distances; //!< one cell's squared distances (k = 1 scan)
     std::vector<Neighbour> heap;
     //! Where each gathered cell's points start in positions/indices, and its
     //! offset from the query cell: the queries skip the cells they cannot need.
@@ -647,13 +648,25 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                         const double gap2 = faceGap2[0][o[0] + 1] + faceGap2[1][o[1] + 1] + faceGap2[2][o[2] + 1];
                         if (gap2 > static_cast<double>(best.squaredDistance) * (1 + kSlack))
                             continue;
+                        const std::uint32_t begin = s.cellStart[static_cast<std::size_t>(c)];
                         const std::uint32_t end = s.cellStart[static_cast<std::size_t>(c) + 1];
-                        for (std::uint32_t j = s.cellStart[static_cast<std::size_t>(c)]; j < end; ++j) {
-                            const Neighbour candidate{s.indices[j], (s.positions[j] - q).squaredNorm()};
-                            if (candidate < best)
-                                best = candidate;
+                        // Distances first (independent, vectorisable), then the
+                        // minimum with the index tie-break.
+                        const std::size_t count = end - begin;
+                        if (s.distances.size() < count)
+                            s.distances.resize(count);
+                        float* d2 = s.distances.data();
+                        const Eigen::Vector3f* p = s.positions.data() + begin;
+                        for (std::size_t j = 0; j < count; ++j)
+                            d2[j] = (p[j] - q).squaredNorm();
+                        for (std::size_t j = 0; j < count; ++j) {
+                            if (d2[j] <= best.squaredDistance) {
+                                const Neighbour candidate{s.indices[begin + j], d2[j]};
+                                if (candidate < best)
+                                    best = candidate;
+                            }
                         }
-                        scanned += end - s.cellStart[static_cast<std::size_t>(c)];
+                        scanned += count;
                     }
                     if (m > 0)
                         s.heap.push_back(best);
