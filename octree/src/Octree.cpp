@@ -561,23 +561,15 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
             groupStart.push_back(i);
     groupStart.push_back(count);
 
-    // A directory of the level's non-empty cells: one binary search over the
-    // cells (small enough to stay in cache) instead of two over every code.
-    std::vector<MortonCode> directoryCodes;
-    std::vector<std::uint32_t> directoryStart;
-    directoryCodes.reserve(stats_[static_cast<std::size_t>(level)].nonEmptyCells);
-    directoryStart.reserve(stats_[static_cast<std::size_t>(level)].nonEmptyCells + 1);
-    forEachCell(level, [&](MortonCode code, std::size_t begin, std::size_t) {
-        directoryCodes.push_back(code);
-        directoryStart.push_back(static_cast<std::uint32_t>(begin));
-    });
-    directoryStart.push_back(static_cast<std::uint32_t>(codes_.size()));
+    // The level's directory of non-empty cells: one binary search over the cells
+    // (small enough to stay in cache) instead of two over every code.
+    const CellDirectory& directory = cellDirectory(level);
     auto lookup = [&](MortonCode code) -> std::pair<std::size_t, std::size_t> {
-        const auto it = std::lower_bound(directoryCodes.begin(), directoryCodes.end(), code);
-        if (it == directoryCodes.end() || *it != code)
+        const auto it = std::lower_bound(directory.codes.begin(), directory.codes.end(), code);
+        if (it == directory.codes.end() || *it != code)
             return {0, 0};
-        const auto d = static_cast<std::size_t>(it - directoryCodes.begin());
-        return {directoryStart[d], directoryStart[d + 1]};
+        const auto d = static_cast<std::size_t>(it - directory.codes.begin());
+        return {directory.starts[d], directory.starts[d + 1]};
     };
 
     tbb::enumerable_thread_specific<BatchScratch> scratch;
@@ -707,6 +699,24 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
             statistics->fullSearches += s.statistics.fullSearches;
         }
     }
+}
+
+const Octree::CellDirectory& Octree::cellDirectory(int level) const
+{
+    std::lock_guard<std::mutex> lock(directories_->mutex);
+    auto& slot = directories_->levels[static_cast<std::size_t>(level)];
+    if (!slot) {
+        auto directory = std::make_unique<CellDirectory>();
+        directory->codes.reserve(stats_[static_cast<std::size_t>(level)].nonEmptyCells);
+        directory->starts.reserve(stats_[static_cast<std::size_t>(level)].nonEmptyCells + 1);
+        forEachCell(level, [&](MortonCode code, std::size_t begin, std::size_t) {
+            directory->codes.push_back(code);
+            directory->starts.push_back(static_cast<std::uint32_t>(begin));
+        });
+        directory->starts.push_back(static_cast<std::uint32_t>(codes_.size()));
+        slot = std::move(directory);
+    }
+    return *slot;
 }
 
 int Octree::bestLevelFor(const Octree& queries, std::size_t k) const

@@ -16,6 +16,8 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -148,8 +150,25 @@ private:
     void scanCell(std::int64_t x, std::int64_t y, std::int64_t z, int level, const Eigen::Vector3f& q, std::size_t k,
                   std::vector<Neighbour>& heap) const;
 
+    //! The non-empty cells of one level with where their points start: batch
+    //! queries search this (small, cache-resident) list instead of every code.
+    struct CellDirectory
+    {
+        std::vector<MortonCode> codes;
+        std::vector<std::uint32_t> starts; //!< one more than codes: the end
+    };
+    //! Built on first use for a level and kept (thread-safe): callers that query
+    //! in chunks must not rebuild it for every chunk.
+    const CellDirectory& cellDirectory(int level) const;
+    struct DirectoryCache
+    {
+        std::mutex mutex;
+        std::array<std::unique_ptr<CellDirectory>, kMaxLevel + 1> levels;
+    };
+
     const Eigen::Vector3f* points_;
     CubicBox box_;
+    std::shared_ptr<DirectoryCache> directories_ = std::make_shared<DirectoryCache>();
     std::vector<MortonCode> codes_;
     std::vector<std::uint32_t> indices_;
     std::vector<LevelStatistics> stats_;
