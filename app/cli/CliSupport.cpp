@@ -5,6 +5,7 @@
 
 #include <tbb/global_control.h>
 
+#include <cmath>
 #include <csignal>
 #include <iomanip>
 #include <cstdio>
@@ -142,10 +143,10 @@ io::ReadOptions ReadFlags::toOptions(ProgressObserver* progress) const
             try {
                 std::size_t used = 0;
                 o[a] = std::stod(parts[static_cast<std::size_t>(a)], &used);
-                if (used != parts[static_cast<std::size_t>(a)].size())
+                if (used != parts[static_cast<std::size_t>(a)].size() || !std::isfinite(o[a]))
                     throw std::invalid_argument("trailing text");
             } catch (const std::exception&) {
-                throw Error(ErrorCode::InvalidArgument, "--origin: '" + parts[static_cast<std::size_t>(a)] + "' is not a number");
+                throw Error(ErrorCode::InvalidArgument, "--origin: '" + parts[static_cast<std::size_t>(a)] + "' is not a finite number");
             }
         }
         options.origin = o;

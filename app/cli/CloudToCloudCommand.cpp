@@ -25,10 +25,10 @@ std::vector<double> parseNumbers(const std::string& text, const std::string& opt
         try {
             std::size_t used = 0;
             values.push_back(std::stod(part, &used));
-            if (used != part.size())
+            if (used != part.size() || !std::isfinite(values.back()))
                 throw std::invalid_argument(part);
         } catch (const std::exception&) {
-            throw Error(ErrorCode::InvalidArgument, option + ": '" + part + "' is not a number");
+            throw Error(ErrorCode::InvalidArgument, option + ": '" + part + "' is not a finite number");
         }
     }
     return values;

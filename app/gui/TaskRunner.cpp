@@ -42,6 +42,10 @@ TaskResult runTask(QWidget* parent, const QString& title, const std::function<vo
         } catch (const std::exception& e) {
             result.outcome = TaskOutcome::Failed;
             result.error = QString::fromStdString(e.what());
+        } catch (...) {
+            // A thread must not let anything escape: std::terminate would follow.
+            result.outcome = TaskOutcome::Failed;
+            result.error = QObject::tr("%1: unknown error").arg(title);
         }
     });
     QEventLoop loop;

@@ -178,11 +178,12 @@ Octree::Octree(const Eigen::Vector3f* points, std::size_t count, std::optional<C
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             std::uint32_t c[3];
             for (int a = 0; a < 3; ++a) {
-                const auto v = static_cast<std::int64_t>(std::floor((points[i][a] - box_.min[a]) * scale));
+                const double offset = points[i][a] - box_.min[a];
                 // The far face itself belongs to the last cell; beyond it, the
                 // geometric pruning of the queries would no longer hold.
-                if (v < 0 || v > maxCell + 1)
+                if (offset < 0 || offset > box_.size)
                     outside = true;
+                const auto v = static_cast<std::int64_t>(std::floor(std::clamp(offset * scale, -1.0, double(maxCell) + 1.0)));
                 c[a] = static_cast<std::uint32_t>(std::clamp<std::int64_t>(v, 0, maxCell));
             }
             keyed[i] = {encodeCell(c[0], c[1], c[2]), static_cast<std::uint32_t>(i)};
@@ -246,8 +247,12 @@ std::array<std::int64_t, 3> Octree::cellOf(const Eigen::Vector3f& q, int level) 
 {
     const double l = cellSize(level);
     std::array<std::int64_t, 3> c{};
+    // Clamped so that a query absurdly far away cannot overflow the integers;
+    // such queries are answered by the descent anyway (see nearest()).
+    const double limit = 4.0 * static_cast<double>(std::int64_t(1) << level);
     for (int a = 0; a < 3; ++a)
-        c[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(std::floor((q[a] - box_.min[a]) / l));
+        c[static_cast<std::size_t>(a)] =
+            static_cast<std::int64_t>(std::floor(std::clamp((q[a] - box_.min[a]) / l, -limit, limit)));
     return c;
 }
 
@@ -341,6 +346,15 @@ void Octree::nearest(const Eigen::Vector3f& q, std::size_t k, int level, std::ve
     const std::int64_t n = std::int64_t(1) << level;
     const auto c = cellOf(q, level);
     const double l = cellSize(level);
+    // A query more than a cube away from the cube: the rings would be empty for
+    // long, and the descent is exact and logarithmic.
+    for (int a = 0; a < 3; ++a)
+        if (c[static_cast<std::size_t>(a)] < -n || c[static_cast<std::size_t>(a)] >= 2 * n) {
+            out.reserve(k);
+            descendNearest(q, k, level, out);
+            std::sort_heap(out.begin(), out.end());
+            return;
+        }
     // Distance from q to the faces of its own cell: the inscribed radius of eq. 4.1 is j*l plus this.
     double inner = std::numeric_limits<double>::infinity();
     std::int64_t firstRing = 0, lastRing = 0;
@@ -409,11 +423,17 @@ void Octree::withinRadius(const Eigen::Vector3f& q, float radius, int level, std
     const float r2 = radius * radius;
     std::int64_t lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
-        lo[a] = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor((q[a] - radius - box_.min[a]) / l)) - 1);
-        hi[a] = std::min<std::int64_t>(n - 1, static_cast<std::int64_t>(std::floor((q[a] + radius - box_.min[a]) / l)) + 1);
+        // Clamped in double first: a huge radius must not overflow the integers.
+        const double first = std::clamp(std::floor((q[a] - static_cast<double>(radius) - box_.min[a]) / l) - 1, 0.0, double(n - 1));
+        const double last = std::clamp(std::floor((q[a] + static_cast<double>(radius) - box_.min[a]) / l) + 1, 0.0, double(n - 1));
+        lo[a] = static_cast<std::int64_t>(first);
+        hi[a] = static_cast<std::int64_t>(last);
+        if (q[a] + static_cast<double>(radius) < box_.min[a] || q[a] - static_cast<double>(radius) > box_.min[a] + box_.size)
+            return; // the sphere misses the cube
     }
-    const std::int64_t boxCells = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
-    if (boxCells > kMaxRadiusCells) {
+    // In double: at deep levels the product exceeds 64-bit integers.
+    const double boxCells = double(hi[0] - lo[0] + 1) * double(hi[1] - lo[1] + 1) * double(hi[2] - lo[2] + 1);
+    if (boxCells > static_cast<double>(kMaxRadiusCells)) {
         descend(
             q, level,
             [&](std::size_t first, std::size_t last) {
@@ -542,8 +562,9 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
             std::int64_t c[3];
             bool inside = queries[i].allFinite();
             for (int a = 0; a < 3 && inside; ++a) {
-                c[a] = static_cast<std::int64_t>(std::floor((queries[i][a] - box_.min[a]) / l));
-                inside = c[a] >= 0 && c[a] < n;
+                const double cell = std::floor((queries[i][a] - box_.min[a]) / l);
+                inside = cell >= 0 && cell < static_cast<double>(n);
+                c[a] = inside ? static_cast<std::int64_t>(cell) : 0;
             }
             order[i] = {inside ? encodeCell(static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]),
                                             static_cast<std::uint32_t>(c[2]))

@@ -395,3 +395,31 @@ TEST(Octree, BatchSettlesQueriesInCellsOnTheCubesLowFaces)
     for (std::size_t i = 0; i < queries.size(); i += 50)
         EXPECT_EQ(got[i].squaredDistance, bruteForceNearest(reference, queries[i], 1)[0].squaredDistance);
 }
+
+TEST(Octree, ExtremeQueriesAndRadiiStayExact)
+{
+    std::mt19937 rng(43);
+    const Cloud cloud = randomCloud(500, rng);
+    const Octree tree(cloud.data(), cloud.size());
+    std::vector<Neighbour> got;
+    // A radius larger than everything returns every point.
+    tree.withinRadius({0, 0, 0}, 1e20f, 1, got);
+    EXPECT_EQ(got.size(), cloud.size());
+    tree.withinRadius({0, 0, 0}, 1e20f, 21, got);
+    EXPECT_EQ(got.size(), cloud.size());
+    // A query absurdly far away still gets its exact nearest points.
+    const Eigen::Vector3f far(3e12f, -2e12f, 1e12f);
+    for (int level : {1, 10, 21}) {
+        tree.nearest(far, 3, level, got);
+        expectSame(got, bruteForceNearest(cloud, far, 3), "far query level " + std::to_string(level));
+    }
+    // A point just beyond a caller's cube is refused rather than mis-filed.
+    CubicBox unit;
+    unit.size = 1.0;
+    const Cloud beyond = {{0.5f, 0.5f, 0.5f}, {1.0000004f, 0.5f, 0.5f}};
+    EXPECT_THROW(Octree(beyond.data(), beyond.size(), unit), std::invalid_argument);
+    const Cloud onFace = {{0.5f, 0.5f, 0.5f}, {1.0f, 0.5f, 0.5f}};
+    const Octree faceTree(onFace.data(), onFace.size(), unit);
+    faceTree.nearest({1.0f, 0.5f, 0.5f}, 1, 21, got);
+    EXPECT_EQ(got[0].index, 1u);
+}

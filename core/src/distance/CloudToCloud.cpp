@@ -203,13 +203,13 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
                     else
                         ++localFallbacks; // thesis: a degenerate neighbourhood is no worse than plain NN
                 }
-                if (params.closestPoints)
-                    closestIndex[i] = nb.index;
                 if (params.maxDistance && std::abs(d) > *params.maxDistance) {
                     if (!params.clampBeyondMax)
                         continue;
                     d = d < 0 ? -*params.maxDistance : *params.maxDistance;
                 }
+                if (params.closestPoints)
+                    closestIndex[i] = nb.index;
                 result.distance.values()[i] = static_cast<float>(d);
                 if (params.splitComponents) {
                     const Eigen::Vector3f v = q - p;

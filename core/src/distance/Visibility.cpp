@@ -27,16 +27,24 @@ Angular toAngular(const Eigen::Matrix3d& worldToSensor, const Eigen::Vector3d& s
 
 DepthMap::DepthMap(const PointCloud& reference, const SensorPose& pose, const VisibilityParams& params,
                    const std::vector<std::uint32_t>& pointsOfScan)
+    : DepthMap(reference, pose, params, pointsOfScan.empty() ? nullptr : &pointsOfScan)
+{
+}
+
+DepthMap::DepthMap(const PointCloud& reference, const SensorPose& pose, const VisibilityParams& params,
+                   const std::vector<std::uint32_t>* pointsOfScan)
     : pose_(pose), worldToSensor_(pose.orientation.normalized().toRotationMatrix().transpose()), tolerance_(params.tolerance)
 {
     if (!(params.tolerance >= 0))
         throw Error(ErrorCode::InvalidArgument, "visibility tolerance must be >= 0 m");
-    const std::size_t count = pointsOfScan.empty() ? reference.size() : pointsOfScan.size();
+    if (!pose.position.allFinite() || !pose.orientation.coeffs().allFinite())
+        throw Error(ErrorCode::InvalidArgument, "a viewpoint's position or orientation is not finite");
+    const std::size_t count = pointsOfScan ? pointsOfScan->size() : reference.size();
     std::vector<Angular> angles;
     angles.reserve(count);
     double yawLo = std::numeric_limits<double>::infinity(), yawHi = -yawLo, pitchLo = yawLo, pitchHi = -yawLo;
     for (std::size_t j = 0; j < count; ++j) {
-        const std::size_t i = pointsOfScan.empty() ? j : pointsOfScan[j];
+        const std::size_t i = pointsOfScan ? (*pointsOfScan)[j] : j;
         if (!reference.positions()[i].allFinite())
             continue;
         const Angular a = toAngular(worldToSensor_, pose.position, reference.globalPosition(i));
@@ -62,10 +70,12 @@ DepthMap::DepthMap(const PointCloud& reference, const SensorPose& pose, const Vi
     // The map covers the scan's own angular extent (its "arbitrary crop") plus half a step.
     yawMin_ = yawLo - 0.5 * yawStep_;
     pitchMin_ = pitchLo - 0.5 * pitchStep_;
-    width_ = std::max(1, static_cast<int>(std::ceil((yawHi - yawLo) / yawStep_)) + 1);
-    height_ = std::max(1, static_cast<int>(std::ceil((pitchHi - pitchLo) / pitchStep_)) + 1);
-    if (static_cast<double>(width_) * height_ > 4e8)
+    // Sizes in double first: a tiny step must give an error, not an int overflow.
+    const double columns = std::ceil((yawHi - yawLo) / yawStep_) + 1, rows = std::ceil((pitchHi - pitchLo) / pitchStep_) + 1;
+    if (!(columns * rows <= 4e8))
         throw Error(ErrorCode::InvalidArgument, "the depth map would need more than 4e8 cells: give larger angular steps");
+    width_ = std::max(1, static_cast<int>(columns));
+    height_ = std::max(1, static_cast<int>(rows));
     const float empty = -1.0f;
     range_.assign(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_), empty);
     for (const Angular& a : angles) {
@@ -126,7 +136,8 @@ std::vector<VisibilityLabel> visibilityLabels(const PointCloud& compared, const 
         throw Error(ErrorCode::InvalidArgument, "the visibility test needs at least one reference viewpoint");
     // Which reference points belong to which scan, when the reference says so.
     std::vector<std::vector<std::uint32_t>> members(viewpoints.size());
-    if (const ScalarField* scan = reference.field(params.scanIndexField); scan && viewpoints.size() > 1) {
+    const ScalarField* scan = viewpoints.size() > 1 ? reference.field(params.scanIndexField) : nullptr;
+    if (scan) {
         for (std::size_t i = 0; i < reference.size(); ++i) {
             const double s = scan->value(i);
             if (s >= 0 && s < static_cast<double>(viewpoints.size()))
@@ -134,8 +145,12 @@ std::vector<VisibilityLabel> visibilityLabels(const PointCloud& compared, const 
         }
     }
     std::vector<DepthMap> maps;
-    for (std::size_t v = 0; v < viewpoints.size(); ++v)
-        maps.emplace_back(reference, viewpoints[v], params, members[v]);
+    for (std::size_t v = 0; v < viewpoints.size(); ++v) {
+        if (scan && members[v].empty())
+            throw Error(ErrorCode::InvalidData, "cloud '" + reference.name + "': no point has " + params.scanIndexField + " = " +
+                                                    std::to_string(v) + ", the index of viewpoint " + std::to_string(v));
+        maps.emplace_back(reference, viewpoints[v], params, scan ? &members[v] : nullptr);
+    }
 
     std::vector<VisibilityLabel> labels(compared.size(), VisibilityLabel::OutOfField);
     ProgressTicker ticker(progress, "Visibility", compared.size());

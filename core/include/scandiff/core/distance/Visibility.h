@@ -44,6 +44,10 @@ public:
     DepthMap(const PointCloud& reference, const SensorPose& pose, const VisibilityParams& params,
              const std::vector<std::uint32_t>& pointsOfScan = {});
 
+    //! `pointsOfScan` null: every reference point.
+    DepthMap(const PointCloud& reference, const SensorPose& pose, const VisibilityParams& params,
+             const std::vector<std::uint32_t>* pointsOfScan);
+
     VisibilityLabel classify(const Eigen::Vector3d& globalPoint) const;
 
     int width() const { return width_; }
