@@ -2,6 +2,8 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/distance/CloudToCloud.h>
 
+#include "TestSupport.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -55,16 +57,6 @@ double rms(const ScalarField& f)
             ++count;
         }
     return std::sqrt(sum / static_cast<double>(count));
-}
-
-ErrorCode errorOf(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.code();
-    }
-    return ErrorCode::Internal;
 }
 
 } // namespace
@@ -223,7 +215,7 @@ TEST(CloudToCloud, SignedByReferenceNormalsOrModel)
     }
     reference.removeNormals();
     params.model = LocalModel::None;
-    EXPECT_EQ(errorOf([&] { cloudToCloud(compared, reference, params); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { cloudToCloud(compared, reference, params); }), ErrorCode::InvalidArgument);
 }
 
 TEST(CloudToCloud, VisibilityOnTheWallScenario)
@@ -291,18 +283,18 @@ TEST(CloudToCloud, BadInputs)
     const PointCloud cloud = randomCloud(10, rng);
     PointCloud empty;
     CloudToCloudParams params;
-    EXPECT_EQ(errorOf([&] { cloudToCloud(cloud, empty, params); }), ErrorCode::InvalidData);
+    EXPECT_EQ(test::errorCodeOf([&] { cloudToCloud(cloud, empty, params); }), ErrorCode::InvalidData);
     PointCloud withNan = cloud.clone();
     withNan.positions()[3] = {std::nanf(""), 0, 0};
-    EXPECT_EQ(errorOf([&] { cloudToCloud(cloud, withNan, params); }), ErrorCode::InvalidData);
+    EXPECT_EQ(test::errorCodeOf([&] { cloudToCloud(cloud, withNan, params); }), ErrorCode::InvalidData);
     const CloudToCloudResult none = cloudToCloud(empty, cloud, params);
     EXPECT_EQ(none.distance.size(), 0u);
     EXPECT_EQ(none.statistics.count, 0u);
     params.maxDistance = -1.0;
-    EXPECT_EQ(errorOf([&] { cloudToCloud(cloud, cloud, params); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { cloudToCloud(cloud, cloud, params); }), ErrorCode::InvalidArgument);
     params.maxDistance.reset();
     params.neighbours = 2;
-    EXPECT_EQ(errorOf([&] { cloudToCloud(cloud, cloud, params); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { cloudToCloud(cloud, cloud, params); }), ErrorCode::InvalidArgument);
 }
 
 TEST(CloudToCloud, CancellationLeavesInputsUntouched)
@@ -317,7 +309,7 @@ TEST(CloudToCloud, CancellationLeavesInputsUntouched)
     const PointCloud reference = randomCloud(1000, rng);
     PointCloud compared = randomCloud(1000, rng);
     const auto before = compared.positions();
-    EXPECT_EQ(errorOf([&] { cloudToCloud(compared, reference, {}, &cancel); }), ErrorCode::Cancelled);
+    EXPECT_EQ(test::errorCodeOf([&] { cloudToCloud(compared, reference, {}, &cancel); }), ErrorCode::Cancelled);
     EXPECT_EQ(compared.positions(), before);
     EXPECT_TRUE(compared.fields().empty());
 }

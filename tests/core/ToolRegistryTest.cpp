@@ -2,6 +2,8 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/ToolRegistry.h>
 
+#include "TestSupport.h"
+
 #include <gtest/gtest.h>
 
 using namespace scandiff;
@@ -20,16 +22,6 @@ ToolSpec sampleTool()
     };
     tool.run = [](const PointCloud&, const ParameterValues&, ProgressObserver*) { return ToolResult{}; };
     return tool;
-}
-
-ErrorCode codeOf(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.code();
-    }
-    return ErrorCode::Internal;
 }
 
 } // namespace
@@ -53,13 +45,13 @@ TEST(ToolRegistry, UserTextIsParsedAndChecked)
     EXPECT_TRUE(v.boolean("signed"));
     EXPECT_EQ(v.text("model"), "quadric");
 
-    EXPECT_EQ(codeOf([&] { tool.resolve({{"k", "0"}}); }), ErrorCode::InvalidArgument);
-    EXPECT_EQ(codeOf([&] { tool.resolve({{"k", "1.5"}}); }), ErrorCode::InvalidArgument);
-    EXPECT_EQ(codeOf([&] { tool.resolve({{"radius", "11"}}); }), ErrorCode::InvalidArgument);
-    EXPECT_EQ(codeOf([&] { tool.resolve({{"radius", "nan"}}); }), ErrorCode::InvalidArgument);
-    EXPECT_EQ(codeOf([&] { tool.resolve({{"model", "spline"}}); }), ErrorCode::InvalidArgument);
-    EXPECT_EQ(codeOf([&] { tool.resolve({{"signed", "maybe"}}); }), ErrorCode::InvalidArgument);
-    EXPECT_EQ(codeOf([&] { tool.resolve({{"unknown", "1"}}); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { tool.resolve({{"k", "0"}}); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { tool.resolve({{"k", "1.5"}}); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { tool.resolve({{"radius", "11"}}); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { tool.resolve({{"radius", "nan"}}); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { tool.resolve({{"model", "spline"}}); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { tool.resolve({{"signed", "maybe"}}); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { tool.resolve({{"unknown", "1"}}); }), ErrorCode::InvalidArgument);
     try {
         tool.resolve({{"radius", "11"}});
     } catch (const Error& e) {

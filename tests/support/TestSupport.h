@@ -3,8 +3,11 @@
 //! Helpers shared by the test suites: data paths (configured by CMake), a
 //! per-test temporary folder, and small file utilities.
 
+#include <scandiff/core/Error.h>
+
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <string>
 
@@ -46,6 +49,17 @@ inline std::string readBytes(const std::filesystem::path& path)
 {
     std::ifstream in(path, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+//! The code of the scandiff::Error that `f` throws; Internal if it throws none.
+inline ErrorCode errorCodeOf(const std::function<void()>& f)
+{
+    try {
+        f();
+    } catch (const Error& e) {
+        return e.code();
+    }
+    return ErrorCode::Internal;
 }
 
 } // namespace scandiff::test
