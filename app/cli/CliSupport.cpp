@@ -80,6 +80,22 @@ bool TerminalProgress::cancelRequested() const
     return interrupted.load();
 }
 
+std::vector<double> parseNumberList(const std::string& text, const std::string& option)
+{
+    std::vector<double> values;
+    for (const std::string& part : splitList(text, ',')) {
+        try {
+            std::size_t used = 0;
+            values.push_back(std::stod(part, &used));
+            if (used != part.size() || !std::isfinite(values.back()))
+                throw std::invalid_argument(part);
+        } catch (const std::exception&) {
+            throw Error(ErrorCode::InvalidArgument, option + ": '" + part + "' is not a finite number");
+        }
+    }
+    return values;
+}
+
 void ThreadLimit::addOption(CLI::App& command, int& threads)
 {
     command.add_option("--threads", threads, "Number of threads (default: all cores)")->check(CLI::Range(1, 1024));
@@ -135,20 +151,10 @@ io::ReadOptions ReadFlags::toOptions(ProgressObserver* progress) const
     if (skipLines >= 0)
         options.asciiSkipLines = static_cast<std::size_t>(skipLines);
     if (!origin.empty()) {
-        const auto parts = splitList(origin, ',');
-        Eigen::Vector3d o;
-        if (parts.size() != 3)
+        const std::vector<double> v = parseNumberList(origin, "--origin");
+        if (v.size() != 3)
             throw Error(ErrorCode::InvalidArgument, "--origin: expected X,Y,Z");
-        for (int a = 0; a < 3; ++a) {
-            try {
-                std::size_t used = 0;
-                o[a] = std::stod(parts[static_cast<std::size_t>(a)], &used);
-                if (used != parts[static_cast<std::size_t>(a)].size() || !std::isfinite(o[a]))
-                    throw std::invalid_argument("trailing text");
-            } catch (const std::exception&) {
-                throw Error(ErrorCode::InvalidArgument, "--origin: '" + parts[static_cast<std::size_t>(a)] + "' is not a finite number");
-            }
-        }
+        const Eigen::Vector3d o(v[0], v[1], v[2]);
         options.origin = o;
     }
     return options;

@@ -53,6 +53,10 @@ struct WriteFlags
     io::WriteOptions toOptions(ProgressObserver* progress) const;
 };
 
+//! "1.5,2,-3" -> {1.5, 2, -3}; throws Error(InvalidArgument) naming `option`
+//! for an empty, non-numeric or non-finite item.
+std::vector<double> parseNumberList(const std::string& text, const std::string& option);
+
 //! --threads N: limits TBB's worker threads for the lifetime of the object.
 class ThreadLimit
 {

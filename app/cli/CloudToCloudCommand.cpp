@@ -16,24 +16,6 @@ namespace scandiff::cli {
 
 namespace {
 
-std::vector<double> parseNumbers(const std::string& text, const std::string& option)
-{
-    std::vector<double> values;
-    std::stringstream stream(text);
-    std::string part;
-    while (std::getline(stream, part, ',')) {
-        try {
-            std::size_t used = 0;
-            values.push_back(std::stod(part, &used));
-            if (used != part.size() || !std::isfinite(values.back()))
-                throw std::invalid_argument(part);
-        } catch (const std::exception&) {
-            throw Error(ErrorCode::InvalidArgument, option + ": '" + part + "' is not a finite number");
-        }
-    }
-    return values;
-}
-
 double radians(double degrees) { return degrees * M_PI / 180.0; }
 
 //! A viewpoint from --sensor X,Y,Z[,HEADING,PITCH,ROLL] (degrees; heading about
@@ -41,7 +23,7 @@ double radians(double degrees) { return degrees * M_PI / 180.0; }
 //! --sensor-fov and --sensor-range.
 SensorPose parseSensor(const std::string& text, const std::string& step, const std::string& fov, double range)
 {
-    const std::vector<double> v = parseNumbers(text, "--sensor");
+    const std::vector<double> v = parseNumberList(text, "--sensor");
     if (v.size() != 3 && v.size() != 6)
         throw Error(ErrorCode::InvalidArgument, "--sensor: expected X,Y,Z or X,Y,Z,HEADING,PITCH,ROLL (degrees)");
     SensorPose pose;
@@ -51,14 +33,14 @@ SensorPose parseSensor(const std::string& text, const std::string& step, const s
                            Eigen::AngleAxisd(radians(v[4]), Eigen::Vector3d::UnitY()) *
                            Eigen::AngleAxisd(radians(v[5]), Eigen::Vector3d::UnitX());
     if (!step.empty()) {
-        const std::vector<double> s = parseNumbers(step, "--sensor-step");
+        const std::vector<double> s = parseNumberList(step, "--sensor-step");
         if (s.empty() || s.size() > 2 || s[0] <= 0 || s.back() <= 0)
             throw Error(ErrorCode::InvalidArgument, "--sensor-step: expected DEG or YAWDEG,PITCHDEG, positive");
         pose.yawStep = radians(s[0]);
         pose.pitchStep = radians(s.back());
     }
     if (!fov.empty()) {
-        const std::vector<double> f = parseNumbers(fov, "--sensor-fov");
+        const std::vector<double> f = parseNumberList(fov, "--sensor-fov");
         if (f.size() != 4 || f[0] >= f[1] || f[2] >= f[3])
             throw Error(ErrorCode::InvalidArgument, "--sensor-fov: expected YAWMIN,YAWMAX,PITCHMIN,PITCHMAX in degrees");
         pose.yawMin = radians(f[0]);

@@ -103,25 +103,28 @@ void radixSort(std::vector<KeyedIndex>& keys)
     }
 }
 
+//! The full-depth code of the cell holding p, clamped to the cube (in double,
+//! so a point far outside cannot overflow the integer conversion).
+MortonCode clampedCellCode(const Eigen::Vector3f& p, const CubicBox& box, double scale)
+{
+    constexpr double lastCell = static_cast<double>(kCellsPerAxisAtMaxLevel - 1);
+    std::uint32_t c[3];
+    for (int a = 0; a < 3; ++a)
+        c[a] = static_cast<std::uint32_t>(std::clamp(std::floor((p[a] - box.min[a]) * scale), 0.0, lastCell));
+    return encodeCell(c[0], c[1], c[2]);
+}
+
 } // namespace
 
 std::vector<std::uint32_t> mortonOrder(const Eigen::Vector3f* points, std::size_t count, const CubicBox& box)
 {
     const double scale = static_cast<double>(kCellsPerAxisAtMaxLevel) / box.size;
-    const auto maxCell = static_cast<std::int64_t>(kCellsPerAxisAtMaxLevel - 1);
     std::vector<KeyedIndex> keyed(count);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            if (!points[i].allFinite()) {
-                keyed[i] = {std::numeric_limits<MortonCode>::max(), static_cast<std::uint32_t>(i)};
-                continue;
-            }
-            std::uint32_t c[3];
-            for (int a = 0; a < 3; ++a) {
-                const auto v = static_cast<std::int64_t>(std::floor((points[i][a] - box.min[a]) * scale));
-                c[a] = static_cast<std::uint32_t>(std::clamp<std::int64_t>(v, 0, maxCell));
-            }
-            keyed[i] = {encodeCell(c[0], c[1], c[2]), static_cast<std::uint32_t>(i)};
+            const MortonCode code =
+                points[i].allFinite() ? clampedCellCode(points[i], box, scale) : std::numeric_limits<MortonCode>::max();
+            keyed[i] = {code, static_cast<std::uint32_t>(i)};
         }
     });
     radixSort(keyed);
@@ -171,22 +174,18 @@ Octree::Octree(const Eigen::Vector3f* points, std::size_t count, std::optional<C
         throw std::invalid_argument("the octree's bounding cube must have a finite, positive size");
 
     const double scale = static_cast<double>(kCellsPerAxisAtMaxLevel) / box_.size;
-    const auto maxCell = static_cast<std::int64_t>(kCellsPerAxisAtMaxLevel - 1);
     std::vector<KeyedIndex> keyed(count);
     std::atomic<bool> outside{false};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            std::uint32_t c[3];
+            // The far face itself belongs to the last cell; beyond it, the
+            // geometric pruning of the queries would no longer hold.
             for (int a = 0; a < 3; ++a) {
                 const double offset = points[i][a] - box_.min[a];
-                // The far face itself belongs to the last cell; beyond it, the
-                // geometric pruning of the queries would no longer hold.
                 if (offset < 0 || offset > box_.size)
                     outside = true;
-                const auto v = static_cast<std::int64_t>(std::floor(std::clamp(offset * scale, -1.0, double(maxCell) + 1.0)));
-                c[a] = static_cast<std::uint32_t>(std::clamp<std::int64_t>(v, 0, maxCell));
             }
-            keyed[i] = {encodeCell(c[0], c[1], c[2]), static_cast<std::uint32_t>(i)};
+            keyed[i] = {clampedCellCode(points[i], box_, scale), static_cast<std::uint32_t>(i)};
         }
     });
     if (outside)

@@ -26,12 +26,6 @@ Angular toAngular(const Eigen::Matrix3d& worldToSensor, const Eigen::Vector3d& s
 } // namespace
 
 DepthMap::DepthMap(const PointCloud& reference, const SensorPose& pose, const VisibilityParams& params,
-                   const std::vector<std::uint32_t>& pointsOfScan)
-    : DepthMap(reference, pose, params, pointsOfScan.empty() ? nullptr : &pointsOfScan)
-{
-}
-
-DepthMap::DepthMap(const PointCloud& reference, const SensorPose& pose, const VisibilityParams& params,
                    const std::vector<std::uint32_t>* pointsOfScan)
     : pose_(pose), worldToSensor_(pose.orientation.normalized().toRotationMatrix().transpose()), tolerance_(params.tolerance)
 {

@@ -40,13 +40,10 @@ struct VisibilityParams
 class DepthMap
 {
 public:
-    //! `pointsOfScan` selects the reference points of this viewpoint (empty: all).
+    //! `pointsOfScan` selects the reference points of this viewpoint; null: every
+    //! reference point (a pointer, so that "none" can never be read as "all").
     DepthMap(const PointCloud& reference, const SensorPose& pose, const VisibilityParams& params,
-             const std::vector<std::uint32_t>& pointsOfScan = {});
-
-    //! `pointsOfScan` null: every reference point.
-    DepthMap(const PointCloud& reference, const SensorPose& pose, const VisibilityParams& params,
-             const std::vector<std::uint32_t>* pointsOfScan);
+             const std::vector<std::uint32_t>* pointsOfScan = nullptr);
 
     VisibilityLabel classify(const Eigen::Vector3d& globalPoint) const;
 
