@@ -152,6 +152,7 @@ void ColourScaleEditor::setScale(const ColourScale& scale)
         nameEdit_->setText(QString::fromStdString(scale.name()));
         symmetricBox_->setChecked(scale.symmetric());
         table_->setRowCount(0);
+        positions_.clear();
         colours_.clear();
         for (const ColourStop& s : scale.stops())
             insertRow(table_->rowCount(), s.position, toQColor(s));
@@ -162,6 +163,7 @@ void ColourScaleEditor::setScale(const ColourScale& scale)
 void ColourScaleEditor::insertRow(int row, double position, const QColor& colour)
 {
     table_->insertRow(row);
+    positions_.insert(row, position);
     colours_.insert(row, colour);
     auto* box = new QDoubleSpinBox(table_);
     box->setRange(0.0, 1.0);
@@ -169,7 +171,8 @@ void ColourScaleEditor::insertRow(int row, double position, const QColor& colour
     box->setSingleStep(0.01);
     box->setValue(position);
     box->setFrame(false);
-    connect(box, qOverload<double>(&QDoubleSpinBox::valueChanged), this, &ColourScaleEditor::revalidate);
+    connect(box, qOverload<double>(&QDoubleSpinBox::valueChanged), this,
+            [this, box](double value) { positionEdited(box, value); });
     table_->setCellWidget(row, 0, box);
     auto* button = new QPushButton(table_);
     button->setFlat(true);
@@ -189,6 +192,17 @@ void ColourScaleEditor::chooseColour(QPushButton* button)
             setStopColour(row, chosen);
         return;
     }
+}
+
+void ColourScaleEditor::positionEdited(QDoubleSpinBox* box, double value)
+{
+    for (int row = 0; row < table_->rowCount(); ++row) {
+        if (table_->cellWidget(row, 0) == box) {
+            positions_[row] = value;
+            break;
+        }
+    }
+    revalidate();
 }
 
 int ColourScaleEditor::stopCount() const { return table_->rowCount(); }
@@ -220,8 +234,8 @@ void ColourScaleEditor::setStopColour(int row, const QColor& colour)
 int ColourScaleEditor::addStop()
 {
     std::vector<double> positions;
-    for (int row = 0; row < stopCount(); ++row)
-        positions.push_back(positionBox(row)->value());
+    for (double p : positions_)
+        positions.push_back(p);
     std::sort(positions.begin(), positions.end());
     double position;
     if (positions.empty() || positions.front() > 0.0) {
@@ -238,7 +252,7 @@ int ColourScaleEditor::addStop()
     }
     // The new row goes where its position sorts, so the table stays readable.
     int row = 0;
-    while (row < stopCount() && positionBox(row)->value() <= position)
+    while (row < stopCount() && positions_[row] <= position)
         ++row;
     const auto c = scale().colourAt(position);
     insertRow(row, position, QColor(c[0], c[1], c[2]));
@@ -255,6 +269,7 @@ void ColourScaleEditor::removeStop()
     if (row < 0 || row >= stopCount())
         row = stopCount() - 1;
     table_->removeRow(row);
+    positions_.remove(row);
     colours_.remove(row);
     revalidate();
 }
@@ -268,7 +283,7 @@ void ColourScaleEditor::revalidate()
     std::vector<ColourStop> stops;
     for (int row = 0; row < stopCount(); ++row) {
         const QColor& c = colours_[row];
-        stops.push_back({positionBox(row)->value(), static_cast<std::uint8_t>(c.red()),
+        stops.push_back({positions_[row], static_cast<std::uint8_t>(c.red()),
                          static_cast<std::uint8_t>(c.green()), static_cast<std::uint8_t>(c.blue())});
     }
     edited_.reset();

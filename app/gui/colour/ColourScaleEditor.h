@@ -57,6 +57,7 @@ signals:
 private:
     void insertRow(int row, double position, const QColor& colour);
     void chooseColour(QPushButton* button);
+    void positionEdited(QDoubleSpinBox* box, double value);
     void revalidate();
 
     QLineEdit* nameEdit_;
@@ -68,7 +69,10 @@ private:
     QWidget* preview_;
     QLabel* message_;
     QDialogButtonBox* buttons_;
-    QVector<QColor> colours_; // one per table row
+    // One per table row. Positions are kept here exactly: the boxes show them
+    // rounded, and an untouched stop (e.g. a preset's 1/3) must not move.
+    QVector<double> positions_;
+    QVector<QColor> colours_;
     std::optional<ColourScale> edited_;
     ColourScale lastValid_;
     QString problem_;
