@@ -141,7 +141,8 @@ bool SessionController::restore(const QString& qpath)
     try {
         // Everything is read: only now is the current document replaced.
         document_.clear();
-        for (const json& s : session.value("customScales", json::array()))
+        const json scales = session.value("customScales", json::array());
+        for (const json& s : scales)
             if (const auto scale = ColourScale::fromText(s.get<std::string>()))
                 scalarPanel_.addCustomScale(*scale);
         std::map<int, EntityId> newIds;
@@ -152,7 +153,8 @@ bool SessionController::restore(const QString& qpath)
                                               parent == newIds.end() ? kNoEntity : parent->second,
                                               QString::fromStdString(e.value("source", std::string())));
             newIds[e.at("id").get<int>()] = id;
-            for (const auto& [name, f] : e.value("fields", json::object()).items()) {
+            const json fields = e.value("fields", json::object()); // items() must not outlive it
+            for (const auto& [name, f] : fields.items()) {
                 FieldDisplay display;
                 if (const auto scale = ColourScale::fromText(f.at("scale").get<std::string>()))
                     display.scale = *scale;

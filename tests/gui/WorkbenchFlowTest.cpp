@@ -1,0 +1,230 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Qt Test: the workbench's whole flow driven through its window, panels and
+// controllers as a user would: open the demo pair, run C2C from the dialog's
+// declarations, set a threshold in the scalar-field panel, split, export, save
+// and restore the session. Answers are checked against core called directly
+// and against brute-force counts.
+#include "MainWindow.h"
+#include "controllers/DistanceController.h"
+#include "controllers/FileController.h"
+#include "controllers/SessionController.h"
+#include "panels/EntityTree.h"
+#include "panels/PropertiesPanel.h"
+#include "panels/ScalarFieldPanel.h"
+#include "tools/ParameterForm.h"
+#include "view/CloudView.h"
+#include "widgets/RangeEditor.h"
+
+#include <scandiff/core/distance/CloudToCloud.h>
+#include <scandiff/core/distance/DistanceParameters.h>
+#include <scandiff/io/FileIO.h>
+#include <scandiff/plugins/PluginRegistry.h>
+
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QPushButton>
+#include <QSignalSpy>
+#include <QTemporaryDir>
+#include <QtTest>
+
+using namespace scandiff;
+using gui::EntityId;
+
+namespace {
+
+const QString kReference = SCANDIFF_SAMPLE_DATA_DIR "/demo/site-2019.ply";
+const QString kCompared = SCANDIFF_SAMPLE_DATA_DIR "/demo/site-2024.ply";
+
+std::size_t bruteForceInside(const ScalarField& f, double low, double high)
+{
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < f.size(); ++i)
+        if (!std::isnan(f.values()[i]) && f.value(i) >= low && f.value(i) <= high)
+            ++n;
+    return n;
+}
+
+} // namespace
+
+class WorkbenchFlowTest : public QObject
+{
+    Q_OBJECT
+
+private slots:
+    void initTestCase()
+    {
+        QCoreApplication::setOrganizationName("scandiff-tests");
+        qRegisterMetaType<gui::EntityId>("EntityId");
+        qRegisterMetaType<std::size_t>("std::size_t");
+    }
+
+    void distanceDialogComesFromTheSharedDeclarations()
+    {
+        gui::Document document;
+        gui::DistanceDialog dialog(gui::DistanceKind::CloudToCloud, document);
+        for (const ParameterSpec& p : cloudToCloudParameters())
+            QVERIFY2(dialog.form()->editor(p.name), p.name.c_str());
+        // Untouched, the dialog gives exactly the command line's defaults.
+        const ParameterValues fromDialog = resolveParameters(cloudToCloudParameters(), dialog.values(), "c2c");
+        const ParameterValues fromCli = resolveParameters(cloudToCloudParameters(), {}, "c2c");
+        QCOMPARE(fromDialog.all().size(), fromCli.all().size());
+        for (const auto& [name, value] : fromCli.all())
+            QVERIFY2(fromDialog.all().at(name) == value, name.c_str());
+        // An optional value is off until its checkbox is ticked.
+        QVERIFY(!dialog.values().count("max-dist"));
+        dialog.form()->enabler("max-dist")->setChecked(true);
+        QCOMPARE(dialog.values().at("max-dist"), std::string("1"));
+    }
+
+    void openComputeThresholdSplitExportRestore()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::MainWindow window(registry);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+
+        // Open the demo pair.
+        QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
+        const std::vector<EntityId> ids = window.document().ids();
+        QCOMPARE(ids.size(), std::size_t(2));
+        const EntityId reference = ids[0], compared = ids[1];
+        QVERIFY(window.tree()->entityRow(reference));
+        QCOMPARE(window.tree()->entityRow(reference)->checkState(0), Qt::Checked);
+        QCOMPARE(window.tree()->currentEntity(), compared);
+        QCOMPARE(window.properties()->value("Points"), QString::number(window.document().item(compared).points().size()));
+
+        // C2C with the same text the dialog would give (split components on).
+        QSignalSpy finished(window.distances(), &gui::DistanceController::finished);
+        QVERIFY(window.distances()->runCloudToCloud(compared, reference, {{"split-xyz", "true"}}));
+        QCOMPARE(finished.count(), 1);
+        QVERIFY(finished.at(0).at(0).toString().contains("C2C"));
+        const PointCloud& comparedCloud = window.document().item(compared).points();
+        const ScalarField* distance = comparedCloud.field("c2c_distance");
+        QVERIFY(distance);
+        QVERIFY(comparedCloud.field("c2c_dz"));
+        QCOMPARE(window.document().item(compared).display.activeField, std::string("c2c_distance"));
+        QVERIFY(window.tree()->fieldRow(compared, "c2c_distance"));
+        // The same numbers as core called directly.
+        const CloudToCloudResult direct =
+            cloudToCloud(comparedCloud, window.document().item(reference).points(), CloudToCloudParams{});
+        QCOMPARE(direct.distance.values(), distance->values());
+
+        // The scalar-field panel shows the new field; type a threshold as a user does.
+        gui::ScalarFieldPanel* panel = window.scalarPanel();
+        QCOMPARE(panel->entity(), compared);
+        QCOMPARE(panel->fieldBox()->currentText(), QString("c2c_distance"));
+        QVERIFY(panel->splitButton()->isEnabled());
+        const double low = 0.5;
+        QDoubleSpinBox* lowBox = panel->rangeEditor()->lowBox();
+        lowBox->setFocus();
+        lowBox->selectAll();
+        QTest::keyClicks(lowBox, "0.5");
+        QTest::keyClick(lowBox, Qt::Key_Return);
+        QCOMPARE(panel->rangeEditor()->low(), low);
+        const double high = panel->rangeEditor()->high();
+        QCOMPARE(window.document().fieldDisplay(compared, "c2c_distance").low, low);
+        const std::size_t inside = bruteForceInside(*distance, low, high);
+        QVERIFY(inside > 0 && inside < distance->size());
+        QVERIFY2(panel->insideText().contains(QString::number(inside)), qPrintable(panel->insideText()));
+
+        // Split at thresholds: two new clouds under the compared one.
+        QTest::mouseClick(panel->splitButton(), Qt::LeftButton);
+        const std::vector<EntityId> afterSplit = window.document().ids();
+        QCOMPARE(afterSplit.size(), std::size_t(4));
+        const gui::Document::Item& insidePart = window.document().item(afterSplit[2]);
+        const gui::Document::Item& outsidePart = window.document().item(afterSplit[3]);
+        QCOMPARE(insidePart.parent, compared);
+        QCOMPARE(outsidePart.parent, compared);
+        QCOMPARE(insidePart.points().size(), inside);
+        QCOMPARE(outsidePart.points().size(), distance->size() - inside);
+        for (std::size_t i = 0; i < insidePart.points().size(); ++i) {
+            const double v = insidePart.points().field("c2c_distance")->value(i);
+            QVERIFY(v >= low && v <= high);
+        }
+        QVERIFY(!window.document().item(compared).display.visible); // the parts replace it on screen
+        QCOMPARE(window.tree()->entityRow(compared)->checkState(0), Qt::Unchecked);
+
+        // Export the inside part: PLY with every field, read back identical.
+        QTemporaryDir dir;
+        const QString exported = dir.filePath("changes.ply");
+        QVERIFY(window.files()->exportEntity(insidePart.id, exported));
+        const PointCloud readBack = io::readPointCloud(registry.formats, exported.toStdString());
+        QCOMPARE(readBack.size(), inside);
+        QVERIFY(readBack.field("c2c_dx"));
+        QCOMPARE(readBack.field("c2c_distance")->values(), insidePart.points().field("c2c_distance")->values());
+
+        // Save and restore the session: entities, tree, active field, thresholds, camera.
+        window.view()->setStandardView(gui::StandardView::Top);
+        const gui::CameraState camera = window.view()->camera();
+        const QString session = dir.filePath("work.scandiff");
+        QVERIFY(window.sessions()->save(session));
+        window.document().clear();
+        QCOMPARE(window.document().size(), std::size_t(0));
+        window.view()->setStandardView(gui::StandardView::Front);
+        QSignalSpy sessionFailed(window.sessions(), &gui::SessionController::failed);
+        const bool restoredOk = window.sessions()->restore(session);
+        QVERIFY2(restoredOk, sessionFailed.isEmpty() ? "" : qPrintable(sessionFailed.at(0).at(0).toString()));
+        const std::vector<EntityId> restored = window.document().ids();
+        QCOMPARE(restored.size(), std::size_t(4));
+        const gui::Document::Item& restoredCompared = window.document().item(restored[1]);
+        QCOMPARE(restoredCompared.name, QString("site-2024"));
+        QCOMPARE(restoredCompared.display.activeField, std::string("c2c_distance"));
+        QVERIFY(!restoredCompared.display.visible);
+        QCOMPARE(window.document().fieldDisplay(restored[1], "c2c_distance").low, low);
+        QCOMPARE(window.document().item(restored[2]).parent, restored[1]);
+        QCOMPARE(window.document().item(restored[2]).points().size(), inside);
+        const gui::CameraState back = window.view()->camera();
+        for (int k = 0; k < 3; ++k) {
+            QCOMPARE(back.position[k], camera.position[k]);
+            QCOMPARE(back.viewUp[k], camera.viewUp[k]);
+        }
+    }
+
+    void pickingShowsEveryFieldOfThePoint()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::MainWindow window(registry);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        QCOMPARE(window.openFiles({kReference}, true), 1);
+        const EntityId id = window.document().ids().front();
+        window.view()->setStandardView(gui::StandardView::Top);
+        QSignalSpy picked(window.view(), &gui::CloudView::pointPicked);
+        // The middle of a top view of a dense airborne scan is always on a point.
+        QVERIFY(window.view()->pickAt(window.view()->width() / 2, window.view()->height() / 2));
+        QCOMPARE(picked.count(), 1);
+        QCOMPARE(picked.at(0).at(0).toInt(), id);
+        const std::size_t index = picked.at(0).at(1).value<std::size_t>();
+        QVERIFY(index < window.document().item(id).points().size());
+        QVERIFY(!window.properties()->value("Picked point").isEmpty());
+        const QString xyz = window.properties()->value("X, Y, Z");
+        QVERIFY(xyz.startsWith(QString::number(window.document().item(id).points().globalPosition(index).x(), 'f', 3)));
+    }
+
+    void badFilesAreReportedNotFatal()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::MainWindow window(registry);
+        QTemporaryDir dir;
+        QFile broken(dir.filePath("broken.ply"));
+        QVERIFY(broken.open(QIODevice::WriteOnly));
+        broken.write("ply\nformat binary_little_endian 1.0\nelement vertex 100\nproperty float x\nend_header\n");
+        broken.close();
+        QSignalSpy failed(window.files(), &gui::FileController::failed);
+        QCOMPARE(window.openFiles({dir.filePath("broken.ply"), dir.filePath("missing.las")}, true), 0);
+        QCOMPARE(failed.count(), 2);
+        QCOMPARE(window.document().size(), std::size_t(0));
+        // A session file that is not one changes nothing.
+        QFile notSession(dir.filePath("x.scandiff"));
+        QVERIFY(notSession.open(QIODevice::WriteOnly));
+        notSession.write("{ not json");
+        notSession.close();
+        QVERIFY(!window.sessions()->restore(dir.filePath("x.scandiff")));
+    }
+};
+
+Q_DECLARE_METATYPE(std::size_t)
+
+QTEST_MAIN(WorkbenchFlowTest)
+#include "WorkbenchFlowTest.moc"
