@@ -4,7 +4,7 @@
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc)
-DEMO_FILES ?= data/pcl-data/samp11-utm.pcd
+DEMO_FILES ?= data/demo/site-2019.ply data/demo/site-2024.ply
 
 .PHONY: all deps configure build run test bench clean
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "MainWindow.h"
 #include "view/CloudView.h"
+#include "view/ViewTimings.h"
 
 #include <QApplication>
 #include <QCommandLineParser>
@@ -23,6 +24,9 @@ int main(int argc, char** argv)
     parser.addVersionOption();
     QCommandLineOption screenshot("screenshot", "Load FILEs, save the view to PNG and quit.", "png");
     parser.addOption(screenshot);
+    QCommandLineOption measure("measure-view",
+                               "Load FILEs, print the view's timings (full render, render while moving, threshold update) and quit.");
+    parser.addOption(measure);
     parser.addPositionalArgument("FILE", "Clouds or meshes to open", "[FILE...]");
     parser.process(app);
 
@@ -33,6 +37,10 @@ int main(int argc, char** argv)
     const bool quiet = parser.isSet(screenshot);
     QTimer::singleShot(0, &window, [&] {
         const int loaded = files.isEmpty() ? 0 : window.openFiles(files, quiet);
+        if (parser.isSet(measure)) {
+            QApplication::exit(loaded == files.size() ? scandiff::gui::measureView(window) : 1);
+            return;
+        }
         if (parser.isSet(screenshot)) {
             const bool saved = window.view()->saveScreenshot(parser.value(screenshot));
             QApplication::exit(saved && loaded == files.size() ? 0 : 1);

@@ -22,11 +22,17 @@ namespace scandiff::gui {
 
 namespace {
 
+//! The run's parameters as `scandiff-cli` options, so a user can repeat it in a
+//! batch: flags only when on, values as typed.
 QString parameterText(const std::map<std::string, std::string>& parameters)
 {
     QStringList parts;
-    for (const auto& [name, value] : parameters)
-        parts << QString("--%1 %2").arg(QString::fromStdString(name), QString::fromStdString(value));
+    for (const auto& [name, value] : parameters) {
+        if (value == "false")
+            continue;
+        parts << (value == "true" ? QString("--%1").arg(QString::fromStdString(name))
+                                  : QString("--%1 %2").arg(QString::fromStdString(name), QString::fromStdString(value)));
+    }
     return parts.join(' ');
 }
 

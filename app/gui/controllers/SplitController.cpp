@@ -37,6 +37,8 @@ std::pair<EntityId, EntityId> SplitController::split(EntityId id, const std::str
             full.low = -std::numeric_limits<double>::infinity();
             full.high = std::numeric_limits<double>::infinity();
             document_.setFieldDisplay(outside, field, full);
+            // What the user was looking for is inside: the rest waits, unticked, in the tree.
+            document_.setVisible(outside, false);
         }
         // The parts replace their parent on screen.
         document_.setVisible(id, false);

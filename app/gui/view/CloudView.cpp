@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "view/CloudView.h"
 
+#include <QElapsedTimer>
+#include <QTimer>
 #include <QVBoxLayout>
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -37,21 +39,6 @@ namespace scandiff::gui {
 
 namespace {
 
-//! One shown entity. A cloud's decimated twin shares its points and colour
-//! arrays and only holds every stride-th vertex, so colour changes reach both
-//! and VTK uploads the arrays once.
-struct Shown
-{
-    bool isCloud = true;
-    std::size_t pointCount = 0;
-    vtkSmartPointer<vtkPolyData> full;
-    vtkSmartPointer<vtkPolyData> decimated;
-    vtkSmartPointer<vtkPolyDataMapper> fullMapper;
-    vtkSmartPointer<vtkPolyDataMapper> decimatedMapper;
-    vtkSmartPointer<vtkUnsignedCharArray> colours;
-    vtkSmartPointer<vtkActor> actor;
-    std::size_t decimatedStride = 0;
-};
 
 vtkSmartPointer<vtkPoints> toVtkPoints(const PointCloud& cloud, const Eigen::Vector3d& sceneOrigin)
 {
@@ -93,6 +80,22 @@ constexpr const char* kDiscardHidden = "//VTK::Light::Impl\n  if (gl_FragData[0]
 
 } // namespace
 
+//! One shown entity. A cloud's decimated twin shares its points and colour
+//! arrays and only holds every stride-th vertex, so colour changes reach both
+//! and VTK uploads the arrays once.
+struct CloudView::Shown
+{
+    bool isCloud = true;
+    std::size_t pointCount = 0;
+    vtkSmartPointer<vtkPolyData> full;
+    vtkSmartPointer<vtkPolyData> decimated;
+    vtkSmartPointer<vtkPolyDataMapper> fullMapper;
+    vtkSmartPointer<vtkPolyDataMapper> decimatedMapper;
+    vtkSmartPointer<vtkUnsignedCharArray> colours;
+    vtkSmartPointer<vtkActor> actor;
+    std::size_t decimatedStride = 0;
+};
+
 struct CloudView::Scene
 {
     vtkNew<vtkGenericOpenGLRenderWindow> window;
@@ -104,10 +107,14 @@ struct CloudView::Scene
     std::optional<Eigen::Vector3d> sceneOrigin;
     float pointSize = 2.0f;
     std::size_t budget = 1'500'000;
+    bool adaptiveBudget = true;
     std::size_t stride = 1;
     bool moving = false;
+    bool settling = false; //!< decimated after a colour change, until the settle timer fires
+    bool renderPending = false;
     bool pickMode = false;
 };
+
 
 //! In pick mode, a left click picks a point and stops there (no rotation).
 class CloudView::PickCommand : public vtkCommand
@@ -127,6 +134,13 @@ public:
 
 CloudView::CloudView(QWidget* parent) : QWidget(parent), scene_(std::make_unique<Scene>())
 {
+    settleTimer_ = new QTimer(this);
+    settleTimer_->setSingleShot(true);
+    settleTimer_->setInterval(250);
+    connect(settleTimer_, &QTimer::timeout, this, [this] {
+        if (scene_->settling)
+            setMoving(false);
+    });
     widget_ = new QVTKOpenGLNativeWidget(this);
     auto* layout = new QVBoxLayout(this);
     layout->setContentsMargins(0, 0, 0, 0);
@@ -219,14 +233,12 @@ void CloudView::refreshEntity(const Document::Item& item)
     Shown& s = it->second;
     s.actor->SetVisibility(item.display.visible);
     if (s.isCloud) {
-        std::vector<std::uint8_t> rgba;
-        colourEntity(item.points(), item.display, rgba);
-        // Same array object: VTK re-uploads the colours only, never the points.
+        // Same array object, written in place: VTK re-uploads the colours only, never the points.
         s.colours->SetNumberOfTuples(static_cast<vtkIdType>(s.pointCount));
-        std::copy(rgba.begin(), rgba.end(), s.colours->GetPointer(0));
+        colourEntity(item.points(), item.display, s.colours->GetPointer(0));
         s.colours->Modified();
     }
-    render();
+    renderInteractively();
 }
 
 void CloudView::removeEntity(EntityId id)
@@ -246,7 +258,7 @@ void CloudView::setLegend(const ColourLegend& legend)
 {
     if (!legend.shown) {
         scene_->scalarBar->VisibilityOff();
-        render();
+        renderSoon();
         return;
     }
     constexpr int kColours = 256;
@@ -258,7 +270,7 @@ void CloudView::setLegend(const ColourLegend& legend)
     scene_->scalarBarTable->SetTableRange(legend.min, legend.max);
     scene_->scalarBar->SetTitle(legend.title.c_str());
     scene_->scalarBar->VisibilityOn();
-    render();
+    renderSoon();
 }
 
 void CloudView::clear()
@@ -355,8 +367,11 @@ void CloudView::setCamera(const CameraState& s)
 void CloudView::setInteractiveBudget(std::size_t points)
 {
     scene_->budget = std::max<std::size_t>(points, 1);
+    scene_->adaptiveBudget = false;
     updateStride();
 }
+
+std::size_t CloudView::interactiveBudget() const { return scene_->budget; }
 
 std::size_t CloudView::interactiveStride() const { return scene_->stride; }
 
@@ -372,9 +387,19 @@ void CloudView::updateStride()
 void CloudView::setMoving(bool moving)
 {
     scene_->moving = moving;
-    for (auto& [id, s] : scene_->shown) {
+    scene_->settling = false;
+    settleTimer_->stop();
+    for (auto& [id, s] : scene_->shown)
+        setDecimated(s, moving);
+    if (!moving)
+        render(); // full detail at rest
+}
+
+void CloudView::setDecimated(Shown& s, bool moving)
+{
+    {
         if (!s.isCloud)
-            continue;
+            return;
         const bool decimate = moving && scene_->stride > 1;
         if (decimate && s.decimatedStride != scene_->stride) {
             s.decimated = vtkSmartPointer<vtkPolyData>::New();
@@ -389,8 +414,6 @@ void CloudView::setMoving(bool moving)
         }
         s.actor->SetMapper(decimate ? s.decimatedMapper.Get() : s.fullMapper.Get());
     }
-    if (!moving)
-        render(); // full detail at rest
 }
 
 void CloudView::setPickMode(bool on)
@@ -426,7 +449,61 @@ bool CloudView::pickAtDevicePixel(int x, int y)
     return false;
 }
 
-void CloudView::render() { scene_->window->Render(); }
+void CloudView::render()
+{
+    scene_->renderPending = false;
+    if (scene_->moving) {
+        scene_->window->Render();
+        return;
+    }
+    // Full-detail frames tell how many points this machine draws per second;
+    // the decimated frames are sized to stay near 20 per second (a GPU draws
+    // tens of millions of points in that time, Mesa's software renderer about
+    // a hundred thousand).
+    QElapsedTimer clock;
+    clock.start();
+    scene_->window->Render();
+    const double seconds = clock.nsecsElapsed() / 1e9;
+    std::size_t drawn = 0;
+    for (const auto& [id, s] : scene_->shown)
+        if (s.isCloud && s.actor->GetVisibility())
+            drawn += s.pointCount;
+    if (scene_->adaptiveBudget && drawn > 100'000 && seconds > 0.005) {
+        constexpr double kFrameSeconds = 0.05;
+        const auto budget = static_cast<std::size_t>(drawn / seconds * kFrameSeconds);
+        scene_->budget = std::max<std::size_t>(budget, 100'000);
+        updateStride();
+    }
+}
+
+void CloudView::renderSoon()
+{
+    if (scene_->renderPending)
+        return;
+    scene_->renderPending = true;
+    QTimer::singleShot(0, this, [this] {
+        if (scene_->renderPending)
+            render();
+    });
+}
+
+void CloudView::renderInteractively()
+{
+    // A threshold drag or a colour change redraws at once with the decimated
+    // clouds, and in full once the changes stop for a moment.
+    if (scene_->stride <= 1) {
+        render();
+        return;
+    }
+    if (!scene_->moving || scene_->settling) {
+        scene_->settling = true;
+        for (auto& [id, s] : scene_->shown)
+            setDecimated(s, true);
+        scene_->moving = true;
+    }
+    scene_->window->Render();
+    settleTimer_->start();
+}
 
 bool CloudView::saveScreenshot(const QString& path)
 {

@@ -15,6 +15,7 @@
 #include <array>
 #include <memory>
 
+class QTimer;
 class QVTKOpenGLNativeWidget;
 
 namespace scandiff::gui {
@@ -57,9 +58,12 @@ public:
     CameraState camera() const;
     void setCamera(const CameraState& state);
 
-    //! Points drawn while the camera moves (default 1.5 M): clouds are decimated
-    //! by one common stride so their total stays below it.
+    //! Points drawn while the camera moves or a threshold is dragged: clouds are
+    //! decimated by one common stride so their total stays below it. By default
+    //! it adapts to the machine (what it draws in 1/20 s, measured on full
+    //! frames); setting it turns the adaptation off.
     void setInteractiveBudget(std::size_t points);
+    std::size_t interactiveBudget() const;
     //! The stride used while moving (1 = no decimation); for tests.
     std::size_t interactiveStride() const;
     //! Switches the decimated drawing on or off as a camera move would.
@@ -73,7 +77,12 @@ public:
 
     //! Renders now and saves the view to a PNG.
     bool saveScreenshot(const QString& path);
+    //! Renders now (in full at rest).
     void render();
+    //! One render at the next event-loop turn, however many changes ask for it.
+    void renderSoon();
+    //! Renders at once decimated, then in full after 250 ms without changes.
+    void renderInteractively();
 
 signals:
     void pointPicked(EntityId id, std::size_t index);
@@ -81,7 +90,10 @@ signals:
 
 private:
     class PickCommand;
+    struct Shown;
     void updateStride();
+    void setDecimated(Shown& shown, bool moving);
+    QTimer* settleTimer_ = nullptr;
     bool pickAtDevicePixel(int x, int y);
     struct Scene;
     QVTKOpenGLNativeWidget* widget_;

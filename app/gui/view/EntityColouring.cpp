@@ -23,10 +23,9 @@ std::pair<double, double> colourRange(const ScalarField& field, const ColourScal
     return {lo, hi};
 }
 
-ColourLegend colourEntity(const PointCloud& points, const DisplayState& display, std::vector<std::uint8_t>& rgba)
+ColourLegend colourEntity(const PointCloud& points, const DisplayState& display, std::uint8_t* rgba)
 {
     const std::size_t n = points.size();
-    rgba.resize(4 * n);
     ColourLegend legend;
     const ScalarField* field = display.activeField.empty() ? nullptr : points.field(display.activeField);
     if (field) {
@@ -37,7 +36,7 @@ ColourLegend colourEntity(const PointCloud& points, const DisplayState& display,
         how.visibleMin = fieldDisplay.low;
         how.visibleMax = fieldDisplay.high;
         how.outside = display.outside;
-        colourise(field->values().data(), n, field->offset(), fieldDisplay.scale, how, rgba.data());
+        colourise(field->values().data(), n, field->offset(), fieldDisplay.scale, how, rgba);
         legend = {true, field->name(), fieldDisplay.scale, how.colourMin, how.colourMax};
         return legend;
     }
@@ -65,7 +64,7 @@ ColourLegend colourEntity(const PointCloud& points, const DisplayState& display,
     how.colourMin = zmin <= zmax ? zmin : 0.0;
     how.colourMax = zmin < zmax ? zmax : how.colourMin + 1.0;
     const ColourScale scale = *ColourScale::preset("Blue-Green-Yellow-Red");
-    colourise(heights.data(), n, 0.0, scale, how, rgba.data());
+    colourise(heights.data(), n, 0.0, scale, how, rgba);
     legend = {true, "height", scale, how.colourMin + points.origin().z(), how.colourMax + points.origin().z()};
     return legend;
 }

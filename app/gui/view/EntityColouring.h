@@ -27,7 +27,8 @@ struct ColourLegend
 //! unit-wide range so it still maps to a colour.
 std::pair<double, double> colourRange(const ScalarField& field, const ColourScale& scale);
 
-//! Fills rgba (4 bytes per point, alpha 0 = hidden) and returns the legend.
-ColourLegend colourEntity(const PointCloud& points, const DisplayState& display, std::vector<std::uint8_t>& rgba);
+//! Fills rgba (4 bytes per point, alpha 0 = hidden; room for 4 x points.size())
+//! and returns the legend.
+ColourLegend colourEntity(const PointCloud& points, const DisplayState& display, std::uint8_t* rgba);
 
 } // namespace scandiff::gui

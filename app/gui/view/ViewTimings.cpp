@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "view/ViewTimings.h"
+
+#include "MainWindow.h"
+#include "panels/EntityTree.h"
+#include "panels/ScalarFieldPanel.h"
+#include "view/CloudView.h"
+#include "widgets/RangeEditor.h"
+
+#include <QApplication>
+#include <QElapsedTimer>
+
+#include <iomanip>
+#include <iostream>
+
+namespace scandiff::gui {
+
+namespace {
+
+constexpr int kRepeats = 5;
+
+template <class F> double averageMilliseconds(F&& f)
+{
+    f(); // the first call uploads buffers and compiles shaders: not what a user waits for at each frame
+    QElapsedTimer clock;
+    clock.start();
+    for (int i = 0; i < kRepeats; ++i)
+        f();
+    return clock.nsecsElapsed() / 1e6 / kRepeats;
+}
+
+} // namespace
+
+int measureView(MainWindow& window)
+{
+    Document& document = window.document();
+    CloudView& view = *window.view();
+    std::size_t points = 0;
+    EntityId cloud = kNoEntity;
+    for (EntityId id : document.ids())
+        if (document.item(id).cloud()) {
+            points += document.item(id).points().size();
+            cloud = id;
+        }
+    if (cloud == kNoEntity) {
+        std::cerr << "measure-view: no point cloud loaded\n";
+        return 1;
+    }
+    view.setStandardView(StandardView::Iso);
+    QApplication::processEvents();
+    const double full = averageMilliseconds([&] { view.render(); });
+    view.setMoving(true);
+    const double moving = averageMilliseconds([&] { view.render(); });
+    view.setMoving(false);
+
+    // A threshold drag: the active field's range narrowed step by step (height
+    // when the cloud has no field: its colours then depend on no threshold).
+    const PointCloud& target = document.item(cloud).points();
+    double threshold = 0;
+    std::string fieldName;
+    if (!target.fields().empty()) {
+        fieldName = target.fields().front().name();
+        document.setActiveField(cloud, fieldName);
+        const ValueRange r = target.fields().front().range();
+        // The path of a slider drag: the panel's range editor, then the document, then the view.
+        window.tree()->selectEntity(cloud);
+        RangeEditor* range = window.scalarPanel()->rangeEditor();
+        int step = 0;
+        threshold = averageMilliseconds([&] { range->setRange(r.min + (r.max - r.min) * 0.05 * (++step % 10), r.max); });
+    }
+    std::cout << std::fixed << std::setprecision(1) << "points " << points << "\n"
+              << "full render ms " << full << "\n"
+              << "moving render ms " << moving << " (stride " << view.interactiveStride() << ")\n";
+    if (!fieldName.empty())
+        std::cout << "threshold update ms " << threshold << " (field " << fieldName << ", as a slider drag: recolour, count, decimated render)\n";
+    return 0;
+}
+
+} // namespace scandiff::gui
