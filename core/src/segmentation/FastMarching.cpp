@@ -11,6 +11,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <queue>
@@ -93,32 +94,42 @@ std::vector<std::size_t> march(const CellGrid& grid, const std::vector<std::size
             const int nonZero = (o.dx != 0) + (o.dy != 0) + (o.dz != 0);
             double t = times[i] + std::sqrt(static_cast<double>(nonZero)) * step;
             if (nonZero == 1) {
-                // Upwind values along each axis: the smaller accepted neighbour time.
+                // Per axis, the upwind side (the smaller accepted neighbour) gives
+                // a term w (T - c)^2 of the discrete |grad T|^2: first order
+                // w = 1, c = T1; second order when the next cell on that side is
+                // accepted and not later, w = 9/4, c = (4 T1 - T2) / 3 (Sethian's
+                // FMM2, whose error on smooth fronts is far below one cell).
                 const octree::CellCoordinates aj = octree::decodeCell(grid.cells[j]);
-                double axis[3];
+                std::array<std::pair<double, double>, 3> terms; // (c, w)
                 for (int a = 0; a < 3; ++a) {
-                    axis[a] = kInf;
+                    terms[a] = {kInf, 1.0};
                     for (int sign : {-1, 1}) {
-                        const detail::CellOffset d{a == 0 ? sign : 0, a == 1 ? sign : 0, a == 2 ? sign : 0};
-                        const std::size_t m = detail::findNeighbour(grid.cells, aj, d, grid.level);
-                        if (m != SIZE_MAX && state[m] == Accepted)
-                            axis[a] = std::min(axis[a], times[m]);
+                        const detail::CellOffset d1{a == 0 ? sign : 0, a == 1 ? sign : 0, a == 2 ? sign : 0};
+                        const std::size_t m1 = detail::findNeighbour(grid.cells, aj, d1, grid.level);
+                        if (m1 == SIZE_MAX || state[m1] != Accepted || !(times[m1] < terms[a].first))
+                            continue;
+                        terms[a] = {times[m1], 1.0};
+                        const detail::CellOffset d2{2 * d1.dx, 2 * d1.dy, 2 * d1.dz};
+                        const std::size_t m2 = detail::findNeighbour(grid.cells, aj, d2, grid.level);
+                        if (m2 != SIZE_MAX && state[m2] == Accepted && times[m2] <= times[m1])
+                            terms[a] = {(4.0 * times[m1] - times[m2]) / 3.0, 2.25};
                     }
                 }
-                std::sort(axis, axis + 3);
-                // Solve sum over the used axes of (T - T_a)^2 = step^2, adding axes
-                // while the solution stays above the next upwind value.
-                double solution = axis[0] + step;
-                double sum = axis[0], sumSquares = axis[0] * axis[0];
-                for (int used = 2; used <= 3; ++used) {
-                    if (!(solution > axis[used - 1]))
+                std::sort(terms.begin(), terms.end());
+                // Solve sum w (T - c)^2 = step^2 over the axes whose c lies below
+                // the solution, adding axes in increasing c.
+                double solution = kInf, sw = 0.0, swc = 0.0, swcc = 0.0;
+                for (int used = 0; used < 3; ++used) {
+                    const auto [c, w] = terms[used];
+                    if (!(c < solution))
                         break;
-                    sum += axis[used - 1];
-                    sumSquares += axis[used - 1] * axis[used - 1];
-                    const double disc = sum * sum - used * (sumSquares - step * step);
+                    sw += w;
+                    swc += w * c;
+                    swcc += w * c * c;
+                    const double disc = swc * swc - sw * (swcc - step * step);
                     if (disc < 0)
                         break;
-                    solution = (sum + std::sqrt(disc)) / used;
+                    solution = (swc + std::sqrt(disc)) / sw;
                 }
                 t = std::min(t, solution);
             }
@@ -283,13 +294,19 @@ FastMarchingResult fastMarching(const PointCloud& cloud, const std::vector<std::
     std::vector<double> times(grid.cells.size(), kInf);
     std::vector<std::uint8_t> state(grid.cells.size(), Far);
     std::vector<std::size_t> sources;
-    // Near the seeds the grid's first-order scheme is least accurate; the seed
-    // cells and their 26 neighbours get their exact distance instead.
+    // Near a seed the front is far from planar and the difference scheme least
+    // accurate; the cells within two cells of a seed get their exact distance instead.
+    std::vector<detail::CellOffset> block;
+    for (int dx = -2; dx <= 2; ++dx)
+        for (int dy = -2; dy <= 2; ++dy)
+            for (int dz = -2; dz <= 2; ++dz)
+                if (dx || dy || dz)
+                    block.push_back({dx, dy, dz});
     for (std::size_t s : seeds) {
         const Eigen::Vector3d p = positions[s].cast<double>();
         const std::size_t c = grid.cellOfPoint[s];
         const octree::CellCoordinates at = octree::decodeCell(grid.cells[c]);
-        for (const auto& o : detail::neighbourOffsets(octree::Connectivity::Corners26, false)) {
+        for (const auto& o : block) {
             const std::size_t m = detail::findNeighbour(grid.cells, at, o, grid.level);
             if (m != SIZE_MAX) {
                 times[m] = std::min(times[m], (grid.centre(m) - p).norm());
@@ -388,9 +405,15 @@ PropagationResult propagationSegmentation(const PointCloud& cloud, const std::st
     std::vector<std::size_t> regionOfCell(cellCount, 0);
     std::vector<std::size_t> regionPoints{0}; // index 0: no region
     const double alpha = params.alpha, stopSpeed = params.stopSpeed;
+    const bool enterSure = params.enterAboveSeedValue;
+    const double minSeed = params.minSeedValue;
     auto speed = [&](std::size_t i, std::size_t j) {
         const double f = std::exp(alpha * (cellGradient[j] - cellGradient[i]));
-        return f < stopSpeed ? 0.0 : f;
+        if (f >= stopSpeed)
+            return f;
+        // A cell that could be a seed itself is changed for sure: crossing into
+        // it is allowed (at the slowest speed) so a plateau does not split.
+        return enterSure && cellValue[j] >= minSeed ? stopSpeed : 0.0;
     };
     ProgressTicker ticker(progress, "Front propagation", cellCount);
     for (std::size_t seed : bySeedValue) {

@@ -89,6 +89,12 @@ struct PropagationParams
     //! take more than 1/stopSpeed times as long as at unit speed (the "time jump"
     //! stop rule). With alpha = 50, 0.1 stops at a drop of the gradient norm of 0.046.
     double stopSpeed = 0.1;
+    //! Let the front enter any cell whose value is at least minSeedValue, even
+    //! against the stop rule. The thesis applies the rule everywhere, which cuts
+    //! an object whose top is a plateau (zero gradient) into its faces when the
+    //! seed falls on an edge; with this (our default) the stop rule only decides
+    //! how far a region extends below the seed value, down its slopes.
+    bool enterAboveSeedValue = true;
     //! Octree level of the grid, 0 = automatic (cells holding ~8 points).
     int level = 0;
     GradientParams gradient;
