@@ -23,16 +23,6 @@ extern "C" void onInterrupt(int)
     interrupted = true;
 }
 
-std::vector<std::string> splitList(const std::string& text, char separator)
-{
-    std::vector<std::string> parts;
-    std::stringstream stream(text);
-    std::string part;
-    while (std::getline(stream, part, separator))
-        parts.push_back(part);
-    return parts;
-}
-
 } // namespace
 
 TerminalProgress::TerminalProgress() : draw_(::isatty(STDERR_FILENO) == 1)
@@ -80,20 +70,54 @@ bool TerminalProgress::cancelRequested() const
     return interrupted.load();
 }
 
-std::vector<double> parseNumberList(const std::string& text, const std::string& option)
+namespace {
+
+std::string parameterHelp(const ParameterSpec& p)
 {
-    std::vector<double> values;
-    for (const std::string& part : splitList(text, ',')) {
-        try {
-            std::size_t used = 0;
-            values.push_back(std::stod(part, &used));
-            if (used != part.size() || !std::isfinite(values.back()))
-                throw std::invalid_argument(part);
-        } catch (const std::exception&) {
-            throw Error(ErrorCode::InvalidArgument, option + ": '" + part + "' is not a finite number");
-        }
+    std::ostringstream s;
+    s << p.description;
+    if (!p.unit.empty())
+        s << " (" << p.unit << ")";
+    if (p.type == ParameterType::Integer || p.type == ParameterType::Real)
+        s << "; range [" << p.minimum << ", " << p.maximum << "]";
+    if (p.type == ParameterType::Choice) {
+        s << "; one of:";
+        for (const auto& c : p.choices)
+            s << ' ' << c;
     }
-    return values;
+    if (!p.optional && p.type != ParameterType::Boolean)
+        s << "; default " << ParameterSpec::format(p.defaultValue);
+    return s.str();
+}
+
+} // namespace
+
+std::map<std::string, CLI::Option*> addParameterOptions(CLI::App& command, const std::vector<ParameterSpec>& parameters,
+                                                        std::shared_ptr<std::map<std::string, std::string>> userText)
+{
+    std::map<std::string, CLI::Option*> options;
+    for (const auto& p : parameters) {
+        const std::string name = p.name;
+        CLI::Option* option = nullptr;
+        if (p.type == ParameterType::Boolean)
+            option = command.add_flag_function("--" + name, [userText, name](std::int64_t count) { (*userText)[name] = count > 0 ? "true" : "false"; },
+                                               parameterHelp(p));
+        else if (p.type == ParameterType::Text)
+            option = command.add_option_function<std::vector<std::string>>(
+                "--" + name,
+                [userText, name](const std::vector<std::string>& values) {
+                    std::string joined;
+                    for (const auto& v : values)
+                        joined += (joined.empty() ? "" : ";") + v;
+                    (*userText)[name] = joined;
+                },
+                parameterHelp(p));
+        else
+            option = command.add_option_function<std::string>("--" + name, [userText, name](const std::string& v) { (*userText)[name] = v; },
+                                                              parameterHelp(p));
+        options[name] = option;
+    }
+    return options;
 }
 
 void ThreadLimit::addOption(CLI::App& command, int& threads)

@@ -3,6 +3,8 @@
 //! Pieces shared by the commands of scandiff-cli.
 
 #include <scandiff/core/Progress.h>
+#include <scandiff/core/TextLists.h>
+#include <scandiff/core/ToolRegistry.h>
 #include <scandiff/core/distance/DistanceStatistics.h>
 #include <scandiff/io/FileIO.h>
 
@@ -10,6 +12,7 @@
 #include <tbb/global_control.h>
 
 #include <atomic>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -53,9 +56,12 @@ struct WriteFlags
     io::WriteOptions toOptions(ProgressObserver* progress) const;
 };
 
-//! "1.5,2,-3" -> {1.5, 2, -3}; throws Error(InvalidArgument) naming `option`
-//! for an empty, non-numeric or non-finite item.
-std::vector<double> parseNumberList(const std::string& text, const std::string& option);
+//! One option per declared parameter, named "--NAME": booleans are flags,
+//! Text options may be repeated (their values joined by ';'), the rest take a
+//! value. What the user typed lands in `userText`, keyed by parameter name, for
+//! resolveParameters(). Returns the options by parameter name (for excludes()).
+std::map<std::string, CLI::Option*> addParameterOptions(CLI::App& command, const std::vector<ParameterSpec>& parameters,
+                                                        std::shared_ptr<std::map<std::string, std::string>> userText);
 
 //! --threads N: limits TBB's worker threads for the lifetime of the object.
 class ThreadLimit

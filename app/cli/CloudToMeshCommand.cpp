@@ -4,8 +4,7 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/distance/CloudToMesh.h>
-
-
+#include <scandiff/core/distance/DistanceParameters.h>
 #include <chrono>
 #include <iomanip>
 #include <memory>
@@ -18,10 +17,7 @@ void addCloudToMeshCommand(CLI::App& app, const PluginRegistry& registry, Stream
     struct Args
     {
         std::string reference, compared, output;
-        bool signedDistances = false;
-        std::optional<double> maxDistance;
-        bool clamp = false;
-        int level = 0;
+        std::shared_ptr<std::map<std::string, std::string>> values = std::make_shared<std::map<std::string, std::string>>();
         int threads = 0;
         ReadFlags read;
         WriteFlags write;
@@ -32,26 +28,15 @@ void addCloudToMeshCommand(CLI::App& app, const PluginRegistry& registry, Stream
     c->add_option("--reference", args->reference, "Reference mesh (PLY, OBJ, STL, OFF...)")->required();
     c->add_option("--compared", args->compared, "Compared cloud (the output keeps its points, in order)")->required();
     c->add_option("-o,--output", args->output, "Output: the compared cloud with c2m_distance (nothing is written without it)");
-    c->add_flag("--signed", args->signedDistances,
-                "Signed distances: + on the side the closest triangle's normal points to (right-hand rule on its vertex order)");
-    c->add_option("--max-dist", args->maxDistance, "Points farther than this (m) get NaN, or the maximum with --clamp")
-        ->check(CLI::PositiveNumber);
-    c->add_flag("--clamp", args->clamp, "With --max-dist: give farther points the maximum instead of NaN");
-    c->add_option("--octree-level", args->level, "Grid level 1..21 (default: automatic, from the mean triangle size)")
-        ->check(CLI::Range(0, 21));
+    // The computation's options come from the declarations the workbench's dialog also uses.
+    addParameterOptions(*c, cloudToMeshParameters(), args->values);
     ThreadLimit::addOption(*c, args->threads);
     args->read.addTo(*c);
     args->write.addTo(*c);
     c->callback([args, &registry, streams] {
         // Parameters are checked before the (possibly long) reads.
-        if (args->clamp && !args->maxDistance)
-            throw Error(ErrorCode::InvalidArgument, "--clamp needs --max-dist");
+        const CloudToMeshParams params = cloudToMeshSettings(resolveParameters(cloudToMeshParameters(), *args->values, "c2m"));
         const ThreadLimit threadLimit(args->threads);
-        CloudToMeshParams params;
-        params.signedDistances = args->signedDistances;
-        params.maxDistance = args->maxDistance;
-        params.clampBeyondMax = args->clamp;
-        params.octreeLevel = args->level;
 
         TerminalProgress progress;
         io::ReadOptions meshOptions;

@@ -13,29 +13,12 @@ namespace scandiff::cli {
 
 namespace {
 
-std::string rangeHelp(const ParameterSpec& p)
-{
-    std::ostringstream s;
-    s << p.description;
-    if (!p.unit.empty())
-        s << " (" << p.unit << ")";
-    if (p.type == ParameterType::Integer || p.type == ParameterType::Real)
-        s << "; range [" << p.minimum << ", " << p.maximum << "]";
-    if (p.type == ParameterType::Choice) {
-        s << "; one of:";
-        for (const auto& c : p.choices)
-            s << ' ' << c;
-    }
-    s << "; default " << ParameterSpec::format(p.defaultValue);
-    return s.str();
-}
-
 void addOneTool(CLI::App& app, const ToolSpec& tool, const PluginRegistry& registry, Streams streams)
 {
     struct Args
     {
         std::string input, output;
-        std::map<std::string, std::string> values;
+        std::shared_ptr<std::map<std::string, std::string>> values = std::make_shared<std::map<std::string, std::string>>();
         ReadFlags read;
         WriteFlags write;
     };
@@ -45,17 +28,13 @@ void addOneTool(CLI::App& app, const ToolSpec& tool, const PluginRegistry& regis
     command->add_option("IN", args->input, "Input cloud")->required();
     command->add_option("-o,--output", args->output, "Output file (nothing is written without it)");
     // Options come from the tool's own parameter declarations: one source of truth.
-    for (const auto& p : tool.parameters) {
-        const std::string name = p.name;
-        command->add_option_function<std::string>("--" + name, [args, name](const std::string& v) { args->values[name] = v; },
-                                                   rangeHelp(p));
-    }
+    addParameterOptions(*command, tool.parameters, args->values);
     args->read.addTo(*command);
     args->write.addTo(*command);
     const ToolSpec* toolPtr = &tool;
     command->callback([args, toolPtr, &registry, streams] {
         // Parameters are checked before the (possibly long) read of the input.
-        const ParameterValues values = toolPtr->resolve(args->values);
+        const ParameterValues values = toolPtr->resolve(*args->values);
         TerminalProgress progress;
         const PointCloud input = io::readPointCloud(registry.formats, args->input, args->read.toOptions(&progress));
         const auto start = std::chrono::steady_clock::now();

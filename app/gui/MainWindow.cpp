@@ -1,22 +1,30 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "MainWindow.h"
 
-#include "TaskRunner.h"
-#include "tools/ToolController.h"
+#include "controllers/DistanceController.h"
+#include "controllers/FileController.h"
+#include "controllers/SessionController.h"
+#include "controllers/SplitController.h"
+#include "controllers/ToolController.h"
+#include "panels/ConsolePanel.h"
+#include "panels/EntityTree.h"
+#include "panels/PropertiesPanel.h"
+#include "panels/ScalarFieldPanel.h"
 #include "view/CloudView.h"
-
-#include <scandiff/io/FileIO.h>
+#include "view/EntityColouring.h"
 
 #include <QAction>
+#include <QActionGroup>
 #include <QApplication>
-#include <QFileDialog>
-#include <QFileInfo>
+#include <QDockWidget>
+#include <QDragEnterEvent>
+#include <QDropEvent>
+#include <QInputDialog>
 #include <QMenuBar>
 #include <QMessageBox>
+#include <QMimeData>
 #include <QStatusBar>
-
-#include <iostream>
-#include <optional>
+#include <QToolBar>
 
 namespace scandiff::gui {
 
@@ -25,29 +33,176 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
 {
     setWindowTitle(tr("scandiff"));
     setCentralWidget(view_);
-    resize(1200, 800);
+    setAcceptDrops(true);
+    resize(1400, 900);
+    buildDocks();
 
-    QMenu* file = menuBar()->addMenu(tr("&File"));
-    QAction* open = file->addAction(tr("&Open..."), this, &MainWindow::openWithDialog);
-    open->setShortcut(QKeySequence::Open);
-    file->addSeparator();
-    QAction* quit = file->addAction(tr("&Quit"), qApp, &QApplication::quit);
-    quit->setShortcut(QKeySequence::Quit);
+    files_ = new FileController(registry_, document_, this);
+    distances_ = new DistanceController(document_, this);
+    splits_ = new SplitController(document_, this);
+    sessions_ = new SessionController(registry_, document_, *view_, *scalarPanel_, this);
+    report(files_);
+    report(distances_);
+    report(splits_);
+    report(sessions_);
+    buildMenus();
 
-    QMenu* viewMenu = menuBar()->addMenu(tr("&View"));
-    viewMenu->addAction(tr("&Reset camera"), view_, &CloudView::resetCamera);
-    viewMenu->addAction(tr("&Clear"), &document_, &Document::clear);
-
-    connect(&document_, &Document::added, this, &MainWindow::showEntity);
+    // The view follows the document.
+    connect(&document_, &Document::added, this, [this](EntityId id) {
+        const bool first = document_.size() == 1;
+        view_->addEntity(document_.item(id));
+        if (first)
+            view_->resetCamera();
+        tree_->selectEntity(id);
+    });
+    connect(&document_, &Document::removed, view_, &CloudView::removeEntity);
     connect(&document_, &Document::cleared, view_, &CloudView::clear);
-    buildToolsMenu();
-
-    statusBar()->showMessage(tr("Open a cloud or a mesh (File > Open)"));
+    connect(&document_, &Document::displayChanged, this, [this](EntityId id) {
+        view_->refreshEntity(document_.item(id));
+        if (id == tree_->currentEntity())
+            showLegendOf(id);
+    });
+    connect(tree_, &EntityTree::currentEntityChanged, this, &MainWindow::onCurrentEntityChanged);
+    connect(scalarPanel_, &ScalarFieldPanel::splitRequested, splits_, &SplitController::split);
+    connect(distances_, &DistanceController::resultReady, tree_, &EntityTree::selectEntity);
+    connect(splits_, &SplitController::resultReady, tree_, &EntityTree::selectEntity);
+    connect(view_, &CloudView::pointPicked, this, [this](EntityId id, std::size_t index) {
+        properties_->showPickedPoint(id, index);
+        const QString text = describePoint(document_.item(id), index);
+        console_->info(tr("picked ") + text);
+        statusBar()->showMessage(text);
+    });
+    statusBar()->showMessage(tr("Open clouds or meshes (File > Open, or drop files here)"));
 }
 
-void MainWindow::buildToolsMenu()
+template <class Controller> void MainWindow::report(Controller* controller)
 {
-    QMenu* toolsMenu = menuBar()->addMenu(tr("&Tools"));
+    connect(controller, &Controller::finished, this, [this](const QString& summary) {
+        console_->info(summary);
+        statusBar()->showMessage(summary);
+    });
+    connect(controller, &Controller::failed, this, [this](const QString& message) {
+        console_->error(message);
+        statusBar()->showMessage(message);
+    });
+}
+
+void MainWindow::buildDocks()
+{
+    const auto dock = [this](const QString& title, QWidget* widget, Qt::DockWidgetArea area) {
+        auto* d = new QDockWidget(title, this);
+        d->setObjectName(title);
+        d->setWidget(widget);
+        addDockWidget(area, d);
+        return d;
+    };
+    tree_ = new EntityTree(document_, this);
+    properties_ = new PropertiesPanel(document_, this);
+    scalarPanel_ = new ScalarFieldPanel(document_, this);
+    console_ = new ConsolePanel(this);
+    dock(tr("Entities"), tree_, Qt::LeftDockWidgetArea);
+    dock(tr("Properties"), properties_, Qt::LeftDockWidgetArea);
+    dock(tr("Scalar field"), scalarPanel_, Qt::RightDockWidgetArea);
+    QDockWidget* consoleDock = dock(tr("Console"), console_, Qt::BottomDockWidgetArea);
+    resizeDocks({consoleDock}, {140}, Qt::Vertical);
+}
+
+void MainWindow::buildMenus()
+{
+    QMenu* file = menuBar()->addMenu(tr("&File"));
+    file->addAction(tr("&Open..."), files_, &FileController::openWithDialog)->setShortcut(QKeySequence::Open);
+    QMenu* recent = file->addMenu(tr("Open &recent"));
+    files_->fillRecentMenu(recent);
+    connect(files_, &FileController::recentFilesChanged, this, [this, recent] { files_->fillRecentMenu(recent); });
+    file->addAction(tr("&Export selected..."), this, [this] { files_->exportWithDialog(tree_->selectedEntities()); })
+        ->setShortcut(QKeySequence(tr("Ctrl+E")));
+    file->addSeparator();
+    file->addAction(tr("Open &session..."), sessions_, &SessionController::restoreWithDialog);
+    file->addAction(tr("&Save session..."), sessions_, &SessionController::saveWithDialog)->setShortcut(QKeySequence::Save);
+    file->addSeparator();
+    file->addAction(tr("&Quit"), qApp, &QApplication::quit)->setShortcut(QKeySequence::Quit);
+
+    QMenu* edit = menuBar()->addMenu(tr("&Edit"));
+    edit->addAction(tr("&Delete selected"), this, [this] {
+        for (EntityId id : tree_->selectedEntities())
+            document_.remove(id);
+    })->setShortcut(QKeySequence::Delete);
+    edit->addAction(tr("&Rename..."), this, [this] {
+        const EntityId id = tree_->currentEntity();
+        if (!document_.contains(id))
+            return;
+        bool ok = false;
+        const QString name = QInputDialog::getText(this, tr("Rename"), tr("Name"), QLineEdit::Normal, document_.item(id).name, &ok);
+        if (ok && !name.isEmpty())
+            document_.rename(id, name);
+    })->setShortcut(QKeySequence(Qt::Key_F2));
+
+    QMenu* viewMenu = menuBar()->addMenu(tr("&View"));
+    QToolBar* viewBar = addToolBar(tr("View"));
+    viewBar->setObjectName("viewToolBar");
+    const std::pair<QString, StandardView> views[] = {{tr("Top"), StandardView::Top},       {tr("Front"), StandardView::Front},
+                                                      {tr("Left"), StandardView::Left},     {tr("Right"), StandardView::Right},
+                                                      {tr("Back"), StandardView::Back},     {tr("Bottom"), StandardView::Bottom},
+                                                      {tr("Iso"), StandardView::Iso}};
+    QMenu* standard = viewMenu->addMenu(tr("&Standard views"));
+    for (const auto& [label, which] : views) {
+        const StandardView v = which;
+        QAction* a = standard->addAction(label, this, [this, v] { view_->setStandardView(v); });
+        viewBar->addAction(a);
+    }
+    viewBar->addSeparator();
+    QAction* zoomAll = viewMenu->addAction(tr("Zoom to &all"), view_, &CloudView::resetCamera);
+    zoomAll->setShortcut(QKeySequence(tr("Ctrl+0")));
+    viewBar->addAction(zoomAll);
+    QAction* zoomSelection = viewMenu->addAction(tr("Zoom to &selection"), this, [this] {
+        if (document_.contains(tree_->currentEntity()))
+            view_->zoomToEntity(tree_->currentEntity());
+    });
+    viewBar->addAction(zoomSelection);
+    QAction* ortho = viewMenu->addAction(tr("&Orthographic projection"));
+    ortho->setCheckable(true);
+    connect(ortho, &QAction::toggled, view_, &CloudView::setParallelProjection);
+    viewBar->addAction(ortho);
+    QAction* pick = viewMenu->addAction(tr("&Pick a point"));
+    pick->setCheckable(true);
+    pick->setShortcut(QKeySequence(tr("P")));
+    pick->setToolTip(tr("Click a point to see its coordinates and field values"));
+    connect(pick, &QAction::toggled, view_, &CloudView::setPickMode);
+    connect(view_, &CloudView::pickModeChanged, pick, &QAction::setChecked);
+    viewBar->addAction(pick);
+    QMenu* sizes = viewMenu->addMenu(tr("Point si&ze"));
+    auto* sizeGroup = new QActionGroup(this);
+    for (int size : {1, 2, 3, 4, 6, 8}) {
+        QAction* a = sizes->addAction(QString::number(size), this, [this, size] { view_->setPointSize(float(size)); });
+        a->setCheckable(true);
+        a->setChecked(size == int(view_->pointSize()));
+        sizeGroup->addAction(a);
+    }
+    viewMenu->addSeparator();
+    for (QDockWidget* d : findChildren<QDockWidget*>())
+        viewMenu->addAction(d->toggleViewAction());
+
+    QMenu* tools = menuBar()->addMenu(tr("&Tools"));
+    QMenu* distances = tools->addMenu(tr("&Distances"));
+    distances->addAction(tr("&Cloud/cloud distance (C2C)..."), this,
+                         [this] { distances_->runInteractively(DistanceKind::CloudToCloud, tree_->currentEntity()); });
+    distances->addAction(tr("Cloud/&mesh distance (C2M)..."), this,
+                         [this] { distances_->runInteractively(DistanceKind::CloudToMesh, tree_->currentEntity()); });
+    tools->addAction(tr("&Split at thresholds"), this, [this] {
+        const EntityId id = scalarPanel_->entity();
+        const Document::Item* item = document_.find(id);
+        if (!item || item->display.activeField.empty()) {
+            QMessageBox::information(this, tr("Split"), tr("Select a cloud and an active scalar field first."));
+            return;
+        }
+        const FieldDisplay d = document_.fieldDisplay(id, item->display.activeField);
+        splits_->split(id, item->display.activeField, d.low, d.high);
+    });
+    buildToolsMenu(tools);
+}
+
+void MainWindow::buildToolsMenu(QMenu* toolsMenu)
+{
     std::map<std::string, QMenu*> categories;
     for (const ToolSpec& tool : registry_.tools.tools()) {
         QMenu*& menu = categories[tool.category];
@@ -55,13 +210,11 @@ void MainWindow::buildToolsMenu()
             menu = tool.category.empty() ? toolsMenu : toolsMenu->addMenu(QString::fromStdString(tool.category));
         auto* controller = new ToolController(tool, document_, this);
         tools_[tool.name] = controller;
-        QAction* action = menu->addAction(QString::fromStdString(tool.title) + "...", controller, &ToolController::runInteractively);
+        QAction* action = menu->addAction(QString::fromStdString(tool.title) + "...", this,
+                                          [this, controller] { controller->runInteractively(tree_->currentEntity()); });
         action->setStatusTip(QString::fromStdString(tool.description));
-        connect(controller, &ToolController::finished, this, [this](const QString& summary) { statusBar()->showMessage(summary); });
-        connect(controller, &ToolController::failed, this, [this](const QString& message) {
-            statusBar()->showMessage(message);
-            std::cerr << "error: " << message.toStdString() << '\n';
-        });
+        report(controller);
+        connect(controller, &ToolController::resultReady, tree_, &EntityTree::selectEntity);
     }
 }
 
@@ -71,64 +224,50 @@ ToolController* MainWindow::toolController(const std::string& toolName) const
     return it == tools_.end() ? nullptr : it->second;
 }
 
-void MainWindow::showEntity(std::size_t index)
+void MainWindow::onCurrentEntityChanged(EntityId id)
 {
-    const Document::Item& item = document_.item(index);
-    if (const auto* mesh = std::get_if<Mesh>(&item.entity))
-        view_->addMesh(*mesh);
-    else
-        view_->addCloud(std::get<PointCloud>(item.entity));
-    view_->resetCamera();
+    properties_->showEntity(id);
+    scalarPanel_->showEntity(id);
+    showLegendOf(id);
 }
 
-QString MainWindow::fileDialogFilter() const
+void MainWindow::showLegendOf(EntityId id)
 {
-    QStringList patterns;
-    QStringList perFormat;
-    for (const auto& handler : registry_.formats.handlers()) {
-        if (!handler.read)
-            continue;
-        QStringList mine;
-        for (const auto& ext : handler.extensions)
-            mine << "*." + QString::fromStdString(ext);
-        patterns << mine;
-        perFormat << QString::fromStdString(handler.name) + " (" + mine.join(' ') + ")";
+    const Document::Item* item = document_.find(id);
+    ColourLegend legend;
+    if (item && item->cloud() && !item->display.activeField.empty()) {
+        if (const ScalarField* field = item->points().field(item->display.activeField)) {
+            const FieldDisplay display = document_.fieldDisplay(id, field->name());
+            legend.shown = true;
+            legend.title = field->name();
+            legend.scale = display.scale;
+            std::tie(legend.min, legend.max) = colourRange(*field, display.scale);
+        }
     }
-    return tr("All supported (%1)").arg(patterns.join(' ')) + ";;" + perFormat.join(";;") + ";;" + tr("All files (*)");
-}
-
-void MainWindow::openWithDialog()
-{
-    const QStringList paths = QFileDialog::getOpenFileNames(this, tr("Open clouds or meshes"), QString(), fileDialogFilter());
-    if (!paths.isEmpty())
-        openFiles(paths);
+    view_->setLegend(legend);
 }
 
 int MainWindow::openFiles(const QStringList& paths, bool quiet)
 {
-    int loaded = 0;
-    for (const QString& path : paths) {
-        std::optional<io::Entity> entity;
-        const TaskResult result = runTask(this, tr("Opening %1").arg(QFileInfo(path).fileName()), [&](ProgressObserver& progress) {
-            io::ReadOptions options;
-            options.progress = &progress;
-            entity = io::readFile(registry_.formats, path.toStdString(), options);
-        });
-        if (result.outcome != TaskOutcome::Done) {
-            const QString message = result.outcome == TaskOutcome::Cancelled ? tr("Opening %1 was cancelled").arg(path) : result.error;
-            statusBar()->showMessage(message);
-            std::cerr << "error: " << message.toStdString() << '\n';
-            if (!quiet && result.outcome == TaskOutcome::Failed)
-                QMessageBox::warning(this, tr("Cannot open file"), message);
-            continue;
-        }
-        const std::size_t points = std::holds_alternative<Mesh>(*entity) ? std::get<Mesh>(*entity).vertices.size()
-                                                                          : std::get<PointCloud>(*entity).size();
-        document_.add(QFileInfo(path).completeBaseName(), std::move(*entity));
-        statusBar()->showMessage(tr("%1: %2 points").arg(QFileInfo(path).fileName()).arg(points));
-        ++loaded;
+    return static_cast<int>(files_->open(paths, quiet).size());
+}
+
+void MainWindow::dragEnterEvent(QDragEnterEvent* event)
+{
+    if (event->mimeData()->hasUrls())
+        event->acceptProposedAction();
+}
+
+void MainWindow::dropEvent(QDropEvent* event)
+{
+    QStringList paths;
+    for (const QUrl& url : event->mimeData()->urls())
+        if (url.isLocalFile())
+            paths << url.toLocalFile();
+    if (!paths.isEmpty()) {
+        files_->open(paths);
+        event->acceptProposedAction();
     }
-    return loaded;
 }
 
 } // namespace scandiff::gui

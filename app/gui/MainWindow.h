@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! The main window only assembles menus, the view and the status bar; reading
-//! goes through io::, tools through their controllers (tools/).
+//! The main window only assembles menus, docks and the view and wires their
+//! signals; files, distances, splits, sessions and plugin tools each have
+//! their own controller (controllers/), panels show the document (panels/).
 
 #include "document/Document.h"
 
@@ -10,9 +11,19 @@
 #include <QMainWindow>
 #include <QStringList>
 
+#include <map>
+
 namespace scandiff::gui {
 
 class CloudView;
+class ConsolePanel;
+class DistanceController;
+class EntityTree;
+class FileController;
+class PropertiesPanel;
+class ScalarFieldPanel;
+class SessionController;
+class SplitController;
 class ToolController;
 
 class MainWindow : public QMainWindow
@@ -21,23 +32,47 @@ class MainWindow : public QMainWindow
 public:
     explicit MainWindow(const PluginRegistry& registry, QWidget* parent = nullptr);
 
-    //! Loads files into the document; errors are shown in a message box (or, with
-    //! `quiet`, only in the status bar and on stderr). Returns how many loaded.
+    //! Loads files (errors in a message box, or with `quiet` only in the console).
+    //! Returns how many loaded.
     int openFiles(const QStringList& paths, bool quiet = false);
-    CloudView* view() const { return view_; }
+
     Document& document() { return document_; }
-    //! The controller of a registered tool, null if unknown.
+    CloudView* view() const { return view_; }
+    EntityTree* tree() const { return tree_; }
+    PropertiesPanel* properties() const { return properties_; }
+    ScalarFieldPanel* scalarPanel() const { return scalarPanel_; }
+    ConsolePanel* console() const { return console_; }
+    FileController* files() const { return files_; }
+    DistanceController* distances() const { return distances_; }
+    SplitController* splits() const { return splits_; }
+    SessionController* sessions() const { return sessions_; }
+    //! The controller of a registered plugin tool, null if unknown.
     ToolController* toolController(const std::string& toolName) const;
 
+protected:
+    void dragEnterEvent(QDragEnterEvent* event) override;
+    void dropEvent(QDropEvent* event) override;
+
 private:
-    void openWithDialog();
-    void buildToolsMenu();
-    void showEntity(std::size_t index);
-    QString fileDialogFilter() const;
+    void buildDocks();
+    void buildMenus();
+    void buildToolsMenu(QMenu* toolsMenu);
+    //! Console + status bar for a controller's finished/failed signals.
+    template <class Controller> void report(Controller* controller);
+    void onCurrentEntityChanged(EntityId id);
+    void showLegendOf(EntityId id);
 
     const PluginRegistry& registry_;
     Document document_;
     CloudView* view_;
+    EntityTree* tree_ = nullptr;
+    PropertiesPanel* properties_ = nullptr;
+    ScalarFieldPanel* scalarPanel_ = nullptr;
+    ConsolePanel* console_ = nullptr;
+    FileController* files_ = nullptr;
+    DistanceController* distances_ = nullptr;
+    SplitController* splits_ = nullptr;
+    SessionController* sessions_ = nullptr;
     std::map<std::string, ToolController*> tools_;
 };
 

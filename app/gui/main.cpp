@@ -15,6 +15,7 @@ int main(int argc, char** argv)
     QApplication app(argc, argv);
     QApplication::setApplicationName("scandiff");
     QApplication::setApplicationVersion("0.1.0");
+    QApplication::setOrganizationName("scandiff"); // where QSettings keeps recent files
 
     QCommandLineParser parser;
     parser.setApplicationDescription("scandiff: a workbench for comparing 3D scans");

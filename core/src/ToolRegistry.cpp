@@ -90,6 +90,24 @@ ParameterSpec ParameterSpec::choice(std::string name, std::string label, std::st
     return s;
 }
 
+ParameterSpec ParameterSpec::text(std::string name, std::string label, std::string description, std::string defaultValue)
+{
+    ParameterSpec s;
+    s.name = std::move(name);
+    s.label = std::move(label);
+    s.description = std::move(description);
+    s.type = ParameterType::Text;
+    s.defaultValue = std::move(defaultValue);
+    return s;
+}
+
+ParameterSpec ParameterSpec::asOptional() const
+{
+    ParameterSpec s = *this;
+    s.optional = true;
+    return s;
+}
+
 ParameterValue ParameterSpec::parse(const std::string& text) const
 {
     ParameterValue value;
@@ -119,6 +137,7 @@ ParameterValue ParameterSpec::parse(const std::string& text) const
             reject(*this, "'" + text + "' is not true or false");
         break;
     case ParameterType::Choice:
+    case ParameterType::Text:
         value = text;
         break;
     }
@@ -159,6 +178,10 @@ void ParameterSpec::validate(const ParameterValue& value) const
         }
         break;
     }
+    case ParameterType::Text:
+        if (!std::holds_alternative<std::string>(value))
+            reject(*this, "text is expected");
+        break;
     }
 }
 
@@ -196,19 +219,25 @@ const ParameterSpec* ToolSpec::parameter(const std::string& parameterName) const
 
 ParameterValues ToolSpec::defaults() const
 {
-    ParameterValues values;
-    for (const auto& p : parameters)
-        values.set(p.name, p.defaultValue);
-    return values;
+    return resolveParameters(parameters, {}, name);
 }
 
 ParameterValues ToolSpec::resolve(const std::map<std::string, std::string>& userText) const
 {
-    ParameterValues values = defaults();
+    return resolveParameters(parameters, userText, "tool '" + name + "'");
+}
+
+ParameterValues resolveParameters(const std::vector<ParameterSpec>& parameters,
+                                  const std::map<std::string, std::string>& userText, const std::string& owner)
+{
+    ParameterValues values;
+    for (const auto& p : parameters)
+        if (!p.optional)
+            values.set(p.name, p.defaultValue);
     for (const auto& [key, text] : userText) {
-        const ParameterSpec* spec = parameter(key);
-        if (!spec)
-            throw Error(ErrorCode::InvalidArgument, "tool '" + name + "' has no parameter '" + key + "'");
+        const auto spec = std::find_if(parameters.begin(), parameters.end(), [&](const ParameterSpec& p) { return p.name == key; });
+        if (spec == parameters.end())
+            throw Error(ErrorCode::InvalidArgument, owner + " has no parameter '" + key + "'");
         values.set(key, spec->parse(text));
     }
     return values;

@@ -181,7 +181,7 @@ TEST(Cli, CloudToCloudAndCloudToMeshWriteTheirFields)
 
     CliRun run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared",
                                    (dir / "compared.ply").string(), "--model", "plane", "--split-xyz", "-o",
-                                   (dir / "c2c.ply").string(), "--both-ways"});
+                                   (dir / "c2c.ply").string(), "--both-ways", "--closest-points"});
     ASSERT_EQ(run.status, 0) << run.err;
     EXPECT_NE(run.out.find("3 values"), std::string::npos) << run.out;
     PointCloud out = io::readPointCloud(registry.formats, dir / "c2c.ply");
@@ -192,6 +192,8 @@ TEST(Cli, CloudToCloudAndCloudToMeshWriteTheirFields)
     EXPECT_NEAR(out.field("c2c_distance")->values()[2], 0.05, 1e-5);
     EXPECT_NE(out.field("c2c_dz"), nullptr);
     EXPECT_TRUE(std::filesystem::exists(dir / "c2c_reference.ply"));
+    const PointCloud closest = io::readPointCloud(registry.formats, dir / "c2c_closest.ply");
+    EXPECT_EQ(closest.size(), 3u);
 
     run = runCli(registry, {"c2m", "--reference", (dir / "mesh.ply").string(), "--compared", (dir / "compared.ply").string(),
                             "--signed", "-o", (dir / "c2m.ply").string()});
@@ -208,6 +210,16 @@ TEST(Cli, CloudToCloudAndCloudToMeshWriteTheirFields)
                             "--signed"});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
     EXPECT_NE(run.err.find("normals"), std::string::npos) << run.err;
+    run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
+                            "--clamp"});
+    EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
+    run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
+                            "--knn", "8", "--radius", "0.5"});
+    EXPECT_NE(run.status, 0);
+    run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
+                            "--visibility"});
+    EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
+    EXPECT_NE(run.err.find("sensor"), std::string::npos) << run.err;
     run = runCli(registry, {"c2m", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string()});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidData)) << run.err;
 }

@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include <scandiff/core/Error.h>
+#include <scandiff/core/FieldRange.h>
 #include <scandiff/core/Mesh.h>
 #include <scandiff/core/PointCloud.h>
+
+#include "TestSupport.h"
 
 #include <gtest/gtest.h>
 
@@ -139,4 +142,31 @@ TEST(Mesh, ConsistencyAndDegenerateTriangles)
     m.checkConsistency();
     m.triangles.push_back({0, 1, 9});
     EXPECT_THROW(m.checkConsistency(), Error);
+}
+
+TEST(FieldRange, SplitKeepsOrderAttributesAndSendsNaNOutside)
+{
+    PointCloud cloud;
+    cloud.resize(6);
+    cloud.setOrigin({1000.0, 0.0, 0.0});
+    ScalarField& f = cloud.addField("d");
+    f.setOffset(100.0);
+    const double values[6] = {100.5, 99.0, 101.0, std::nan(""), 100.0, 102.0};
+    for (std::size_t i = 0; i < 6; ++i) {
+        cloud.positions()[i] = {float(i), 0.0f, 0.0f};
+        f.setValue(i, values[i]);
+    }
+    const FieldRangeSplit split = splitByFieldRange(cloud, "d", 100.0, 101.0);
+    ASSERT_EQ(split.inside.size(), 3u);
+    ASSERT_EQ(split.outside.size(), 3u);
+    EXPECT_EQ(split.inside.positions()[0].x(), 0.0f);
+    EXPECT_EQ(split.inside.positions()[1].x(), 2.0f);
+    EXPECT_EQ(split.inside.positions()[2].x(), 4.0f);
+    EXPECT_EQ(split.outside.positions()[1].x(), 3.0f);
+    EXPECT_TRUE(std::isnan(split.outside.field("d")->values()[1]));
+    EXPECT_DOUBLE_EQ(split.inside.origin().x(), 1000.0);
+    EXPECT_DOUBLE_EQ(split.inside.field("d")->value(0), 100.5);
+    EXPECT_EQ(countInRange(*cloud.field("d"), 100.0, 101.0), 3u);
+    EXPECT_EQ(test::errorCodeOf([&] { splitByFieldRange(cloud, "none", 0, 1); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { splitByFieldRange(cloud, "d", 2, 1); }), ErrorCode::InvalidArgument);
 }

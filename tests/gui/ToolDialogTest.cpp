@@ -2,7 +2,7 @@
 // Qt Test, offscreen platform: the generated tool dialog and the tool controller,
 // driven through their widgets as a user would.
 #include "document/Document.h"
-#include "tools/ToolController.h"
+#include "controllers/ToolController.h"
 #include "tools/ToolDialog.h"
 
 #include <scandiff/plugins/PluginRegistry.h>
@@ -71,14 +71,16 @@ private slots:
             input.positions()[i] = {u(rng), u(rng), 0.0f};
         input.positions()[1000] = {9.0f, 9.0f, 9.0f};
         input.name = "plane";
+        const gui::EntityId inputId = document.add("plane", std::move(input));
         gui::ToolController controller(*tool, document, nullptr);
         QSignalSpy finished(&controller, &gui::ToolController::finished);
-        QVERIFY(controller.run(input, {{"k", "8"}, {"n-sigma", "2"}}));
+        QVERIFY(controller.run(inputId, {{"k", "8"}, {"n-sigma", "2"}}));
         QCOMPARE(finished.count(), 1);
-        QCOMPARE(document.size(), std::size_t(1));
-        const auto& output = std::get<PointCloud>(document.item(0).entity);
-        QVERIFY(output.size() < 1001);
-        QCOMPARE(input.size(), std::size_t(1001)); // the input is untouched
+        QCOMPARE(document.size(), std::size_t(2));
+        const gui::Document::Item& output = document.item(document.ids().back());
+        QVERIFY(output.points().size() < 1001);
+        QCOMPARE(output.parent, inputId); // shown under its input in the tree
+        QCOMPARE(document.item(inputId).points().size(), std::size_t(1001)); // the input is untouched
         QVERIFY(finished.at(0).at(0).toString().contains("kept"));
     }
 
@@ -89,12 +91,13 @@ private slots:
         gui::Document document;
         PointCloud input;
         input.resize(3);
+        const gui::EntityId inputId = document.add("three", std::move(input));
         gui::ToolController controller(*tool, document, nullptr);
         QSignalSpy failed(&controller, &gui::ToolController::failed);
-        QVERIFY(!controller.run(input, {{"k", "0"}}));
+        QVERIFY(!controller.run(inputId, {{"k", "0"}}));
         QCOMPARE(failed.count(), 1);
         QVERIFY(failed.at(0).at(0).toString().contains("k"));
-        QCOMPARE(document.size(), std::size_t(0));
+        QCOMPARE(document.size(), std::size_t(1));
     }
 };
 

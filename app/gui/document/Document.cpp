@@ -1,27 +1,163 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "document/Document.h"
 
+#include <algorithm>
+#include <stdexcept>
+
 namespace scandiff::gui {
 
-std::size_t Document::add(QString name, io::Entity entity)
+const PointCloud& Document::Item::points() const
 {
-    items_.push_back(std::make_unique<Item>(Item{std::move(name), std::move(entity)}));
-    emit added(items_.size() - 1);
-    return items_.size() - 1;
+    if (const Mesh* m = mesh())
+        return m->vertices;
+    return std::get<PointCloud>(entity);
 }
 
-const PointCloud* Document::lastCloud() const
+EntityId Document::add(QString name, io::Entity entity, EntityId parent, QString sourcePath)
 {
-    for (auto it = items_.rbegin(); it != items_.rend(); ++it)
-        if (const auto* cloud = std::get_if<PointCloud>(&(*it)->entity))
-            return cloud;
-    return nullptr;
+    auto item = std::make_unique<Item>();
+    item->id = nextId_++;
+    item->name = std::move(name);
+    item->entity = std::move(entity);
+    item->parent = contains(parent) ? parent : kNoEntity;
+    item->sourcePath = std::move(sourcePath);
+    if (const PointCloud* cloud = item->cloud(); cloud && !cloud->fields().empty())
+        item->display.activeField = cloud->fields().front().name();
+    const EntityId id = item->id;
+    items_.push_back(std::move(item));
+    emit added(id);
+    return id;
+}
+
+void Document::remove(EntityId id)
+{
+    if (!contains(id))
+        return;
+    // Children first, so observers never see an orphan.
+    std::vector<EntityId> children;
+    for (const auto& item : items_)
+        if (item->parent == id)
+            children.push_back(item->id);
+    for (EntityId child : children)
+        remove(child);
+    items_.erase(std::remove_if(items_.begin(), items_.end(), [id](const auto& item) { return item->id == id; }), items_.end());
+    emit removed(id);
 }
 
 void Document::clear()
 {
     items_.clear();
     emit cleared();
+}
+
+std::vector<EntityId> Document::ids() const
+{
+    std::vector<EntityId> out;
+    for (const auto& item : items_)
+        out.push_back(item->id);
+    return out;
+}
+
+const Document::Item* Document::find(EntityId id) const
+{
+    for (const auto& item : items_)
+        if (item->id == id)
+            return item.get();
+    return nullptr;
+}
+
+Document::Item* Document::findMutable(EntityId id) { return const_cast<Item*>(find(id)); }
+
+const Document::Item& Document::item(EntityId id) const
+{
+    const Item* item = find(id);
+    if (!item)
+        throw std::out_of_range("no entity with id " + std::to_string(id));
+    return *item;
+}
+
+const PointCloud* Document::lastCloud() const
+{
+    const EntityId id = lastCloudId();
+    return id == kNoEntity ? nullptr : item(id).cloud();
+}
+
+EntityId Document::lastCloudId() const
+{
+    for (auto it = items_.rbegin(); it != items_.rend(); ++it)
+        if ((*it)->cloud())
+            return (*it)->id;
+    return kNoEntity;
+}
+
+void Document::addField(EntityId id, ScalarField field)
+{
+    Item* item = findMutable(id);
+    auto* cloud = item ? std::get_if<PointCloud>(&item->entity) : nullptr;
+    if (!cloud)
+        return;
+    const std::string name = field.name();
+    cloud->addField(std::move(field));
+    // A recomputed field starts again from its full range.
+    item->display.fields.erase(name);
+    item->display.activeField = name;
+    emit fieldsChanged(id);
+    emit displayChanged(id);
+}
+
+void Document::setVisible(EntityId id, bool visible)
+{
+    Item* item = findMutable(id);
+    if (!item || item->display.visible == visible)
+        return;
+    item->display.visible = visible;
+    emit displayChanged(id);
+}
+
+void Document::setActiveField(EntityId id, const std::string& fieldName)
+{
+    Item* item = findMutable(id);
+    if (!item || item->display.activeField == fieldName)
+        return;
+    if (!fieldName.empty() && !item->points().field(fieldName))
+        return;
+    item->display.activeField = fieldName;
+    emit displayChanged(id);
+}
+
+void Document::setFieldDisplay(EntityId id, const std::string& fieldName, const FieldDisplay& display)
+{
+    Item* item = findMutable(id);
+    if (!item)
+        return;
+    item->display.fields[fieldName] = display;
+    emit displayChanged(id);
+}
+
+void Document::setOutsideMode(EntityId id, FieldColouring::Outside mode)
+{
+    Item* item = findMutable(id);
+    if (!item || item->display.outside == mode)
+        return;
+    item->display.outside = mode;
+    emit displayChanged(id);
+}
+
+FieldDisplay Document::fieldDisplay(EntityId id, const std::string& fieldName) const
+{
+    const Item* item = find(id);
+    if (!item)
+        return {};
+    const auto it = item->display.fields.find(fieldName);
+    return it == item->display.fields.end() ? FieldDisplay{} : it->second;
+}
+
+void Document::rename(EntityId id, const QString& name)
+{
+    if (Item* item = findMutable(id)) {
+        item->name = name;
+        emit renamed(id);
+    }
 }
 
 } // namespace scandiff::gui

@@ -1,17 +1,45 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! The entities loaded in the workbench (clouds and meshes), owned here and
-//! shown by the view. Tools read their inputs from it and add their outputs.
+//! The entities loaded in the workbench (clouds and meshes) and how each is
+//! shown: visibility, active scalar field, colour scale and thresholds per field.
+//! Owned here; the view, the panels and the controllers observe the signals.
+//! Entities have stable ids; a derived entity (a split part, closest points)
+//! names its parent so the tree shows it underneath.
+
+#include "colour/ColourScale.h"
 
 #include <scandiff/io/FileIO.h>
 
 #include <QObject>
 #include <QString>
 
+#include <limits>
+#include <map>
 #include <memory>
 #include <vector>
 
 namespace scandiff::gui {
+
+using EntityId = int;
+constexpr EntityId kNoEntity = -1;
+
+//! How one scalar field is shown: its colour scale and the threshold range
+//! (inclusive) outside which points are hidden or greyed.
+struct FieldDisplay
+{
+    ColourScale scale = *ColourScale::preset("Blue-Green-Yellow-Red");
+    double low = -std::numeric_limits<double>::infinity();
+    double high = std::numeric_limits<double>::infinity();
+};
+
+struct DisplayState
+{
+    bool visible = true;
+    //! Empty: the entity's colours, else its height.
+    std::string activeField;
+    FieldColouring::Outside outside = FieldColouring::Outside::Hide;
+    std::map<std::string, FieldDisplay> fields; //!< by field name; absent = defaults
+};
 
 class Document : public QObject
 {
@@ -19,26 +47,62 @@ class Document : public QObject
 public:
     struct Item
     {
+        EntityId id = kNoEntity;
         QString name;
         io::Entity entity;
+        EntityId parent = kNoEntity;
+        QString sourcePath; //!< the file it was read from, empty for derived entities
+        DisplayState display;
+
+        const PointCloud* cloud() const { return std::get_if<PointCloud>(&entity); }
+        const Mesh* mesh() const { return std::get_if<Mesh>(&entity); }
+        //! The points of a cloud, or the vertices of a mesh.
+        const PointCloud& points() const;
     };
 
-    //! Takes ownership; returns the item's index.
-    std::size_t add(QString name, io::Entity entity);
-    std::size_t size() const { return items_.size(); }
-    const Item& item(std::size_t i) const { return *items_.at(i); }
-    //! The most recently added point cloud, or null.
-    const PointCloud* lastCloud() const;
+    //! Takes ownership; returns the new id. A cloud's first scalar field becomes active.
+    EntityId add(QString name, io::Entity entity, EntityId parent = kNoEntity, QString sourcePath = {});
+    //! Removes the entity and its descendants.
+    void remove(EntityId id);
     void clear();
 
+    std::size_t size() const { return items_.size(); }
+    //! In the order they were added.
+    std::vector<EntityId> ids() const;
+    bool contains(EntityId id) const { return find(id) != nullptr; }
+    //! Throws std::out_of_range for an unknown id.
+    const Item& item(EntityId id) const;
+    const Item* find(EntityId id) const;
+    //! The most recently added point cloud, or null.
+    const PointCloud* lastCloud() const;
+    EntityId lastCloudId() const;
+
+    //! Adds (or replaces) a scalar field of a cloud and makes it active.
+    void addField(EntityId id, ScalarField field);
+    void setVisible(EntityId id, bool visible);
+    //! Empty name: colours / height. Unknown names are ignored.
+    void setActiveField(EntityId id, const std::string& fieldName);
+    void setFieldDisplay(EntityId id, const std::string& fieldName, const FieldDisplay& display);
+    void setOutsideMode(EntityId id, FieldColouring::Outside mode);
+    //! The display of a field (defaults when never set).
+    FieldDisplay fieldDisplay(EntityId id, const std::string& fieldName) const;
+    void rename(EntityId id, const QString& name);
+
 signals:
-    void added(std::size_t index);
+    void added(EntityId id);
+    void removed(EntityId id);
+    void fieldsChanged(EntityId id);
+    //! Visibility, active field, scale, thresholds or outside mode changed.
+    void displayChanged(EntityId id);
+    void renamed(EntityId id);
     void cleared();
 
 private:
+    Item* findMutable(EntityId id);
     // unique_ptr keeps each entity in place while the vector grows: the view and
     // running tools may hold references to it.
     std::vector<std::unique_ptr<Item>> items_;
+    EntityId nextId_ = 1;
 };
 
 } // namespace scandiff::gui

@@ -1,9 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! A parameter dialog generated from a tool's declarations (ToolSpec): one
-//! widget per ParameterSpec, initialised with its default, limited to its range,
-//! with its help as tooltip. There is no second copy of any default: the values
-//! go back through ToolSpec::resolve, exactly as the CLI's options do.
+//! A plugin tool's parameter dialog: its description above a ParameterForm
+//! generated from the tool's declarations (ToolSpec).
 
 #include <scandiff/core/ToolRegistry.h>
 
@@ -15,6 +13,8 @@
 class QWidget;
 
 namespace scandiff::gui {
+
+class ParameterForm;
 
 class ToolDialog : public QDialog
 {
@@ -28,8 +28,7 @@ public:
     QWidget* editor(const std::string& parameterName) const;
 
 private:
-    const ToolSpec& tool_;
-    std::map<std::string, QWidget*> editors_;
+    ParameterForm* form_;
 };
 
 } // namespace scandiff::gui

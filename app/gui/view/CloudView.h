@@ -1,18 +1,34 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! The 3D view: a QVTKOpenGLNativeWidget that shows clouds and meshes.
-//! Conversion from scandiff's data model to VTK happens here and only here.
+//! The 3D view: a QVTKOpenGLNativeWidget that shows the document's clouds and
+//! meshes. Conversion from scandiff's data model to VTK happens here and only
+//! here. Thresholds and colour changes only rewrite the per-point colour array
+//! (points outside the range get alpha 0 and are discarded by the fragment
+//! shader); the geometry is uploaded once. While the camera moves, clouds above
+//! the interactive budget are drawn decimated, in full at rest.
 
-#include <scandiff/core/Mesh.h>
-#include <scandiff/core/PointCloud.h>
+#include "document/Document.h"
+#include "view/EntityColouring.h"
 
 #include <QWidget>
 
+#include <array>
 #include <memory>
 
 class QVTKOpenGLNativeWidget;
 
 namespace scandiff::gui {
+
+enum class StandardView { Top, Bottom, Front, Back, Left, Right, Iso };
+
+//! Everything needed to put the camera back (sessions).
+struct CameraState
+{
+    std::array<double, 3> position{0, 0, 1}, focalPoint{0, 0, 0}, viewUp{0, 1, 0};
+    double viewAngle = 30.0;
+    bool parallel = false;
+    double parallelScale = 1.0;
+};
 
 class CloudView : public QWidget
 {
@@ -21,18 +37,52 @@ public:
     explicit CloudView(QWidget* parent = nullptr);
     ~CloudView() override;
 
-    //! Shows a cloud: its colours if it has some, else its first scalar field,
-    //! else its height. Coordinates are drawn relative to the first entity's
-    //! origin, so georeferenced data stays precise on the GPU.
-    void addCloud(const PointCloud& cloud);
-    void addMesh(const Mesh& mesh);
+    //! Shows a document entity (coordinates relative to the first entity's
+    //! origin, so georeferenced data stays precise on the GPU).
+    void addEntity(const Document::Item& item);
+    void removeEntity(EntityId id);
+    //! Re-reads visibility and colours of an entity from its display state.
+    void refreshEntity(const Document::Item& item);
+    //! The colour-scale bar (hidden when `legend.shown` is false).
+    void setLegend(const ColourLegend& legend);
     void clear();
+
     void resetCamera();
+    void zoomToEntity(EntityId id);
+    void setStandardView(StandardView view);
     void setPointSize(float size);
-    //! Renders now and saves the view to a PNG (used by --screenshot).
+    float pointSize() const;
+    void setParallelProjection(bool parallel);
+    bool parallelProjection() const;
+    CameraState camera() const;
+    void setCamera(const CameraState& state);
+
+    //! Points drawn while the camera moves (default 1.5 M): clouds are decimated
+    //! by one common stride so their total stays below it.
+    void setInteractiveBudget(std::size_t points);
+    //! The stride used while moving (1 = no decimation); for tests.
+    std::size_t interactiveStride() const;
+    //! Switches the decimated drawing on or off as a camera move would.
+    void setMoving(bool moving);
+
+    //! In pick mode a left click picks the nearest point instead of rotating.
+    void setPickMode(bool on);
+    bool pickMode() const;
+    //! Picks at widget pixel (x, y from the top-left); emits pointPicked on success.
+    bool pickAt(int x, int y);
+
+    //! Renders now and saves the view to a PNG.
     bool saveScreenshot(const QString& path);
+    void render();
+
+signals:
+    void pointPicked(EntityId id, std::size_t index);
+    void pickModeChanged(bool on);
 
 private:
+    class PickCommand;
+    void updateStride();
+    bool pickAtDevicePixel(int x, int y);
     struct Scene;
     QVTKOpenGLNativeWidget* widget_;
     std::unique_ptr<Scene> scene_;

@@ -21,7 +21,9 @@
 
 namespace scandiff {
 
-enum class ParameterType { Integer, Real, Boolean, Choice };
+//! Text is free text checked by the tool itself (lists of numbers such as a
+//! sensor pose "X,Y,Z"); the others are checked against their declaration.
+enum class ParameterType { Integer, Real, Boolean, Choice, Text };
 
 using ParameterValue = std::variant<std::int64_t, double, bool, std::string>;
 
@@ -36,6 +38,10 @@ struct ParameterSpec
     double minimum = -std::numeric_limits<double>::infinity(); //!< Integer/Real: inclusive
     double maximum = std::numeric_limits<double>::infinity();  //!< Integer/Real: inclusive
     std::vector<std::string> choices;                            //!< Choice only
+    //! An optional parameter has no value unless the user gives one (the CLI
+    //! option is absent, the GUI's checkbox beside it is off); `defaultValue` is
+    //! then only the value a dialog proposes when the user switches it on.
+    bool optional = false;
 
     static ParameterSpec integer(std::string name, std::string label, std::string description, std::int64_t defaultValue,
                                  std::int64_t minimum, std::int64_t maximum, std::string unit = {});
@@ -44,6 +50,9 @@ struct ParameterSpec
     static ParameterSpec boolean(std::string name, std::string label, std::string description, bool defaultValue);
     static ParameterSpec choice(std::string name, std::string label, std::string description,
                                 std::vector<std::string> choices, std::string defaultValue);
+    static ParameterSpec text(std::string name, std::string label, std::string description, std::string defaultValue = {});
+    //! The same declaration, made optional (see `optional`).
+    ParameterSpec asOptional() const;
 
     //! Parses user text ("12", "0.5", "true", "plane") into a valid value.
     //! Throws Error(InvalidArgument) naming the parameter and its valid range.
@@ -59,6 +68,7 @@ class ParameterValues
 {
 public:
     void set(const std::string& name, ParameterValue value) { values_[name] = std::move(value); }
+    //! False for an optional parameter the user left unset.
     bool has(const std::string& name) const { return values_.count(name) != 0; }
     std::int64_t integer(const std::string& name) const;
     double real(const std::string& name) const;
@@ -93,6 +103,13 @@ struct ToolSpec
     //! Throws Error(InvalidArgument) for an unknown name or a bad value.
     ParameterValues resolve(const std::map<std::string, std::string>& userText) const;
 };
+
+//! The declared defaults (optional parameters left unset), overridden by user
+//! text keyed by parameter name; every value parsed and checked. `owner` names
+//! the tool or command in error messages. Throws Error(InvalidArgument) for an
+//! unknown name or a bad value.
+ParameterValues resolveParameters(const std::vector<ParameterSpec>& parameters,
+                                  const std::map<std::string, std::string>& userText, const std::string& owner);
 
 class ToolRegistry
 {

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! Runs a registered tool from the GUI: its generated dialog, then the tool's
-//! own run function on a worker thread with progress and Cancel; the result is
-//! added to the document. No algorithm code lives here.
+//! Runs a plugin tool from the GUI: its generated dialog, then the tool's own
+//! run function on a worker thread with progress and Cancel; the result is
+//! added to the document under its input. No algorithm code lives here.
 
 #include "document/Document.h"
 
@@ -20,15 +20,16 @@ class ToolController : public QObject
 public:
     ToolController(const ToolSpec& tool, Document& document, QWidget* parentWindow);
 
-    //! Asks for the parameters, then runs on the document's last cloud.
-    void runInteractively();
+    //! Asks for the parameters, then runs on `input` (else the last cloud).
+    void runInteractively(EntityId input);
     //! Runs with the given parameter text (the dialog's or a test's) on `input`.
     //! Returns false and emits failed() on error or cancellation.
-    bool run(const PointCloud& input, const std::map<std::string, std::string>& parameters);
+    bool run(EntityId input, const std::map<std::string, std::string>& parameters);
 
 signals:
     void finished(const QString& summary);
     void failed(const QString& message);
+    void resultReady(EntityId id);
 
 private:
     const ToolSpec& tool_;

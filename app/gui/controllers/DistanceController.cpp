@@ -1,0 +1,210 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "controllers/DistanceController.h"
+
+#include "TaskRunner.h"
+#include "tools/ParameterForm.h"
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/distance/DistanceParameters.h>
+
+#include <QComboBox>
+#include <QDialogButtonBox>
+#include <QElapsedTimer>
+#include <QFormLayout>
+#include <QLabel>
+#include <QMessageBox>
+#include <QScrollArea>
+#include <QVBoxLayout>
+
+#include <optional>
+
+namespace scandiff::gui {
+
+namespace {
+
+QString parameterText(const std::map<std::string, std::string>& parameters)
+{
+    QStringList parts;
+    for (const auto& [name, value] : parameters)
+        parts << QString("--%1 %2").arg(QString::fromStdString(name), QString::fromStdString(value));
+    return parts.join(' ');
+}
+
+QString statisticsText(const DistanceStatistics& s)
+{
+    return QString("%1 values, mean %2, std %3, min %4, max %5, RMS %6")
+        .arg(s.count)
+        .arg(s.mean, 0, 'g', 6)
+        .arg(s.standardDeviation, 0, 'g', 6)
+        .arg(s.min, 0, 'g', 6)
+        .arg(s.max, 0, 'g', 6)
+        .arg(s.rms, 0, 'g', 6);
+}
+
+void fillEntities(QComboBox* box, const Document& document, bool meshes, bool clouds)
+{
+    for (EntityId id : document.ids()) {
+        const Document::Item& item = document.item(id);
+        if ((meshes && item.mesh()) || (clouds && item.cloud()))
+            box->addItem(item.name, id);
+    }
+}
+
+} // namespace
+
+DistanceDialog::DistanceDialog(DistanceKind kind, const Document& document, QWidget* parent) : QDialog(parent)
+{
+    const bool c2c = kind == DistanceKind::CloudToCloud;
+    setWindowTitle(c2c ? tr("Cloud-to-cloud distance") : tr("Cloud-to-mesh distance"));
+    auto* layout = new QVBoxLayout(this);
+    auto* help = new QLabel(c2c ? tr("For every point of the compared cloud, its distance to the reference cloud "
+                                     "(nearest neighbour, or a local model of the reference).")
+                                : tr("For every point of the compared cloud, its exact distance to the reference mesh."),
+                            this);
+    help->setWordWrap(true);
+    layout->addWidget(help);
+    auto* entities = new QFormLayout;
+    reference_ = new QComboBox(this);
+    reference_->setObjectName("reference");
+    compared_ = new QComboBox(this);
+    compared_->setObjectName("compared");
+    fillEntities(reference_, document, !c2c, c2c);
+    fillEntities(compared_, document, false, true);
+    entities->addRow(tr("Reference"), reference_);
+    entities->addRow(tr("Compared"), compared_);
+    layout->addLayout(entities);
+    form_ = new ParameterForm(c2c ? cloudToCloudParameters() : cloudToMeshParameters(), this);
+    auto* scroll = new QScrollArea(this);
+    scroll->setWidget(form_);
+    scroll->setWidgetResizable(true);
+    scroll->setFrameShape(QFrame::NoFrame);
+    layout->addWidget(scroll, 1);
+    auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel, this);
+    connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
+    connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
+    layout->addWidget(buttons);
+    resize(520, c2c ? 640 : 360);
+}
+
+EntityId DistanceDialog::reference() const { return reference_->currentData().isValid() ? reference_->currentData().toInt() : kNoEntity; }
+EntityId DistanceDialog::compared() const { return compared_->currentData().isValid() ? compared_->currentData().toInt() : kNoEntity; }
+
+void DistanceDialog::setReference(EntityId id)
+{
+    if (const int i = reference_->findData(id); i >= 0)
+        reference_->setCurrentIndex(i);
+}
+
+void DistanceDialog::setCompared(EntityId id)
+{
+    if (const int i = compared_->findData(id); i >= 0)
+        compared_->setCurrentIndex(i);
+}
+
+std::map<std::string, std::string> DistanceDialog::values() const { return form_->values(); }
+
+DistanceController::DistanceController(Document& document, QWidget* parentWindow)
+    : QObject(parentWindow), document_(document), parentWindow_(parentWindow)
+{
+}
+
+void DistanceController::runInteractively(DistanceKind kind, EntityId current)
+{
+    DistanceDialog dialog(kind, document_, parentWindow_);
+    const bool c2c = kind == DistanceKind::CloudToCloud;
+    if (dialog.reference() == kNoEntity || dialog.compared() == kNoEntity) {
+        QMessageBox::information(parentWindow_, dialog.windowTitle(),
+                                 c2c ? tr("Open two point clouds first.") : tr("Open a mesh and a point cloud first."));
+        return;
+    }
+    // CloudCompare's habit: the older epoch (opened first) is the reference;
+    // the current selection, else the last cloud, is compared.
+    const Document::Item* currentItem = document_.find(current);
+    dialog.setCompared(currentItem && currentItem->cloud() ? current : document_.lastCloudId());
+    if (c2c && dialog.reference() == dialog.compared())
+        for (EntityId id : document_.ids())
+            if (id != dialog.compared() && document_.item(id).cloud()) {
+                dialog.setReference(id);
+                break;
+            }
+    if (dialog.exec() != QDialog::Accepted)
+        return;
+    if (c2c)
+        runCloudToCloud(dialog.compared(), dialog.reference(), dialog.values());
+    else
+        runCloudToMesh(dialog.compared(), dialog.reference(), dialog.values());
+}
+
+bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId referenceId,
+                                         const std::map<std::string, std::string>& parameters)
+{
+    const Document::Item* compared = document_.find(comparedId);
+    const Document::Item* reference = document_.find(referenceId);
+    if (!compared || !reference || !compared->cloud() || !reference->cloud()) {
+        emit failed(tr("C2C needs two point clouds"));
+        return false;
+    }
+    std::optional<CloudToCloudRun> run;
+    QElapsedTimer clock;
+    clock.start();
+    const TaskResult outcome = runTask(parentWindow_, tr("Cloud-to-cloud distance"), [&](ProgressObserver& progress) {
+        const ParameterValues values = resolveParameters(cloudToCloudParameters(), parameters, "c2c");
+        run = scandiff::runCloudToCloud(*compared->cloud(), *reference->cloud(), values, &progress);
+    });
+    if (outcome.outcome != TaskOutcome::Done) {
+        emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("C2C was cancelled") : outcome.error);
+        return false;
+    }
+    const double seconds = clock.elapsed() / 1000.0;
+    CloudToCloudResult& forward = run->forward;
+    for (auto* extra : {&forward.dx, &forward.dy, &forward.dz, &forward.visibility})
+        if (*extra)
+            document_.addField(comparedId, std::move(**extra));
+    const DistanceStatistics statistics = forward.statistics;
+    document_.addField(comparedId, std::move(forward.distance)); // last: the active field
+    if (run->reverse)
+        document_.addField(referenceId, std::move(run->reverse->distance));
+    if (forward.closest) {
+        PointCloud closest = std::move(*forward.closest);
+        document_.add(compared->name + tr(" closest points"), std::move(closest), comparedId);
+    }
+    emit finished(tr("C2C %1 -> %2 [%3] %4; octree level %5; %6 s")
+                      .arg(compared->name, reference->name, parameterText(parameters), statisticsText(statistics))
+                      .arg(forward.level)
+                      .arg(seconds, 0, 'f', 3));
+    emit resultReady(comparedId);
+    return true;
+}
+
+bool DistanceController::runCloudToMesh(EntityId comparedId, EntityId referenceId,
+                                        const std::map<std::string, std::string>& parameters)
+{
+    const Document::Item* compared = document_.find(comparedId);
+    const Document::Item* reference = document_.find(referenceId);
+    if (!compared || !reference || !compared->cloud() || !reference->mesh()) {
+        emit failed(tr("C2M needs a point cloud and a mesh"));
+        return false;
+    }
+    std::optional<CloudToMeshResult> result;
+    QElapsedTimer clock;
+    clock.start();
+    const TaskResult outcome = runTask(parentWindow_, tr("Cloud-to-mesh distance"), [&](ProgressObserver& progress) {
+        const CloudToMeshParams params = cloudToMeshSettings(resolveParameters(cloudToMeshParameters(), parameters, "c2m"));
+        result = cloudToMesh(*compared->cloud(), *reference->mesh(), params, &progress);
+    });
+    if (outcome.outcome != TaskOutcome::Done) {
+        emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("C2M was cancelled") : outcome.error);
+        return false;
+    }
+    const double seconds = clock.elapsed() / 1000.0;
+    const DistanceStatistics statistics = result->statistics;
+    document_.addField(comparedId, std::move(result->distance));
+    emit finished(tr("C2M %1 -> %2 [%3] %4; %5 degenerate triangles; %6 s")
+                      .arg(compared->name, reference->name, parameterText(parameters), statisticsText(statistics))
+                      .arg(result->degenerateTriangles)
+                      .arg(seconds, 0, 'f', 3));
+    emit resultReady(comparedId);
+    return true;
+}
+
+} // namespace scandiff::gui

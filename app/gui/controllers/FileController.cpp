@@ -1,0 +1,161 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "controllers/FileController.h"
+
+#include "TaskRunner.h"
+
+#include <scandiff/io/FileIO.h>
+
+#include <QDir>
+#include <QElapsedTimer>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QMenu>
+#include <QMessageBox>
+#include <QSettings>
+
+#include <optional>
+
+namespace scandiff::gui {
+
+namespace {
+
+constexpr int kRecentFiles = 10;
+const char* kRecentKey = "recentFiles";
+
+} // namespace
+
+FileController::FileController(const PluginRegistry& registry, Document& document, QWidget* parentWindow)
+    : QObject(parentWindow), registry_(registry), document_(document), parentWindow_(parentWindow)
+{
+}
+
+QString FileController::fileFilter(bool forWriting) const
+{
+    QStringList patterns;
+    QStringList perFormat;
+    for (const auto& handler : registry_.formats.handlers()) {
+        if (forWriting ? !(handler.writeCloud || handler.writeMesh) : !handler.read)
+            continue;
+        QStringList mine;
+        for (const auto& ext : handler.extensions)
+            mine << "*." + QString::fromStdString(ext);
+        patterns << mine;
+        perFormat << QString::fromStdString(handler.name) + " (" + mine.join(' ') + ")";
+    }
+    if (forWriting)
+        return perFormat.join(";;");
+    return tr("All supported (%1)").arg(patterns.join(' ')) + ";;" + perFormat.join(";;") + ";;" + tr("All files (*)");
+}
+
+std::vector<EntityId> FileController::open(const QStringList& paths, bool quiet)
+{
+    std::vector<EntityId> loaded;
+    for (const QString& path : paths) {
+        std::optional<io::Entity> entity;
+        QElapsedTimer clock;
+        clock.start();
+        const TaskResult result = runTask(parentWindow_, tr("Opening %1").arg(QFileInfo(path).fileName()), [&](ProgressObserver& progress) {
+            io::ReadOptions options;
+            options.progress = &progress;
+            entity = io::readFile(registry_.formats, path.toStdString(), options);
+        });
+        if (result.outcome != TaskOutcome::Done) {
+            const QString message = result.outcome == TaskOutcome::Cancelled ? tr("Opening %1 was cancelled").arg(path) : result.error;
+            emit failed(message);
+            if (!quiet && result.outcome == TaskOutcome::Failed)
+                QMessageBox::warning(parentWindow_, tr("Cannot open file"), message);
+            continue;
+        }
+        const bool isMesh = std::holds_alternative<Mesh>(*entity);
+        const std::size_t points = isMesh ? std::get<Mesh>(*entity).vertices.size() : std::get<PointCloud>(*entity).size();
+        const QString absolute = QFileInfo(path).absoluteFilePath();
+        loaded.push_back(document_.add(QFileInfo(path).completeBaseName(), std::move(*entity), kNoEntity, absolute));
+        remember(absolute);
+        emit finished(tr("opened %1: %2 %3 in %4 s")
+                          .arg(absolute)
+                          .arg(points)
+                          .arg(isMesh ? tr("vertices") : tr("points"))
+                          .arg(clock.elapsed() / 1000.0, 0, 'f', 3));
+    }
+    return loaded;
+}
+
+void FileController::openWithDialog()
+{
+    const QStringList paths = QFileDialog::getOpenFileNames(parentWindow_, tr("Open clouds or meshes"), QString(), fileFilter(false));
+    if (!paths.isEmpty())
+        open(paths);
+}
+
+bool FileController::exportEntity(EntityId id, const QString& path)
+{
+    const Document::Item* item = document_.find(id);
+    if (!item) {
+        emit failed(tr("Nothing to export"));
+        return false;
+    }
+    QElapsedTimer clock;
+    clock.start();
+    const TaskResult result = runTask(parentWindow_, tr("Writing %1").arg(QFileInfo(path).fileName()), [&](ProgressObserver& progress) {
+        io::WriteOptions options;
+        options.progress = &progress;
+        io::writeFile(registry_.formats, item->entity, path.toStdString(), options);
+    });
+    if (result.outcome != TaskOutcome::Done) {
+        emit failed(result.outcome == TaskOutcome::Cancelled ? tr("Writing %1 was cancelled").arg(path) : result.error);
+        return false;
+    }
+    emit finished(tr("exported %1 to %2 (%3 points, %4 fields) in %5 s")
+                      .arg(item->name, path)
+                      .arg(item->points().size())
+                      .arg(item->points().fields().size())
+                      .arg(clock.elapsed() / 1000.0, 0, 'f', 3));
+    return true;
+}
+
+void FileController::exportWithDialog(const std::vector<EntityId>& ids)
+{
+    if (ids.empty()) {
+        QMessageBox::information(parentWindow_, tr("Export"), tr("Select the entities to export in the tree first."));
+        return;
+    }
+    if (ids.size() == 1) {
+        const Document::Item& item = document_.item(ids.front());
+        QString selectedFilter = "PLY (*.ply)";
+        const QString path = QFileDialog::getSaveFileName(parentWindow_, tr("Export %1").arg(item.name), item.name + ".ply",
+                                                          fileFilter(true), &selectedFilter);
+        if (!path.isEmpty() && exportEntity(ids.front(), path))
+            return;
+        return;
+    }
+    const QString folder = QFileDialog::getExistingDirectory(parentWindow_, tr("Export %1 entities as PLY into").arg(ids.size()));
+    if (folder.isEmpty())
+        return;
+    for (EntityId id : ids)
+        if (!exportEntity(id, QDir(folder).filePath(document_.item(id).name + ".ply")))
+            break;
+}
+
+QStringList FileController::recentFiles() const { return QSettings().value(kRecentKey).toStringList(); }
+
+void FileController::remember(const QString& path)
+{
+    QStringList files = recentFiles();
+    files.removeAll(path);
+    files.prepend(path);
+    while (files.size() > kRecentFiles)
+        files.removeLast();
+    QSettings().setValue(kRecentKey, files);
+    emit recentFilesChanged();
+}
+
+void FileController::fillRecentMenu(QMenu* menu)
+{
+    menu->clear();
+    const QStringList files = recentFiles();
+    for (const QString& file : files)
+        menu->addAction(file, this, [this, file] { open({file}); });
+    menu->setEnabled(!files.isEmpty());
+}
+
+} // namespace scandiff::gui

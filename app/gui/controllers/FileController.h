@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Files in and out of the workbench: open (menu, command line, drag and
+//! drop), recent files, export of entities in any format io/ writes. Reading
+//! and writing run on a worker thread behind the progress dialog.
+
+#include "document/Document.h"
+
+#include <scandiff/plugins/PluginRegistry.h>
+
+#include <QObject>
+#include <QStringList>
+
+class QMenu;
+class QWidget;
+
+namespace scandiff::gui {
+
+class FileController : public QObject
+{
+    Q_OBJECT
+public:
+    FileController(const PluginRegistry& registry, Document& document, QWidget* parentWindow);
+
+    //! Loads files; errors go to failed() and, unless `quiet`, a message box.
+    //! Returns the ids of the loaded entities.
+    std::vector<EntityId> open(const QStringList& paths, bool quiet = false);
+    void openWithDialog();
+    //! Writes one entity (format from the extension); false and failed() on error.
+    bool exportEntity(EntityId id, const QString& path);
+    //! Asks where to write the given entities: a file for one, a folder for several.
+    void exportWithDialog(const std::vector<EntityId>& ids);
+
+    QStringList recentFiles() const;
+    //! Rebuilds `menu` with the recent files (kept in QSettings).
+    void fillRecentMenu(QMenu* menu);
+    //! "All supported (*.ply *.las ...);;PLY (*.ply);;..." for reading or writing.
+    QString fileFilter(bool forWriting) const;
+
+signals:
+    void finished(const QString& summary);
+    void failed(const QString& message);
+    void recentFilesChanged();
+
+private:
+    void remember(const QString& path);
+    const PluginRegistry& registry_;
+    Document& document_;
+    QWidget* parentWindow_;
+};
+
+} // namespace scandiff::gui

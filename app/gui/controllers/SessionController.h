@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Save and restore a session: every entity (written as PLY beside the session
+//! file, so computed fields and split parts survive), the tree's parent links,
+//! visibility, active fields, colour scales, thresholds, the camera and the
+//! point size. The session file is JSON (`.scandiff`), its data in
+//! `<name>.scandiff.data/`.
+
+#include "document/Document.h"
+
+#include <scandiff/plugins/PluginRegistry.h>
+
+#include <QObject>
+
+class QWidget;
+
+namespace scandiff::gui {
+
+class CloudView;
+class ScalarFieldPanel;
+
+class SessionController : public QObject
+{
+    Q_OBJECT
+public:
+    SessionController(const PluginRegistry& registry, Document& document, CloudView& view, ScalarFieldPanel& scalarPanel,
+                      QWidget* parentWindow);
+
+    bool save(const QString& path);
+    //! Replaces the document's content with the session's.
+    bool restore(const QString& path);
+    void saveWithDialog();
+    void restoreWithDialog();
+
+signals:
+    void finished(const QString& summary);
+    void failed(const QString& message);
+
+private:
+    const PluginRegistry& registry_;
+    Document& document_;
+    CloudView& view_;
+    ScalarFieldPanel& scalarPanel_;
+    QWidget* parentWindow_;
+};
+
+} // namespace scandiff::gui

@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "panels/PropertiesPanel.h"
+
+#include <QHeaderView>
+
+#include <cmath>
+
+namespace scandiff::gui {
+
+namespace {
+
+QString number(double v, int decimals = 3)
+{
+    return std::isnan(v) ? QStringLiteral("NaN") : QString::number(v, 'f', decimals);
+}
+
+QString triple(const Eigen::Vector3d& v, int decimals = 3)
+{
+    return QString("%1, %2, %3").arg(number(v.x(), decimals), number(v.y(), decimals), number(v.z(), decimals));
+}
+
+//! Significant digits for field values, whatever their magnitude.
+QString fieldValue(double v) { return std::isnan(v) ? QStringLiteral("NaN (no value)") : QString::number(v, 'g', 8); }
+
+} // namespace
+
+QString describePoint(const Document::Item& item, std::size_t index)
+{
+    const PointCloud& points = item.points();
+    QString text = QString("%1 #%2: %3").arg(item.name).arg(index).arg(triple(points.globalPosition(index)));
+    for (const ScalarField& f : points.fields())
+        text += QString("; %1 = %2").arg(QString::fromStdString(f.name()), fieldValue(f.value(index)));
+    return text;
+}
+
+PropertiesPanel::PropertiesPanel(const Document& document, QWidget* parent) : QTreeWidget(parent), document_(document)
+{
+    setColumnCount(2);
+    setHeaderLabels({tr("Property"), tr("Value")});
+    header()->setSectionResizeMode(0, QHeaderView::ResizeToContents);
+    setRootIsDecorated(true);
+    connect(&document_, &Document::fieldsChanged, this, [this](EntityId id) {
+        if (id == entity_)
+            rebuild();
+    });
+    connect(&document_, &Document::removed, this, [this](EntityId id) {
+        if (id == pickedEntity_)
+            pickedEntity_ = kNoEntity;
+        if (id == entity_)
+            entity_ = kNoEntity;
+        rebuild();
+    });
+    connect(&document_, &Document::cleared, this, [this] {
+        entity_ = pickedEntity_ = kNoEntity;
+        rebuild();
+    });
+}
+
+void PropertiesPanel::showEntity(EntityId id)
+{
+    entity_ = id;
+    rebuild();
+}
+
+void PropertiesPanel::showPickedPoint(EntityId id, std::size_t index)
+{
+    pickedEntity_ = id;
+    pickedIndex_ = index;
+    rebuild();
+}
+
+void PropertiesPanel::rebuild()
+{
+    clear();
+    const auto add = [this](QTreeWidgetItem* parent, const QString& key, const QString& value) {
+        auto* row = parent ? new QTreeWidgetItem(parent) : new QTreeWidgetItem(this);
+        row->setText(0, key);
+        row->setText(1, value);
+        return row;
+    };
+    if (const Document::Item* item = document_.find(entity_)) {
+        const PointCloud& points = item->points();
+        add(nullptr, tr("Name"), item->name);
+        add(nullptr, tr("Type"), item->mesh() ? tr("Mesh") : tr("Point cloud"));
+        if (!item->sourcePath.isEmpty())
+            add(nullptr, tr("File"), item->sourcePath);
+        add(nullptr, item->mesh() ? tr("Vertices") : tr("Points"), QString::number(points.size()));
+        if (const Mesh* mesh = item->mesh())
+            add(nullptr, tr("Triangles"), QString::number(mesh->triangles.size()));
+        add(nullptr, tr("Global shift"), triple(points.origin()));
+        const BoundingBox box = points.bounds();
+        if (!box.empty) {
+            add(nullptr, tr("Bounds min"), triple(box.min));
+            add(nullptr, tr("Bounds max"), triple(box.max));
+            add(nullptr, tr("Extent"), triple(box.max - box.min));
+        }
+        add(nullptr, tr("Colours"), points.hasColors() ? tr("yes") : tr("no"));
+        add(nullptr, tr("Normals"), points.hasNormals() ? tr("yes") : tr("no"));
+        add(nullptr, tr("Sensor poses"), QString::number(points.sensors().size()));
+        QTreeWidgetItem* fields = add(nullptr, tr("Scalar fields"), QString::number(points.fields().size()));
+        for (const ScalarField& f : points.fields()) {
+            const ValueRange r = f.range();
+            const QString range = r.validCount ? QString("[%1, %2], %3 values").arg(fieldValue(r.min), fieldValue(r.max)).arg(r.validCount)
+                                               : tr("no value");
+            add(fields, QString::fromStdString(f.name()), range);
+        }
+        fields->setExpanded(true);
+    }
+    if (const Document::Item* picked = document_.find(pickedEntity_); picked && pickedIndex_ < picked->points().size()) {
+        const PointCloud& points = picked->points();
+        QTreeWidgetItem* point = add(nullptr, tr("Picked point"), QString("%1 #%2").arg(picked->name).arg(pickedIndex_));
+        add(point, tr("X, Y, Z"), triple(points.globalPosition(pickedIndex_)));
+        if (points.hasColors()) {
+            const Rgb8 c = points.colors()[pickedIndex_];
+            add(point, tr("RGB"), QString("%1, %2, %3").arg(c.r).arg(c.g).arg(c.b));
+        }
+        for (const ScalarField& f : points.fields())
+            add(point, QString::fromStdString(f.name()), fieldValue(f.value(pickedIndex_)));
+        point->setExpanded(true);
+    }
+}
+
+QString PropertiesPanel::value(const QString& property) const
+{
+    const QList<QTreeWidgetItem*> rows = findItems(property, Qt::MatchExactly | Qt::MatchRecursive, 0);
+    return rows.isEmpty() ? QString() : rows.first()->text(1);
+}
+
+} // namespace scandiff::gui

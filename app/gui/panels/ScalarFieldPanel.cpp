@@ -1,0 +1,246 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "panels/ScalarFieldPanel.h"
+
+#include "colour/ColourScaleEditor.h"
+#include "view/EntityColouring.h"
+#include "widgets/HistogramWidget.h"
+#include "widgets/RangeEditor.h"
+
+#include <scandiff/core/FieldRange.h>
+
+#include <QComboBox>
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QPushButton>
+#include <QVBoxLayout>
+
+#include <algorithm>
+#include <cmath>
+
+namespace scandiff::gui {
+
+namespace {
+
+constexpr int kHistogramBins = 128;
+
+} // namespace
+
+ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidget(parent), document_(document)
+{
+    auto* layout = new QVBoxLayout(this);
+    title_ = new QLabel(this);
+    title_->setWordWrap(true);
+    layout->addWidget(title_);
+    auto* form = new QFormLayout;
+    fieldBox_ = new QComboBox(this);
+    fieldBox_->setObjectName("fieldBox");
+    form->addRow(tr("Active field"), fieldBox_);
+    auto* scaleRow = new QHBoxLayout;
+    scaleBox_ = new QComboBox(this);
+    scaleBox_->setObjectName("scaleBox");
+    editScale_ = new QPushButton(tr("Edit..."), this);
+    editScale_->setToolTip(tr("Edit the colour scale's stops and save it as a new scale"));
+    scaleRow->addWidget(scaleBox_, 1);
+    scaleRow->addWidget(editScale_);
+    form->addRow(tr("Colour scale"), scaleRow);
+    outsideBox_ = new QComboBox(this);
+    outsideBox_->setObjectName("outsideBox");
+    outsideBox_->addItem(tr("Hidden"));
+    outsideBox_->addItem(tr("Greyed"));
+    form->addRow(tr("Outside the range"), outsideBox_);
+    layout->addLayout(form);
+    range_ = new RangeEditor(this);
+    range_->setObjectName("thresholds");
+    layout->addWidget(new QLabel(tr("Threshold range (points inside are shown):"), this));
+    layout->addWidget(range_);
+    histogram_ = new HistogramWidget(this);
+    histogram_->setObjectName("histogram");
+    layout->addWidget(histogram_, 1);
+    inside_ = new QLabel(this);
+    layout->addWidget(inside_);
+    auto* buttons = new QHBoxLayout;
+    resetRange_ = new QPushButton(tr("Full range"), this);
+    split_ = new QPushButton(tr("Split at thresholds"), this);
+    split_->setObjectName("splitButton");
+    split_->setToolTip(tr("Add the points inside and outside the range as two new clouds"));
+    buttons->addWidget(resetRange_);
+    buttons->addStretch(1);
+    buttons->addWidget(split_);
+    layout->addLayout(buttons);
+
+    connect(fieldBox_, qOverload<int>(&QComboBox::activated), this, &ScalarFieldPanel::onFieldChosen);
+    connect(scaleBox_, qOverload<int>(&QComboBox::activated), this, &ScalarFieldPanel::onScaleChosen);
+    connect(editScale_, &QPushButton::clicked, this, &ScalarFieldPanel::editScale);
+    connect(outsideBox_, qOverload<int>(&QComboBox::activated), this, [this](int index) {
+        document_.setOutsideMode(entity_, index == 1 ? FieldColouring::Outside::Grey : FieldColouring::Outside::Hide);
+    });
+    connect(range_, &RangeEditor::rangeChanged, this, &ScalarFieldPanel::onRangeEdited);
+    connect(histogram_, &HistogramWidget::markedRangeEdited, this, [this](double low, double high) { range_->setRange(low, high); });
+    connect(resetRange_, &QPushButton::clicked, this, [this] {
+        if (const ScalarField* field = activeField()) {
+            FieldDisplay display = document_.fieldDisplay(entity_, field->name());
+            display.low = -std::numeric_limits<double>::infinity();
+            display.high = std::numeric_limits<double>::infinity();
+            document_.setFieldDisplay(entity_, field->name(), display);
+            refresh();
+        }
+    });
+    connect(split_, &QPushButton::clicked, this, [this] {
+        if (const ScalarField* field = activeField())
+            emit splitRequested(entity_, field->name(), range_->low(), range_->high());
+    });
+    connect(&document_, &Document::fieldsChanged, this, [this](EntityId id) {
+        if (id == entity_)
+            refresh();
+    });
+    connect(&document_, &Document::displayChanged, this, [this](EntityId id) {
+        if (id == entity_ && !updating_)
+            refresh();
+    });
+    connect(&document_, &Document::removed, this, [this](EntityId id) {
+        if (id == entity_)
+            showEntity(kNoEntity);
+    });
+    connect(&document_, &Document::cleared, this, [this] { showEntity(kNoEntity); });
+    refreshScaleBox();
+    refresh();
+}
+
+void ScalarFieldPanel::showEntity(EntityId id)
+{
+    entity_ = document_.contains(id) ? id : kNoEntity;
+    refresh();
+}
+
+void ScalarFieldPanel::addCustomScale(const ColourScale& scale)
+{
+    const auto same = std::find_if(customScales_.begin(), customScales_.end(), [&](const ColourScale& s) { return s.name() == scale.name(); });
+    if (same != customScales_.end())
+        *same = scale;
+    else
+        customScales_.push_back(scale);
+    refreshScaleBox();
+}
+
+const ScalarField* ScalarFieldPanel::activeField() const
+{
+    const Document::Item* item = document_.find(entity_);
+    return item && !item->display.activeField.empty() ? item->points().field(item->display.activeField) : nullptr;
+}
+
+void ScalarFieldPanel::refreshScaleBox()
+{
+    scaleBox_->clear();
+    for (const ColourScale& s : ColourScale::presets())
+        scaleBox_->addItem(QString::fromStdString(s.name()));
+    for (const ColourScale& s : customScales_)
+        scaleBox_->addItem(QString::fromStdString(s.name()));
+}
+
+void ScalarFieldPanel::refresh()
+{
+    updating_ = true;
+    const Document::Item* item = document_.find(entity_);
+    fieldBox_->clear();
+    const ScalarField* field = activeField();
+    if (item) {
+        title_->setText(tr("<b>%1</b>").arg(item->name.toHtmlEscaped()));
+        fieldBox_->addItem(item->points().hasColors() ? tr("(colours)") : tr("(height)"));
+        for (const ScalarField& f : item->points().fields())
+            fieldBox_->addItem(QString::fromStdString(f.name()));
+        fieldBox_->setCurrentIndex(field ? fieldBox_->findText(QString::fromStdString(field->name())) : 0);
+        outsideBox_->setCurrentIndex(item->display.outside == FieldColouring::Outside::Grey ? 1 : 0);
+    } else {
+        title_->setText(tr("Select a cloud in the tree."));
+    }
+    const bool enabled = field != nullptr;
+    for (QWidget* w : std::initializer_list<QWidget*>{scaleBox_, editScale_, outsideBox_, range_, histogram_, resetRange_, split_})
+        w->setEnabled(enabled);
+    fieldBox_->setEnabled(item != nullptr);
+    if (field) {
+        const FieldDisplay display = document_.fieldDisplay(entity_, field->name());
+        scaleBox_->setCurrentText(QString::fromStdString(display.scale.name()));
+        const ValueRange r = field->range();
+        const double lo = r.validCount ? r.min : 0.0, hi = r.validCount ? r.max : 0.0;
+        range_->setBounds(lo, hi);
+        range_->setRange(std::max(lo, display.low), std::min(hi, display.high));
+        histogram_->setHistogram(computeHistogram(field->values().data(), field->size(), field->offset(), kHistogramBins));
+        const auto [cmin, cmax] = colourRange(*field, display.scale);
+        histogram_->setColouring(display.scale, cmin, cmax);
+        histogram_->setMarkedRange(range_->low(), range_->high());
+    } else {
+        histogram_->setHistogram({});
+    }
+    updating_ = false;
+    updateInsideCount();
+}
+
+void ScalarFieldPanel::onFieldChosen(int index)
+{
+    const Document::Item* item = document_.find(entity_);
+    if (!item)
+        return;
+    document_.setActiveField(entity_, index <= 0 ? std::string() : fieldBox_->itemText(index).toStdString());
+}
+
+void ScalarFieldPanel::onScaleChosen(int index)
+{
+    const ScalarField* field = activeField();
+    if (!field || index < 0)
+        return;
+    const auto& presets = ColourScale::presets();
+    const std::size_t i = static_cast<std::size_t>(index);
+    FieldDisplay display = document_.fieldDisplay(entity_, field->name());
+    display.scale = i < presets.size() ? presets[i] : customScales_.at(i - presets.size());
+    document_.setFieldDisplay(entity_, field->name(), display);
+}
+
+void ScalarFieldPanel::onRangeEdited(double low, double high)
+{
+    const ScalarField* field = activeField();
+    if (!field || updating_)
+        return;
+    FieldDisplay display = document_.fieldDisplay(entity_, field->name());
+    display.low = low;
+    display.high = high;
+    updating_ = true; // the panel already shows this range: no rebuild while dragging
+    document_.setFieldDisplay(entity_, field->name(), display);
+    updating_ = false;
+    histogram_->setMarkedRange(low, high);
+    updateInsideCount();
+}
+
+void ScalarFieldPanel::editScale()
+{
+    const ScalarField* field = activeField();
+    if (!field)
+        return;
+    FieldDisplay display = document_.fieldDisplay(entity_, field->name());
+    ColourScaleEditor editor(display.scale, this);
+    if (editor.exec() != QDialog::Accepted)
+        return;
+    display.scale = editor.scale();
+    const auto& presets = ColourScale::presets();
+    const bool isPreset = std::any_of(presets.begin(), presets.end(), [&](const ColourScale& s) { return s.name() == display.scale.name(); });
+    if (isPreset) // an edited preset becomes a custom scale of its own
+        display.scale = ColourScale(display.scale.name() + " (custom)", display.scale.stops(), display.scale.symmetric());
+    addCustomScale(display.scale);
+    document_.setFieldDisplay(entity_, field->name(), display);
+}
+
+void ScalarFieldPanel::updateInsideCount()
+{
+    const ScalarField* field = activeField();
+    if (!field) {
+        inside_->clear();
+        return;
+    }
+    const std::size_t inside = countInRange(*field, range_->low(), range_->high());
+    const double percent = field->size() ? 100.0 * double(inside) / double(field->size()) : 0.0;
+    inside_->setText(tr("Inside the range: %1 of %2 points (%3 %)").arg(inside).arg(field->size()).arg(percent, 0, 'f', 1));
+}
+
+QString ScalarFieldPanel::insideText() const { return inside_->text(); }
+
+} // namespace scandiff::gui

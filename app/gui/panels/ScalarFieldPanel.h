@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! The active scalar field of the current entity: which field, its colour scale
+//! (presets or user-edited), the threshold range (double-ended slider with
+//! numeric boxes), what happens to points outside it (hidden or greyed), the
+//! histogram with the range marked, and "Split at thresholds". Every change goes
+//! to the Document; the view follows the document's signals.
+
+#include "colour/ColourScale.h"
+#include "document/Document.h"
+
+#include <QWidget>
+
+#include <vector>
+
+class QComboBox;
+class QLabel;
+class QPushButton;
+
+namespace scandiff::gui {
+
+class HistogramWidget;
+class RangeEditor;
+
+class ScalarFieldPanel : public QWidget
+{
+    Q_OBJECT
+public:
+    ScalarFieldPanel(Document& document, QWidget* parent = nullptr);
+
+    void showEntity(EntityId id);
+    EntityId entity() const { return entity_; }
+    //! Scales offered besides the presets (user-edited ones; sessions restore them).
+    const std::vector<ColourScale>& customScales() const { return customScales_; }
+    void addCustomScale(const ColourScale& scale);
+
+    // For tests and controllers.
+    QComboBox* fieldBox() const { return fieldBox_; }
+    QComboBox* scaleBox() const { return scaleBox_; }
+    QComboBox* outsideBox() const { return outsideBox_; }
+    RangeEditor* rangeEditor() const { return range_; }
+    HistogramWidget* histogram() const { return histogram_; }
+    QPushButton* splitButton() const { return split_; }
+    QString insideText() const;
+
+signals:
+    void splitRequested(EntityId id, const std::string& field, double low, double high);
+
+private:
+    void refresh();
+    void refreshScaleBox();
+    void onFieldChosen(int index);
+    void onScaleChosen(int index);
+    void onRangeEdited(double low, double high);
+    void editScale();
+    void updateInsideCount();
+    const ScalarField* activeField() const;
+
+    Document& document_;
+    EntityId entity_ = kNoEntity;
+    std::vector<ColourScale> customScales_;
+    QLabel* title_;
+    QComboBox* fieldBox_;
+    QComboBox* scaleBox_;
+    QPushButton* editScale_;
+    QComboBox* outsideBox_;
+    RangeEditor* range_;
+    HistogramWidget* histogram_;
+    QLabel* inside_;
+    QPushButton* resetRange_;
+    QPushButton* split_;
+    bool updating_ = false;
+};
+
+} // namespace scandiff::gui

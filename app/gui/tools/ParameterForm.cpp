@@ -1,0 +1,164 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "tools/ParameterForm.h"
+
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QLineEdit>
+#include <QSpinBox>
+
+#include <cmath>
+#include <limits>
+
+namespace scandiff::gui {
+
+namespace {
+
+QString helpText(const ParameterSpec& p)
+{
+    QString text = QString::fromStdString(p.description);
+    if (!p.unit.empty())
+        text += QString(" (%1)").arg(QString::fromStdString(p.unit));
+    return text;
+}
+
+double finiteOr(double v, double fallback) { return std::isfinite(v) ? v : fallback; }
+
+QWidget* makeEditor(const ParameterSpec& p, QWidget* parent)
+{
+    switch (p.type) {
+    case ParameterType::Integer: {
+        auto* box = new QSpinBox(parent);
+        box->setRange(static_cast<int>(std::max<double>(finiteOr(p.minimum, INT_MIN), INT_MIN)),
+                      static_cast<int>(std::min<double>(finiteOr(p.maximum, INT_MAX), INT_MAX)));
+        box->setValue(static_cast<int>(std::get<std::int64_t>(p.defaultValue)));
+        if (!p.unit.empty())
+            box->setSuffix(" " + QString::fromStdString(p.unit));
+        return box;
+    }
+    case ParameterType::Real: {
+        auto* box = new QDoubleSpinBox(parent);
+        box->setDecimals(6);
+        box->setRange(finiteOr(p.minimum, -1e12), finiteOr(p.maximum, 1e12));
+        box->setValue(std::get<double>(p.defaultValue));
+        if (!p.unit.empty())
+            box->setSuffix(" " + QString::fromStdString(p.unit));
+        return box;
+    }
+    case ParameterType::Boolean: {
+        auto* box = new QCheckBox(parent);
+        box->setChecked(std::get<bool>(p.defaultValue));
+        return box;
+    }
+    case ParameterType::Choice: {
+        auto* box = new QComboBox(parent);
+        for (const auto& c : p.choices)
+            box->addItem(QString::fromStdString(c));
+        box->setCurrentText(QString::fromStdString(std::get<std::string>(p.defaultValue)));
+        return box;
+    }
+    case ParameterType::Text: {
+        auto* line = new QLineEdit(QString::fromStdString(std::get<std::string>(p.defaultValue)), parent);
+        line->setPlaceholderText(QString::fromStdString(p.description));
+        return line;
+    }
+    }
+    return nullptr;
+}
+
+std::string editorText(const ParameterSpec& p, QWidget* editor)
+{
+    switch (p.type) {
+    case ParameterType::Integer:
+        return std::to_string(static_cast<QSpinBox*>(editor)->value());
+    case ParameterType::Real:
+        return ParameterSpec::format(static_cast<QDoubleSpinBox*>(editor)->value());
+    case ParameterType::Boolean:
+        return static_cast<QCheckBox*>(editor)->isChecked() ? "true" : "false";
+    case ParameterType::Choice:
+        return static_cast<QComboBox*>(editor)->currentText().toStdString();
+    case ParameterType::Text:
+        return static_cast<QLineEdit*>(editor)->text().toStdString();
+    }
+    return {};
+}
+
+} // namespace
+
+ParameterForm::ParameterForm(const std::vector<ParameterSpec>& parameters, QWidget* parent)
+    : QWidget(parent), parameters_(parameters)
+{
+    auto* form = new QFormLayout(this);
+    form->setContentsMargins(0, 0, 0, 0);
+    for (const ParameterSpec& p : parameters_) {
+        QWidget* editor = makeEditor(p, this);
+        editor->setObjectName(QString::fromStdString(p.name));
+        editor->setToolTip(helpText(p));
+        editors_[p.name] = editor;
+        if (!p.optional) {
+            form->addRow(QString::fromStdString(p.label), editor);
+            continue;
+        }
+        // An optional value: the checkbox says whether it is given at all.
+        auto* row = new QWidget(this);
+        auto* layout = new QHBoxLayout(row);
+        layout->setContentsMargins(0, 0, 0, 0);
+        auto* enabler = new QCheckBox(row);
+        enabler->setObjectName(QString::fromStdString(p.name + "-enabled"));
+        enabler->setToolTip(tr("Use this parameter"));
+        layout->addWidget(enabler);
+        layout->addWidget(editor, 1);
+        editor->setEnabled(false);
+        connect(enabler, &QCheckBox::toggled, editor, &QWidget::setEnabled);
+        enablers_[p.name] = enabler;
+        form->addRow(QString::fromStdString(p.label), row);
+    }
+}
+
+std::map<std::string, std::string> ParameterForm::values() const
+{
+    std::map<std::string, std::string> out;
+    for (const ParameterSpec& p : parameters_) {
+        if (p.optional && !enablers_.at(p.name)->isChecked())
+            continue;
+        out[p.name] = editorText(p, editors_.at(p.name));
+    }
+    return out;
+}
+
+bool ParameterForm::setValue(const std::string& parameterName, const QString& text)
+{
+    const auto it = editors_.find(parameterName);
+    if (it == editors_.end())
+        return false;
+    QWidget* editor = it->second;
+    if (auto* box = qobject_cast<QSpinBox*>(editor))
+        box->setValue(text.toInt());
+    else if (auto* real = qobject_cast<QDoubleSpinBox*>(editor))
+        real->setValue(text.toDouble());
+    else if (auto* check = qobject_cast<QCheckBox*>(editor))
+        check->setChecked(text == "true" || text == "1");
+    else if (auto* combo = qobject_cast<QComboBox*>(editor))
+        combo->setCurrentText(text);
+    else if (auto* line = qobject_cast<QLineEdit*>(editor))
+        line->setText(text);
+    if (QCheckBox* enabler = this->enabler(parameterName))
+        enabler->setChecked(true);
+    return true;
+}
+
+QWidget* ParameterForm::editor(const std::string& parameterName) const
+{
+    const auto it = editors_.find(parameterName);
+    return it == editors_.end() ? nullptr : it->second;
+}
+
+QCheckBox* ParameterForm::enabler(const std::string& parameterName) const
+{
+    const auto it = enablers_.find(parameterName);
+    return it == enablers_.end() ? nullptr : it->second;
+}
+
+} // namespace scandiff::gui

@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Draws a scalar field's histogram: one bar per bin, coloured as colourise
+//! would colour the bin's centre, a marked range (e.g. the visible threshold)
+//! with the outside shaded, and the value axis labelled at min, middle and max.
+//! The markers can be dragged with the mouse; hovering a bar shows its count.
+
+#include "colour/ColourScale.h"
+
+#include <QWidget>
+
+namespace scandiff::gui {
+
+class HistogramWidget : public QWidget
+{
+    Q_OBJECT
+public:
+    explicit HistogramWidget(QWidget* parent = nullptr);
+
+    void setHistogram(Histogram histogram);
+    void setColouring(const ColourScale& scale, double colourMin, double colourMax);
+    //! Swapped if low > high. Markers outside the histogram's span are not drawn,
+    //! but the shading still covers the part of the span outside [low, high].
+    void setMarkedRange(double low, double high);
+    //! Bar heights on a log(1 + count) scale, so sparse tails stay visible.
+    void setLogarithmic(bool logarithmic);
+
+    const Histogram& histogram() const { return histogram_; }
+    double markedLow() const { return markedLow_; }
+    double markedHigh() const { return markedHigh_; }
+    bool logarithmic() const { return logarithmic_; }
+
+    //! The value axis as drawn: the histogram's span, widened when it is empty.
+    double axisMin() const;
+    double axisMax() const;
+    //! The plot area (bars) in widget coordinates, and the x of a value in it.
+    QRect plotRect() const;
+    int xOfValue(double value) const;
+
+    QSize sizeHint() const override;
+    QSize minimumSizeHint() const override;
+
+signals:
+    //! While a marker is dragged; the widget has already moved it.
+    void markedRangeEdited(double low, double high);
+
+protected:
+    void paintEvent(QPaintEvent* event) override;
+    void mousePressEvent(QMouseEvent* event) override;
+    void mouseMoveEvent(QMouseEvent* event) override;
+    void mouseReleaseEvent(QMouseEvent* event) override;
+    bool event(QEvent* event) override;
+
+private:
+    enum class Marker { None, Low, High };
+    Marker markerNear(int x) const;
+    double valueAtX(int x) const;
+    QString formatValue(double value) const;
+
+    Histogram histogram_;
+    ColourScale scale_;
+    double colourMin_ = 0, colourMax_ = 1;
+    double markedLow_ = -std::numeric_limits<double>::infinity();
+    double markedHigh_ = std::numeric_limits<double>::infinity();
+    bool logarithmic_ = false;
+    Marker dragging_ = Marker::None;
+};
+
+} // namespace scandiff::gui

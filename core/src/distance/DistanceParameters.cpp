@@ -1,0 +1,193 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/core/Error.h>
+#include <scandiff/core/TextLists.h>
+#include <scandiff/core/distance/DistanceParameters.h>
+
+#include <cmath>
+
+namespace scandiff {
+
+namespace {
+
+double radians(double degrees) { return degrees * M_PI / 180.0; }
+
+// Distances are positive; the smallest value a dialog can show stands for "> 0".
+constexpr double kSmallestDistance = 1e-6;
+
+ParameterSpec maxDistanceParameter()
+{
+    return ParameterSpec::real("max-dist", "Maximum distance",
+                               "Points farther than this get NaN, or the maximum itself with clamp", 1.0, kSmallestDistance,
+                               1e9, "m")
+        .asOptional();
+}
+
+ParameterSpec clampParameter()
+{
+    return ParameterSpec::boolean("clamp", "Clamp to maximum", "With a maximum distance: farther points get the maximum instead of NaN",
+                                  false);
+}
+
+ParameterSpec octreeLevelParameter(const std::string& automatic)
+{
+    return ParameterSpec::integer("octree-level", "Octree level", "Octree level 1..21; 0 = automatic (" + automatic + ")", 0, 0, 21);
+}
+
+void checkClamp(const ParameterValues& values)
+{
+    if (values.boolean("clamp") && !values.has("max-dist"))
+        throw Error(ErrorCode::InvalidArgument, "clamp needs a maximum distance (max-dist)");
+}
+
+} // namespace
+
+const std::vector<ParameterSpec>& cloudToCloudParameters()
+{
+    static const std::vector<ParameterSpec> parameters = [] {
+        const CloudToCloudParams defaults;
+        return std::vector<ParameterSpec>{
+            maxDistanceParameter(),
+            clampParameter(),
+            ParameterSpec::choice("model", "Local model", "Model of the reference around each nearest neighbour (thesis 000 §2.3.2)",
+                                  {"none", "plane", "delaunay", "quadric"}, localModelName(defaults.model)),
+            ParameterSpec::integer("knn", "Model neighbours", "Local model fitted on the k nearest reference points", defaults.neighbours,
+                                   3, 500, "points"),
+            ParameterSpec::real("radius", "Model radius", "Local model fitted on the reference points within this radius instead of knn",
+                                0.5, kSmallestDistance, 1e9, "m")
+                .asOptional(),
+            ParameterSpec::boolean("split-xyz", "Split X/Y/Z", "Also output c2c_dx, c2c_dy, c2c_dz", defaults.splitComponents),
+            ParameterSpec::boolean("signed", "Signed distances", "Sign by the reference normals or the local model's normal",
+                                   defaults.signedDistances),
+            ParameterSpec::boolean("closest-points", "Closest points", "Also output the matched reference points as a cloud",
+                                   defaults.closestPoints),
+            ParameterSpec::boolean("both-ways", "Both ways", "Also compute reference -> compared, kept on the reference (§3.5)", false),
+            ParameterSpec::boolean("visibility", "Visibility test",
+                                   "Depth-map visibility (§2.3.3) from the sensor poses stored with the reference, or from 'sensor'",
+                                   false),
+            ParameterSpec::text("sensor", "Sensor pose",
+                                "Reference viewpoint X,Y,Z[,HEADING,PITCH,ROLL] (degrees); several separated by ';'; turns on the "
+                                "visibility test")
+                .asOptional(),
+            ParameterSpec::text("sensor-step", "Sensor angular step", "Depth-map step DEG or YAWDEG,PITCHDEG (default: from the data)")
+                .asOptional(),
+            ParameterSpec::text("sensor-fov", "Sensor field of view", "YAWMIN,YAWMAX,PITCHMIN,PITCHMAX in degrees").asOptional(),
+            ParameterSpec::real("sensor-range", "Sensor range", "Maximum range of the scanner", 100.0, kSmallestDistance, 1e9, "m")
+                .asOptional(),
+            ParameterSpec::real("visibility-tolerance", "Visibility tolerance", "Depth-map tolerance", defaults.visibility.tolerance, 0.0,
+                                1e9, "m"),
+            octreeLevelParameter("from the reference's cell populations"),
+        };
+    }();
+    return parameters;
+}
+
+SensorPose parseSensorPose(const std::string& text, const std::string& step, const std::string& fov, double range)
+{
+    const std::vector<double> v = parseNumberList(text, "sensor");
+    if (v.size() != 3 && v.size() != 6)
+        throw Error(ErrorCode::InvalidArgument, "sensor: expected X,Y,Z or X,Y,Z,HEADING,PITCH,ROLL (degrees)");
+    SensorPose pose;
+    pose.position = {v[0], v[1], v[2]};
+    if (v.size() == 6)
+        pose.orientation = Eigen::AngleAxisd(radians(v[3]), Eigen::Vector3d::UnitZ()) *
+                           Eigen::AngleAxisd(radians(v[4]), Eigen::Vector3d::UnitY()) *
+                           Eigen::AngleAxisd(radians(v[5]), Eigen::Vector3d::UnitX());
+    if (!step.empty()) {
+        const std::vector<double> s = parseNumberList(step, "sensor-step");
+        if (s.empty() || s.size() > 2 || s[0] <= 0 || s.back() <= 0)
+            throw Error(ErrorCode::InvalidArgument, "sensor-step: expected DEG or YAWDEG,PITCHDEG, positive");
+        pose.yawStep = radians(s[0]);
+        pose.pitchStep = radians(s.back());
+    }
+    if (!fov.empty()) {
+        const std::vector<double> f = parseNumberList(fov, "sensor-fov");
+        if (f.size() != 4 || f[0] >= f[1] || f[2] >= f[3])
+            throw Error(ErrorCode::InvalidArgument, "sensor-fov: expected YAWMIN,YAWMAX,PITCHMIN,PITCHMAX in degrees");
+        pose.yawMin = radians(f[0]);
+        pose.yawMax = radians(f[1]);
+        pose.pitchMin = radians(f[2]);
+        pose.pitchMax = radians(f[3]);
+    }
+    if (range > 0)
+        pose.maxRange = range;
+    return pose;
+}
+
+CloudToCloudParams cloudToCloudSettings(const ParameterValues& values, const PointCloud& reference)
+{
+    checkClamp(values);
+    CloudToCloudParams params;
+    if (values.has("max-dist"))
+        params.maxDistance = values.real("max-dist");
+    params.clampBeyondMax = values.boolean("clamp");
+    params.model = parseLocalModel(values.text("model"));
+    params.neighbours = static_cast<int>(values.integer("knn"));
+    if (values.has("radius"))
+        params.radius = values.real("radius");
+    params.splitComponents = values.boolean("split-xyz");
+    params.signedDistances = values.boolean("signed");
+    params.closestPoints = values.boolean("closest-points");
+    params.octreeLevel = static_cast<int>(values.integer("octree-level"));
+    params.visibility.tolerance = values.real("visibility-tolerance");
+
+    const std::string step = values.has("sensor-step") ? values.text("sensor-step") : std::string();
+    const std::string fov = values.has("sensor-fov") ? values.text("sensor-fov") : std::string();
+    const double range = values.has("sensor-range") ? values.real("sensor-range") : 0.0;
+    if (values.has("sensor"))
+        for (const std::string& pose : splitList(values.text("sensor"), ';'))
+            if (pose.find_first_not_of(" \t") != std::string::npos)
+                params.viewpoints.push_back(parseSensorPose(pose, step, fov, range));
+    if (values.boolean("visibility") && params.viewpoints.empty()) {
+        if (reference.sensors().empty())
+            throw Error(ErrorCode::InvalidArgument, "visibility: the reference holds no sensor pose; give one with 'sensor'");
+        params.viewpoints = reference.sensors();
+    }
+    return params;
+}
+
+bool cloudToCloudBothWays(const ParameterValues& values) { return values.boolean("both-ways"); }
+
+CloudToCloudRun runCloudToCloud(const PointCloud& compared, const PointCloud& reference, const ParameterValues& values,
+                                ProgressObserver* progress)
+{
+    CloudToCloudRun run;
+    run.params = cloudToCloudSettings(values, reference);
+    run.forward = cloudToCloud(compared, reference, run.params, progress);
+    if (cloudToCloudBothWays(values)) {
+        CloudToCloudParams reverseParams = run.params;
+        reverseParams.viewpoints = compared.sensors();
+        reverseParams.closestPoints = false;
+        run.reverse = cloudToCloud(reference, compared, reverseParams, progress);
+    }
+    return run;
+}
+
+const std::vector<ParameterSpec>& cloudToMeshParameters()
+{
+    static const std::vector<ParameterSpec> parameters = [] {
+        const CloudToMeshParams defaults;
+        return std::vector<ParameterSpec>{
+            ParameterSpec::boolean("signed", "Signed distances",
+                                   "+ on the side the closest triangle's normal points to (right-hand rule on its vertex order)",
+                                   defaults.signedDistances),
+            maxDistanceParameter(),
+            clampParameter(),
+            octreeLevelParameter("from the mean triangle size"),
+        };
+    }();
+    return parameters;
+}
+
+CloudToMeshParams cloudToMeshSettings(const ParameterValues& values)
+{
+    checkClamp(values);
+    CloudToMeshParams params;
+    params.signedDistances = values.boolean("signed");
+    if (values.has("max-dist"))
+        params.maxDistance = values.real("max-dist");
+    params.clampBeyondMax = values.boolean("clamp");
+    params.octreeLevel = static_cast<int>(values.integer("octree-level"));
+    return params;
+}
+
+} // namespace scandiff
