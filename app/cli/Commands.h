@@ -25,6 +25,10 @@ void addConvertCommand(CLI::App& app, const PluginRegistry& registry, Streams st
 void addCloudToCloudCommand(CLI::App& app, const PluginRegistry& registry, Streams streams);
 //! `c2m`: cloud-to-mesh distances (CloudToMeshCommand.cpp).
 void addCloudToMeshCommand(CLI::App& app, const PluginRegistry& registry, Streams streams);
+//! `segment`: change regions from a distance field, exported (SegmentCommand.cpp).
+void addSegmentCommand(CLI::App& app, const PluginRegistry& registry, Streams streams);
+//! `compare`: c2c, then segment, in one command (SegmentCommand.cpp).
+void addCompareCommand(CLI::App& app, const PluginRegistry& registry, Streams streams);
 //! `formats`, `tools`, and one subcommand per registered tool.
 void addToolCommands(CLI::App& app, const PluginRegistry& registry, Streams streams);
 

@@ -82,6 +82,8 @@ int runCli(int argc, const char* const* argv, const PluginRegistry& registry, St
     addConvertCommand(app, registry, streams);
     addCloudToCloudCommand(app, registry, streams);
     addCloudToMeshCommand(app, registry, streams);
+    addSegmentCommand(app, registry, streams);
+    addCompareCommand(app, registry, streams);
     addToolCommands(app, registry, streams);
     try {
         app.parse(argc, argv);

@@ -1,0 +1,177 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `segment` and `compare`: change regions from a distance field (thesis 000
+// chapter 3), and the whole chain c2c + segment in one command for batch users.
+#include "CliSupport.h"
+#include "Commands.h"
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/distance/CloudToCloud.h>
+#include <scandiff/core/distance/DistanceParameters.h>
+#include <scandiff/core/segmentation/RegionReport.h>
+#include <scandiff/core/segmentation/SegmentationParameters.h>
+#include <scandiff/io/RegionExport.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iomanip>
+#include <memory>
+
+namespace scandiff::cli {
+
+namespace {
+
+//! Options of the export shared by both commands.
+struct ExportFlags
+{
+    std::string outDir;
+    bool dxfPoints = false;
+    double textHeight = 0.0;
+    std::string cloudFormat = "ply";
+
+    void addTo(CLI::App& command)
+    {
+        command.add_option("--out-dir", outDir, "Output folder: regions.ply, region_NNNN.ply, regions.dxf, regions.csv")->required();
+        command.add_flag("--dxf-points", dxfPoints, "Also draw each region's points in the DXF");
+        command.add_option("--dxf-text-height", textHeight, "Height of the DXF labels (m); default 3 % of the region's size")
+            ->check(CLI::PositiveNumber);
+        command.add_option("--cloud-format", cloudFormat, "Extension of the region clouds (default ply)");
+    }
+};
+
+//! The segmentation options: the declared parameters, with `range` taking the
+//! issue's two-value form `--range A B`.
+std::shared_ptr<std::map<std::string, std::string>> addSegmentationOptions(CLI::App& command)
+{
+    auto values = std::make_shared<std::map<std::string, std::string>>();
+    auto options = addParameterOptions(command, segmentationParameters(), values);
+    options.at("range")->expected(2);
+    for (const char* a : {"range", "above", "kmeans", "stat-test"})
+        for (const char* b : {"range", "above", "kmeans", "stat-test", "propagate"})
+            if (std::string(a) != b)
+                options.at(a)->excludes(options.at(b));
+    options.at("fit-box")->excludes(options.at("noise"));
+    return values;
+}
+
+//! Segments `cloud` (adding the fields), reports and exports the regions, and
+//! prints what was done.
+void segmentAndExport(PointCloud& cloud, const ParameterValues& values, const PointCloud* reference, const ExportFlags& flags,
+                      const io::FormatRegistry& formats, const io::WriteOptions& write, ProgressObserver* progress, Streams streams)
+{
+    const auto start = std::chrono::steady_clock::now();
+    SegmentationRun run = runSegmentation(cloud, values, progress);
+    streams.out << "segment " << run.summary << '\n';
+    attachFields(cloud, std::move(run));
+    const std::vector<RegionStatistics> report = regionReport(cloud, regionReportSettings(values, reference), progress);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (const RegionStatistics& r : report)
+        streams.out << "  " << io::regionLabel(r) << '\n';
+    streams.out << std::fixed << std::setprecision(3) << seconds << " s\n" << std::defaultfloat;
+
+    io::RegionExportOptions options;
+    options.dxf.includePoints = flags.dxfPoints;
+    options.dxf.textHeight = flags.textHeight;
+    options.write = write;
+    options.cloudExtension = flags.cloudFormat;
+    const io::RegionExportFiles files = io::exportRegions(formats, cloud, report, flags.outDir, options);
+    streams.out << "wrote " << files.allRegions.string() << ", " << files.regionClouds.size() << " region clouds, "
+                << files.dxf.string() << ", " << files.csv.string() << '\n';
+}
+
+} // namespace
+
+void addSegmentCommand(CLI::App& app, const PluginRegistry& registry, Streams streams)
+{
+    struct Args
+    {
+        std::string input, reference;
+        std::shared_ptr<std::map<std::string, std::string>> values;
+        ExportFlags exportFlags;
+        int threads = 0;
+        ReadFlags read;
+        WriteFlags write;
+    };
+    auto args = std::make_shared<Args>();
+    CLI::App* c = app.add_subcommand(
+        "segment", "Segment the changes of a distance field into regions and export them (thesis 000 chapter 3)");
+    c->add_option("IN", args->input, "Cloud holding the field (e.g. the output of c2c)")->required();
+    args->values = addSegmentationOptions(*c);
+    c->add_option("--reference", args->reference, "The other epoch: adds the volume between the epochs to the report");
+    args->exportFlags.addTo(*c);
+    ThreadLimit::addOption(*c, args->threads);
+    args->read.addTo(*c);
+    args->write.addTo(*c);
+    c->callback([args, &registry, streams] {
+        const ThreadLimit threadLimit(args->threads);
+        // Parameters are checked before the (possibly long) reads.
+        const ParameterValues values = resolveParameters(segmentationParameters(), *args->values, "segment");
+        TerminalProgress progress;
+        const io::ReadOptions readOptions = args->read.toOptions(&progress);
+        PointCloud cloud = io::readPointCloud(registry.formats, args->input, readOptions);
+        std::optional<PointCloud> reference;
+        if (!args->reference.empty())
+            reference = io::readPointCloud(registry.formats, args->reference, readOptions);
+        segmentAndExport(cloud, values, reference ? &*reference : nullptr, args->exportFlags, registry.formats,
+                         args->write.toOptions(&progress), &progress, streams);
+    });
+}
+
+void addCompareCommand(CLI::App& app, const PluginRegistry& registry, Streams streams)
+{
+    struct Args
+    {
+        std::string reference, compared;
+        std::shared_ptr<std::map<std::string, std::string>> distanceValues = std::make_shared<std::map<std::string, std::string>>();
+        std::shared_ptr<std::map<std::string, std::string>> segmentValues;
+        ExportFlags exportFlags;
+        int threads = 0;
+        ReadFlags read;
+        WriteFlags write;
+    };
+    auto args = std::make_shared<Args>();
+    CLI::App* c = app.add_subcommand("compare",
+                                     "The whole change detection in one command: c2c distances, then segment, then export "
+                                     "(DIR/compared.ply with every field, and the region files of segment)");
+    c->add_option("--reference", args->reference, "Reference cloud (the earlier epoch)")->required();
+    c->add_option("--compared", args->compared, "Compared cloud (the later epoch)")->required();
+    const auto distanceOptions = addParameterOptions(*c, cloudToCloudParameters(), args->distanceValues);
+    distanceOptions.at("knn")->excludes(distanceOptions.at("radius"));
+    args->segmentValues = addSegmentationOptions(*c);
+    args->exportFlags.addTo(*c);
+    ThreadLimit::addOption(*c, args->threads);
+    args->read.addTo(*c);
+    args->write.addTo(*c);
+    c->callback([args, &registry, streams] {
+        const ThreadLimit threadLimit(args->threads);
+        const ParameterValues distanceValues = resolveParameters(cloudToCloudParameters(), *args->distanceValues, "compare");
+        const ParameterValues segmentValues = resolveParameters(segmentationParameters(), *args->segmentValues, "compare");
+        TerminalProgress progress;
+        const io::ReadOptions readOptions = args->read.toOptions(&progress);
+        PointCloud reference = io::readPointCloud(registry.formats, args->reference, readOptions);
+        PointCloud compared = io::readPointCloud(registry.formats, args->compared, readOptions);
+        CloudToCloudRun run = runCloudToCloud(compared, reference, distanceValues, &progress);
+        printStatistics(streams.out, "c2c " + std::string(localModelName(run.params.model)) + " (compared -> reference)",
+                        run.forward.statistics);
+        std::optional<PointCloud> closest = std::move(run.forward.closest);
+        attachFields(compared, std::move(run.forward));
+        const io::WriteOptions write = args->write.toOptions(&progress);
+        segmentAndExport(compared, segmentValues, &reference, args->exportFlags, registry.formats, write, &progress, streams);
+
+        const std::filesystem::path dir(args->exportFlags.outDir);
+        const std::string ext = "." + args->exportFlags.cloudFormat;
+        io::writePointCloud(registry.formats, compared, dir / ("compared" + ext), write);
+        streams.out << "wrote " << (dir / ("compared" + ext)).string() << '\n';
+        if (closest) {
+            io::writePointCloud(registry.formats, *closest, dir / ("closest" + ext), write);
+            streams.out << "wrote " << (dir / ("closest" + ext)).string() << '\n';
+        }
+        if (run.reverse) {
+            printStatistics(streams.out, "c2c reverse (reference -> compared)", run.reverse->statistics);
+            attachFields(reference, std::move(*run.reverse));
+            io::writePointCloud(registry.formats, reference, dir / ("reference" + ext), write);
+            streams.out << "wrote " << (dir / ("reference" + ext)).string() << '\n';
+        }
+    });
+}
+
+} // namespace scandiff::cli

@@ -1,0 +1,287 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/core/Error.h>
+#include <scandiff/core/TextLists.h>
+#include <scandiff/core/segmentation/Classification.h>
+#include <scandiff/core/segmentation/ConnectedComponents.h>
+#include <scandiff/core/segmentation/FastMarching.h>
+#include <scandiff/core/segmentation/SegmentationParameters.h>
+
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+namespace scandiff {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+//! "A,B" or "A;B" (the CLI joins repeated values with ';').
+std::vector<double> numbers(const std::string& text, const std::string& what)
+{
+    std::string commas = text;
+    for (char& c : commas)
+        if (c == ';')
+            c = ',';
+    return parseNumberList(commas, what);
+}
+
+} // namespace
+
+const std::vector<ParameterSpec>& segmentationParameters()
+{
+    static const std::vector<ParameterSpec> parameters = [] {
+        const LocalChiSquareParams chi;
+        const ConnectedComponentsParams cc;
+        const PropagationParams propagation;
+        return std::vector<ParameterSpec>{
+            ParameterSpec::text("field", "Field", "Scalar field to segment (the distances)", "c2c_distance"),
+            ParameterSpec::boolean("absolute", "Absolute values", "Segment |value| (signed distances as unsigned ones)", false),
+            ParameterSpec::text("range", "Range", "Changed: values in [A, B], given as 'A B' or 'A,B' (§3.2.1)").asOptional(),
+            ParameterSpec::real("above", "Above", "Changed: values >= this threshold (§3.2.1)", 0.1, -1e30, 1e30).asOptional(),
+            ParameterSpec::integer("kmeans", "K-means classes",
+                                   "Changed: K-means with this many classes, all but the one nearest 0 (§3.2.2)", 2, 2, 64)
+                .asOptional(),
+            ParameterSpec::choice("stat-test", "Local statistical test",
+                                  "Changed: the local chi-square test against this noise model (§3.2.3)", {"gaussian", "weibull"},
+                                  "weibull")
+                .asOptional(),
+            ParameterSpec::integer("neighbours", "Test neighbours", "stat-test: n nearest neighbours per test (sqrt(n) classes)",
+                                   chi.neighbours, 4, 1024, "points"),
+            ParameterSpec::real("confidence", "Confidence", "stat-test: confidence of the test (the chi-square quantile)",
+                                chi.confidence, 0.5, 0.999999),
+            ParameterSpec::real("chi2-threshold", "Chi-square cut", "stat-test: cut on the chi-square distance instead of the quantile",
+                                20.0, 0.0, 1e12)
+                .asOptional(),
+            ParameterSpec::text("fit-box", "Unchanged zone",
+                                "stat-test: fit the noise on the points inside X0,Y0,Z0,X1,Y1,Z1 (global coordinates) instead of "
+                                "the whole field")
+                .asOptional(),
+            ParameterSpec::text("noise", "Noise parameters",
+                                "stat-test: known noise parameters instead of a fit: MEAN,SIGMA (gaussian) or SHAPE,SCALE (weibull)")
+                .asOptional(),
+            ParameterSpec::boolean("components", "Connected components",
+                                   "Group the changed points by connected components on the octree grid (§3.2.4); without it "
+                                   "all changed points form region 1",
+                                   false),
+            ParameterSpec::integer("level", "Octree level",
+                                   "Grid of the components / propagation: octree level 1..21 of the cloud's cube; 0 = automatic",
+                                   cc.level, 0, 21),
+            ParameterSpec::choice("connectivity", "Connectivity", "Adjacent cells: faces (6), + edges (18), + corners (26)",
+                                  {"6", "18", "26"}, "26"),
+            ParameterSpec::integer("min-points", "Minimum region size", "Smaller regions are dropped",
+                                   static_cast<std::int64_t>(cc.minPoints), 1, 1000000000, "points"),
+            ParameterSpec::boolean("propagate", "Front propagation",
+                                   "Segment by gradient-constrained fast marching (§3.3) instead of a classification", false),
+            ParameterSpec::real("alpha", "Alpha", "propagate: speed exp(alpha (|grad|_j - |grad|_i)) (eq. 3.11)", propagation.alpha,
+                                0.0, 1e4),
+            ParameterSpec::real("min-seed", "Minimum seed value", "propagate: regions start only from values >= this", 0.1, -1e30,
+                                1e30)
+                .asOptional(),
+            ParameterSpec::real("stop-speed", "Stop speed", "propagate: the front does not cross where the speed falls below this",
+                                propagation.stopSpeed, 1e-12, 1.0),
+            ParameterSpec::real("gradient-radius", "Gradient radius", "propagate: neighbourhood radius of the gradient; 0 = automatic",
+                                0.0, 0.0, 1e9, "m"),
+            ParameterSpec::real("smoothing", "Gradient smoothing", "propagate: Gaussian smoothing of the gradient norm, sigma", 0.05,
+                                1e-9, 1e9, "m")
+                .asOptional(),
+            ParameterSpec::real("outline-cell", "Outline cell",
+                                "Cell of the regions' concave outlines; 0 = automatic (1.5 x the 4th-neighbour spacing)", 0.0, 0.0, 1e9,
+                                "m"),
+        };
+    }();
+    return parameters;
+}
+
+SegmentationRun runSegmentation(const PointCloud& cloud, const ParameterValues& values, ProgressObserver* progress)
+{
+    const std::string fieldName = values.text("field");
+    const ScalarField* original = cloud.field(fieldName);
+    if (!original)
+        throw Error(ErrorCode::InvalidArgument, "segment: cloud '" + cloud.name + "' has no field '" + fieldName + "'");
+    if (cloud.empty())
+        throw Error(ErrorCode::InvalidData, "segment: cloud '" + cloud.name + "' is empty");
+    int methods = 0;
+    for (const char* m : {"range", "above", "kmeans", "stat-test"})
+        methods += values.has(m);
+    const bool propagate = values.boolean("propagate");
+    if (propagate && methods > 0)
+        throw Error(ErrorCode::InvalidArgument, "segment: propagate replaces the classification; drop range/above/kmeans/stat-test");
+    if (!propagate && methods != 1)
+        throw Error(ErrorCode::InvalidArgument, methods == 0 ? "segment: choose a method: range, above, kmeans, stat-test or propagate"
+                                                             : "segment: choose only one of range, above, kmeans and stat-test");
+
+    // The field segmented: the original, or its absolute values, under the
+    // original name so the algorithms can find it on a working cloud.
+    const bool absolute = values.boolean("absolute");
+    PointCloud working;
+    const PointCloud* source = &cloud;
+    if (absolute) {
+        // Positions are needed for neighbourhoods; only the one field is copied.
+        working.setOrigin(cloud.origin());
+        working.positions() = cloud.positions();
+        working.name = cloud.name;
+        working.addField(absoluteValues(*original));
+        source = &working;
+    }
+    const ScalarField& field = *source->field(fieldName);
+
+    SegmentationRun run;
+    std::ostringstream summary;
+    summary << std::setprecision(6);
+    if (propagate) {
+        PropagationParams p;
+        if (!values.has("min-seed"))
+            throw Error(ErrorCode::InvalidArgument, "segment: propagate needs min-seed (the smallest value a region may start from)");
+        p.minSeedValue = values.real("min-seed");
+        p.alpha = values.real("alpha");
+        p.stopSpeed = values.real("stop-speed");
+        p.level = static_cast<int>(values.integer("level"));
+        p.minPoints = static_cast<std::size_t>(values.integer("min-points"));
+        p.gradient.radius = values.real("gradient-radius");
+        if (values.has("smoothing"))
+            p.gradient.smoothingSigma = values.real("smoothing");
+        PropagationResult r = propagationSegmentation(*source, fieldName, p, progress);
+        run.regionCount = r.regionCount;
+        run.regionSizes = r.regionSizes;
+        run.level = r.level;
+        summary << "propagation (alpha " << p.alpha << ", stop speed " << p.stopSpeed << ", min seed " << p.minSeedValue << ", level "
+                << r.level << "): " << r.regionCount << " regions";
+        if (r.droppedRegions)
+            summary << " (" << r.droppedRegions << " smaller than " << p.minPoints << " points dropped)";
+        run.fields.push_back(std::move(r.regionId));
+        run.fields.push_back(std::move(r.arrivalTime));
+        run.fields.push_back(std::move(r.gradient));
+        run.summary = summary.str();
+        return run;
+    }
+
+    ScalarField changed;
+    if (values.has("range") || values.has("above")) {
+        double low = 0.0, high = kInf;
+        if (values.has("range")) {
+            const std::vector<double> range = numbers(values.text("range"), "range");
+            if (range.size() != 2)
+                throw Error(ErrorCode::InvalidArgument, "range: expected two values A B");
+            low = range[0];
+            high = range[1];
+            summary << "range [" << low << ", " << high << "]";
+        } else {
+            low = values.real("above");
+            summary << "above " << low;
+        }
+        changed = classifyByRange(field, low, high);
+    } else if (values.has("kmeans")) {
+        KMeansParams p;
+        p.classes = static_cast<int>(values.integer("kmeans"));
+        KMeansResult r = kMeans(field, p, progress);
+        run.centres = r.centres;
+        summary << "K-means (" << p.classes << " classes, centres";
+        for (double c : r.centres)
+            summary << ' ' << c;
+        summary << ", " << r.iterations << " iterations)";
+        changed = std::move(r.changed);
+        run.fields.push_back(std::move(r.classes));
+    } else {
+        LocalChiSquareParams p;
+        p.model = parseNoiseModel(values.text("stat-test"));
+        p.neighbours = static_cast<int>(values.integer("neighbours"));
+        p.confidence = values.real("confidence");
+        if (values.has("chi2-threshold"))
+            p.threshold = values.real("chi2-threshold");
+        if (values.has("noise")) {
+            const std::vector<double> n = numbers(values.text("noise"), "noise");
+            if (n.size() != 2 || !(n[1] > 0) || (p.model == NoiseModel::Weibull && !(n[0] > 0)))
+                throw Error(ErrorCode::InvalidArgument,
+                            "noise: expected MEAN,SIGMA (gaussian) or SHAPE,SCALE (weibull), the spread and shape positive");
+            NoiseDistribution d;
+            d.model = p.model;
+            if (p.model == NoiseModel::Gaussian) {
+                d.mean = n[0];
+                d.sigma = n[1];
+            } else {
+                d.shape = n[0];
+                d.scale = n[1];
+            }
+            p.noise = d;
+        } else if (values.has("fit-box")) {
+            const std::vector<double> b = numbers(values.text("fit-box"), "fit-box");
+            if (b.size() != 6)
+                throw Error(ErrorCode::InvalidArgument, "fit-box: expected X0,Y0,Z0,X1,Y1,Z1");
+            const Eigen::Vector3d lo(std::min(b[0], b[3]), std::min(b[1], b[4]), std::min(b[2], b[5]));
+            const Eigen::Vector3d hi(std::max(b[0], b[3]), std::max(b[1], b[4]), std::max(b[2], b[5]));
+            std::vector<std::size_t> inside;
+            for (std::size_t i = 0; i < source->size(); ++i) {
+                const Eigen::Vector3d g = source->globalPosition(i);
+                if ((g.array() >= lo.array()).all() && (g.array() <= hi.array()).all() && field.hasValue(i))
+                    inside.push_back(i);
+            }
+            if (inside.size() < 2)
+                throw Error(ErrorCode::InvalidArgument, "fit-box: fewer than 2 points with a value inside the box");
+            p.noise = fitNoise(field, p.model, &inside);
+        }
+        LocalChiSquareResult r = localChiSquareTest(*source, fieldName, p, progress);
+        run.noise = r.noise;
+        run.threshold = r.threshold;
+        summary << "local chi-square test (" << noiseModelName(p.model) << ' ';
+        if (p.model == NoiseModel::Gaussian)
+            summary << "mean " << r.noise.mean << " sigma " << r.noise.sigma;
+        else
+            summary << "shape " << r.noise.shape << " scale " << r.noise.scale;
+        summary << ", n " << p.neighbours << ", " << r.classes << " classes, cut " << r.threshold << ")";
+        changed = std::move(r.changed);
+        run.fields.push_back(std::move(r.chiSquare));
+    }
+    const std::vector<std::uint8_t> selected = selectionFromLabels(changed);
+    for (std::uint8_t s : selected)
+        run.changedCount += s;
+    summary << ": " << run.changedCount << " changed points";
+
+    ScalarField regionId(fields::kRegionId, cloud.size());
+    if (values.boolean("components")) {
+        ConnectedComponentsParams p;
+        p.level = static_cast<int>(values.integer("level"));
+        p.connectivity = parseConnectivity(std::stoi(values.text("connectivity")));
+        p.minPoints = static_cast<std::size_t>(values.integer("min-points"));
+        ConnectedComponentsResult r = connectedComponents(*source, selected, p, progress);
+        run.regionCount = r.regionCount;
+        run.regionSizes = r.regionSizes;
+        run.level = r.level;
+        summary << ", " << r.regionCount << " regions (level " << r.level << ", cell " << r.cellSize << " m, "
+                << static_cast<int>(p.connectivity) << "-connectivity";
+        if (r.droppedComponents)
+            summary << ", " << r.droppedComponents << " components smaller than " << p.minPoints << " points dropped";
+        summary << ")";
+        regionId = std::move(r.regionId);
+    } else if (run.changedCount >= static_cast<std::size_t>(values.integer("min-points"))) {
+        for (std::size_t i = 0; i < selected.size(); ++i)
+            if (selected[i])
+                regionId.values()[i] = 1.0f;
+        run.regionCount = 1;
+        run.regionSizes = {run.changedCount};
+        summary << ", one region";
+    }
+    run.fields.push_back(std::move(changed));
+    run.fields.push_back(std::move(regionId));
+    run.summary = summary.str();
+    return run;
+}
+
+void attachFields(PointCloud& cloud, SegmentationRun&& run)
+{
+    for (ScalarField& f : run.fields)
+        cloud.addField(std::move(f));
+    run.fields.clear();
+}
+
+RegionReportParams regionReportSettings(const ParameterValues& values, const PointCloud* reference)
+{
+    RegionReportParams p;
+    p.distanceField = values.text("field");
+    p.outlineCellSize = values.real("outline-cell");
+    p.reference = reference;
+    return p;
+}
+
+} // namespace scandiff

@@ -1,0 +1,156 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `segment` and `compare` on the synthetic pair with three known changes.
+#include "Commands.h"
+
+#include <scandiff/core/Error.h>
+
+#include "../segmentation/SyntheticScene.h"
+#include "TestSupport.h"
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+
+using namespace scandiff;
+
+namespace {
+
+struct CliResult
+{
+    int status = 0;
+    std::string out, err;
+};
+
+CliResult runCommand(const PluginRegistry& registry, std::vector<std::string> args)
+{
+    args.insert(args.begin(), "scandiff-cli");
+    std::vector<const char*> argv;
+    for (const auto& a : args)
+        argv.push_back(a.c_str());
+    std::ostringstream out, err;
+    CliResult run;
+    run.status = cli::runCli(static_cast<int>(argv.size()), argv.data(), registry, {out, err});
+    run.out = out.str();
+    run.err = err.str();
+    return run;
+}
+
+std::size_t lineCount(const std::filesystem::path& file)
+{
+    std::ifstream in(file);
+    std::size_t n = 0;
+    for (std::string line; std::getline(in, line);)
+        ++n;
+    return n;
+}
+
+//! Exit status of tests/io/check_dxf.py (ezdxf's audit) on `file`.
+int dxfAudit(const std::filesystem::path& file)
+{
+    const std::string command = "python3 '" + (std::filesystem::path(SCANDIFF_TEST_SCRIPTS_DIR) / "check_dxf.py").string() + "' '" +
+                                file.string() + "' > /dev/null";
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+//! The two epochs written as PLY files in `dir`.
+std::pair<std::string, std::string> writeEpochs(const PluginRegistry& registry, const std::filesystem::path& dir)
+{
+    const auto reference = dir / "reference.ply", compared = dir / "compared.ply";
+    io::writePointCloud(registry.formats, test::referenceEpoch(), reference);
+    io::writePointCloud(registry.formats, test::comparedEpoch(), compared);
+    return {reference.string(), compared.string()};
+}
+
+} // namespace
+
+TEST(SegmentCli, CompareRunsTheWholeChainAndFindsTheThreeChanges)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    const auto [reference, compared] = writeEpochs(registry, dir);
+    const auto out = dir / "out";
+    const CliResult run = runCommand(registry, {"compare", "--reference", reference, "--compared", compared, "--model", "plane", "--above", "0.1",
+                                   "--components", "--min-points", "50", "--out-dir", out.string()});
+    ASSERT_EQ(run.status, 0) << run.err;
+    EXPECT_NE(run.out.find("3 regions"), std::string::npos) << run.out;
+    for (const char* name : {"regions.ply", "region_0001.ply", "region_0002.ply", "region_0003.ply", "regions.dxf", "regions.csv",
+                             "compared.ply"})
+        EXPECT_TRUE(std::filesystem::exists(out / name)) << name;
+    EXPECT_FALSE(std::filesystem::exists(out / "region_0004.ply"));
+    EXPECT_EQ(lineCount(out / "regions.csv"), 4u);
+    EXPECT_EQ(dxfAudit(out / "regions.dxf"), 0);
+    const PointCloud all = io::readPointCloud(registry.formats, out / "compared.ply");
+    ASSERT_NE(all.field("c2c_distance"), nullptr);
+    ASSERT_NE(all.field("region_id"), nullptr);
+    ASSERT_NE(all.field("changed"), nullptr);
+    EXPECT_EQ(all.field("region_id")->range().max, 3.0);
+    // The volume column is filled: compare knows the reference.
+    std::ifstream csv(out / "regions.csv");
+    std::string header, first;
+    std::getline(csv, header);
+    std::getline(csv, first);
+    EXPECT_NE(first.back(), ',') << first;
+}
+
+TEST(SegmentCli, SegmentWithEachMethodOnTheDistances)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    const auto [reference, compared] = writeEpochs(registry, dir);
+    ASSERT_EQ(runCommand(registry, {"c2c", "--reference", reference, "--compared", compared, "--model", "plane", "-o",
+                             (dir / "distances.ply").string()})
+                  .status,
+              0);
+    const std::string input = (dir / "distances.ply").string();
+    const std::vector<std::vector<std::string>> methods = {
+        {"--range", "0.1", "100", "--components", "--level", "6", "--connectivity", "26"},
+        {"--stat-test", "weibull", "--fit-box", "16,10,-1,20,20,1", "--confidence", "0.999", "--components"},
+        {"--propagate", "--min-seed", "0.15"},
+    };
+    for (const auto& method : methods) {
+        std::vector<std::string> args{"segment", input, "--field", "c2c_distance", "--min-points", "50", "--reference", reference,
+                                      "--dxf-points", "--out-dir", (dir / method[0].substr(2)).string()};
+        args.insert(args.end(), method.begin(), method.end());
+        const CliResult run = runCommand(registry, args);
+        ASSERT_EQ(run.status, 0) << method[0] << ": " << run.err;
+        EXPECT_NE(run.out.find("3 regions"), std::string::npos) << method[0] << ": " << run.out;
+        EXPECT_EQ(lineCount(dir / method[0].substr(2) / "regions.csv"), 4u) << method[0];
+        EXPECT_EQ(dxfAudit(dir / method[0].substr(2) / "regions.dxf"), 0) << method[0];
+    }
+    // Without --components the changed points form one region.
+    const CliResult one = runCommand(registry, {"segment", input, "--kmeans", "2", "--out-dir", (dir / "kmeans").string()});
+    ASSERT_EQ(one.status, 0) << one.err;
+    EXPECT_NE(one.out.find("one region"), std::string::npos) << one.out;
+}
+
+TEST(SegmentCli, BadInputGivesAnErrorAndAStatus)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    PointCloud cloud;
+    cloud.resize(20);
+    for (std::size_t i = 0; i < 20; ++i)
+        cloud.positions()[i] = {static_cast<float>(i), 0.0f, 0.0f};
+    ScalarField& d = cloud.addField("d");
+    for (std::size_t i = 0; i < 20; ++i)
+        d.values()[i] = i % 3 == 0 ? std::nanf("") : static_cast<float>(i) * 0.1f; // NaN values are not an error
+    io::writePointCloud(registry.formats, cloud, dir / "in.ply");
+    const std::string in = (dir / "in.ply").string(), out = (dir / "out").string();
+    EXPECT_EQ(runCommand(registry, {"segment", in, "--field", "d", "--above", "1", "--components", "--out-dir", out}).status, 0);
+    CliResult run = runCommand(registry, {"segment", in, "--field", "d", "--out-dir", out});
+    EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
+    EXPECT_NE(run.err.find("choose a method"), std::string::npos) << run.err;
+    run = runCommand(registry, {"segment", in, "--field", "missing", "--above", "1", "--out-dir", out});
+    EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
+    EXPECT_NE(run.err.find("missing"), std::string::npos) << run.err;
+    EXPECT_NE(runCommand(registry, {"segment", in, "--field", "d", "--above", "1", "--kmeans", "2", "--out-dir", out}).status, 0);
+    run = runCommand(registry, {"segment", in, "--field", "d", "--propagate", "--out-dir", out});
+    EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
+    EXPECT_NE(run.err.find("min-seed"), std::string::npos) << run.err;
+    run = runCommand(registry, {"segment", in, "--field", "d", "--stat-test", "weibull", "--fit-box", "1,2,3", "--out-dir", out});
+    EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
+    run = runCommand(registry, {"segment", (dir / "none.ply").string(), "--field", "d", "--above", "1", "--out-dir", out});
+    EXPECT_EQ(run.status, static_cast<int>(ErrorCode::Io));
+}
