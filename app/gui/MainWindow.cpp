@@ -3,6 +3,7 @@
 
 #include "controllers/DistanceController.h"
 #include "controllers/FileController.h"
+#include "controllers/SegmentationController.h"
 #include "controllers/SessionController.h"
 #include "controllers/SplitController.h"
 #include "controllers/ToolController.h"
@@ -45,6 +46,9 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
     report(distances_);
     report(splits_);
     report(sessions_);
+    segmentation_ = new SegmentationController(registry_, document_, this);
+    report(segmentation_);
+    connect(segmentation_, &SegmentationController::resultReady, tree_, &EntityTree::selectEntity);
     buildMenus();
 
     // The view follows the document.
@@ -116,6 +120,7 @@ void MainWindow::buildMenus()
     connect(files_, &FileController::recentFilesChanged, this, [this, recent] { files_->fillRecentMenu(recent); });
     file->addAction(tr("&Export selected..."), this, [this] { files_->exportWithDialog(tree_->selectedEntities()); })
         ->setShortcut(QKeySequence(tr("Ctrl+E")));
+    file->addAction(tr("Export re&gions (PLY, DXF, CSV)..."), this, [this] { segmentation_->exportRegionsWithDialog(tree_->currentEntity()); });
     file->addSeparator();
     file->addAction(tr("Open &session..."), sessions_, &SessionController::restoreWithDialog);
     file->addAction(tr("&Save session..."), sessions_, &SessionController::saveWithDialog)->setShortcut(QKeySequence::Save);
@@ -188,6 +193,7 @@ void MainWindow::buildMenus()
                          [this] { distances_->runInteractively(DistanceKind::CloudToCloud, tree_->currentEntity()); });
     distances->addAction(tr("Cloud/&mesh distance (C2M)..."), this,
                          [this] { distances_->runInteractively(DistanceKind::CloudToMesh, tree_->currentEntity()); });
+    tools->addAction(tr("S&egment the changes..."), this, [this] { segmentation_->runInteractively(tree_->currentEntity()); });
     tools->addAction(tr("&Split at thresholds"), this, [this] {
         const EntityId id = scalarPanel_->entity();
         const Document::Item* item = document_.find(id);
@@ -199,6 +205,22 @@ void MainWindow::buildMenus()
         splits_->split(id, item->display.activeField, d.low, d.high);
     });
     buildToolsMenu(tools);
+
+    // The tree's own menu: what applies to the entity under the mouse.
+    tree_->setContextMenuPolicy(Qt::ActionsContextMenu);
+    tree_->addAction(zoomSelection);
+    QAction* exportOne = new QAction(tr("Export..."), tree_);
+    connect(exportOne, &QAction::triggered, this, [this] { files_->exportWithDialog(tree_->selectedEntities()); });
+    tree_->addAction(exportOne);
+    QAction* exportRegions = new QAction(tr("Export regions (PLY, DXF, CSV)..."), tree_);
+    connect(exportRegions, &QAction::triggered, this, [this] { segmentation_->exportRegionsWithDialog(tree_->currentEntity()); });
+    tree_->addAction(exportRegions);
+    QAction* remove = new QAction(tr("Delete"), tree_);
+    connect(remove, &QAction::triggered, this, [this] {
+        for (EntityId id : tree_->selectedEntities())
+            document_.remove(id);
+    });
+    tree_->addAction(remove);
 }
 
 void MainWindow::buildToolsMenu(QMenu* toolsMenu)

@@ -22,6 +22,7 @@ class EntityTree;
 class FileController;
 class PropertiesPanel;
 class ScalarFieldPanel;
+class SegmentationController;
 class SessionController;
 class SplitController;
 class ToolController;
@@ -46,6 +47,7 @@ public:
     DistanceController* distances() const { return distances_; }
     SplitController* splits() const { return splits_; }
     SessionController* sessions() const { return sessions_; }
+    SegmentationController* segmentation() const { return segmentation_; }
     //! The controller of a registered plugin tool, null if unknown.
     ToolController* toolController(const std::string& toolName) const;
 
@@ -73,6 +75,7 @@ private:
     DistanceController* distances_ = nullptr;
     SplitController* splits_ = nullptr;
     SessionController* sessions_ = nullptr;
+    SegmentationController* segmentation_ = nullptr;
     std::map<std::string, ToolController*> tools_;
 };
 

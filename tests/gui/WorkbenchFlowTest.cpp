@@ -7,6 +7,7 @@
 #include "MainWindow.h"
 #include "controllers/DistanceController.h"
 #include "controllers/FileController.h"
+#include "controllers/SegmentationController.h"
 #include "controllers/SessionController.h"
 #include "panels/EntityTree.h"
 #include "panels/PropertiesPanel.h"
@@ -200,6 +201,53 @@ private slots:
         QVERIFY(!window.properties()->value("Picked point").isEmpty());
         const QString xyz = window.properties()->value("X, Y, Z");
         QVERIFY(xyz.startsWith(QString::number(window.document().item(id).points().globalPosition(index).x(), 'f', 3)));
+    }
+
+    void segmentTheChangesAndExportTheRegions()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::MainWindow window(registry);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
+        const EntityId reference = window.document().ids()[0], compared = window.document().ids()[1];
+        QVERIFY(window.distances()->runCloudToCloud(compared, reference, {}));
+
+        // The dialog proposes the field on screen.
+        gui::SegmentationDialog dialog(window.document(), compared);
+        QCOMPARE(dialog.input(), compared);
+        QCOMPARE(dialog.values().at("field"), std::string("c2c_distance"));
+
+        // The demo's compared epoch holds two changes seen from it: the raised
+        // block (+2 m) and the appeared box (the removed area has no points there).
+        QVERIFY(window.segmentation()->run(compared, reference,
+                                           {{"field", "c2c_distance"}, {"above", "0.5"}, {"components", "true"}, {"min-points", "20"}}));
+        const gui::Document::Item& item = window.document().item(compared);
+        QCOMPARE(item.display.activeField, std::string("region_id"));
+        const auto& report = window.segmentation()->report(compared);
+        QCOMPARE(report.size(), std::size_t(2));
+        // Each region is listed under its cloud with exactly its points.
+        std::size_t children = 0;
+        for (EntityId id : window.document().ids())
+            if (window.document().item(id).parent == compared) {
+                const gui::Document::Item& region = window.document().item(id);
+                QCOMPARE(region.points().size(), report[children].pointCount);
+                ++children;
+            }
+        QCOMPARE(children, report.size());
+        // The raised block: no point of it is farther than its 2 m lift (plus the 2 cm noise) from the old surface.
+        QVERIFY(std::abs(report[0].maxDistance - 2.0) < 0.1 || std::abs(report[1].maxDistance - 2.0) < 0.1);
+
+        QTemporaryDir dir;
+        QVERIFY(window.segmentation()->exportRegions(compared, dir.path()));
+        for (const char* name : {"regions.ply", "regions.dxf", "regions.csv", "region_0001.ply", "region_0002.ply"})
+            QVERIFY2(QFile::exists(dir.filePath(name)), name);
+        QFile csv(dir.filePath("regions.csv"));
+        QVERIFY(csv.open(QIODevice::ReadOnly));
+        QCOMPARE(QString(csv.readAll()).trimmed().split('\n').size(), 3); // header + two regions
+        const PointCloud all = io::readPointCloud(registry.formats, dir.filePath("regions.ply").toStdString());
+        QCOMPARE(all.size(), report[0].pointCount + report[1].pointCount);
+        QVERIFY(all.field("region_id"));
     }
 
     void badFilesAreReportedNotFatal()

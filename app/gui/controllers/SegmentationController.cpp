@@ -1,0 +1,238 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "controllers/SegmentationController.h"
+
+#include "TaskRunner.h"
+#include "tools/ParameterForm.h"
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/segmentation/SegmentationParameters.h>
+#include <scandiff/io/RegionExport.h>
+
+#include <QComboBox>
+#include <QDialogButtonBox>
+#include <QElapsedTimer>
+#include <QFileDialog>
+#include <QFormLayout>
+#include <QLabel>
+#include <QMessageBox>
+#include <QScrollArea>
+#include <QVBoxLayout>
+
+#include <cmath>
+#include <optional>
+
+namespace scandiff::gui {
+
+namespace {
+
+QString cliText(const std::map<std::string, std::string>& parameters)
+{
+    QStringList parts;
+    for (const auto& [name, value] : parameters) {
+        if (value == "false")
+            continue;
+        parts << (value == "true" ? QString("--%1").arg(QString::fromStdString(name))
+                                  : QString("--%1 %2").arg(QString::fromStdString(name), QString::fromStdString(value)));
+    }
+    return parts.join(' ');
+}
+
+} // namespace
+
+SegmentationDialog::SegmentationDialog(const Document& document, EntityId input, QWidget* parent) : QDialog(parent)
+{
+    setWindowTitle(tr("Segment the changes"));
+    auto* layout = new QVBoxLayout(this);
+    auto* help = new QLabel(tr("Classify a field (thresholds, K-means or the local chi-square test), group the changed points "
+                               "into regions (connected components on the octree grid) or grow them by fast marching, and "
+                               "measure each region."),
+                            this);
+    help->setWordWrap(true);
+    layout->addWidget(help);
+    auto* entities = new QFormLayout;
+    input_ = new QComboBox(this);
+    input_->setObjectName("input");
+    reference_ = new QComboBox(this);
+    reference_->setObjectName("reference");
+    reference_->addItem(tr("(none: no volume)"), kNoEntity);
+    for (EntityId id : document.ids()) {
+        const Document::Item& item = document.item(id);
+        if (!item.cloud())
+            continue;
+        if (!item.points().fields().empty())
+            input_->addItem(item.name, id);
+        reference_->addItem(item.name, id);
+    }
+    if (const int i = input_->findData(input); i >= 0)
+        input_->setCurrentIndex(i);
+    entities->addRow(tr("Cloud"), input_);
+    entities->addRow(tr("Other epoch (volume)"), reference_);
+    layout->addLayout(entities);
+    form_ = new ParameterForm(segmentationParameters(), this);
+    // The field to segment is the one the user is looking at.
+    const auto followInput = [this, &document] {
+        const Document::Item* item = document.find(this->input());
+        if (item && !item->display.activeField.empty())
+            form_->setValue("field", QString::fromStdString(item->display.activeField));
+    };
+    followInput();
+    connect(input_, qOverload<int>(&QComboBox::currentIndexChanged), this, followInput);
+    auto* scroll = new QScrollArea(this);
+    scroll->setWidget(form_);
+    scroll->setWidgetResizable(true);
+    scroll->setFrameShape(QFrame::NoFrame);
+    layout->addWidget(scroll, 1);
+    auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel, this);
+    connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
+    connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
+    layout->addWidget(buttons);
+    resize(560, 700);
+}
+
+EntityId SegmentationDialog::input() const { return input_->currentData().isValid() ? input_->currentData().toInt() : kNoEntity; }
+EntityId SegmentationDialog::reference() const { return reference_->currentData().toInt(); }
+std::map<std::string, std::string> SegmentationDialog::values() const { return form_->values(); }
+
+SegmentationController::SegmentationController(const PluginRegistry& registry, Document& document, QWidget* parentWindow)
+    : QObject(parentWindow), registry_(registry), document_(document), parentWindow_(parentWindow)
+{
+    connect(&document_, &Document::removed, this, [this](EntityId id) {
+        reports_.erase(id);
+        distanceFields_.erase(id);
+    });
+    connect(&document_, &Document::cleared, this, [this] {
+        reports_.clear();
+        distanceFields_.clear();
+    });
+}
+
+void SegmentationController::runInteractively(EntityId current)
+{
+    SegmentationDialog dialog(document_, current, parentWindow_);
+    if (dialog.input() == kNoEntity) {
+        QMessageBox::information(parentWindow_, dialog.windowTitle(), tr("Compute distances first: segmentation works on a scalar field."));
+        return;
+    }
+    if (dialog.exec() == QDialog::Accepted)
+        run(dialog.input(), dialog.reference(), dialog.values());
+}
+
+bool SegmentationController::run(EntityId inputId, EntityId referenceId, const std::map<std::string, std::string>& parameters)
+{
+    const Document::Item* input = document_.find(inputId);
+    const Document::Item* reference = document_.find(referenceId);
+    if (!input || !input->cloud()) {
+        emit failed(tr("Segmentation needs a point cloud"));
+        return false;
+    }
+    QElapsedTimer clock;
+    clock.start();
+    std::optional<SegmentationRun> run;
+    std::optional<ParameterValues> values;
+    TaskResult outcome = runTask(parentWindow_, tr("Segmenting"), [&](ProgressObserver& progress) {
+        values = resolveParameters(segmentationParameters(), parameters, "segment");
+        run = runSegmentation(*input->cloud(), *values, &progress);
+    });
+    if (outcome.outcome != TaskOutcome::Done) {
+        emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("Segmentation was cancelled") : outcome.error);
+        return false;
+    }
+    const std::string summary = run->summary;
+    std::vector<ScalarField> fields = std::move(run->fields);
+    // region_id last: it becomes the active field, coloured by region.
+    std::stable_partition(fields.begin(), fields.end(), [](const ScalarField& f) { return f.name() != "region_id"; });
+    for (ScalarField& field : fields)
+        document_.addField(inputId, std::move(field));
+
+    // The report and the regions as clouds, from the cloud that now holds region_id.
+    const PointCloud& cloud = *input->cloud();
+    std::vector<RegionStatistics> report;
+    std::vector<PointCloud> regionClouds;
+    outcome = runTask(parentWindow_, tr("Measuring the regions"), [&](ProgressObserver& progress) {
+        report = regionReport(cloud, regionReportSettings(*values, reference ? reference->cloud() : nullptr), &progress);
+        const ScalarField* ids = cloud.field("region_id");
+        std::vector<std::vector<std::size_t>> members(std::min(report.size(), kMaxRegionEntities));
+        for (std::size_t i = 0; ids && i < cloud.size(); ++i) {
+            const double id = ids->value(i);
+            if (std::isfinite(id) && id >= 1 && id <= double(members.size()))
+                members[static_cast<std::size_t>(id) - 1].push_back(i);
+        }
+        for (const auto& m : members)
+            regionClouds.push_back(cloud.subset(m));
+    });
+    if (outcome.outcome != TaskOutcome::Done) {
+        emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("Measuring the regions was cancelled") : outcome.error);
+        return false;
+    }
+    const std::string distanceField = values->text("field");
+    for (std::size_t r = 0; r < regionClouds.size(); ++r) {
+        const RegionStatistics& s = report[r];
+        const EntityId child = document_.add(tr("region %1 (%2 points, %3 m2)").arg(s.id).arg(s.pointCount).arg(s.footprintArea, 0, 'f', 1),
+                                             std::move(regionClouds[r]), inputId);
+        document_.setActiveField(child, distanceField);
+    }
+    if (report.size() > regionClouds.size())
+        emit finished(tr("%1 regions: the %2 largest are listed in the tree, all are exported").arg(report.size()).arg(regionClouds.size()));
+    reports_[inputId] = std::move(report);
+    distanceFields_[inputId] = distanceField;
+    document_.setActiveField(inputId, "region_id");
+    emit finished(tr("segment %1 [%2]: %3; %4 s")
+                      .arg(input->name, cliText(parameters), QString::fromStdString(summary))
+                      .arg(clock.elapsed() / 1000.0, 0, 'f', 3));
+    emit resultReady(inputId);
+    return true;
+}
+
+const std::vector<RegionStatistics>& SegmentationController::report(EntityId id) const
+{
+    static const std::vector<RegionStatistics> none;
+    const auto it = reports_.find(id);
+    return it == reports_.end() ? none : it->second;
+}
+
+bool SegmentationController::exportRegions(EntityId id, const QString& folder)
+{
+    const Document::Item* item = document_.find(id);
+    if (!item || !item->cloud() || !item->points().field("region_id")) {
+        emit failed(tr("Export regions: the cloud has no region_id field (run Segment the changes first)"));
+        return false;
+    }
+    const PointCloud& cloud = *item->cloud();
+    std::vector<RegionStatistics> report = this->report(id);
+    io::RegionExportFiles files;
+    const TaskResult outcome = runTask(parentWindow_, tr("Exporting regions"), [&](ProgressObserver& progress) {
+        if (report.empty()) { // a cloud read with its region_id: measure it now
+            RegionReportParams params;
+            const auto known = distanceFields_.find(id);
+            params.distanceField = known != distanceFields_.end() ? known->second : item->display.activeField;
+            if (params.distanceField == "region_id" || !cloud.field(params.distanceField))
+                params.distanceField.clear();
+            report = regionReport(cloud, params, &progress);
+        }
+        io::RegionExportOptions options;
+        options.write.progress = &progress;
+        files = io::exportRegions(registry_.formats, cloud, report, folder.toStdString(), options);
+    });
+    if (outcome.outcome != TaskOutcome::Done) {
+        emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("Export was cancelled") : outcome.error);
+        return false;
+    }
+    emit finished(tr("exported %1 regions of %2 to %3: regions.ply, %4 region files, regions.dxf, regions.csv")
+                      .arg(report.size())
+                      .arg(item->name, folder)
+                      .arg(files.regionClouds.size()));
+    return true;
+}
+
+void SegmentationController::exportRegionsWithDialog(EntityId id)
+{
+    const Document::Item* item = document_.find(id);
+    // A region's own entity exports its parent's regions.
+    if (item && !item->points().field("region_id") && document_.contains(item->parent))
+        id = item->parent;
+    const QString folder = QFileDialog::getExistingDirectory(parentWindow_, tr("Export the regions (PLY, DXF, CSV) into"));
+    if (!folder.isEmpty())
+        exportRegions(id, folder);
+}
+
+} // namespace scandiff::gui
