@@ -15,6 +15,7 @@
 #include <scandiff/plugins/PluginRegistry.h>
 
 #include <algorithm>
+#include <iomanip>
 #include <iostream>
 #include <random>
 
@@ -76,7 +77,7 @@ int main(int argc, char** argv)
             out.positions()[i] = (compared[i] - out.origin()).cast<float>();
         io::writePointCloud(registry.formats, reference, argv[2]);
         io::writePointCloud(registry.formats, out, argv[3]);
-        std::cout << "reference " << reference.size() << " points, compared " << out.size() << " points\n"
+        std::cout << std::fixed << std::setprecision(2) << "reference " << reference.size() << " points, compared " << out.size() << " points\n"
                   << "raised block: x " << blockCorner.x() << ".." << blockCorner.x() + blockSide << ", y " << blockCorner.y() << ".."
                   << blockCorner.y() + blockSide << ", +" << blockLift << " m\n"
                   << "removed disc: centre " << removedCentre.x() << ", " << removedCentre.y() << ", radius " << removedRadius << " m\n"
