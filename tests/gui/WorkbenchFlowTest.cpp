@@ -22,6 +22,8 @@
 #include <scandiff/plugins/PluginRegistry.h>
 
 #include <QCheckBox>
+#include <QDropEvent>
+#include <QMimeData>
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QPushButton>
@@ -248,6 +250,32 @@ private slots:
         const PointCloud all = io::readPointCloud(registry.formats, dir.filePath("regions.ply").toStdString());
         QCOMPARE(all.size(), report[0].pointCount + report[1].pointCount);
         QVERIFY(all.field("region_id"));
+    }
+
+    void dropRecentAndDecimation()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::MainWindow window(registry);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        // A file dropped on the window opens, and joins the recent files.
+        auto* mime = new QMimeData;
+        mime->setUrls({QUrl::fromLocalFile(kReference)});
+        QDragEnterEvent enter(QPoint(200, 200), Qt::CopyAction, mime, Qt::LeftButton, Qt::NoModifier);
+        QApplication::sendEvent(&window, &enter);
+        QVERIFY(enter.isAccepted());
+        QDropEvent drop(QPointF(200, 200), Qt::CopyAction, mime, Qt::LeftButton, Qt::NoModifier);
+        QApplication::sendEvent(&window, &drop);
+        delete mime;
+        QCOMPARE(window.document().size(), std::size_t(1));
+        QCOMPARE(window.files()->recentFiles().value(0), QFileInfo(kReference).absoluteFilePath());
+        // Above the interactive budget, a moving camera draws every k-th point.
+        window.view()->setInteractiveBudget(10000);
+        const std::size_t points = window.document().item(window.document().ids().front()).points().size();
+        QCOMPARE(window.view()->interactiveStride(), (points + 9999) / 10000);
+        window.view()->setMoving(true);
+        window.view()->render();
+        window.view()->setMoving(false);
     }
 
     void badFilesAreReportedNotFatal()

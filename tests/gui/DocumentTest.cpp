@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Qt Test, offscreen platform: the document, the colouring of entities, the
+// entity tree and the split controller, without a 3D view.
+#include "controllers/SplitController.h"
+#include "document/Document.h"
+#include "panels/EntityTree.h"
+#include "panels/ScalarFieldPanel.h"
+#include "view/EntityColouring.h"
+#include "widgets/RangeEditor.h"
+
+#include <QComboBox>
+#include <QPushButton>
+#include <QSignalSpy>
+#include <QtTest>
+
+#include <cmath>
+
+using namespace scandiff;
+using gui::EntityId;
+
+namespace {
+
+//! Four points with field d = 0, 1, 2, NaN (stored around an offset of 100).
+PointCloud fourPoints()
+{
+    PointCloud cloud;
+    cloud.resize(4);
+    ScalarField& d = cloud.addField("d");
+    d.setOffset(100.0);
+    for (std::size_t i = 0; i < 3; ++i) {
+        cloud.positions()[i] = {float(i), 0, 0};
+        d.setValue(i, double(i));
+    }
+    d.values()[3] = std::nanf("");
+    return cloud;
+}
+
+} // namespace
+
+class DocumentTest : public QObject
+{
+    Q_OBJECT
+
+private slots:
+    void initTestCase() { qRegisterMetaType<gui::EntityId>("EntityId"); }
+
+    void colouringHidesOrGreysOutsideTheThresholds()
+    {
+        gui::Document document;
+        const EntityId id = document.add("four", fourPoints());
+        QCOMPARE(document.item(id).display.activeField, std::string("d")); // the first field is active
+        gui::FieldDisplay display = document.fieldDisplay(id, "d");
+        display.low = 0.5;
+        display.high = 1.5;
+        document.setFieldDisplay(id, "d", display);
+        std::vector<std::uint8_t> rgba(16);
+        gui::ColourLegend legend = gui::colourEntity(document.item(id).points(), document.item(id).display, rgba.data());
+        QVERIFY(legend.shown);
+        QCOMPARE(legend.min, 0.0); // the scale spans the field's range, not the thresholds
+        QCOMPARE(legend.max, 2.0);
+        QCOMPARE(int(rgba[3]), 0);    // 0: below, hidden
+        QCOMPARE(int(rgba[7]), 255);  // 1: inside
+        QCOMPARE(int(rgba[11]), 0);   // 2: above, hidden
+        QCOMPARE(int(rgba[15]), 255); // NaN: shown in the no-value grey
+        // The inside point has the scale's middle colour (1 in [0, 2]).
+        const auto middle = display.scale.colourAt(0.5);
+        QCOMPARE(int(rgba[4]), int(middle[0]));
+        QCOMPARE(int(rgba[5]), int(middle[1]));
+        QCOMPARE(int(rgba[6]), int(middle[2]));
+
+        document.setOutsideMode(id, gui::FieldColouring::Outside::Grey);
+        gui::colourEntity(document.item(id).points(), document.item(id).display, rgba.data());
+        QCOMPARE(int(rgba[3]), 255);
+        QCOMPARE(int(rgba[0]), int(gui::FieldColouring{}.greyColour[0]));
+
+        // A diverging scale is centred on 0.
+        display.scale = *gui::ColourScale::preset("Diverging Blue-White-Red");
+        document.setFieldDisplay(id, "d", display);
+        legend = gui::colourEntity(document.item(id).points(), document.item(id).display, rgba.data());
+        QCOMPARE(legend.min, -2.0);
+        QCOMPARE(legend.max, 2.0);
+    }
+
+    void treeMirrorsTheDocument()
+    {
+        gui::Document document;
+        gui::EntityTree tree(document);
+        const EntityId id = document.add("four", fourPoints());
+        QVERIFY(tree.entityRow(id));
+        QCOMPARE(tree.entityRow(id)->checkState(0), Qt::Checked);
+        QVERIFY(document.item(id).display.visible);
+        // Unticking hides the entity.
+        tree.entityRow(id)->setCheckState(0, Qt::Unchecked);
+        QVERIFY(!document.item(id).display.visible);
+        // A new field appears under the cloud; clicking it makes it active.
+        ScalarField e("e", 4);
+        document.addField(id, std::move(e));
+        QVERIFY(tree.fieldRow(id, "e"));
+        QCOMPARE(document.item(id).display.activeField, std::string("e"));
+        emit tree.itemClicked(tree.fieldRow(id, "d"), 0);
+        QCOMPARE(document.item(id).display.activeField, std::string("d"));
+        // Derived entities sit under their parent, and go with it.
+        const EntityId child = document.add("part", fourPoints(), id);
+        QCOMPARE(tree.entityRow(child)->parent(), tree.entityRow(id));
+        document.remove(id);
+        QVERIFY(!document.contains(child));
+        QVERIFY(!tree.entityRow(child));
+        QCOMPARE(tree.topLevelItemCount(), 0);
+    }
+
+    void panelThresholdsAndSplit()
+    {
+        gui::Document document;
+        gui::ScalarFieldPanel panel(document);
+        gui::SplitController splits(document);
+        connect(&panel, &gui::ScalarFieldPanel::splitRequested, &splits, &gui::SplitController::split);
+        const EntityId id = document.add("four", fourPoints());
+        panel.showEntity(id);
+        QCOMPARE(panel.fieldBox()->currentText(), QString("d"));
+        QCOMPARE(panel.rangeEditor()->low(), 0.0);
+        QCOMPARE(panel.rangeEditor()->high(), 2.0);
+        panel.rangeEditor()->setRange(1.5, 2.0);
+        QCOMPARE(document.fieldDisplay(id, "d").low, 1.5);
+        QVERIFY(panel.insideText().contains("1 of 4"));
+        QSignalSpy done(&splits, &gui::SplitController::finished);
+        QTest::mouseClick(panel.splitButton(), Qt::LeftButton);
+        QCOMPARE(done.count(), 1);
+        const std::vector<EntityId> ids = document.ids();
+        QCOMPARE(ids.size(), std::size_t(3));
+        QCOMPARE(document.item(ids[1]).points().size(), std::size_t(1)); // value 2
+        QCOMPARE(document.item(ids[2]).points().size(), std::size_t(3)); // 0, 1 and NaN
+        QCOMPARE(document.item(ids[1]).parent, id);
+        QVERIFY(!document.item(ids[2]).display.visible);
+        // Values are compared with the offset applied: 2 + 100 stored as 2 around 100.
+        QCOMPARE(document.item(ids[1]).points().field("d")->value(0), 2.0);
+    }
+};
+
+QTEST_MAIN(DocumentTest)
+#include "DocumentTest.moc"
