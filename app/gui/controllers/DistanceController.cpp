@@ -8,12 +8,10 @@
 #include <scandiff/core/distance/DistanceParameters.h>
 
 #include <QComboBox>
-#include <QDialogButtonBox>
 #include <QElapsedTimer>
 #include <QFormLayout>
 #include <QLabel>
 #include <QMessageBox>
-#include <QScrollArea>
 #include <QVBoxLayout>
 
 #include <optional>
@@ -21,20 +19,6 @@
 namespace scandiff::gui {
 
 namespace {
-
-//! The run's parameters as `scandiff-cli` options, so a user can repeat it in a
-//! batch: flags only when on, values as typed.
-QString parameterText(const std::map<std::string, std::string>& parameters)
-{
-    QStringList parts;
-    for (const auto& [name, value] : parameters) {
-        if (value == "false")
-            continue;
-        parts << (value == "true" ? QString("--%1").arg(QString::fromStdString(name))
-                                  : QString("--%1 %2").arg(QString::fromStdString(name), QString::fromStdString(value)));
-    }
-    return parts.join(' ');
-}
 
 QString statisticsText(const DistanceStatistics& s)
 {
@@ -80,15 +64,7 @@ DistanceDialog::DistanceDialog(DistanceKind kind, const Document& document, QWid
     entities->addRow(tr("Compared"), compared_);
     layout->addLayout(entities);
     form_ = new ParameterForm(c2c ? cloudToCloudParameters() : cloudToMeshParameters(), this);
-    auto* scroll = new QScrollArea(this);
-    scroll->setWidget(form_);
-    scroll->setWidgetResizable(true);
-    scroll->setFrameShape(QFrame::NoFrame);
-    layout->addWidget(scroll, 1);
-    auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel, this);
-    connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
-    connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
-    layout->addWidget(buttons);
+    addFormAndButtons(*this, *layout, form_);
     resize(520, c2c ? 640 : 360);
 }
 
@@ -175,7 +151,7 @@ bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId reference
         document_.add(compared->name + tr(" closest points"), std::move(closest), comparedId);
     }
     emit finished(tr("C2C %1 -> %2 [%3] %4; octree level %5; %6 s")
-                      .arg(compared->name, reference->name, parameterText(parameters), statisticsText(statistics))
+                      .arg(compared->name, reference->name, commandLineText(parameters), statisticsText(statistics))
                       .arg(forward.level)
                       .arg(seconds, 0, 'f', 3));
     emit resultReady(comparedId);
@@ -206,7 +182,7 @@ bool DistanceController::runCloudToMesh(EntityId comparedId, EntityId referenceI
     const DistanceStatistics statistics = result->statistics;
     document_.addField(comparedId, std::move(result->distance));
     emit finished(tr("C2M %1 -> %2 [%3] %4; %5 degenerate triangles; %6 s")
-                      .arg(compared->name, reference->name, parameterText(parameters), statisticsText(statistics))
+                      .arg(compared->name, reference->name, commandLineText(parameters), statisticsText(statistics))
                       .arg(result->degenerateTriangles)
                       .arg(seconds, 0, 'f', 3));
     emit resultReady(comparedId);

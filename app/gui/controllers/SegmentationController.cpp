@@ -9,35 +9,17 @@
 #include <scandiff/io/RegionExport.h>
 
 #include <QComboBox>
-#include <QDialogButtonBox>
 #include <QElapsedTimer>
 #include <QFileDialog>
 #include <QFormLayout>
 #include <QLabel>
 #include <QMessageBox>
-#include <QScrollArea>
 #include <QVBoxLayout>
 
 #include <cmath>
 #include <optional>
 
 namespace scandiff::gui {
-
-namespace {
-
-QString cliText(const std::map<std::string, std::string>& parameters)
-{
-    QStringList parts;
-    for (const auto& [name, value] : parameters) {
-        if (value == "false")
-            continue;
-        parts << (value == "true" ? QString("--%1").arg(QString::fromStdString(name))
-                                  : QString("--%1 %2").arg(QString::fromStdString(name), QString::fromStdString(value)));
-    }
-    return parts.join(' ');
-}
-
-} // namespace
 
 SegmentationDialog::SegmentationDialog(const Document& document, EntityId input, QWidget* parent) : QDialog(parent)
 {
@@ -77,15 +59,7 @@ SegmentationDialog::SegmentationDialog(const Document& document, EntityId input,
     };
     followInput();
     connect(input_, qOverload<int>(&QComboBox::currentIndexChanged), this, followInput);
-    auto* scroll = new QScrollArea(this);
-    scroll->setWidget(form_);
-    scroll->setWidgetResizable(true);
-    scroll->setFrameShape(QFrame::NoFrame);
-    layout->addWidget(scroll, 1);
-    auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel, this);
-    connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
-    connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
-    layout->addWidget(buttons);
+    addFormAndButtons(*this, *layout, form_);
     resize(560, 700);
 }
 
@@ -177,7 +151,7 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
     distanceFields_[inputId] = distanceField;
     document_.setActiveField(inputId, "region_id");
     emit finished(tr("segment %1 [%2]: %3; %4 s")
-                      .arg(input->name, cliText(parameters), QString::fromStdString(summary))
+                      .arg(input->name, commandLineText(parameters), QString::fromStdString(summary))
                       .arg(clock.elapsed() / 1000.0, 0, 'f', 3));
     emit resultReady(inputId);
     return true;

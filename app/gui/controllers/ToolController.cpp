@@ -2,6 +2,7 @@
 #include "controllers/ToolController.h"
 
 #include "TaskRunner.h"
+#include "tools/ParameterForm.h"
 #include "tools/ToolDialog.h"
 
 #include <scandiff/core/Error.h>
@@ -51,13 +52,10 @@ bool ToolController::run(EntityId inputId, const std::map<std::string, std::stri
                                                                : outcome.error);
         return false;
     }
-    QStringList parameterText;
-    for (const auto& [name, value] : parameters)
-        parameterText << QString("--%1 %2").arg(QString::fromStdString(name), QString::fromStdString(value));
     const QString name = QString::fromStdString(result->cloud.name.empty() ? tool_.name : result->cloud.name);
     const EntityId output = document_.add(name, std::move(result->cloud), inputId);
     emit finished(QString("%1 on %2 [%3]: %4; %5 s")
-                      .arg(QString::fromStdString(tool_.name), item->name, parameterText.join(' '),
+                      .arg(QString::fromStdString(tool_.name), item->name, commandLineText(parameters),
                            QString::fromStdString(result->summary))
                       .arg(clock.elapsed() / 1000.0, 0, 'f', 3));
     emit resultReady(output);

@@ -2,6 +2,10 @@
 #include "tools/ParameterForm.h"
 
 #include <QCheckBox>
+#include <QDialog>
+#include <QDialogButtonBox>
+#include <QScrollArea>
+#include <QVBoxLayout>
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
@@ -159,6 +163,31 @@ QCheckBox* ParameterForm::enabler(const std::string& parameterName) const
 {
     const auto it = enablers_.find(parameterName);
     return it == enablers_.end() ? nullptr : it->second;
+}
+
+QString commandLineText(const std::map<std::string, std::string>& parameters)
+{
+    QStringList parts;
+    for (const auto& [name, value] : parameters) {
+        if (value == "false")
+            continue;
+        parts << (value == "true" ? QString("--%1").arg(QString::fromStdString(name))
+                                  : QString("--%1 %2").arg(QString::fromStdString(name), QString::fromStdString(value)));
+    }
+    return parts.join(' ');
+}
+
+void addFormAndButtons(QDialog& dialog, QVBoxLayout& layout, ParameterForm* form)
+{
+    auto* scroll = new QScrollArea(&dialog);
+    scroll->setWidget(form);
+    scroll->setWidgetResizable(true);
+    scroll->setFrameShape(QFrame::NoFrame);
+    layout.addWidget(scroll, 1);
+    auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel, &dialog);
+    QObject::connect(buttons, &QDialogButtonBox::accepted, &dialog, &QDialog::accept);
+    QObject::connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
+    layout.addWidget(buttons);
 }
 
 } // namespace scandiff::gui

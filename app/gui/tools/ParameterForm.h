@@ -15,6 +15,8 @@
 #include <vector>
 
 class QCheckBox;
+class QDialog;
+class QVBoxLayout;
 
 namespace scandiff::gui {
 
@@ -39,5 +41,13 @@ private:
     std::map<std::string, QWidget*> editors_;
     std::map<std::string, QCheckBox*> enablers_;
 };
+
+//! Parameter text as `scandiff-cli` options ("--knn 12 --signed"): flags only
+//! when on, so the console's line can be pasted into a batch script.
+QString commandLineText(const std::map<std::string, std::string>& parameters);
+
+//! Puts `form` in a scroll area and OK/Cancel buttons below it, the bottom of
+//! every parameter dialog.
+void addFormAndButtons(QDialog& dialog, QVBoxLayout& layout, ParameterForm* form);
 
 } // namespace scandiff::gui

@@ -3,7 +3,6 @@
 
 #include "tools/ParameterForm.h"
 
-#include <QDialogButtonBox>
 #include <QLabel>
 #include <QVBoxLayout>
 
@@ -17,11 +16,7 @@ ToolDialog::ToolDialog(const ToolSpec& tool, QWidget* parent) : QDialog(parent)
     description->setWordWrap(true);
     layout->addWidget(description);
     form_ = new ParameterForm(tool.parameters, this);
-    layout->addWidget(form_);
-    auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel, this);
-    connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
-    connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
-    layout->addWidget(buttons);
+    addFormAndButtons(*this, *layout, form_);
 }
 
 std::map<std::string, std::string> ToolDialog::values() const { return form_->values(); }
