@@ -24,6 +24,7 @@
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QMimeData>
+#include <QPushButton>
 #include <QStatusBar>
 #include <QToolBar>
 
@@ -129,7 +130,7 @@ void MainWindow::buildMenus()
 
     QMenu* edit = menuBar()->addMenu(tr("&Edit"));
     edit->addAction(tr("&Delete selected"), this, [this] {
-        for (EntityId id : tree_->selectedEntities())
+        for (EntityId id : tree_->selectedEntities(false))
             document_.remove(id);
     })->setShortcut(QKeySequence::Delete);
     edit->addAction(tr("&Rename..."), this, [this] {
@@ -194,16 +195,8 @@ void MainWindow::buildMenus()
     distances->addAction(tr("Cloud/&mesh distance (C2M)..."), this,
                          [this] { distances_->runInteractively(DistanceKind::CloudToMesh, tree_->currentEntity()); });
     tools->addAction(tr("S&egment the changes..."), this, [this] { segmentation_->runInteractively(tree_->currentEntity()); });
-    tools->addAction(tr("&Split at thresholds"), this, [this] {
-        const EntityId id = scalarPanel_->entity();
-        const Document::Item* item = document_.find(id);
-        if (!item || item->display.activeField.empty()) {
-            QMessageBox::information(this, tr("Split"), tr("Select a cloud and an active scalar field first."));
-            return;
-        }
-        const FieldDisplay d = document_.fieldDisplay(id, item->display.activeField);
-        splits_->split(id, item->display.activeField, d.low, d.high);
-    });
+    // The panel's own button: one place decides what a split takes.
+    tools->addAction(tr("&Split at thresholds"), scalarPanel_->splitButton(), &QPushButton::click);
     buildToolsMenu(tools);
 
     // The tree's own menu: what applies to the entity under the mouse.
@@ -217,7 +210,7 @@ void MainWindow::buildMenus()
     tree_->addAction(exportRegions);
     QAction* remove = new QAction(tr("Delete"), tree_);
     connect(remove, &QAction::triggered, this, [this] {
-        for (EntityId id : tree_->selectedEntities())
+        for (EntityId id : tree_->selectedEntities(false))
             document_.remove(id);
     });
     tree_->addAction(remove);
@@ -256,17 +249,7 @@ void MainWindow::onCurrentEntityChanged(EntityId id)
 void MainWindow::showLegendOf(EntityId id)
 {
     const Document::Item* item = document_.find(id);
-    ColourLegend legend;
-    if (item && item->cloud() && !item->display.activeField.empty()) {
-        if (const ScalarField* field = item->points().field(item->display.activeField)) {
-            const FieldDisplay display = document_.fieldDisplay(id, field->name());
-            legend.shown = true;
-            legend.title = field->name();
-            legend.scale = display.scale;
-            std::tie(legend.min, legend.max) = colourRange(*field, display.scale);
-        }
-    }
-    view_->setLegend(legend);
+    view_->setLegend(item && item->cloud() ? legendOf(item->points(), item->display) : ColourLegend{});
 }
 
 int MainWindow::openFiles(const QStringList& paths, bool quiet)

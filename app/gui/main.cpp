@@ -7,12 +7,11 @@
 #include <QCommandLineParser>
 #include <QSurfaceFormat>
 #include <QTimer>
-#include <QVTKOpenGLNativeWidget.h>
 
 int main(int argc, char** argv)
 {
     // VTK's widget needs its OpenGL format set before the application exists.
-    QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+    QSurfaceFormat::setDefaultFormat(scandiff::gui::CloudView::defaultSurfaceFormat());
     QApplication app(argc, argv);
     QApplication::setApplicationName("scandiff");
     QApplication::setApplicationVersion("0.1.0");

@@ -128,13 +128,11 @@ RegionExportFiles exportRegions(const FormatRegistry& registry, const PointCloud
     // Check the extension before writing anything.
     (void)registry.forPath(dir / ("regions." + options.cloudExtension));
 
-    std::map<int, std::vector<std::size_t>> members;
+    std::map<int, std::vector<std::size_t>> members = pointsByRegion(*ids);
     std::vector<std::size_t> all;
     for (std::size_t i = 0; i < cloud.size(); ++i)
-        if (ids->hasValue(i)) {
-            members[static_cast<int>(std::lround(ids->value(i)))].push_back(i);
+        if (ids->hasValue(i))
             all.push_back(i);
-        }
 
     RegionExportFiles files;
     files.allRegions = dir / ("regions." + options.cloudExtension);

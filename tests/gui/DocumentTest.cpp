@@ -122,6 +122,12 @@ private slots:
         panel.rangeEditor()->setRange(1.5, 2.0);
         QCOMPARE(document.fieldDisplay(id, "d").low, 1.5);
         QVERIFY(panel.insideText().contains("1 of 4"));
+        // A range holding no point splits nothing and says so.
+        QSignalSpy refused(&splits, &gui::SplitController::failed);
+        QCOMPARE(splits.split(id, "d", 5.0, 6.0).first, gui::kNoEntity);
+        QCOMPARE(refused.count(), 1);
+        QCOMPARE(document.size(), std::size_t(1));
+        QVERIFY(document.item(id).display.visible);
         QSignalSpy done(&splits, &gui::SplitController::finished);
         QTest::mouseClick(panel.splitButton(), Qt::LeftButton);
         QCOMPARE(done.count(), 1);
@@ -131,7 +137,7 @@ private slots:
         QCOMPARE(document.item(ids[2]).points().size(), std::size_t(3)); // 0, 1 and NaN
         QCOMPARE(document.item(ids[1]).parent, id);
         QVERIFY(!document.item(ids[2]).display.visible);
-        // Values are compared with the offset applied: 2 + 100 stored as 2 around 100.
+        // Values are compared with the offset applied (stored as value - 100).
         QCOMPARE(document.item(ids[1]).points().field("d")->value(0), 2.0);
     }
 };

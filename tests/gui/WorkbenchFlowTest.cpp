@@ -28,6 +28,7 @@
 #include <QDoubleSpinBox>
 #include <QPushButton>
 #include <QSignalSpy>
+#include <QStandardPaths>
 #include <QTemporaryDir>
 #include <QtTest>
 
@@ -57,6 +58,7 @@ class WorkbenchFlowTest : public QObject
 private slots:
     void initTestCase()
     {
+        QStandardPaths::setTestModeEnabled(true); // recent files go to a test location, not the user's
         QCoreApplication::setOrganizationName("scandiff-tests");
         qRegisterMetaType<gui::EntityId>("EntityId");
         qRegisterMetaType<std::size_t>("std::size_t");
@@ -237,6 +239,11 @@ private slots:
                 ++children;
             }
         QCOMPARE(children, report.size());
+        // Running again replaces the regions instead of adding a second set.
+        const std::size_t entitiesBefore = window.document().size();
+        QVERIFY(window.segmentation()->run(compared, reference,
+                                           {{"field", "c2c_distance"}, {"above", "0.5"}, {"components", "true"}, {"min-points", "20"}}));
+        QCOMPARE(window.document().size(), entitiesBefore);
         // The raised block: no point of it is farther than its 2 m lift (plus the 2 cm noise) from the old surface.
         QVERIFY(std::abs(report[0].maxDistance - 2.0) < 0.1 || std::abs(report[1].maxDistance - 2.0) < 0.1);
 
@@ -288,15 +295,22 @@ private slots:
         broken.write("ply\nformat binary_little_endian 1.0\nelement vertex 100\nproperty float x\nend_header\n");
         broken.close();
         QSignalSpy failed(window.files(), &gui::FileController::failed);
-        QCOMPARE(window.openFiles({dir.filePath("broken.ply"), dir.filePath("missing.las")}, true), 0);
+        QCOMPARE(window.openFiles({dir.filePath("broken.ply"), dir.filePath("missing.las"), kReference}, true), 1);
         QCOMPARE(failed.count(), 2);
-        QCOMPARE(window.document().size(), std::size_t(0));
+        QCOMPARE(window.document().size(), std::size_t(1));
         // A session file that is not one changes nothing.
         QFile notSession(dir.filePath("x.scandiff"));
         QVERIFY(notSession.open(QIODevice::WriteOnly));
         notSession.write("{ not json");
         notSession.close();
         QVERIFY(!window.sessions()->restore(dir.filePath("x.scandiff")));
+        // A session whose entries are wrong changes nothing either: the open cloud stays.
+        QFile wrongEntries(dir.filePath("y.scandiff"));
+        QVERIFY(wrongEntries.open(QIODevice::WriteOnly));
+        wrongEntries.write(R"({"scandiffSession": 1, "entities": [{"id": 1, "name": 3}]})");
+        wrongEntries.close();
+        QVERIFY(!window.sessions()->restore(dir.filePath("y.scandiff")));
+        QCOMPARE(window.document().size(), std::size_t(1));
     }
 };
 

@@ -6,6 +6,8 @@
 #include <scandiff/io/FileIO.h>
 
 #include <QDir>
+#include <QRegularExpression>
+#include <QSet>
 #include <QElapsedTimer>
 #include <QFileDialog>
 #include <QFileInfo>
@@ -131,9 +133,18 @@ void FileController::exportWithDialog(const std::vector<EntityId>& ids)
     const QString folder = QFileDialog::getExistingDirectory(parentWindow_, tr("Export %1 entities as PLY into").arg(ids.size()));
     if (folder.isEmpty())
         return;
-    for (EntityId id : ids)
-        if (!exportEntity(id, QDir(folder).filePath(document_.item(id).name + ".ply")))
+    QSet<QString> used;
+    for (EntityId id : ids) {
+        // Names become file names: no separators, and two entities never share a file.
+        QString base = document_.item(id).name;
+        base.replace(QRegularExpression(R"([/\\:*?"<>|])"), "_");
+        QString name = base + ".ply";
+        for (int n = 2; used.contains(name) || QFileInfo::exists(QDir(folder).filePath(name)); ++n)
+            name = QString("%1_%2.ply").arg(base).arg(n);
+        used.insert(name);
+        if (!exportEntity(id, QDir(folder).filePath(name)))
             break;
+    }
 }
 
 QStringList FileController::recentFiles() const { return QSettings().value(kRecentKey).toStringList(); }

@@ -16,6 +16,7 @@
 #include <QMessageBox>
 #include <QVBoxLayout>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -73,10 +74,14 @@ SegmentationController::SegmentationController(const PluginRegistry& registry, D
     connect(&document_, &Document::removed, this, [this](EntityId id) {
         reports_.erase(id);
         distanceFields_.erase(id);
+        regionEntities_.erase(id);
+        for (auto& [parent, children] : regionEntities_)
+            children.erase(std::remove(children.begin(), children.end(), id), children.end());
     });
     connect(&document_, &Document::cleared, this, [this] {
         reports_.clear();
         distanceFields_.clear();
+        regionEntities_.clear();
     });
 }
 
@@ -111,6 +116,10 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
         emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("Segmentation was cancelled") : outcome.error);
         return false;
     }
+    // A new run replaces the regions of the previous one.
+    for (EntityId old : regionEntities_[inputId])
+        document_.remove(old);
+    regionEntities_[inputId].clear();
     const std::string summary = run->summary;
     std::vector<ScalarField> fields = std::move(run->fields);
     // region_id last: it becomes the active field, coloured by region.
@@ -124,15 +133,11 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
     std::vector<PointCloud> regionClouds;
     outcome = runTask(parentWindow_, tr("Measuring the regions"), [&](ProgressObserver& progress) {
         report = regionReport(cloud, regionReportSettings(*values, reference ? reference->cloud() : nullptr), &progress);
-        const ScalarField* ids = cloud.field("region_id");
-        std::vector<std::vector<std::size_t>> members(std::min(report.size(), kMaxRegionEntities));
-        for (std::size_t i = 0; ids && i < cloud.size(); ++i) {
-            const double id = ids->value(i);
-            if (std::isfinite(id) && id >= 1 && id <= double(members.size()))
-                members[static_cast<std::size_t>(id) - 1].push_back(i);
+        const std::map<int, std::vector<std::size_t>> members = pointsByRegion(*cloud.field("region_id"));
+        for (std::size_t r = 0; r < report.size() && r < kMaxRegionEntities; ++r) {
+            const auto m = members.find(report[r].id);
+            regionClouds.push_back(cloud.subset(m == members.end() ? std::vector<std::size_t>{} : m->second));
         }
-        for (const auto& m : members)
-            regionClouds.push_back(cloud.subset(m));
     });
     if (outcome.outcome != TaskOutcome::Done) {
         emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("Measuring the regions was cancelled") : outcome.error);
@@ -144,6 +149,7 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
         const EntityId child = document_.add(tr("region %1 (%2 points, %3 m2)").arg(s.id).arg(s.pointCount).arg(s.footprintArea, 0, 'f', 1),
                                              std::move(regionClouds[r]), inputId);
         document_.setActiveField(child, distanceField);
+        regionEntities_[inputId].push_back(child);
     }
     if (report.size() > regionClouds.size())
         emit finished(tr("%1 regions: the %2 largest are listed in the tree, all are exported").arg(report.size()).arg(regionClouds.size()));
@@ -173,16 +179,16 @@ bool SegmentationController::exportRegions(EntityId id, const QString& folder)
     }
     const PointCloud& cloud = *item->cloud();
     std::vector<RegionStatistics> report = this->report(id);
+    // Everything the worker needs is read here, on the GUI thread.
+    RegionReportParams params;
+    const auto known = distanceFields_.find(id);
+    params.distanceField = known != distanceFields_.end() ? known->second : item->display.activeField;
+    if (params.distanceField == "region_id" || !cloud.field(params.distanceField))
+        params.distanceField.clear();
     io::RegionExportFiles files;
     const TaskResult outcome = runTask(parentWindow_, tr("Exporting regions"), [&](ProgressObserver& progress) {
-        if (report.empty()) { // a cloud read with its region_id: measure it now
-            RegionReportParams params;
-            const auto known = distanceFields_.find(id);
-            params.distanceField = known != distanceFields_.end() ? known->second : item->display.activeField;
-            if (params.distanceField == "region_id" || !cloud.field(params.distanceField))
-                params.distanceField.clear();
+        if (report.empty()) // a cloud read with its region_id: measure it now
             report = regionReport(cloud, params, &progress);
-        }
         io::RegionExportOptions options;
         options.write.progress = &progress;
         files = io::exportRegions(registry_.formats, cloud, report, folder.toStdString(), options);
@@ -200,10 +206,10 @@ bool SegmentationController::exportRegions(EntityId id, const QString& folder)
 
 void SegmentationController::exportRegionsWithDialog(EntityId id)
 {
-    const Document::Item* item = document_.find(id);
     // A region's own entity exports its parent's regions.
-    if (item && !item->points().field("region_id") && document_.contains(item->parent))
-        id = item->parent;
+    for (const auto& [parent, children] : regionEntities_)
+        if (std::find(children.begin(), children.end(), id) != children.end())
+            id = parent;
     const QString folder = QFileDialog::getExistingDirectory(parentWindow_, tr("Export the regions (PLY, DXF, CSV) into"));
     if (!folder.isEmpty())
         exportRegions(id, folder);

@@ -74,6 +74,7 @@ private:
     QWidget* parentWindow_;
     std::map<EntityId, std::vector<RegionStatistics>> reports_;
     std::map<EntityId, std::string> distanceFields_;
+    std::map<EntityId, std::vector<EntityId>> regionEntities_; //!< the region entities listed under each cloud
 };
 
 } // namespace scandiff::gui

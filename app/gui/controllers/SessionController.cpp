@@ -17,6 +17,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 namespace scandiff::gui {
 
@@ -63,41 +64,60 @@ SessionController::SessionController(const PluginRegistry& registry, Document& d
 bool SessionController::save(const QString& qpath)
 {
     const fs::path path = qpath.toStdString();
-    const TaskResult result = runTask(parentWindow_, tr("Saving session"), [&](ProgressObserver&) {
-        const fs::path data = dataFolder(path);
-        fs::create_directories(data);
-        json entities = json::array();
-        for (EntityId id : document_.ids()) {
-            const Document::Item& item = document_.item(id);
-            const std::string file = "entity_" + std::to_string(id) + ".ply";
-            io::writeFile(registry_.formats, item.entity, data / file);
-            json fields = json::object();
-            for (const auto& [name, display] : item.display.fields)
-                fields[name] = {{"scale", display.scale.toText()}, {"low", bound(display.low)}, {"high", bound(display.high)}};
-            entities.push_back({{"id", id},
-                                {"name", item.name.toStdString()},
-                                {"parent", item.parent},
-                                {"data", data.filename().string() + "/" + file},
-                                {"source", item.sourcePath.toStdString()},
-                                {"visible", item.display.visible},
-                                {"activeField", item.display.activeField},
-                                {"outside", item.display.outside == FieldColouring::Outside::Grey ? "grey" : "hide"},
-                                {"fields", fields}});
-        }
-        json scales = json::array();
-        for (const ColourScale& s : scalarPanel_.customScales())
-            scales.push_back(s.toText());
-        const json session = {{"scandiffSession", kSessionVersion},
-                              {"entities", entities},
-                              {"customScales", scales},
-                              {"camera", cameraJson(view_.camera())},
-                              {"pointSize", view_.pointSize()}};
+    const fs::path data = dataFolder(path);
+    // The description is made here, on the GUI thread; the worker only writes files.
+    json entities = json::array();
+    std::vector<std::pair<const io::Entity*, std::string>> files;
+    for (EntityId id : document_.ids()) {
+        const Document::Item& item = document_.item(id);
+        const std::string file = "entity_" + std::to_string(id) + ".ply";
+        files.emplace_back(&item.entity, file);
+        json fields = json::object();
+        for (const auto& [name, display] : item.display.fields)
+            fields[name] = {{"scale", display.scale.toText()}, {"low", bound(display.low)}, {"high", bound(display.high)}};
+        entities.push_back({{"id", id},
+                            {"name", item.name.toStdString()},
+                            {"parent", item.parent},
+                            {"data", data.filename().string() + "/" + file},
+                            {"source", item.sourcePath.toStdString()},
+                            {"visible", item.display.visible},
+                            {"activeField", item.display.activeField},
+                            {"outside", item.display.outside == FieldColouring::Outside::Grey ? "grey" : "hide"},
+                            {"fields", fields}});
+    }
+    json scales = json::array();
+    for (const ColourScale& s : scalarPanel_.customScales())
+        scales.push_back(s.toText());
+    const json session = {{"scandiffSession", kSessionVersion},
+                          {"entities", entities},
+                          {"customScales", scales},
+                          {"camera", cameraJson(view_.camera())},
+                          {"pointSize", view_.pointSize()}};
+
+    const TaskResult result = runTask(parentWindow_, tr("Saving session"), [&](ProgressObserver& progress) {
+        // A previous save stays whole until the new one is: its data folder is
+        // replaced only once every file of the new one is written.
+        const fs::path fresh = data.parent_path() / (data.filename().string() + ".new");
+        const fs::path previous = data.parent_path() / (data.filename().string() + ".old");
+        std::error_code ec;
+        fs::remove_all(fresh, ec);
+        fs::create_directories(fresh);
+        io::WriteOptions options;
+        options.progress = &progress;
+        for (const auto& [entity, file] : files)
+            io::writeFile(registry_.formats, *entity, fresh / file, options);
+        fs::remove_all(previous, ec);
+        if (fs::exists(data))
+            fs::rename(data, previous);
+        fs::rename(fresh, data);
         io::AtomicFile out(path);
         out.stream() << session.dump(2) << '\n';
         out.commit();
+        fs::remove_all(previous, ec);
     });
     if (result.outcome != TaskOutcome::Done) {
-        emit failed(tr("Saving the session failed: %1").arg(result.error));
+        emit failed(result.outcome == TaskOutcome::Cancelled ? tr("Saving the session was cancelled; the previous one is unchanged")
+                                                             : tr("Saving the session failed: %1").arg(result.error));
         return false;
     }
     emit finished(tr("saved session %1 (%2 entities)").arg(qpath).arg(document_.size()));
@@ -107,73 +127,87 @@ bool SessionController::save(const QString& qpath)
 bool SessionController::restore(const QString& qpath)
 {
     const fs::path path = qpath.toStdString();
-    json session;
-    struct Loaded
+    // Everything is read and checked by the worker before the document changes:
+    // a bad session leaves the current work as it was.
+    struct Entry
     {
-        json description;
+        int id = kNoEntity, parent = kNoEntity;
+        QString name, source;
+        bool visible = true;
+        std::string activeField;
+        FieldColouring::Outside outside = FieldColouring::Outside::Hide;
+        std::map<std::string, FieldDisplay> fields;
         io::Entity entity;
     };
-    std::vector<Loaded> loaded;
+    std::vector<Entry> entries;
+    std::vector<ColourScale> scales;
+    std::optional<CameraState> camera;
+    float pointSize = 2.0f;
     const TaskResult result = runTask(parentWindow_, tr("Opening session"), [&](ProgressObserver& progress) {
         std::ifstream in(path);
         if (!in)
             throw Error(ErrorCode::Io, "cannot read " + path.string());
         try {
-            session = json::parse(in);
+            const json session = json::parse(in);
+            if (!session.contains("scandiffSession") || session.at("scandiffSession").get<int>() > kSessionVersion)
+                throw Error(ErrorCode::InvalidData, path.string() + " is not a scandiff session this version reads");
+            io::ReadOptions options;
+            options.progress = &progress;
+            for (const json& e : session.at("entities")) {
+                Entry entry;
+                entry.id = e.at("id").get<int>();
+                entry.parent = e.value("parent", int(kNoEntity));
+                entry.name = QString::fromStdString(e.at("name").get<std::string>());
+                entry.source = QString::fromStdString(e.value("source", std::string()));
+                entry.visible = e.value("visible", true);
+                entry.activeField = e.value("activeField", std::string());
+                entry.outside = e.value("outside", std::string("hide")) == "grey" ? FieldColouring::Outside::Grey
+                                                                                  : FieldColouring::Outside::Hide;
+                const json fields = e.value("fields", json::object()); // items() must not outlive it
+                for (const auto& [name, f] : fields.items()) {
+                    FieldDisplay display;
+                    if (const auto scale = ColourScale::fromText(f.at("scale").get<std::string>()))
+                        display.scale = *scale;
+                    display.low = bound(f.at("low"), -std::numeric_limits<double>::infinity());
+                    display.high = bound(f.at("high"), std::numeric_limits<double>::infinity());
+                    entry.fields[name] = display;
+                }
+                entry.entity = io::readFile(registry_.formats, path.parent_path() / e.at("data").get<std::string>(), options);
+                entries.push_back(std::move(entry));
+            }
+            const json scaleTexts = session.value("customScales", json::array());
+            for (const json& text : scaleTexts)
+                if (const auto scale = ColourScale::fromText(text.get<std::string>()))
+                    scales.push_back(*scale);
+            if (session.contains("camera"))
+                camera = cameraFrom(session.at("camera"));
+            pointSize = session.value("pointSize", 2.0f);
         } catch (const json::exception& e) {
-            throw Error(ErrorCode::InvalidData, path.string() + " is not a scandiff session: " + e.what());
-        }
-        if (!session.contains("scandiffSession") || session.at("scandiffSession").get<int>() > kSessionVersion)
-            throw Error(ErrorCode::InvalidData, path.string() + " is not a scandiff session this version reads");
-        io::ReadOptions options;
-        options.progress = &progress;
-        try {
-            for (const json& e : session.at("entities"))
-                loaded.push_back({e, io::readFile(registry_.formats, path.parent_path() / e.at("data").get<std::string>(), options)});
-        } catch (const json::exception& e) {
-            throw Error(ErrorCode::InvalidData, path.string() + ": malformed session entry: " + e.what());
+            throw Error(ErrorCode::InvalidData, path.string() + " is not a valid scandiff session: " + e.what());
         }
     });
     if (result.outcome != TaskOutcome::Done) {
-        emit failed(tr("Opening the session failed: %1").arg(result.error));
+        emit failed(result.outcome == TaskOutcome::Cancelled ? tr("Opening the session was cancelled")
+                                                             : tr("Opening the session failed: %1").arg(result.error));
         return false;
     }
-    try {
-        // Everything is read: only now is the current document replaced.
-        document_.clear();
-        const json scales = session.value("customScales", json::array());
-        for (const json& s : scales)
-            if (const auto scale = ColourScale::fromText(s.get<std::string>()))
-                scalarPanel_.addCustomScale(*scale);
-        std::map<int, EntityId> newIds;
-        for (Loaded& l : loaded) {
-            const json& e = l.description;
-            const auto parent = newIds.find(e.value("parent", int(kNoEntity)));
-            const EntityId id = document_.add(QString::fromStdString(e.at("name").get<std::string>()), std::move(l.entity),
-                                              parent == newIds.end() ? kNoEntity : parent->second,
-                                              QString::fromStdString(e.value("source", std::string())));
-            newIds[e.at("id").get<int>()] = id;
-            const json fields = e.value("fields", json::object()); // items() must not outlive it
-            for (const auto& [name, f] : fields.items()) {
-                FieldDisplay display;
-                if (const auto scale = ColourScale::fromText(f.at("scale").get<std::string>()))
-                    display.scale = *scale;
-                display.low = bound(f.at("low"), -std::numeric_limits<double>::infinity());
-                display.high = bound(f.at("high"), std::numeric_limits<double>::infinity());
-                document_.setFieldDisplay(id, name, display);
-            }
-            document_.setActiveField(id, e.value("activeField", std::string()));
-            document_.setOutsideMode(id, e.value("outside", std::string("hide")) == "grey" ? FieldColouring::Outside::Grey
-                                                                                          : FieldColouring::Outside::Hide);
-            document_.setVisible(id, e.value("visible", true));
-        }
-        view_.setPointSize(session.value("pointSize", 2.0f));
-        if (session.contains("camera"))
-            view_.setCamera(cameraFrom(session.at("camera")));
-    } catch (const json::exception& e) {
-        emit failed(tr("Opening the session failed: malformed entry: %1").arg(e.what()));
-        return false;
+    document_.clear();
+    for (const ColourScale& scale : scales)
+        scalarPanel_.addCustomScale(scale);
+    std::map<int, EntityId> newIds;
+    for (Entry& e : entries) {
+        const auto parent = newIds.find(e.parent);
+        const EntityId id = document_.add(e.name, std::move(e.entity), parent == newIds.end() ? kNoEntity : parent->second, e.source);
+        newIds[e.id] = id;
+        for (const auto& [name, display] : e.fields)
+            document_.setFieldDisplay(id, name, display);
+        document_.setActiveField(id, e.activeField);
+        document_.setOutsideMode(id, e.outside);
+        document_.setVisible(id, e.visible);
     }
+    view_.setPointSize(pointSize);
+    if (camera)
+        view_.setCamera(*camera);
     emit finished(tr("opened session %1 (%2 entities)").arg(qpath).arg(document_.size()));
     return true;
 }

@@ -17,6 +17,13 @@ std::pair<EntityId, EntityId> SplitController::split(EntityId id, const std::str
     }
     try {
         FieldRangeSplit parts = splitByFieldRange(*item->cloud(), field, low, high);
+        if (parts.inside.empty()) {
+            emit failed(tr("split %1: no point has %2 in [%3, %4]; nothing was split")
+                            .arg(item->name, QString::fromStdString(field))
+                            .arg(low, 0, 'g', 6)
+                            .arg(high, 0, 'g', 6));
+            return {kNoEntity, kNoEntity};
+        }
         const QString name = item->name;
         const QString range = QString("[%1, %2]").arg(low, 0, 'g', 6).arg(high, 0, 'g', 6);
         const std::size_t insideCount = parts.inside.size(), outsideCount = parts.outside.size();

@@ -15,8 +15,9 @@ class SplitController : public QObject
 public:
     explicit SplitController(Document& document, QObject* parent = nullptr);
 
-    //! Adds "<name> [low, high]" and "<name> outside" (an empty part is not
-    //! added); returns their ids (kNoEntity for a part not added).
+    //! Adds "<name> [low, high]" and "<name> outside" (an empty outside part is
+    //! not added); returns their ids (kNoEntity for a part not added). With no
+    //! point inside, nothing changes and failed() explains why.
     std::pair<EntityId, EntityId> split(EntityId id, const std::string& field, double low, double high);
 
 signals:

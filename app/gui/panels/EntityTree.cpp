@@ -140,12 +140,12 @@ EntityId EntityTree::currentEntity() const
     return row ? row->data(0, kEntityRole).toInt() : kNoEntity;
 }
 
-std::vector<EntityId> EntityTree::selectedEntities() const
+std::vector<EntityId> EntityTree::selectedEntities(bool fieldRowsCount) const
 {
     std::vector<EntityId> ids;
     for (const auto& [id, row] : rows_) {
         bool selected = row->isSelected();
-        for (int i = 0; i < row->childCount() && !selected; ++i)
+        for (int i = 0; fieldRowsCount && i < row->childCount() && !selected; ++i)
             selected = row->child(i)->isSelected() && !row->child(i)->data(0, kFieldRole).toString().isEmpty();
         if (selected)
             ids.push_back(id);

@@ -21,8 +21,9 @@ public:
 
     //! The entity of the current row (a field row gives its entity).
     EntityId currentEntity() const;
-    //! The selected entities (field rows count as their entity), in tree order.
-    std::vector<EntityId> selectedEntities() const;
+    //! The selected entities, in tree order; with `fieldRowsCount` a selected
+    //! field row stands for its entity (export), else only entity rows do (delete).
+    std::vector<EntityId> selectedEntities(bool fieldRowsCount = true) const;
     void selectEntity(EntityId id);
     //! The row of an entity, null if unknown (tests click it).
     QTreeWidgetItem* entityRow(EntityId id) const;

@@ -43,6 +43,10 @@ PropertiesPanel::PropertiesPanel(const Document& document, QWidget* parent) : QT
         if (id == entity_)
             rebuild();
     });
+    connect(&document_, &Document::renamed, this, [this](EntityId id) {
+        if (id == entity_ || id == pickedEntity_)
+            rebuild();
+    });
     connect(&document_, &Document::removed, this, [this](EntityId id) {
         if (id == pickedEntity_)
             pickedEntity_ = kNoEntity;

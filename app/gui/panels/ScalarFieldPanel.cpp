@@ -8,6 +8,7 @@
 
 #include <scandiff/core/FieldRange.h>
 
+#include <QCheckBox>
 #include <QComboBox>
 #include <QFormLayout>
 #include <QHBoxLayout>
@@ -57,8 +58,15 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
     histogram_ = new HistogramWidget(this);
     histogram_->setObjectName("histogram");
     layout->addWidget(histogram_, 1);
+    auto* countsRow = new QHBoxLayout;
     inside_ = new QLabel(this);
-    layout->addWidget(inside_);
+    auto* logScale = new QCheckBox(tr("Log counts"), this);
+    logScale->setObjectName("logCounts");
+    logScale->setToolTip(tr("Histogram heights on a logarithmic scale: the few changed points next to the many unchanged ones"));
+    countsRow->addWidget(inside_, 1);
+    countsRow->addWidget(logScale);
+    layout->addLayout(countsRow);
+    connect(logScale, &QCheckBox::toggled, histogram_, &HistogramWidget::setLogarithmic);
     auto* buttons = new QHBoxLayout;
     resetRange_ = new QPushButton(tr("Full range"), this);
     split_ = new QPushButton(tr("Split at thresholds"), this);
@@ -93,6 +101,10 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
     connect(&document_, &Document::fieldsChanged, this, [this](EntityId id) {
         if (id == entity_)
             refresh();
+    });
+    connect(&document_, &Document::renamed, this, [this](EntityId id) {
+        if (const Document::Item* item = document_.find(id); item && id == entity_)
+            title_->setText(tr("<b>%1</b>").arg(item->name.toHtmlEscaped()));
     });
     connect(&document_, &Document::displayChanged, this, [this](EntityId id) {
         if (id == entity_ && !updating_)

@@ -1,17 +1,21 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "view/CloudView.h"
 
+#include <scandiff/core/Log.h>
+
 #include <QElapsedTimer>
 #include <QTimer>
 #include <QVBoxLayout>
 #include <QVTKOpenGLNativeWidget.h>
 
 #include <vtkActor.h>
+#include <vtkBoundingBox.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkGenericOpenGLRenderWindow.h>
-#include <vtkIdTypeArray.h>
+#include <vtkFloatArray.h>
+#include <vtkTypeInt32Array.h>
 #include <vtkInteractorStyleTrackballCamera.h>
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
@@ -40,35 +44,31 @@ namespace scandiff::gui {
 namespace {
 
 
-vtkSmartPointer<vtkPoints> toVtkPoints(const PointCloud& cloud, const Eigen::Vector3d& sceneOrigin)
+//! VTK points reading `count` xyz triples at `xyz` in place (no copy; VTK does not free them).
+vtkSmartPointer<vtkPoints> pointsOver(const float* xyz, std::size_t count)
 {
     auto points = vtkSmartPointer<vtkPoints>::New();
     points->SetDataTypeToFloat();
-    points->SetNumberOfPoints(static_cast<vtkIdType>(cloud.size()));
-    const Eigen::Vector3f delta = (cloud.origin() - sceneOrigin).cast<float>();
-    auto* raw = static_cast<float*>(points->GetVoidPointer(0));
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        const Eigen::Vector3f p = cloud.positions()[i] + delta;
-        raw[3 * i] = p.x();
-        raw[3 * i + 1] = p.y();
-        raw[3 * i + 2] = p.z();
-    }
+    vtkFloatArray::SafeDownCast(points->GetData())
+        ->SetArray(const_cast<float*>(xyz), static_cast<vtkIdType>(3 * count), /*save: VTK does not free*/ 1);
     return points;
 }
 
-//! Vertex cells for every stride-th point, built as two flat arrays.
+//! Vertex cells for every stride-th point, as two flat 32-bit arrays (half the
+//! memory of VTK's default 64-bit ids; a cloud above 2^31 points is refused by
+//! the view before this).
 vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride)
 {
     const auto n = static_cast<vtkIdType>((count + stride - 1) / stride);
-    vtkNew<vtkIdTypeArray> offsets;
-    vtkNew<vtkIdTypeArray> connectivity;
+    vtkNew<vtkTypeInt32Array> offsets;
+    vtkNew<vtkTypeInt32Array> connectivity;
     offsets->SetNumberOfValues(n + 1);
     connectivity->SetNumberOfValues(n);
     for (vtkIdType i = 0; i < n; ++i) {
-        offsets->SetValue(i, i);
-        connectivity->SetValue(i, i * static_cast<vtkIdType>(stride));
+        offsets->SetValue(i, static_cast<std::int32_t>(i));
+        connectivity->SetValue(i, static_cast<std::int32_t>(i * static_cast<vtkIdType>(stride)));
     }
-    offsets->SetValue(n, n);
+    offsets->SetValue(n, static_cast<std::int32_t>(n));
     auto cells = vtkSmartPointer<vtkCellArray>::New();
     cells->SetData(offsets, connectivity);
     return cells;
@@ -80,20 +80,28 @@ constexpr const char* kDiscardHidden = "//VTK::Light::Impl\n  if (gl_FragData[0]
 
 } // namespace
 
-//! One shown entity. A cloud's decimated twin shares its points and colour
-//! arrays and only holds every stride-th vertex, so colour changes reach both
-//! and VTK uploads the arrays once.
+//! One shown entity, drawn as chunks of at most kChunkPoints points, one
+//! actor each: a renderer (software ones above all) then works on bounded
+//! buffers, as CloudCompare draws its clouds chunk by chunk. A chunk's VTK
+//! arrays are views on the entity's positions and RGBA colours (no copies); its
+//! decimated twin shares them and holds every stride-th vertex only.
 struct CloudView::Shown
 {
+    struct Chunk
+    {
+        std::size_t begin = 0, count = 0;
+        vtkSmartPointer<vtkPolyData> full, decimated;
+        vtkSmartPointer<vtkPolyDataMapper> fullMapper, decimatedMapper;
+        vtkSmartPointer<vtkUnsignedCharArray> colours;
+        vtkSmartPointer<vtkActor> actor;
+        std::size_t decimatedStride = 0;
+    };
     bool isCloud = true;
     std::size_t pointCount = 0;
-    vtkSmartPointer<vtkPolyData> full;
-    vtkSmartPointer<vtkPolyData> decimated;
-    vtkSmartPointer<vtkPolyDataMapper> fullMapper;
-    vtkSmartPointer<vtkPolyDataMapper> decimatedMapper;
-    vtkSmartPointer<vtkUnsignedCharArray> colours;
-    vtkSmartPointer<vtkActor> actor;
-    std::size_t decimatedStride = 0;
+    //! Positions shifted to the scene origin when the entity's origin differs; else empty.
+    std::vector<Eigen::Vector3f> shifted;
+    std::vector<std::uint8_t> rgba; //!< 4 bytes per point, what the chunks' colour arrays show
+    std::vector<Chunk> chunks;
 };
 
 struct CloudView::Scene
@@ -171,7 +179,15 @@ CloudView::CloudView(QWidget* parent) : QWidget(parent), scene_(std::make_unique
     auto onMove = vtkSmartPointer<vtkCallbackCommand>::New();
     onMove->SetClientData(this);
     onMove->SetCallback([](vtkObject*, unsigned long event, void* self, void*) {
-        static_cast<CloudView*>(self)->setMoving(event == vtkCommand::StartInteractionEvent);
+        auto* view = static_cast<CloudView*>(self);
+        if (event == vtkCommand::StartInteractionEvent) {
+            view->setMoving(true);
+            return;
+        }
+        // VTK renders once more itself after a move (each wheel notch is one):
+        // full detail comes when the moves have stopped for a moment.
+        view->scene_->settling = true;
+        view->settleTimer_->start();
     });
     style->AddObserver(vtkCommand::StartInteractionEvent, onMove);
     style->AddObserver(vtkCommand::EndInteractionEvent, onMove);
@@ -185,29 +201,34 @@ CloudView::~CloudView() = default;
 void CloudView::addEntity(const Document::Item& item)
 {
     const PointCloud& points = item.points();
+    if (points.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
+        logWarning(item.name.toStdString() + ": more than 2^31 points cannot be shown (the data stays usable by the tools)");
+        return;
+    }
+    if (points.empty())
+        return;
     if (!scene_->sceneOrigin)
         scene_->sceneOrigin = points.origin();
-    Shown s;
+    Shown& s = scene_->shown[item.id];
     s.isCloud = item.cloud() != nullptr;
     s.pointCount = points.size();
-    s.full = vtkSmartPointer<vtkPolyData>::New();
-    s.full->SetPoints(toVtkPoints(points, *scene_->sceneOrigin));
-    s.fullMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-    s.fullMapper->SetInputData(s.full);
-    s.actor = vtkSmartPointer<vtkActor>::New();
-    s.actor->SetMapper(s.fullMapper);
-    if (s.isCloud) {
-        s.full->SetVerts(vertexCells(points.size(), 1));
-        s.colours = vtkSmartPointer<vtkUnsignedCharArray>::New();
-        s.colours->SetNumberOfComponents(4);
-        s.colours->SetName("display colours");
-        s.full->GetPointData()->SetScalars(s.colours);
-        s.fullMapper->SetColorModeToDirectScalars();
-        s.fullMapper->ScalarVisibilityOn();
-        s.actor->GetProperty()->SetPointSize(scene_->pointSize);
-        s.actor->ForceOpaqueOn();
-        s.actor->GetShaderProperty()->AddFragmentShaderReplacement("//VTK::Light::Impl", true, kDiscardHidden, false);
-    } else {
+    // The document never moves or resizes a shown entity's positions, and the
+    // view drops an entity before any further render once it is removed.
+    const float* xyz = points.positions().front().data();
+    if (points.origin() != *scene_->sceneOrigin) {
+        const Eigen::Vector3f delta = (points.origin() - *scene_->sceneOrigin).cast<float>();
+        s.shifted.resize(points.size());
+        for (std::size_t i = 0; i < points.size(); ++i)
+            s.shifted[i] = points.positions()[i] + delta;
+        xyz = s.shifted.front().data();
+    }
+    static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "positions are packed xyz triples");
+
+    if (!s.isCloud) { // a mesh: one piece, its triangles index every vertex
+        Shown::Chunk c;
+        c.count = points.size();
+        c.full = vtkSmartPointer<vtkPolyData>::New();
+        c.full->SetPoints(pointsOver(xyz, c.count));
         const Mesh& mesh = *item.mesh();
         vtkNew<vtkCellArray> polys;
         polys->AllocateExact(static_cast<vtkIdType>(mesh.triangles.size()), static_cast<vtkIdType>(3 * mesh.triangles.size()));
@@ -215,12 +236,42 @@ void CloudView::addEntity(const Document::Item& item)
             const vtkIdType ids[3] = {t[0], t[1], t[2]};
             polys->InsertNextCell(3, ids);
         }
-        s.full->SetPolys(polys);
-        s.fullMapper->ScalarVisibilityOff();
-        s.actor->GetProperty()->SetColor(0.85, 0.85, 0.8);
+        c.full->SetPolys(polys);
+        c.fullMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+        c.fullMapper->SetInputData(c.full);
+        c.fullMapper->ScalarVisibilityOff();
+        c.actor = vtkSmartPointer<vtkActor>::New();
+        c.actor->SetMapper(c.fullMapper);
+        c.actor->GetProperty()->SetColor(0.85, 0.85, 0.8);
+        scene_->renderer->AddActor(c.actor);
+        s.chunks.push_back(c);
+    } else {
+        s.rgba.assign(4 * points.size(), 255);
+        for (std::size_t begin = 0; begin < points.size(); begin += kChunkPoints) {
+            Shown::Chunk c;
+            c.begin = begin;
+            c.count = std::min(kChunkPoints, points.size() - begin);
+            c.full = vtkSmartPointer<vtkPolyData>::New();
+            c.full->SetPoints(pointsOver(xyz + 3 * begin, c.count));
+            c.full->SetVerts(vertexCells(c.count, 1));
+            c.colours = vtkSmartPointer<vtkUnsignedCharArray>::New();
+            c.colours->SetNumberOfComponents(4);
+            c.colours->SetName("display colours");
+            c.colours->SetArray(s.rgba.data() + 4 * begin, static_cast<vtkIdType>(4 * c.count), /*save*/ 1);
+            c.full->GetPointData()->SetScalars(c.colours);
+            c.fullMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+            c.fullMapper->SetInputData(c.full);
+            c.fullMapper->SetColorModeToDirectScalars();
+            c.fullMapper->ScalarVisibilityOn();
+            c.actor = vtkSmartPointer<vtkActor>::New();
+            c.actor->SetMapper(c.fullMapper);
+            c.actor->GetProperty()->SetPointSize(scene_->pointSize);
+            c.actor->ForceOpaqueOn();
+            c.actor->GetShaderProperty()->AddFragmentShaderReplacement("//VTK::Light::Impl", true, kDiscardHidden, false);
+            scene_->renderer->AddActor(c.actor);
+            s.chunks.push_back(c);
+        }
     }
-    scene_->renderer->AddActor(s.actor);
-    scene_->shown[item.id] = s;
     updateStride();
     refreshEntity(item);
 }
@@ -231,12 +282,16 @@ void CloudView::refreshEntity(const Document::Item& item)
     if (it == scene_->shown.end())
         return;
     Shown& s = it->second;
-    s.actor->SetVisibility(item.display.visible);
+    const bool visibilityChanged = s.chunks.front().actor->GetVisibility() != int(item.display.visible);
+    for (auto& c : s.chunks)
+        c.actor->SetVisibility(item.display.visible);
+    if (visibilityChanged)
+        updateStride();
     if (s.isCloud) {
-        // Same array object, written in place: VTK re-uploads the colours only, never the points.
-        s.colours->SetNumberOfTuples(static_cast<vtkIdType>(s.pointCount));
-        colourEntity(item.points(), item.display, s.colours->GetPointer(0));
-        s.colours->Modified();
+        // Written in place: VTK re-uploads the colours only, never the points.
+        colourEntity(item.points(), item.display, s.rgba.data());
+        for (auto& c : s.chunks)
+            c.colours->Modified();
     }
     renderInteractively();
 }
@@ -246,12 +301,13 @@ void CloudView::removeEntity(EntityId id)
     const auto it = scene_->shown.find(id);
     if (it == scene_->shown.end())
         return;
-    scene_->renderer->RemoveActor(it->second.actor);
+    for (auto& c : it->second.chunks)
+        scene_->renderer->RemoveActor(c.actor);
     scene_->shown.erase(it);
     if (scene_->shown.empty())
         scene_->sceneOrigin.reset();
     updateStride();
-    render();
+    renderSoon(); // deleting a cloud and its 100 regions draws once
 }
 
 void CloudView::setLegend(const ColourLegend& legend)
@@ -276,7 +332,8 @@ void CloudView::setLegend(const ColourLegend& legend)
 void CloudView::clear()
 {
     for (auto& [id, s] : scene_->shown)
-        scene_->renderer->RemoveActor(s.actor);
+        for (auto& c : s.chunks)
+            scene_->renderer->RemoveActor(c.actor);
     scene_->shown.clear();
     scene_->sceneOrigin.reset();
     scene_->scalarBar->VisibilityOff();
@@ -294,7 +351,12 @@ void CloudView::zoomToEntity(EntityId id)
     const auto it = scene_->shown.find(id);
     if (it == scene_->shown.end())
         return;
-    scene_->renderer->ResetCamera(it->second.actor->GetBounds());
+    vtkBoundingBox box;
+    for (auto& c : it->second.chunks)
+        box.AddBounds(c.actor->GetBounds());
+    double bounds[6];
+    box.GetBounds(bounds);
+    scene_->renderer->ResetCamera(bounds);
     render();
 }
 
@@ -323,7 +385,8 @@ void CloudView::setPointSize(float size)
     scene_->pointSize = size;
     for (auto& [id, s] : scene_->shown)
         if (s.isCloud)
-            s.actor->GetProperty()->SetPointSize(size);
+            for (auto& c : s.chunks)
+                c.actor->GetProperty()->SetPointSize(size);
     render();
 }
 
@@ -344,6 +407,12 @@ CameraState CloudView::camera() const
     CameraState s;
     c->GetPosition(s.position.data());
     c->GetFocalPoint(s.focalPoint.data());
+    // Global coordinates: the scene's origin depends on which entity came first.
+    const Eigen::Vector3d origin = scene_->sceneOrigin.value_or(Eigen::Vector3d::Zero());
+    for (int k = 0; k < 3; ++k) {
+        s.position[k] += origin[k];
+        s.focalPoint[k] += origin[k];
+    }
     c->GetViewUp(s.viewUp.data());
     s.viewAngle = c->GetViewAngle();
     s.parallel = c->GetParallelProjection() != 0;
@@ -354,8 +423,9 @@ CameraState CloudView::camera() const
 void CloudView::setCamera(const CameraState& s)
 {
     vtkCamera* c = scene_->renderer->GetActiveCamera();
-    c->SetPosition(s.position.data());
-    c->SetFocalPoint(s.focalPoint.data());
+    const Eigen::Vector3d origin = scene_->sceneOrigin.value_or(Eigen::Vector3d::Zero());
+    c->SetPosition(s.position[0] - origin.x(), s.position[1] - origin.y(), s.position[2] - origin.z());
+    c->SetFocalPoint(s.focalPoint[0] - origin.x(), s.focalPoint[1] - origin.y(), s.focalPoint[2] - origin.z());
     c->SetViewUp(s.viewUp.data());
     c->SetViewAngle(s.viewAngle);
     c->SetParallelProjection(s.parallel);
@@ -377,9 +447,9 @@ std::size_t CloudView::interactiveStride() const { return scene_->stride; }
 
 void CloudView::updateStride()
 {
-    std::size_t total = 0;
+    std::size_t total = 0; // what is drawn: hidden clouds cost nothing
     for (const auto& [id, s] : scene_->shown)
-        if (s.isCloud)
+        if (s.isCloud && s.chunks.front().actor->GetVisibility())
             total += s.pointCount;
     scene_->stride = std::max<std::size_t>(1, (total + scene_->budget - 1) / scene_->budget);
 }
@@ -397,22 +467,22 @@ void CloudView::setMoving(bool moving)
 
 void CloudView::setDecimated(Shown& s, bool moving)
 {
-    {
-        if (!s.isCloud)
-            return;
-        const bool decimate = moving && scene_->stride > 1;
-        if (decimate && s.decimatedStride != scene_->stride) {
-            s.decimated = vtkSmartPointer<vtkPolyData>::New();
-            s.decimated->SetPoints(s.full->GetPoints());
-            s.decimated->GetPointData()->SetScalars(s.colours);
-            s.decimated->SetVerts(vertexCells(s.pointCount, scene_->stride));
-            s.decimatedMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-            s.decimatedMapper->SetInputData(s.decimated);
-            s.decimatedMapper->SetColorModeToDirectScalars();
-            s.decimatedMapper->ScalarVisibilityOn();
-            s.decimatedStride = scene_->stride;
+    if (!s.isCloud)
+        return;
+    const bool decimate = moving && scene_->stride > 1;
+    for (auto& c : s.chunks) {
+        if (decimate && c.decimatedStride != scene_->stride) {
+            c.decimated = vtkSmartPointer<vtkPolyData>::New();
+            c.decimated->SetPoints(c.full->GetPoints());
+            c.decimated->GetPointData()->SetScalars(c.colours);
+            c.decimated->SetVerts(vertexCells(c.count, scene_->stride));
+            c.decimatedMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+            c.decimatedMapper->SetInputData(c.decimated);
+            c.decimatedMapper->SetColorModeToDirectScalars();
+            c.decimatedMapper->ScalarVisibilityOn();
+            c.decimatedStride = scene_->stride;
         }
-        s.actor->SetMapper(decimate ? s.decimatedMapper.Get() : s.fullMapper.Get());
+        c.actor->SetMapper(decimate ? c.decimatedMapper.Get() : c.fullMapper.Get());
     }
 }
 
@@ -442,10 +512,15 @@ bool CloudView::pickAtDevicePixel(int x, int y)
     vtkActor* actor = scene_->picker->GetActor();
     const vtkIdType point = scene_->picker->GetPointId();
     for (const auto& [id, s] : scene_->shown)
-        if (s.actor.Get() == actor && point >= 0) {
-            emit pointPicked(id, static_cast<std::size_t>(point));
-            return true;
-        }
+        for (const auto& c : s.chunks)
+            if (c.actor.Get() == actor && point >= 0) {
+                const std::size_t index = c.begin + static_cast<std::size_t>(point);
+                // The picker sees every point; one hidden by the thresholds is not an answer.
+                if (s.isCloud && s.rgba[4 * index + 3] == 0)
+                    return false;
+                emit pointPicked(id, index);
+                return true;
+            }
     return false;
 }
 
@@ -466,7 +541,7 @@ void CloudView::render()
     const double seconds = clock.nsecsElapsed() / 1e9;
     std::size_t drawn = 0;
     for (const auto& [id, s] : scene_->shown)
-        if (s.isCloud && s.actor->GetVisibility())
+        if (s.isCloud && s.chunks.front().actor->GetVisibility())
             drawn += s.pointCount;
     if (scene_->adaptiveBudget && drawn > 100'000 && seconds > 0.005) {
         constexpr double kFrameSeconds = 0.05;
@@ -507,6 +582,8 @@ void CloudView::renderInteractively()
 
 bool CloudView::saveScreenshot(const QString& path)
 {
+    if (scene_->moving)
+        setMoving(false); // a picture shows every point
     scene_->window->Render();
     vtkNew<vtkWindowToImageFilter> grab;
     grab->SetInput(scene_->window);
@@ -518,5 +595,7 @@ bool CloudView::saveScreenshot(const QString& path)
     writer->Write();
     return writer->GetErrorCode() == 0;
 }
+
+QSurfaceFormat CloudView::defaultSurfaceFormat() { return QVTKOpenGLNativeWidget::defaultFormat(); }
 
 } // namespace scandiff::gui

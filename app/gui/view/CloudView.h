@@ -10,6 +10,7 @@
 #include "document/Document.h"
 #include "view/EntityColouring.h"
 
+#include <QSurfaceFormat>
 #include <QWidget>
 
 #include <array>
@@ -22,7 +23,7 @@ namespace scandiff::gui {
 
 enum class StandardView { Top, Bottom, Front, Back, Left, Right, Iso };
 
-//! Everything needed to put the camera back (sessions).
+//! Everything needed to put the camera back (sessions), in global coordinates.
 struct CameraState
 {
     std::array<double, 3> position{0, 0, 1}, focalPoint{0, 0, 0}, viewUp{0, 1, 0};
@@ -37,6 +38,9 @@ class CloudView : public QWidget
 public:
     explicit CloudView(QWidget* parent = nullptr);
     ~CloudView() override;
+
+    //! The OpenGL format the view needs; set as the default before QApplication exists.
+    static QSurfaceFormat defaultSurfaceFormat();
 
     //! Shows a document entity (coordinates relative to the first entity's
     //! origin, so georeferenced data stays precise on the GPU).
@@ -91,6 +95,7 @@ signals:
 private:
     class PickCommand;
     struct Shown;
+    static constexpr std::size_t kChunkPoints = 1u << 18;
     void updateStride();
     void setDecimated(Shown& shown, bool moving);
     QTimer* settleTimer_ = nullptr;

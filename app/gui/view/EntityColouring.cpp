@@ -23,6 +23,20 @@ std::pair<double, double> colourRange(const ScalarField& field, const ColourScal
     return {lo, hi};
 }
 
+ColourLegend legendOf(const PointCloud& points, const DisplayState& display)
+{
+    ColourLegend legend;
+    const ScalarField* field = display.activeField.empty() ? nullptr : points.field(display.activeField);
+    if (!field)
+        return legend;
+    const auto it = display.fields.find(field->name());
+    legend.shown = true;
+    legend.title = field->name();
+    legend.scale = it == display.fields.end() ? FieldDisplay{}.scale : it->second.scale;
+    std::tie(legend.min, legend.max) = colourRange(*field, legend.scale);
+    return legend;
+}
+
 ColourLegend colourEntity(const PointCloud& points, const DisplayState& display, std::uint8_t* rgba)
 {
     const std::size_t n = points.size();

@@ -27,6 +27,9 @@ struct ColourLegend
 //! unit-wide range so it still maps to a colour.
 std::pair<double, double> colourRange(const ScalarField& field, const ColourScale& scale);
 
+//! The legend of the active field (not shown for colours or height).
+ColourLegend legendOf(const PointCloud& points, const DisplayState& display);
+
 //! Fills rgba (4 bytes per point, alpha 0 = hidden; room for 4 x points.size())
 //! and returns the legend.
 ColourLegend colourEntity(const PointCloud& points, const DisplayState& display, std::uint8_t* rgba);

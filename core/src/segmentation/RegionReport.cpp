@@ -388,4 +388,13 @@ std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const Region
     return report;
 }
 
+std::map<int, std::vector<std::size_t>> pointsByRegion(const ScalarField& regionIds)
+{
+    std::map<int, std::vector<std::size_t>> members;
+    for (std::size_t i = 0; i < regionIds.size(); ++i)
+        if (regionIds.hasValue(i))
+            members[static_cast<int>(std::lround(regionIds.value(i)))].push_back(i);
+    return members;
+}
+
 } // namespace scandiff

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -75,6 +76,10 @@ struct RegionStatistics
     //! Fraction of the region's columns where the reference had points.
     double volumeCoverage = 0.0;
 };
+
+//! The point indices of each region, by region id (values rounded to the
+//! nearest integer; NaN, no region, skipped), in input order.
+std::map<int, std::vector<std::size_t>> pointsByRegion(const ScalarField& regionIds);
 
 //! One entry per region id present, in increasing id order. Points with a
 //! non-finite position are ignored. Throws Error(InvalidArgument) for a missing
