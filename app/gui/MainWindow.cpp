@@ -168,6 +168,7 @@ void MainWindow::buildMenus()
     QAction* ortho = viewMenu->addAction(tr("&Orthographic projection"));
     ortho->setCheckable(true);
     connect(ortho, &QAction::toggled, view_, &CloudView::setParallelProjection);
+    connect(view_, &CloudView::projectionChanged, ortho, &QAction::setChecked);
     viewBar->addAction(ortho);
     QAction* pick = viewMenu->addAction(tr("&Pick a point"));
     pick->setCheckable(true);
@@ -183,6 +184,7 @@ void MainWindow::buildMenus()
         a->setCheckable(true);
         a->setChecked(size == int(view_->pointSize()));
         sizeGroup->addAction(a);
+        connect(view_, &CloudView::pointSizeChanged, a, [a, size](float now) { a->setChecked(int(now) == size); });
     }
     viewMenu->addSeparator();
     for (QDockWidget* d : findChildren<QDockWidget*>())

@@ -8,6 +8,10 @@
 #include <scandiff/plugins/PluginRegistry.h>
 
 #include <QDoubleSpinBox>
+#include <QProgressDialog>
+#include <QPushButton>
+#include <QThread>
+#include <QTimer>
 #include <QSignalSpy>
 #include <QSpinBox>
 #include <QtTest>
@@ -82,6 +86,46 @@ private slots:
         QCOMPARE(output.parent, inputId); // shown under its input in the tree
         QCOMPARE(document.item(inputId).points().size(), std::size_t(1001)); // the input is untouched
         QVERIFY(finished.at(0).at(0).toString().contains("kept"));
+    }
+
+    void cancelStopsTheWorkAndKeepsTheDocument()
+    {
+        // A tool that works until it is told to stop.
+        ToolSpec slow;
+        slow.name = "slow";
+        slow.title = "Slow tool";
+        slow.run = [](const PointCloud&, const ParameterValues&, ProgressObserver* progress) -> ToolResult {
+            ProgressTicker ticker(progress, "waiting", 1000000);
+            for (;;) {
+                ticker.checkCancel();
+                QThread::msleep(5);
+            }
+        };
+        gui::Document document;
+        PointCloud input;
+        input.resize(10);
+        const gui::EntityId inputId = document.add("ten", std::move(input));
+        QWidget window;
+        gui::ToolController controller(slow, document, &window);
+        QSignalSpy failed(&controller, &gui::ToolController::failed);
+        // Once the progress dialog shows, press its Cancel button as a user would.
+        bool clicked = false;
+        QTimer poll;
+        connect(&poll, &QTimer::timeout, [&] {
+            for (QWidget* w : QApplication::topLevelWidgets())
+                if (auto* dialog = qobject_cast<QProgressDialog*>(w); dialog && dialog->isVisible() && !clicked) {
+                    QPushButton* cancel = dialog->findChild<QPushButton*>();
+                    QVERIFY(cancel);
+                    QTest::mouseClick(cancel, Qt::LeftButton);
+                    clicked = true;
+                }
+        });
+        poll.start(50);
+        QVERIFY(!controller.run(inputId, {}));
+        QVERIFY(clicked);
+        QCOMPARE(failed.count(), 1);
+        QVERIFY(failed.at(0).at(0).toString().contains("cancelled"));
+        QCOMPARE(document.size(), std::size_t(1));
     }
 
     void controllerReportsInvalidParameters()

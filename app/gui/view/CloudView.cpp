@@ -382,7 +382,10 @@ void CloudView::setStandardView(StandardView view)
 
 void CloudView::setPointSize(float size)
 {
-    scene_->pointSize = size;
+    if (size != scene_->pointSize) {
+        scene_->pointSize = size;
+        emit pointSizeChanged(size);
+    }
     for (auto& [id, s] : scene_->shown)
         if (s.isCloud)
             for (auto& c : s.chunks)
@@ -394,7 +397,10 @@ float CloudView::pointSize() const { return scene_->pointSize; }
 
 void CloudView::setParallelProjection(bool parallel)
 {
-    scene_->renderer->GetActiveCamera()->SetParallelProjection(parallel);
+    if (parallel != parallelProjection()) {
+        scene_->renderer->GetActiveCamera()->SetParallelProjection(parallel);
+        emit projectionChanged(parallel);
+    }
     scene_->renderer->ResetCameraClippingRange();
     render();
 }
@@ -428,7 +434,10 @@ void CloudView::setCamera(const CameraState& s)
     c->SetFocalPoint(s.focalPoint[0] - origin.x(), s.focalPoint[1] - origin.y(), s.focalPoint[2] - origin.z());
     c->SetViewUp(s.viewUp.data());
     c->SetViewAngle(s.viewAngle);
-    c->SetParallelProjection(s.parallel);
+    if (bool(c->GetParallelProjection()) != s.parallel) {
+        c->SetParallelProjection(s.parallel);
+        emit projectionChanged(s.parallel);
+    }
     c->SetParallelScale(s.parallelScale);
     scene_->renderer->ResetCameraClippingRange();
     render();

@@ -91,6 +91,9 @@ public:
 signals:
     void pointPicked(EntityId id, std::size_t index);
     void pickModeChanged(bool on);
+    //! The view changed these itself (a session restored them): menus follow.
+    void pointSizeChanged(float size);
+    void projectionChanged(bool parallel);
 
 private:
     class PickCommand;
