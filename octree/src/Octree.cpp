@@ -510,7 +510,7 @@ struct BatchScratch
 {
     std::vector<Eigen::Vector3f> positions;
     std::vector<std::uint32_t> indices;
-    std::vector<float> distances; //!< one cell's squared distances (k = 1 scan)
+    std::vector<float> distances; //!< one cell's squared distances
     std::vector<Neighbour> heap;
     //! Where each gathered cell's points start in positions/indices, and its
     //! offset from the query cell: the queries skip the cells they cannot need.
@@ -684,26 +684,72 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                         s.heap.push_back(best);
                     s.statistics.distances += scanned;
                 } else {
-                    // All candidate distances, then a selection: linear in the
-                    // candidates, cheaper than a heap update per candidate.
-                    s.heap.resize(m);
-                    for (std::size_t j = 0; j < m; ++j)
-                        s.heap[j] = Neighbour{s.indices[j], (s.positions[j] - q).squaredNorm()};
-                    if (m > k) {
-                        std::nth_element(s.heap.begin(), s.heap.begin() + static_cast<std::ptrdiff_t>(k - 1), s.heap.end());
-                        s.heap.resize(k);
+                    // The cells by increasing gap to q, then a sorted list of the k
+                    // best so far: once it is full, a cell whose box lies farther
+                    // than its last entry cannot contribute, and neither can any
+                    // later cell. With cells of about k points, a query usually
+                    // scans two or three of them instead of the whole neighbourhood.
+                    const Eigen::Vector3d local = q.cast<double>() - centre;
+                    double faceGap2[3][3];
+                    for (int a = 0; a < 3; ++a) {
+                        const double below = 0.5 * l + local[a], above = 0.5 * l - local[a];
+                        faceGap2[a][0] = below * below;
+                        faceGap2[a][1] = 0.0;
+                        faceGap2[a][2] = above * above;
                     }
-                    std::make_heap(s.heap.begin(), s.heap.end());
-                    s.statistics.distances += m;
+                    std::array<std::pair<double, int>, 27> byGap;
+                    for (int c = 0; c < s.cellCount; ++c) {
+                        const auto& o = s.cellOffset[static_cast<std::size_t>(c)];
+                        const double gap2 = faceGap2[0][o[0] + 1] + faceGap2[1][o[1] + 1] + faceGap2[2][o[2] + 1];
+                        int j = c;
+                        for (; j > 0 && byGap[static_cast<std::size_t>(j - 1)].first > gap2; --j)
+                            byGap[static_cast<std::size_t>(j)] = byGap[static_cast<std::size_t>(j - 1)];
+                        byGap[static_cast<std::size_t>(j)] = {gap2, c};
+                    }
+                    std::vector<Neighbour>& top = s.heap; // the k best so far, sorted
+                    std::size_t scanned = 0;
+                    for (int r = 0; r < s.cellCount; ++r) {
+                        const auto [gap2, c] = byGap[static_cast<std::size_t>(r)];
+                        if (top.size() == k && gap2 > static_cast<double>(top.back().squaredDistance) * (1 + kSlack))
+                            break;
+                        const std::uint32_t begin = s.cellStart[static_cast<std::size_t>(c)];
+                        const std::uint32_t end = s.cellStart[static_cast<std::size_t>(c) + 1];
+                        const std::size_t count = end - begin;
+                        if (s.distances.size() < count)
+                            s.distances.resize(count);
+                        float* d2 = s.distances.data();
+                        const Eigen::Vector3f* p = s.positions.data() + begin;
+                        for (std::size_t j = 0; j < count; ++j)
+                            d2[j] = (p[j] - q).squaredNorm();
+                        for (std::size_t j = 0; j < count; ++j) {
+                            if (top.size() == k && d2[j] > top.back().squaredDistance)
+                                continue;
+                            const Neighbour candidate{s.indices[begin + j], d2[j]};
+                            if (top.size() == k) {
+                                if (!(candidate < top.back()))
+                                    continue;
+                            } else {
+                                top.push_back(candidate);
+                            }
+                            // Insertion from the back: for a dozen entries, cheaper
+                            // than a binary search's unpredictable branches.
+                            std::size_t at = top.size() - 1;
+                            for (; at > 0 && candidate < top[at - 1]; --at)
+                                top[at] = top[at - 1];
+                            top[at] = candidate;
+                        }
+                        scanned += count;
+                    }
+                    s.statistics.distances += scanned;
                 }
                 // Inscribed sphere of the 27 cells around q (eq. 4.1 with j = 1).
                 const double inner = 0.5 * l - (q.cast<double>() - centre).cwiseAbs().maxCoeff();
                 const double inscribed = l + inner;
+                // k = 1 leaves its single entry in s.heap, k > 1 a sorted list: either
+                // way the k-th distance is the last entry.
                 const bool settled = heapFull(s.heap, k) &&
-                                     static_cast<double>(s.heap.front().squaredDistance) * (1 + kSlack) < inscribed * inscribed;
-                if (settled) {
-                    std::sort_heap(s.heap.begin(), s.heap.end());
-                } else {
+                                     static_cast<double>(s.heap.back().squaredDistance) * (1 + kSlack) < inscribed * inscribed;
+                if (!settled) {
                     nearest(q, k, level, s.heap);
                     ++s.statistics.fullSearches;
                 }
