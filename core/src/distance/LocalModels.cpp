@@ -126,6 +126,165 @@ bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::V
 
 } // namespace
 
+namespace {
+
+//! Whether d lies strictly inside the circumcircle of the triangle t of p.
+bool inCircumcircle(const std::vector<Eigen::Vector2d>& p, const std::array<int, 3>& t, const Eigen::Vector2d& d)
+{
+    const Eigen::Vector2d a = p[static_cast<std::size_t>(t[0])] - d, b = p[static_cast<std::size_t>(t[1])] - d,
+                          c = p[static_cast<std::size_t>(t[2])] - d;
+    const double det = (a.squaredNorm()) * (b.x() * c.y() - c.x() * b.y()) -
+                       (b.squaredNorm()) * (a.x() * c.y() - c.x() * a.y()) +
+                       (c.squaredNorm()) * (a.x() * b.y() - b.x() * a.y());
+    const double orientation = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    return orientation > 0 ? det > 0 : det < 0;
+}
+
+//! The plain Bowyer-Watson insertion: every triangle is tested against every
+//! new point and the cavity's boundary is found by matching edges pairwise,
+//! O(n^2) per point. Used when the fast insertion meets a configuration its
+//! floating-point tests cannot walk through consistently (nearly cocircular or
+//! collinear points), where this version needs no adjacency to stay coherent.
+void delaunay2dQuadratic(std::vector<Eigen::Vector2d>& p, int n, std::vector<std::array<int, 3>>& work,
+                         std::vector<std::array<int, 2>>& edges, double span)
+{
+    work.assign(1, {n, n + 1, n + 2});
+    for (int i = 0; i < n; ++i) {
+        const Eigen::Vector2d& d = p[static_cast<std::size_t>(i)];
+        bool duplicate = false;
+        for (int j = 0; j < i && !duplicate; ++j)
+            duplicate = (p[static_cast<std::size_t>(j)] - d).squaredNorm() <= 1e-24 * span * span;
+        if (duplicate)
+            continue;
+        edges.clear();
+        std::size_t kept = 0;
+        for (std::size_t t = 0; t < work.size(); ++t) {
+            if (inCircumcircle(p, work[t], d)) {
+                for (int e = 0; e < 3; ++e)
+                    edges.push_back({work[t][static_cast<std::size_t>(e)], work[t][static_cast<std::size_t>((e + 1) % 3)]});
+            } else {
+                work[kept++] = work[t];
+            }
+        }
+        work.resize(kept);
+        for (std::size_t e = 0; e < edges.size(); ++e) {
+            bool shared = false;
+            for (std::size_t f = 0; f < edges.size() && !shared; ++f)
+                shared = f != e && edges[f][0] == edges[e][1] && edges[f][1] == edges[e][0];
+            if (!shared)
+                work.push_back({edges[e][0], edges[e][1], i});
+        }
+    }
+}
+
+double orient2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c)
+{
+    return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+}
+
+//! Bowyer-Watson with triangle adjacency: a walk finds the triangle holding
+//! the new point, the cavity grows from it through neighbours only, and its
+//! boundary comes from the adjacency, so a point costs about the size of its
+//! cavity instead of the whole triangulation. Returns false (the caller then
+//! uses delaunay2dQuadratic) if a floating-point test contradicts the
+//! structure: a walk that does not end, a cavity that is not star-shaped.
+bool delaunay2dAdjacency(const std::vector<Eigen::Vector2d>& p, int n, ModelScratch& s, double span)
+{
+    auto& mesh = s.mesh;
+    mesh.clear();
+    // Counter-clockwise super-triangle (the vertices n, n+2, n+1 of the caller's layout).
+    mesh.push_back({{n, n + 2, n + 1}, {-1, -1, -1}, true});
+    const std::size_t vertices = static_cast<std::size_t>(n) + 3;
+    s.startAt.assign(vertices, -1);
+    s.startStamp.assign(vertices, -1);
+    int last = 0;
+    for (int i = 0; i < n; ++i) {
+        const Eigen::Vector2d& d = p[static_cast<std::size_t>(i)];
+        bool duplicate = false;
+        for (int j = 0; j < i && !duplicate; ++j)
+            duplicate = (p[static_cast<std::size_t>(j)] - d).squaredNorm() <= 1e-24 * span * span;
+        if (duplicate)
+            continue;
+        // Walk towards d: leave through an edge that d lies strictly beyond.
+        int t = last;
+        std::size_t steps = 0;
+        for (;; ++steps) {
+            if (steps > mesh.size())
+                return false;
+            const auto& tri = mesh[static_cast<std::size_t>(t)];
+            int next = -1;
+            for (int e = 0; e < 3; ++e) {
+                const auto a = static_cast<std::size_t>(tri.v[static_cast<std::size_t>(e)]);
+                const auto b = static_cast<std::size_t>(tri.v[static_cast<std::size_t>((e + 1) % 3)]);
+                if (orient2d(p[a], p[b], d) < 0) {
+                    next = tri.nb[static_cast<std::size_t>(e)];
+                    if (next < 0)
+                        return false; // beyond the super-triangle: cannot happen with exact tests
+                    break;
+                }
+            }
+            if (next < 0)
+                break;
+            t = next;
+        }
+        if (!inCircumcircle(p, mesh[static_cast<std::size_t>(t)].v, d))
+            return false;
+        // The cavity: the connected triangles whose circumcircle holds d.
+        s.cavity.clear();
+        s.cavity.push_back(t);
+        mesh[static_cast<std::size_t>(t)].alive = false;
+        for (std::size_t c = 0; c < s.cavity.size(); ++c) {
+            const auto& tri = mesh[static_cast<std::size_t>(s.cavity[c])];
+            for (int e = 0; e < 3; ++e) {
+                const int w = tri.nb[static_cast<std::size_t>(e)];
+                if (w >= 0 && mesh[static_cast<std::size_t>(w)].alive && inCircumcircle(p, mesh[static_cast<std::size_t>(w)].v, d)) {
+                    mesh[static_cast<std::size_t>(w)].alive = false;
+                    s.cavity.push_back(w);
+                }
+            }
+        }
+        // One new triangle (a, b, i) per boundary edge (a, b), linked to the
+        // triangle outside it; the new triangles are then linked to each other
+        // through the boundary vertex they share.
+        const std::size_t firstNew = mesh.size();
+        for (const int c : s.cavity) {
+            for (int e = 0; e < 3; ++e) {
+                const auto& tri = mesh[static_cast<std::size_t>(c)];
+                const int w = tri.nb[static_cast<std::size_t>(e)];
+                if (w >= 0 && !mesh[static_cast<std::size_t>(w)].alive)
+                    continue;
+                const int a = tri.v[static_cast<std::size_t>(e)], b = tri.v[static_cast<std::size_t>((e + 1) % 3)];
+                if (orient2d(p[static_cast<std::size_t>(a)], p[static_cast<std::size_t>(b)], d) <= 0)
+                    return false; // the cavity is not star-shaped from d
+                if (s.startStamp[static_cast<std::size_t>(a)] == i)
+                    return false; // two boundary edges leave a: not a simple cycle
+                const int created = static_cast<int>(mesh.size());
+                s.startAt[static_cast<std::size_t>(a)] = created;
+                s.startStamp[static_cast<std::size_t>(a)] = i;
+                mesh.push_back({{a, b, i}, {w, -1, -1}, true});
+                if (w >= 0) {
+                    auto& outside = mesh[static_cast<std::size_t>(w)];
+                    for (int f = 0; f < 3; ++f)
+                        if (outside.v[static_cast<std::size_t>(f)] == b && outside.v[static_cast<std::size_t>((f + 1) % 3)] == a)
+                            outside.nb[static_cast<std::size_t>(f)] = created;
+                }
+            }
+        }
+        for (std::size_t m = firstNew; m < mesh.size(); ++m) {
+            const auto b = static_cast<std::size_t>(mesh[m].v[1]);
+            if (s.startStamp[b] != i)
+                return false; // the boundary is not closed
+            const int following = s.startAt[b];
+            mesh[m].nb[1] = following;
+            mesh[static_cast<std::size_t>(following)].nb[2] = static_cast<int>(m);
+        }
+        last = static_cast<int>(mesh.size()) - 1;
+    }
+    return true;
+}
+
+} // namespace
+
 void delaunay2d(const std::vector<Eigen::Vector2d>& input, std::vector<std::array<int, 3>>& triangles, ModelScratch& scratch)
 {
     triangles.clear();
@@ -146,49 +305,16 @@ void delaunay2d(const std::vector<Eigen::Vector2d>& input, std::vector<std::arra
     p.emplace_back(mid.x() - 20 * span, mid.y() - span);
     p.emplace_back(mid.x(), mid.y() + 20 * span);
     p.emplace_back(mid.x() + 20 * span, mid.y() - span);
-    std::vector<std::array<int, 3>>& work = scratch.triangles;
-    work.assign(1, {n, n + 1, n + 2});
-    auto inCircumcircle = [&](const std::array<int, 3>& t, const Eigen::Vector2d& d) {
-        const Eigen::Vector2d a = p[static_cast<std::size_t>(t[0])] - d, b = p[static_cast<std::size_t>(t[1])] - d,
-                              c = p[static_cast<std::size_t>(t[2])] - d;
-        const double det = (a.squaredNorm()) * (b.x() * c.y() - c.x() * b.y()) -
-                           (b.squaredNorm()) * (a.x() * c.y() - c.x() * a.y()) +
-                           (c.squaredNorm()) * (a.x() * b.y() - b.x() * a.y());
-        const double orientation = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-        return orientation > 0 ? det > 0 : det < 0;
-    };
-    std::vector<std::array<int, 2>>& edges = scratch.edges;
-    for (int i = 0; i < n; ++i) {
-        const Eigen::Vector2d& d = p[static_cast<std::size_t>(i)];
-        // Coincident points add nothing to a triangulation.
-        bool duplicate = false;
-        for (int j = 0; j < i && !duplicate; ++j)
-            duplicate = (p[static_cast<std::size_t>(j)] - d).squaredNorm() <= 1e-24 * span * span;
-        if (duplicate)
-            continue;
-        edges.clear();
-        std::size_t kept = 0;
-        for (std::size_t t = 0; t < work.size(); ++t) {
-            if (inCircumcircle(work[t], d)) {
-                for (int e = 0; e < 3; ++e)
-                    edges.push_back({work[t][static_cast<std::size_t>(e)], work[t][static_cast<std::size_t>((e + 1) % 3)]});
-            } else {
-                work[kept++] = work[t];
-            }
-        }
-        work.resize(kept);
-        // Edges seen once bound the cavity; re-triangulate it around the new point.
-        for (std::size_t e = 0; e < edges.size(); ++e) {
-            bool shared = false;
-            for (std::size_t f = 0; f < edges.size() && !shared; ++f)
-                shared = f != e && edges[f][0] == edges[e][1] && edges[f][1] == edges[e][0];
-            if (!shared)
-                work.push_back({edges[e][0], edges[e][1], i});
-        }
+    if (delaunay2dAdjacency(p, n, scratch, span)) {
+        for (const auto& t : scratch.mesh)
+            if (t.alive && t.v[0] < n && t.v[1] < n && t.v[2] < n)
+                triangles.push_back(t.v);
+    } else {
+        delaunay2dQuadratic(p, n, scratch.triangles, scratch.edges, span);
+        for (const auto& t : scratch.triangles)
+            if (t[0] < n && t[1] < n && t[2] < n)
+                triangles.push_back(t);
     }
-    for (const auto& t : work)
-        if (t[0] < n && t[1] < n && t[2] < n)
-            triangles.push_back(t);
     p.resize(static_cast<std::size_t>(n));
 }
 

@@ -12,12 +12,24 @@
 
 namespace scandiff::detail {
 
+//! A triangle of the 2D triangulation under construction: its vertices counter-
+//! clockwise and, across each edge (v[e], v[e+1]), the neighbouring triangle (-1: none).
+struct DelaunayTriangle
+{
+    std::array<int, 3> v;
+    std::array<int, 3> nb;
+    bool alive;
+};
+
+//! Buffers reused from point to point, so that a model costs no allocation.
 struct ModelScratch
 {
     std::vector<Eigen::Vector2d> planar;
     std::vector<std::array<int, 3>> triangles;
     std::vector<std::array<int, 3>> keep;
     std::vector<std::array<int, 2>> edges;
+    std::vector<DelaunayTriangle> mesh;
+    std::vector<int> cavity, startAt, startStamp;
 };
 
 //! Signed distance from q to the model of `points` (positive on the side of the
@@ -26,10 +38,11 @@ struct ModelScratch
 bool modelDistance(LocalModel model, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q,
                    const Eigen::Vector3d& orientation, double& signedDistance, ModelScratch& scratch);
 
-//! 2D Delaunay triangulation (Bowyer-Watson) of up to a few hundred points, the
-//! size of a local neighbourhood. Written here because core may not use CGAL
-//! (it lives in the GPL plugins), and for so few points a direct O(n^2)
-//! insertion is faster than setting up a general-purpose triangulation.
+//! 2D Delaunay triangulation (Bowyer-Watson in a super-triangle, points inserted
+//! in their given order, coincident points skipped) of up to a few hundred
+//! points, the size of a local neighbourhood. Written here because core may not
+//! use CGAL (it lives in the GPL plugins), and for so few points a direct
+//! incremental insertion is faster than setting up a general-purpose triangulation.
 void delaunay2d(const std::vector<Eigen::Vector2d>& points, std::vector<std::array<int, 3>>& triangles, ModelScratch& scratch);
 
 } // namespace scandiff::detail
