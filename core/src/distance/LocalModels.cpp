@@ -12,11 +12,10 @@ namespace scandiff::detail {
 
 namespace {
 
-struct PlaneFrame
+double orient2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c)
 {
-    Eigen::Vector3d centroid;
-    Eigen::Vector3d u, v, normal;
-};
+    return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+}
 
 //! Least-squares plane through the points; false if they are (nearly) collinear.
 bool fitPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& orientation, PlaneFrame& frame)
@@ -47,12 +46,14 @@ bool fitPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d&
     return true;
 }
 
-bool quadricDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q, const PlaneFrame& f, double& out)
+//! The quadric's coefficients over the plane frame; false if the points do not determine one.
+bool fitQuadric(const std::vector<Eigen::Vector3d>& points, FittedModel& m)
 {
     // h = a u^2 + b uv + c v^2 + d u + e v + f0 over the plane, by linear least
     // squares (the thesis used gradient descent; the closed form is exact).
     // Normal equations in fixed 6x6 size: no allocation per point; u and v are
     // scaled by the neighbourhood's extent so the system stays well conditioned.
+    const PlaneFrame& f = m.frame;
     if (points.size() < 6)
         return false;
     double extent = 0;
@@ -75,38 +76,160 @@ bool quadricDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::Ve
     if (solver.info() != Eigen::Success || !solver.isPositive() ||
         solver.vectorD().minCoeff() <= 1e-12 * solver.vectorD().maxCoeff())
         return false; // the points do not determine a quadric (e.g. all on a line)
-    const Eigen::Matrix<double, 6, 1> c = solver.solve(rhs);
+    m.quadric = solver.solve(rhs);
+    m.extent = extent;
+    return true;
+}
+
+bool quadricDistance(const FittedModel& m, const Eigen::Vector3d& q, double& out)
+{
+    const PlaneFrame& f = m.frame;
+    const Eigen::Matrix<double, 6, 1>& c = m.quadric;
+    const double scale = 1.0 / m.extent;
     const Eigen::Vector3d d = q - f.centroid;
     const double u = d.dot(f.u) * scale, v = d.dot(f.v) * scale, hq = d.dot(f.normal) * scale;
     const double surface = c[0] * u * u + c[1] * u * v + c[2] * v * v + c[3] * u + c[4] * v + c[5];
     const double du = 2 * c[0] * u + c[1] * v + c[3], dv = c[1] * u + 2 * c[2] * v + c[4];
     // Height difference brought to the surface normal (first order), back in metres.
-    out = (hq - surface) / std::sqrt(1.0 + du * du + dv * dv) * extent;
+    out = (hq - surface) / std::sqrt(1.0 + du * du + dv * dv) * m.extent;
     return std::isfinite(out);
 }
 
-bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q, const PlaneFrame& f,
-                      double& out, ModelScratch& scratch)
+//! Squared distance from x to the segment [a, b] in the plane.
+double squaredSegmentDistance(const Eigen::Vector2d& x, const Eigen::Vector2d& a, const Eigen::Vector2d& b)
+{
+    const Eigen::Vector2d ab = b - a;
+    const double length2 = ab.squaredNorm();
+    const double t = length2 > 0 ? std::clamp((x - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+    return (a + t * ab - x).squaredNorm();
+}
+
+//! Whether planar point `i` coincides with an earlier one: the triangulation
+//! keeps only the first of coincident points (see delaunay2d).
+bool coincidesWithEarlier(const std::vector<Eigen::Vector2d>& p, std::size_t i, double span)
+{
+    for (std::size_t j = 0; j < i; ++j)
+        if ((p[j] - p[i]).squaredNorm() <= 1e-24 * span * span)
+            return true;
+    return false;
+}
+
+//! The triangles around point 0 (the group's nearest reference point) in the
+//! Delaunay triangulation of the planar points and the super-triangle that
+//! delaunay2d uses: the dual of point 0's Voronoi cell, which is a convex
+//! polygon clipped out of a large square by the bisector of point 0 and every
+//! other site; each remaining edge names a Delaunay neighbour, and two
+//! consecutive neighbours make a triangle with point 0. This costs one small
+//! polygon clip per site instead of a whole triangulation. Returns false when
+//! point 0 touches the super-triangle (it is on the hull: the real triangles
+//! around it do not close) or the clip degenerates; scratch.star then stays unusable.
+bool starOfFirstPoint(ModelScratch& s)
+{
+    const std::vector<Eigen::Vector2d>& p = s.planar;
+    const int n = static_cast<int>(p.size());
+    s.star.clear();
+    if (n < 3)
+        return false;
+    Eigen::Vector2d lo = p[0], hi = p[0];
+    for (const auto& x : p) {
+        lo = lo.cwiseMin(x);
+        hi = hi.cwiseMax(x);
+    }
+    const double span = std::max((hi - lo).maxCoeff(), 1e-12);
+    const Eigen::Vector2d mid = 0.5 * (lo + hi);
+    // The super-triangle's vertices, exactly as delaunay2d places them.
+    const Eigen::Vector2d super[3] = {{mid.x() - 20 * span, mid.y() - span},
+                                      {mid.x(), mid.y() + 20 * span},
+                                      {mid.x() + 20 * span, mid.y() - span}};
+    // The cell, relative to point 0, counter-clockwise; generator[i] is the site
+    // across the edge from corner i to corner i + 1 (-1: the initial square).
+    const double r = 100 * span;
+    auto& cell = s.cell;
+    auto& generator = s.generator;
+    cell.assign({{-r, -r}, {r, -r}, {r, r}, {-r, r}});
+    generator.assign({-1, -1, -1, -1});
+    auto clip = [&](const Eigen::Vector2d& site, int id) {
+        // Keep the points x (relative to point 0) closer to point 0 than to the
+        // site: 2 x . w <= |w|^2 with w the site relative to point 0.
+        const Eigen::Vector2d w = site - p[0];
+        const double w2 = w.squaredNorm();
+        const std::size_t m = cell.size();
+        s.side.resize(m);
+        bool cut = false;
+        for (std::size_t i = 0; i < m; ++i) {
+            s.side[i] = 2 * cell[i].dot(w) - w2;
+            cut = cut || s.side[i] > 0;
+        }
+        if (!cut)
+            return;
+        s.nextCell.clear();
+        s.nextGenerator.clear();
+        for (std::size_t i = 0; i < m; ++i) {
+            const std::size_t j = (i + 1) % m;
+            const double fa = s.side[i], fb = s.side[j];
+            if (fa <= 0) {
+                s.nextCell.push_back(cell[i]);
+                s.nextGenerator.push_back(generator[i]);
+            }
+            if ((fa <= 0) != (fb <= 0)) {
+                s.nextCell.push_back(cell[i] + (cell[j] - cell[i]) * (fa / (fa - fb)));
+                s.nextGenerator.push_back(fa <= 0 ? id : generator[i]);
+            }
+        }
+        cell.swap(s.nextCell);
+        generator.swap(s.nextGenerator);
+    };
+    for (int i = 1; i < n; ++i)
+        if (!coincidesWithEarlier(p, static_cast<std::size_t>(i), span))
+            clip(p[static_cast<std::size_t>(i)], i);
+    for (int i = 0; i < 3; ++i)
+        clip(super[i], n + i);
+    const std::size_t m = generator.size();
+    if (m < 3)
+        return false;
+    for (std::size_t i = 0; i < m; ++i) {
+        const int a = generator[i], b = generator[(i + 1) % m];
+        if (a < 0 || a >= n || b < 0 || b >= n)
+            return false; // on the hull, or the square survived
+        if (a != b)
+            s.star.push_back({0, a, b});
+    }
+    return s.star.size() >= 3;
+}
+
+//! Prepares the Delaunay model: the planar coordinates, and the triangles
+//! around point 0 (starOfFirstPoint). The whole triangulation is only built
+//! (fullTriangulation) when a compared point needs more than those triangles,
+//! or when point 0 lies on the hull.
+bool fitDelaunay(const std::vector<Eigen::Vector3d>& points, const PlaneFrame& f, ModelScratch& scratch)
 {
     scratch.planar.clear();
     for (const auto& p : points) {
         const Eigen::Vector3d d = p - f.centroid;
         scratch.planar.emplace_back(d.dot(f.u), d.dot(f.v));
     }
-    std::vector<std::array<int, 3>>& triangles = scratch.keep;
-    delaunay2d(scratch.planar, triangles, scratch);
-    if (triangles.empty())
-        return false;
+    scratch.triangulated = false;
+    scratch.keep.clear();
+    scratch.starUsable = starOfFirstPoint(scratch);
+    if (scratch.starUsable)
+        return true;
+    delaunay2d(scratch.planar, scratch.keep, scratch);
+    scratch.triangulated = true;
+    return !scratch.keep.empty();
+}
+
+//! Smallest squared distance from q to the given triangles, and the closest point.
+double nearestTriangle(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector2d>& planar,
+                       const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector3d& q,
+                       const Eigen::Vector2d& qPlanar, Eigen::Vector3d& closest)
+{
     double best = std::numeric_limits<double>::infinity();
-    Eigen::Vector3d closest = Eigen::Vector3d::Zero();
-    const Eigen::Vector3d dq = q - f.centroid;
-    const Eigen::Vector2d qPlanar(dq.dot(f.u), dq.dot(f.v));
     for (const auto& t : triangles) {
         // Projection onto the plane shortens distances, so the in-plane gap to
         // the triangle's box is a lower bound: skip triangles that cannot win.
-        const Eigen::Vector2d& a = scratch.planar[static_cast<std::size_t>(t[0])];
-        const Eigen::Vector2d& b = scratch.planar[static_cast<std::size_t>(t[1])];
-        const Eigen::Vector2d& c = scratch.planar[static_cast<std::size_t>(t[2])];
+        const Eigen::Vector2d& a = planar[static_cast<std::size_t>(t[0])];
+        const Eigen::Vector2d& b = planar[static_cast<std::size_t>(t[1])];
+        const Eigen::Vector2d& c = planar[static_cast<std::size_t>(t[2])];
         const Eigen::Vector2d lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
         const Eigen::Vector2d gap = (lo - qPlanar).cwiseMax(qPlanar - hi).cwiseMax(Eigen::Vector2d::Zero());
         if (gap.squaredNorm() > best)
@@ -118,6 +241,46 @@ bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::V
             best = r.squaredDistance;
             closest = r.closestPoint;
         }
+    }
+    return best;
+}
+
+bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q, const PlaneFrame& f,
+                      ModelScratch& scratch, double& out)
+{
+    const Eigen::Vector3d dq = q - f.centroid;
+    const Eigen::Vector2d qPlanar(dq.dot(f.u), dq.dot(f.v));
+    Eigen::Vector3d closest = Eigen::Vector3d::Zero();
+    double best = std::numeric_limits<double>::infinity();
+    bool settled = false;
+    if (scratch.starUsable) {
+        // The triangles around point 0 decide alone when q projects inside
+        // them, farther from their outer boundary than from the nearest one:
+        // every other triangle lies beyond that boundary, and the distance to
+        // a triangle is at least the in-plane distance to its projection. The
+        // small margin keeps rounding on the safe side.
+        const auto& p = scratch.planar;
+        double boundary2 = std::numeric_limits<double>::infinity();
+        bool inside = false;
+        for (const auto& t : scratch.star) {
+            const Eigen::Vector2d& a = p[static_cast<std::size_t>(t[1])];
+            const Eigen::Vector2d& b = p[static_cast<std::size_t>(t[2])];
+            boundary2 = std::min(boundary2, squaredSegmentDistance(qPlanar, a, b));
+            inside = inside || (orient2d(p[0], a, qPlanar) >= 0 && orient2d(a, b, qPlanar) >= 0 && orient2d(b, p[0], qPlanar) >= 0);
+        }
+        if (inside) {
+            best = nearestTriangle(points, p, scratch.star, q, qPlanar, closest);
+            settled = best < boundary2 * (1 - 1e-9);
+        }
+    }
+    if (!settled) {
+        if (!scratch.triangulated) {
+            delaunay2d(scratch.planar, scratch.keep, scratch);
+            scratch.triangulated = true;
+        }
+        if (scratch.keep.empty())
+            return false;
+        best = nearestTriangle(points, scratch.planar, scratch.keep, q, qPlanar, closest);
     }
     const double side = (q - closest).dot(f.normal);
     out = std::sqrt(best) * (side < 0 ? -1.0 : 1.0);
@@ -175,11 +338,6 @@ void delaunay2dQuadratic(std::vector<Eigen::Vector2d>& p, int n, std::vector<std
                 work.push_back({edges[e][0], edges[e][1], i});
         }
     }
-}
-
-double orient2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c)
-{
-    return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
 }
 
 //! Bowyer-Watson with triangle adjacency: a walk finds the triangle holding
@@ -318,20 +476,36 @@ void delaunay2d(const std::vector<Eigen::Vector2d>& input, std::vector<std::arra
     p.resize(static_cast<std::size_t>(n));
 }
 
-bool modelDistance(LocalModel model, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q,
-                   const Eigen::Vector3d& orientation, double& signedDistance, ModelScratch& scratch)
+bool fitModel(LocalModel model, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& orientation,
+              FittedModel& fitted, ModelScratch& scratch)
 {
-    PlaneFrame frame;
-    if (!fitPlane(points, orientation, frame))
+    fitted.model = model;
+    if (!fitPlane(points, orientation, fitted.frame))
         return false;
     switch (model) {
     case LocalModel::Plane:
-        signedDistance = (q - frame.centroid).dot(frame.normal);
         return true;
     case LocalModel::Quadric:
-        return quadricDistance(points, q, frame, signedDistance);
+        return fitQuadric(points, fitted);
     case LocalModel::Delaunay:
-        return delaunayDistance(points, q, frame, signedDistance, scratch);
+        return fitDelaunay(points, fitted.frame, scratch);
+    case LocalModel::None:
+        break;
+    }
+    return false;
+}
+
+bool modelDistance(const FittedModel& fitted, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q,
+                   double& signedDistance, ModelScratch& scratch)
+{
+    switch (fitted.model) {
+    case LocalModel::Plane:
+        signedDistance = (q - fitted.frame.centroid).dot(fitted.frame.normal);
+        return true;
+    case LocalModel::Quadric:
+        return quadricDistance(fitted, q, signedDistance);
+    case LocalModel::Delaunay:
+        return delaunayDistance(points, q, fitted.frame, scratch, signedDistance);
     case LocalModel::None:
         break;
     }
