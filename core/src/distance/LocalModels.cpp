@@ -114,20 +114,24 @@ bool coincidesWithEarlier(const std::vector<Eigen::Vector2d>& p, std::size_t i, 
     return false;
 }
 
-//! The triangles around point 0 (the group's nearest reference point) in the
-//! Delaunay triangulation of the planar points and the super-triangle that
-//! delaunay2d uses: the dual of point 0's Voronoi cell, which is a convex
-//! polygon clipped out of a large square by the bisector of point 0 and every
-//! other site; each remaining edge names a Delaunay neighbour, and two
-//! consecutive neighbours make a triangle with point 0. This costs one small
-//! polygon clip per site instead of a whole triangulation. Returns false when
-//! point 0 touches the super-triangle (it is on the hull: the real triangles
-//! around it do not close) or the clip degenerates; scratch.star then stays unusable.
-bool starOfFirstPoint(ModelScratch& s)
+double nearestTriangle(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector2d>& planar,
+                       const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector3d& q,
+                       const Eigen::Vector2d& qPlanar, Eigen::Vector3d& closest);
+
+//! The triangles around planar point c in the Delaunay triangulation of the
+//! planar points and the super-triangle that delaunay2d uses: the dual of c's
+//! Voronoi cell, a convex polygon clipped out of a large square by the
+//! bisector of c and every other site; each remaining edge names a Delaunay
+//! neighbour, and two consecutive neighbours make a triangle with c. This
+//! costs one small polygon clip per site instead of a whole triangulation.
+//! Returns false when c is a skipped duplicate, touches the super-triangle (it
+//! is on the hull: the real triangles around it do not close) or the clip
+//! degenerates.
+bool starOf(ModelScratch& s, int c, std::vector<std::array<int, 3>>& star)
 {
     const std::vector<Eigen::Vector2d>& p = s.planar;
     const int n = static_cast<int>(p.size());
-    s.star.clear();
+    star.clear();
     if (n < 3)
         return false;
     Eigen::Vector2d lo = p[0], hi = p[0];
@@ -136,12 +140,15 @@ bool starOfFirstPoint(ModelScratch& s)
         hi = hi.cwiseMax(x);
     }
     const double span = std::max((hi - lo).maxCoeff(), 1e-12);
+    if (coincidesWithEarlier(p, static_cast<std::size_t>(c), span))
+        return false;
     const Eigen::Vector2d mid = 0.5 * (lo + hi);
     // The super-triangle's vertices, exactly as delaunay2d places them.
     const Eigen::Vector2d super[3] = {{mid.x() - 20 * span, mid.y() - span},
                                       {mid.x(), mid.y() + 20 * span},
                                       {mid.x() + 20 * span, mid.y() - span}};
-    // The cell, relative to point 0, counter-clockwise; generator[i] is the site
+    const Eigen::Vector2d& centre = p[static_cast<std::size_t>(c)];
+    // The cell, relative to c, counter-clockwise; generator[i] is the site
     // across the edge from corner i to corner i + 1 (-1: the initial square).
     const double r = 100 * span;
     auto& cell = s.cell;
@@ -149,9 +156,9 @@ bool starOfFirstPoint(ModelScratch& s)
     cell.assign({{-r, -r}, {r, -r}, {r, r}, {-r, r}});
     generator.assign({-1, -1, -1, -1});
     auto clip = [&](const Eigen::Vector2d& site, int id) {
-        // Keep the points x (relative to point 0) closer to point 0 than to the
-        // site: 2 x . w <= |w|^2 with w the site relative to point 0.
-        const Eigen::Vector2d w = site - p[0];
+        // Keep the points x (relative to c) closer to c than to the site:
+        // 2 x . w <= |w|^2 with w the site relative to c.
+        const Eigen::Vector2d w = site - centre;
         const double w2 = w.squaredNorm();
         const std::size_t m = cell.size();
         s.side.resize(m);
@@ -179,8 +186,8 @@ bool starOfFirstPoint(ModelScratch& s)
         cell.swap(s.nextCell);
         generator.swap(s.nextGenerator);
     };
-    for (int i = 1; i < n; ++i)
-        if (!coincidesWithEarlier(p, static_cast<std::size_t>(i), span))
+    for (int i = 0; i < n; ++i)
+        if (i != c && !coincidesWithEarlier(p, static_cast<std::size_t>(i), span))
             clip(p[static_cast<std::size_t>(i)], i);
     for (int i = 0; i < 3; ++i)
         clip(super[i], n + i);
@@ -192,13 +199,37 @@ bool starOfFirstPoint(ModelScratch& s)
         if (a < 0 || a >= n || b < 0 || b >= n)
             return false; // on the hull, or the square survived
         if (a != b)
-            s.star.push_back({0, a, b});
+            star.push_back({c, a, b});
     }
-    return s.star.size() >= 3;
+    return star.size() >= 3;
+}
+
+//! Whether the triangles around one point (starOf) settle q: true when q
+//! projects inside them, farther from their outer boundary than from the
+//! nearest of them. Every other triangle lies beyond that boundary, and the
+//! distance to a triangle is at least the in-plane distance to its projection;
+//! the small margin keeps rounding on the safe side.
+bool starSettles(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector2d>& p,
+                 const std::vector<std::array<int, 3>>& star, const Eigen::Vector3d& q, const Eigen::Vector2d& qPlanar,
+                 double& best, Eigen::Vector3d& closest)
+{
+    double boundary2 = std::numeric_limits<double>::infinity();
+    bool inside = false;
+    for (const auto& t : star) {
+        const Eigen::Vector2d& c = p[static_cast<std::size_t>(t[0])];
+        const Eigen::Vector2d& a = p[static_cast<std::size_t>(t[1])];
+        const Eigen::Vector2d& b = p[static_cast<std::size_t>(t[2])];
+        boundary2 = std::min(boundary2, squaredSegmentDistance(qPlanar, a, b));
+        inside = inside || (orient2d(c, a, qPlanar) >= 0 && orient2d(a, b, qPlanar) >= 0 && orient2d(b, c, qPlanar) >= 0);
+    }
+    if (!inside)
+        return false;
+    best = nearestTriangle(points, p, star, q, qPlanar, closest);
+    return best < boundary2 * (1 - 1e-9);
 }
 
 //! Prepares the Delaunay model: the planar coordinates, and the triangles
-//! around point 0 (starOfFirstPoint). The whole triangulation is only built
+//! around point 0 (starOf). The whole triangulation is only built
 //! (fullTriangulation) when a compared point needs more than those triangles,
 //! or when point 0 lies on the hull.
 bool fitDelaunay(const std::vector<Eigen::Vector3d>& points, const PlaneFrame& f, ModelScratch& scratch)
@@ -210,7 +241,8 @@ bool fitDelaunay(const std::vector<Eigen::Vector3d>& points, const PlaneFrame& f
     }
     scratch.triangulated = false;
     scratch.keep.clear();
-    scratch.starUsable = starOfFirstPoint(scratch);
+    scratch.starUsable = starOf(scratch, 0, scratch.star);
+    scratch.otherStarCentre = -1;
     if (scratch.starUsable)
         return true;
     delaunay2d(scratch.planar, scratch.keep, scratch);
@@ -253,24 +285,23 @@ bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::V
     Eigen::Vector3d closest = Eigen::Vector3d::Zero();
     double best = std::numeric_limits<double>::infinity();
     bool settled = false;
-    if (scratch.starUsable) {
-        // The triangles around point 0 decide alone when q projects inside
-        // them, farther from their outer boundary than from the nearest one:
-        // every other triangle lies beyond that boundary, and the distance to
-        // a triangle is at least the in-plane distance to its projection. The
-        // small margin keeps rounding on the safe side.
-        const auto& p = scratch.planar;
-        double boundary2 = std::numeric_limits<double>::infinity();
-        bool inside = false;
-        for (const auto& t : scratch.star) {
-            const Eigen::Vector2d& a = p[static_cast<std::size_t>(t[1])];
-            const Eigen::Vector2d& b = p[static_cast<std::size_t>(t[2])];
-            boundary2 = std::min(boundary2, squaredSegmentDistance(qPlanar, a, b));
-            inside = inside || (orient2d(p[0], a, qPlanar) >= 0 && orient2d(a, b, qPlanar) >= 0 && orient2d(b, p[0], qPlanar) >= 0);
-        }
-        if (inside) {
-            best = nearestTriangle(points, p, scratch.star, q, qPlanar, closest);
-            settled = best < boundary2 * (1 - 1e-9);
+    // The triangles around point 0 usually decide; a compared point that
+    // projects beyond them tries those around the planar point nearest to its
+    // projection (kept for the next compared point of the group).
+    if (scratch.starUsable)
+        settled = starSettles(points, scratch.planar, scratch.star, q, qPlanar, best, closest);
+    if (!settled && !scratch.triangulated) {
+        int nearest = 0;
+        for (std::size_t i = 1; i < scratch.planar.size(); ++i)
+            if ((scratch.planar[i] - qPlanar).squaredNorm() < (scratch.planar[static_cast<std::size_t>(nearest)] - qPlanar).squaredNorm())
+                nearest = static_cast<int>(i);
+        if (nearest != 0) {
+            if (nearest != scratch.otherStarCentre) {
+                scratch.otherStarCentre = nearest;
+                scratch.otherStarUsable = starOf(scratch, nearest, scratch.otherStar);
+            }
+            if (scratch.otherStarUsable)
+                settled = starSettles(points, scratch.planar, scratch.otherStar, q, qPlanar, best, closest);
         }
     }
     if (!settled) {

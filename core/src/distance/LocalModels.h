@@ -30,10 +30,13 @@ struct ModelScratch
     std::vector<std::array<int, 2>> edges;
     std::vector<DelaunayTriangle> mesh;
     std::vector<int> cavity, startAt, startStamp;
-    //! The Delaunay model: the triangles around point 0, and whether they can be
-    //! used; whether `keep` holds the whole triangulation of `planar`.
-    std::vector<std::array<int, 3>> star;
+    //! The Delaunay model: the triangles around point 0 and around another
+    //! point, and whether they can be used; whether `keep` holds the whole
+    //! triangulation of `planar`.
+    std::vector<std::array<int, 3>> star, otherStar;
     bool starUsable = false, triangulated = false;
+    int otherStarCentre = -1; //!< the point otherStar surrounds (-1: none yet)
+    bool otherStarUsable = false;
     std::vector<Eigen::Vector2d> cell, nextCell; //!< point 0's Voronoi cell while it is clipped
     std::vector<int> generator, nextGenerator;
     std::vector<double> side;
