@@ -286,16 +286,17 @@ bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::V
     double best = std::numeric_limits<double>::infinity();
     bool settled = false;
     // The triangles around point 0 usually decide; a compared point that
-    // projects beyond them tries those around the planar point nearest to its
-    // projection (kept for the next compared point of the group).
+    // projects beyond them (point 0's Voronoi cell reaches past its triangles
+    // where an angle at point 0 is obtuse) tries those around the other planar
+    // point nearest to its projection (kept for the next compared point of the group).
     if (scratch.starUsable)
         settled = starSettles(points, scratch.planar, scratch.star, q, qPlanar, best, closest);
-    if (!settled && !scratch.triangulated) {
-        int nearest = 0;
-        for (std::size_t i = 1; i < scratch.planar.size(); ++i)
+    if (!settled && !scratch.triangulated && scratch.planar.size() > 1) {
+        int nearest = 1;
+        for (std::size_t i = 2; i < scratch.planar.size(); ++i)
             if ((scratch.planar[i] - qPlanar).squaredNorm() < (scratch.planar[static_cast<std::size_t>(nearest)] - qPlanar).squaredNorm())
                 nearest = static_cast<int>(i);
-        if (nearest != 0) {
+        {
             if (nearest != scratch.otherStarCentre) {
                 scratch.otherStarCentre = nearest;
                 scratch.otherStarUsable = starOf(scratch, nearest, scratch.otherStar);
