@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 
 using namespace scandiff;
@@ -333,23 +334,27 @@ PointCloud wavySamples(std::size_t n, double offset, std::mt19937& rng)
     return c;
 }
 
-//! Brute force of the documented neighbourhood: the k nearest reference points
-//! (ties by index) of q's nearest reference point, closest first.
-std::vector<Eigen::Vector3d> neighbourhoodOfNearest(const PointCloud& reference, const Eigen::Vector3f& q, std::size_t k)
+//! Brute force of the documented neighbourhoods, closest first (ties by index):
+//! with k, the k nearest reference points of q; with a radius, the reference
+//! points within it of q's nearest reference point.
+std::vector<Eigen::Vector3d> neighbourhood(const PointCloud& reference, const Eigen::Vector3f& q, std::size_t k,
+                                           std::optional<float> radius = std::nullopt)
 {
     const auto& r = reference.positions();
-    std::size_t nearest = 0;
-    for (std::size_t j = 1; j < r.size(); ++j) {
-        const float d = (r[j] - q).squaredNorm(), best = (r[nearest] - q).squaredNorm();
-        if (d < best)
-            nearest = j;
+    Eigen::Vector3f centre = q;
+    if (radius) {
+        std::size_t nearest = 0;
+        for (std::size_t j = 1; j < r.size(); ++j)
+            if ((r[j] - q).squaredNorm() < (r[nearest] - q).squaredNorm())
+                nearest = j;
+        centre = r[nearest];
     }
     std::vector<std::pair<float, std::size_t>> all;
     for (std::size_t j = 0; j < r.size(); ++j)
-        all.emplace_back((r[j] - r[nearest]).squaredNorm(), j);
+        all.emplace_back((r[j] - centre).squaredNorm(), j);
     std::sort(all.begin(), all.end());
     std::vector<Eigen::Vector3d> points;
-    for (std::size_t m = 0; m < k; ++m)
+    for (std::size_t m = 0; m < all.size() && (radius ? all[m].first <= *radius * *radius : m < k); ++m)
         points.push_back(r[all[m].second].cast<double>());
     return points;
 }
@@ -382,12 +387,12 @@ Plane leastSquaresPlane(const std::vector<Eigen::Vector3d>& points)
 
 } // namespace
 
-TEST(CloudToCloud, ModelIsFittedOnTheNeighbourhoodOfTheNearestReferencePoint)
+TEST(CloudToCloud, PlaneIsFittedOnTheDocumentedNeighbourhood)
 {
-    // §2.3.2, "a local model around each nearest neighbour": with --knn, the
-    // model is fitted on the k nearest reference points of the compared point's
-    // nearest reference point. Compared points that share that point share the
-    // model: every one must get the distance to the model of its own nearest point.
+    // --knn: the compared point's k nearest reference points; --radius: the
+    // reference points within the radius of its nearest reference point. In
+    // the second case compared points with the same nearest point share one
+    // fit: each must still get the distance to the model of its own nearest point.
     std::mt19937 rng(9);
     const PointCloud reference = wavySamples(3000, 0.0, rng);
     PointCloud compared = wavySamples(400, 0.03, rng);
@@ -396,13 +401,18 @@ TEST(CloudToCloud, ModelIsFittedOnTheNeighbourhoodOfTheNearestReferencePoint)
         compared.positions()[i] = reference.positions()[7] + Eigen::Vector3f(0.002f * static_cast<float>(i % 5), 0.001f, 0.01f);
     CloudToCloudParams params;
     params.model = LocalModel::Plane;
-    for (int k : {6, 12}) {
-        params.neighbours = k;
+    for (int k : {6, 12, 0}) {
+        std::optional<float> radius;
+        if (k == 0)
+            radius = 0.15f;
+        params.neighbours = k == 0 ? 12 : k;
+        if (radius)
+            params.radius = *radius;
         const CloudToCloudResult r = cloudToCloud(compared, reference, params);
         EXPECT_EQ(r.modelFallbacks, 0u);
         for (std::size_t i = 0; i < compared.size(); ++i) {
             const Eigen::Vector3f& q = compared.positions()[i];
-            const Plane plane = leastSquaresPlane(neighbourhoodOfNearest(reference, q, static_cast<std::size_t>(k)));
+            const Plane plane = leastSquaresPlane(neighbourhood(reference, q, static_cast<std::size_t>(k), radius));
             const double expected = std::abs((q.cast<double>() - plane.centroid).dot(plane.normal));
             ASSERT_NEAR(r.distance.values()[i], expected, 1e-6) << "k " << k << " point " << i;
         }
@@ -412,10 +422,11 @@ TEST(CloudToCloud, ModelIsFittedOnTheNeighbourhoodOfTheNearestReferencePoint)
 TEST(CloudToCloud, DelaunayModelEqualsTheNearestTriangleOfABruteForceTriangulation)
 {
     // The Delaunay model's triangles come from the Voronoi cell of the nearest
-    // reference point when they decide, else from the whole triangulation; both
-    // must give the distance to the nearest triangle of the Delaunay
-    // triangulation of the neighbourhood projected on its plane, built here by
-    // brute force (every triangle whose circumcircle holds no other point).
+    // reference point (or of the planar point nearest to the projection) when
+    // they decide, else from the whole triangulation; all must give the distance
+    // to the nearest triangle of the Delaunay triangulation of the neighbourhood
+    // projected on its plane, built here by brute force (every triangle whose
+    // circumcircle holds no other site).
     std::mt19937 rng(10);
     const PointCloud reference = wavySamples(3000, 0.0, rng);
     PointCloud compared = wavySamples(300, 0.05, rng);
@@ -431,7 +442,7 @@ TEST(CloudToCloud, DelaunayModelEqualsTheNearestTriangleOfABruteForceTriangulati
         EXPECT_EQ(r.modelFallbacks, 0u);
         for (std::size_t i = 0; i < compared.size(); ++i) {
             const Eigen::Vector3d q = compared.positions()[i].cast<double>();
-            const auto points = neighbourhoodOfNearest(reference, compared.positions()[i], static_cast<std::size_t>(k));
+            const auto points = neighbourhood(reference, compared.positions()[i], static_cast<std::size_t>(k));
             const Plane plane = leastSquaresPlane(points);
             std::vector<Eigen::Vector2d> planar;
             for (const auto& p : points)

@@ -108,11 +108,13 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
     const std::vector<std::uint32_t> order = octree::mortonOrder(queries, n, cube);
     const octree::Octree tree = buildOctree(reference, cube);
 
-    // Levels whose cells hold about 30 reference points for the nearest
-    // neighbours (the batch prunes the neighbour cells a query cannot need;
-    // level sweep in docs/benchmarks.md), and about 1.5 k for the k nearest
-    // neighbours of the models, so that the 27 cells around a query almost
-    // always settle it.
+    // With a k-neighbourhood model, the k nearest reference points of each
+    // compared point (§2.3.2: "its k nearest neighbours instead of only the
+    // nearest one") come from the same batch query; the first is the nearest
+    // neighbour, so there is no separate NN pass. Levels whose cells hold about
+    // 30 reference points for NN (the batch prunes the neighbour cells a query
+    // cannot need; level sweep in docs/benchmarks.md) and about 1.5 k for k
+    // neighbours, so that the 27 cells around a query almost always settle it.
     const bool useModel = params.model != LocalModel::None;
     const bool knnModel = useModel && !params.radius;
     const std::size_t k = static_cast<std::size_t>(params.neighbours);
@@ -128,8 +130,9 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
         }
         return best;
     };
-    result.level = params.octreeLevel != 0 ? params.octreeLevel : levelFor(30.0);
-    const int modelLevel = params.octreeLevel != 0 ? params.octreeLevel : levelFor(std::max(8.0, 1.5 * static_cast<double>(k)));
+    result.level = params.octreeLevel != 0 ? params.octreeLevel
+                   : knnModel            ? levelFor(std::max(8.0, 1.5 * static_cast<double>(k)))
+                                         : levelFor(30.0);
 
     std::vector<VisibilityLabel> labels;
     if (!params.viewpoints.empty()) {
@@ -156,7 +159,8 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
     ProgressTicker ticker(progress, useModel ? "Distances with local models" : "Nearest-neighbour distances", n);
     constexpr std::size_t kChunk = 1 << 16;
     std::vector<Eigen::Vector3f> chunkQueries;
-    std::vector<octree::Neighbour> chunkNeighbours;
+    std::vector<octree::Neighbour> chunkNeighbours; // the nearest reference point of each chunk point
+    std::vector<octree::Neighbour> chunkLists;      // with --knn: the k nearest of each
 
     // Writes the distance d of the compared point at position j of the order
     // (maximum distance, closest point, components).
@@ -179,16 +183,14 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
         }
     };
 
-    // With a model, the compared points of a chunk are grouped by nearest
-    // reference point: the model is a function of that point only (§2.3.2,
-    // "a local model around each nearest neighbour": its k nearest reference
-    // points, or the reference points within a radius of it), so it is fitted
-    // once per group. On two samplings of one surface, about 6 in 10 reference
-    // points are someone's nearest neighbour.
-    std::vector<std::uint32_t> groupOf(useModel ? reference.size() : 0, kNone); // reference point -> group, within a chunk
+    // With --radius, the compared points of a chunk are grouped by nearest
+    // reference point: the neighbourhood, the reference points within the
+    // radius of that point ([ISPRS05]), is a function of it alone, so the model
+    // is fitted once per group. On two samplings of one surface, about 6 in 10
+    // reference points are someone's nearest neighbour.
+    const bool radiusModel = useModel && params.radius;
+    std::vector<std::uint32_t> groupOf(radiusModel ? reference.size() : 0, kNone); // reference point -> group, within a chunk
     std::vector<std::uint32_t> groupPoint, groupStart, members;
-    std::vector<Eigen::Vector3f> groupQueries;
-    std::vector<octree::Neighbour> groupNeighbours;
 
     for (std::size_t chunkBegin = 0; chunkBegin < n; chunkBegin += kChunk) {
         const std::size_t chunkEnd = std::min(n, chunkBegin + kChunk);
@@ -199,7 +201,48 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
             // A NaN query gets no neighbour: how hidden points are skipped cheaply.
             chunkQueries[j - chunkBegin] = hidden ? Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()) : queries[i];
         }
-        tree.nearestBatch(chunkQueries.data(), chunkQueries.size(), 1, result.level, chunkNeighbours);
+        if (knnModel) {
+            tree.nearestBatch(chunkQueries.data(), chunkQueries.size(), k, result.level, chunkLists);
+            chunkNeighbours.resize(chunkQueries.size());
+            for (std::size_t j = 0; j < chunkQueries.size(); ++j)
+                chunkNeighbours[j] = chunkLists[j * k];
+        } else {
+            tree.nearestBatch(chunkQueries.data(), chunkQueries.size(), 1, result.level, chunkNeighbours);
+        }
+        // Which side of a model is "positive": the reference normal at the
+        // nearest point, else the scanner, else up.
+        auto orientationAt = [&](std::uint32_t r) -> Eigen::Vector3d {
+            if (reference.hasNormals())
+                return reference.normals()[r].cast<double>();
+            if (haveSensor)
+                return sensorPosition - refPoints[r].cast<double>();
+            return Eigen::Vector3d::UnitZ();
+        };
+        if (knnModel) {
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(chunkBegin, chunkEnd, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+                Scratch& s = scratch.local();
+                std::size_t localFallbacks = 0;
+                for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                    const octree::Neighbour* list = chunkLists.data() + (j - chunkBegin) * k;
+                    if (list[0].index == kNone)
+                        continue; // NaN query, or not comparable: the value stays NaN
+                    s.points.clear();
+                    for (std::size_t m = 0; m < k && list[m].index != kNone; ++m)
+                        s.points.push_back(refPoints[list[m].index].cast<double>());
+                    double d = std::sqrt(static_cast<double>(list[0].squaredDistance));
+                    double modelSigned = 0;
+                    if (detail::fitModel(params.model, s.points, orientationAt(list[0].index), s.fitted, s.model) &&
+                        detail::modelDistance(s.fitted, s.points, chunkQueries[j - chunkBegin].cast<double>(), modelSigned, s.model))
+                        d = params.signedDistances ? modelSigned : std::abs(modelSigned);
+                    else
+                        ++localFallbacks; // thesis: a degenerate neighbourhood is no worse than plain NN
+                    store(j, d);
+                }
+                fallbacks += localFallbacks;
+                ticker.step(range.size());
+            });
+            continue;
+        }
         if (!useModel) {
             tbb::parallel_for(tbb::blocked_range<std::size_t>(chunkBegin, chunkEnd, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
                 for (std::size_t j = range.begin(); j != range.end(); ++j) {
@@ -216,7 +259,7 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
             continue;
         }
 
-        // Groups by nearest reference point, in order of first appearance, as
+        // --radius: groups by nearest reference point, in order of first appearance, as
         // lists of positions in the chunk (a counting sort).
         groupPoint.clear();
         groupStart.clear();
@@ -250,14 +293,6 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
         for (const std::uint32_t r : groupPoint)
             groupOf[r] = kNone;
 
-        // The k nearest reference points of every group's reference point, in one batch.
-        if (knnModel) {
-            groupQueries.resize(groupPoint.size());
-            for (std::size_t g = 0; g < groupPoint.size(); ++g)
-                groupQueries[g] = refPoints[groupPoint[g]];
-            tree.nearestBatch(groupQueries.data(), groupQueries.size(), k, modelLevel, groupNeighbours);
-        }
-
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groupPoint.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
             Scratch& s = scratch.local();
             std::size_t localFallbacks = 0, done = 0;
@@ -265,22 +300,10 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
                 const std::uint32_t r = groupPoint[g];
                 const Eigen::Vector3f& p = refPoints[r];
                 s.points.clear();
-                if (knnModel) {
-                    const octree::Neighbour* list = groupNeighbours.data() + g * k;
-                    for (std::size_t m = 0; m < k && list[m].index != kNone; ++m)
-                        s.points.push_back(refPoints[list[m].index].cast<double>());
-                } else {
-                    tree.withinRadius(p, static_cast<float>(*params.radius), result.level, s.neighbours);
-                    for (const auto& m : s.neighbours)
-                        s.points.push_back(refPoints[m.index].cast<double>());
-                }
-                // Which side is "positive": the reference normal, else the scanner, else up.
-                Eigen::Vector3d orientation = Eigen::Vector3d::UnitZ();
-                if (reference.hasNormals())
-                    orientation = reference.normals()[r].cast<double>();
-                else if (haveSensor)
-                    orientation = sensorPosition - p.cast<double>();
-                const bool fitted = detail::fitModel(params.model, s.points, orientation, s.fitted, s.model);
+                tree.withinRadius(p, static_cast<float>(*params.radius), result.level, s.neighbours);
+                for (const auto& m : s.neighbours)
+                    s.points.push_back(refPoints[m.index].cast<double>());
+                const bool fitted = detail::fitModel(params.model, s.points, orientationAt(r), s.fitted, s.model);
                 for (std::uint32_t m = groupStart[g]; m < groupStart[g + 1]; ++m) {
                     const std::size_t j = chunkBegin + members[m];
                     const octree::Neighbour nb = chunkNeighbours[members[m]];

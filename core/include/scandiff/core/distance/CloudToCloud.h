@@ -5,15 +5,12 @@
 //!
 //! - Nearest-neighbour distance (§2.3.1), exact, through the octree's batch
 //!   query on a cube shared by both clouds.
-//! - Optional local model of the reference around each compared point's nearest
-//!   reference point (§2.3.2, "a local model around each nearest neighbour"):
+//! - Optional local model of the reference near each compared point (§2.3.2):
 //!   least-squares plane, 2.5D Delaunay triangulation on that plane, or a
-//!   quadric height function over it, fitted on the k nearest reference points
-//!   of that nearest neighbour (itself first), or on the reference points within
-//!   a radius of it; CloudCompare's C2C does the same. The model depends on the
-//!   nearest neighbour only, so compared points sharing one share its model.
-//!   Two samplings of one surface are at NN distance ~1/sqrt(pi*lambda) RMS
-//!   (eq. 2.5); a local model removes that bias.
+//!   quadric height function over it, fitted on the point's k nearest reference
+//!   points (the first being its nearest neighbour) or on the reference points
+//!   within a radius of its nearest neighbour. Two samplings of one surface are at
+//!   NN distance ~1/sqrt(pi*lambda) RMS (eq. 2.5); a local model removes that bias.
 //! - Optional visibility (§2.3.3, Algorithm 3): with reference viewpoints, each
 //!   compared point is labelled visible / hidden / out of range / out of field,
 //!   and only visible points get a distance.
@@ -43,8 +40,7 @@ struct CloudToCloudParams
     bool clampBeyondMax = false;
     //! Local model of the reference near each compared point. Default: none.
     LocalModel model = LocalModel::None;
-    //! k, in [3, 500]: the model is fitted on the k nearest reference points of the
-    //! compared point's nearest reference point (that point included). Default 12.
+    //! k, in [3, 500]: the model is fitted on the compared point's k nearest reference points. Default 12.
     int neighbours = 12;
     //! Metres, > 0: fit on the reference points within this radius of the nearest neighbour instead.
     std::optional<double> radius;
