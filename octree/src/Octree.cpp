@@ -508,9 +508,11 @@ namespace {
 //! contiguously so the inner loop streams through memory.
 struct BatchScratch
 {
-    std::vector<Eigen::Vector3f> positions;
+    //! Candidate coordinates as three arrays (structure of arrays), so that the
+    //! distances of a cell's candidates are computed four at a time.
+    std::vector<float> x, y, z;
     std::vector<std::uint32_t> indices;
-    std::vector<float> distances; //!< one cell's squared distances (k = 1 scan)
+    std::vector<float> distances; //!< one cell's squared distances
     std::vector<Neighbour> heap;
     //! Where each gathered cell's points start in positions/indices, and its
     //! offset from the query cell: the queries skip the cells they cannot need.
@@ -518,6 +520,18 @@ struct BatchScratch
     std::array<std::array<int, 3>, 27> cellOffset{};
     int cellCount = 0;
     QueryStatistics statistics;
+
+    //! Squared distances from q to candidates [begin, begin + count) into d2,
+    //! with the float operations of Eigen's squaredNorm(), x^2 + (y^2 + z^2),
+    //! so that the results are bitwise those of nearest() and brute force.
+    void squaredDistances(const Eigen::Vector3f& q, std::size_t begin, std::size_t count, float* d2) const
+    {
+        using Column = Eigen::Map<const Eigen::ArrayXf>;
+        const Eigen::Index n = static_cast<Eigen::Index>(count);
+        Eigen::Map<Eigen::ArrayXf>(d2, n) = (Column(x.data() + begin, n) - q.x()).square() +
+                                            ((Column(y.data() + begin, n) - q.y()).square() +
+                                             (Column(z.data() + begin, n) - q.z()).square());
+    }
 };
 
 //! The 27 cell offsets, the own cell first, then faces, edges and corners, so
@@ -613,7 +627,9 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
             const CellCoordinates cellCoordinates = decodeCell(cell);
             // Signed copies: the neighbourhood of a cell on the cube's low faces starts at -1.
             const std::int64_t cx = cellCoordinates.x, cy = cellCoordinates.y, cz = cellCoordinates.z;
-            s.positions.clear();
+            s.x.clear();
+            s.y.clear();
+            s.z.clear();
             s.indices.clear();
             s.cellCount = 0;
             for (const auto& offset : neighbourhoodOffsets()) {
@@ -625,22 +641,27 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                 ++s.statistics.cellLookups;
                 if (b == e)
                     continue;
-                s.cellStart[static_cast<std::size_t>(s.cellCount)] = static_cast<std::uint32_t>(s.positions.size());
+                s.cellStart[static_cast<std::size_t>(s.cellCount)] = static_cast<std::uint32_t>(s.indices.size());
                 s.cellOffset[static_cast<std::size_t>(s.cellCount)] = offset;
                 ++s.cellCount;
                 for (std::size_t i = b; i < e; ++i) {
+                    const Eigen::Vector3f& p = points_[indices_[i]];
                     s.indices.push_back(indices_[i]);
-                    s.positions.push_back(points_[indices_[i]]);
+                    s.x.push_back(p.x());
+                    s.y.push_back(p.y());
+                    s.z.push_back(p.z());
                 }
             }
-            s.cellStart[static_cast<std::size_t>(s.cellCount)] = static_cast<std::uint32_t>(s.positions.size());
+            s.cellStart[static_cast<std::size_t>(s.cellCount)] = static_cast<std::uint32_t>(s.indices.size());
+            if (s.distances.size() < s.indices.size())
+                s.distances.resize(s.indices.size());
             const Eigen::Vector3d centre =
                 box_.min + (Eigen::Vector3d(double(cx), double(cy), double(cz)).array() + 0.5).matrix() * l;
             for (std::size_t i = first; i < last; ++i) {
                 const std::uint32_t qi = order[i].index;
                 const Eigen::Vector3f& q = queries[qi];
                 s.heap.clear();
-                const std::size_t m = s.positions.size();
+                const std::size_t m = s.indices.size();
                 if (k == 1) {
                     // The common case (cloud/cloud distance): a running minimum, no
                     // heap, and a cell is skipped when its box is already farther
@@ -653,57 +674,101 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                         faceGap2[a][1] = 0.0;
                         faceGap2[a][2] = above * above;
                     }
-                    Neighbour best{0, std::numeric_limits<float>::infinity()};
+                    // Per cell: the distances (vectorised), their minimum (a
+                    // vectorised reduction, no dependent compare-and-branch per
+                    // candidate); the index tie-break is a second pass over the
+                    // scanned cells, which rarely finds more than one equal.
+                    float bestDistance = std::numeric_limits<float>::infinity();
                     std::size_t scanned = 0;
+                    std::uint32_t scannedCells = 0; // bit c: cell c was scanned
+                    float* d2 = s.distances.data();
                     for (int c = 0; c < s.cellCount; ++c) {
                         const auto& o = s.cellOffset[static_cast<std::size_t>(c)];
                         const double gap2 = faceGap2[0][o[0] + 1] + faceGap2[1][o[1] + 1] + faceGap2[2][o[2] + 1];
-                        if (gap2 > static_cast<double>(best.squaredDistance) * (1 + kSlack))
+                        if (gap2 > static_cast<double>(bestDistance) * (1 + kSlack))
                             continue;
                         const std::uint32_t begin = s.cellStart[static_cast<std::size_t>(c)];
                         const std::uint32_t end = s.cellStart[static_cast<std::size_t>(c) + 1];
-                        // Distances first (independent, vectorisable), then the
-                        // minimum with the index tie-break.
-                        const std::size_t count = end - begin;
-                        if (s.distances.size() < count)
-                            s.distances.resize(count);
-                        float* d2 = s.distances.data();
-                        const Eigen::Vector3f* p = s.positions.data() + begin;
-                        for (std::size_t j = 0; j < count; ++j)
-                            d2[j] = (p[j] - q).squaredNorm();
-                        for (std::size_t j = 0; j < count; ++j) {
-                            if (d2[j] <= best.squaredDistance) {
-                                const Neighbour candidate{s.indices[begin + j], d2[j]};
-                                if (candidate < best)
-                                    best = candidate;
-                            }
-                        }
-                        scanned += count;
+                        s.squaredDistances(q, begin, end - begin, d2 + begin);
+                        bestDistance = std::min(bestDistance, Eigen::Map<const Eigen::ArrayXf>(d2 + begin, end - begin).minCoeff());
+                        scannedCells |= std::uint32_t(1) << c;
+                        scanned += end - begin;
+                    }
+                    Neighbour best{std::numeric_limits<std::uint32_t>::max(), bestDistance};
+                    for (int c = 0; c < s.cellCount; ++c) {
+                        if (!(scannedCells >> c & 1))
+                            continue;
+                        const std::uint32_t end = s.cellStart[static_cast<std::size_t>(c) + 1];
+                        for (std::uint32_t j = s.cellStart[static_cast<std::size_t>(c)]; j < end; ++j)
+                            if (d2[j] == bestDistance)
+                                best.index = std::min(best.index, s.indices[j]);
                     }
                     if (m > 0)
                         s.heap.push_back(best);
                     s.statistics.distances += scanned;
                 } else {
-                    // All candidate distances, then a selection: linear in the
-                    // candidates, cheaper than a heap update per candidate.
-                    s.heap.resize(m);
-                    for (std::size_t j = 0; j < m; ++j)
-                        s.heap[j] = Neighbour{s.indices[j], (s.positions[j] - q).squaredNorm()};
-                    if (m > k) {
-                        std::nth_element(s.heap.begin(), s.heap.begin() + static_cast<std::ptrdiff_t>(k - 1), s.heap.end());
-                        s.heap.resize(k);
+                    // The cells by increasing gap to q, then a sorted list of the k
+                    // best so far: once it is full, a cell whose box lies farther
+                    // than its last entry cannot contribute, and neither can any
+                    // later cell. With cells of about k points, a query usually
+                    // scans two or three of them instead of the whole neighbourhood.
+                    const Eigen::Vector3d local = q.cast<double>() - centre;
+                    double faceGap2[3][3];
+                    for (int a = 0; a < 3; ++a) {
+                        const double below = 0.5 * l + local[a], above = 0.5 * l - local[a];
+                        faceGap2[a][0] = below * below;
+                        faceGap2[a][1] = 0.0;
+                        faceGap2[a][2] = above * above;
                     }
-                    std::make_heap(s.heap.begin(), s.heap.end());
-                    s.statistics.distances += m;
+                    std::array<std::pair<double, int>, 27> byGap;
+                    for (int c = 0; c < s.cellCount; ++c) {
+                        const auto& o = s.cellOffset[static_cast<std::size_t>(c)];
+                        const double gap2 = faceGap2[0][o[0] + 1] + faceGap2[1][o[1] + 1] + faceGap2[2][o[2] + 1];
+                        int j = c;
+                        for (; j > 0 && byGap[static_cast<std::size_t>(j - 1)].first > gap2; --j)
+                            byGap[static_cast<std::size_t>(j)] = byGap[static_cast<std::size_t>(j - 1)];
+                        byGap[static_cast<std::size_t>(j)] = {gap2, c};
+                    }
+                    std::vector<Neighbour>& top = s.heap; // the k best so far, sorted
+                    std::size_t scanned = 0;
+                    for (int r = 0; r < s.cellCount; ++r) {
+                        const auto [gap2, c] = byGap[static_cast<std::size_t>(r)];
+                        if (top.size() == k && gap2 > static_cast<double>(top.back().squaredDistance) * (1 + kSlack))
+                            break;
+                        const std::uint32_t begin = s.cellStart[static_cast<std::size_t>(c)];
+                        const std::uint32_t end = s.cellStart[static_cast<std::size_t>(c) + 1];
+                        const std::size_t count = end - begin;
+                        float* d2 = s.distances.data();
+                        s.squaredDistances(q, begin, count, d2);
+                        for (std::size_t j = 0; j < count; ++j) {
+                            if (top.size() == k && d2[j] > top.back().squaredDistance)
+                                continue;
+                            const Neighbour candidate{s.indices[begin + j], d2[j]};
+                            if (top.size() == k) {
+                                if (!(candidate < top.back()))
+                                    continue;
+                            } else {
+                                top.push_back(candidate);
+                            }
+                            // Insertion from the back: for a dozen entries, cheaper
+                            // than a binary search's unpredictable branches.
+                            std::size_t at = top.size() - 1;
+                            for (; at > 0 && candidate < top[at - 1]; --at)
+                                top[at] = top[at - 1];
+                            top[at] = candidate;
+                        }
+                        scanned += count;
+                    }
+                    s.statistics.distances += scanned;
                 }
                 // Inscribed sphere of the 27 cells around q (eq. 4.1 with j = 1).
                 const double inner = 0.5 * l - (q.cast<double>() - centre).cwiseAbs().maxCoeff();
                 const double inscribed = l + inner;
+                // k = 1 leaves its single entry in s.heap, k > 1 a sorted list: either
+                // way the k-th distance is the last entry.
                 const bool settled = heapFull(s.heap, k) &&
-                                     static_cast<double>(s.heap.front().squaredDistance) * (1 + kSlack) < inscribed * inscribed;
-                if (settled) {
-                    std::sort_heap(s.heap.begin(), s.heap.end());
-                } else {
+                                     static_cast<double>(s.heap.back().squaredDistance) * (1 + kSlack) < inscribed * inscribed;
+                if (!settled) {
                     nearest(q, k, level, s.heap);
                     ++s.statistics.fullSearches;
                 }

@@ -1,12 +1,16 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include <scandiff/core/Error.h>
 #include <scandiff/core/distance/CloudToCloud.h>
+#include <scandiff/core/geometry/PointTriangleDistance.h>
 
 #include "TestSupport.h"
 
+#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 
 using namespace scandiff;
@@ -312,4 +316,181 @@ TEST(CloudToCloud, CancellationLeavesInputsUntouched)
     EXPECT_EQ(test::errorCodeOf([&] { cloudToCloud(compared, reference, {}, &cancel); }), ErrorCode::Cancelled);
     EXPECT_EQ(compared.positions(), before);
     EXPECT_TRUE(compared.fields().empty());
+}
+
+namespace {
+
+//! A gently curved, randomly sampled surface over [0, 3]^2.
+PointCloud wavySamples(std::size_t n, double offset, std::mt19937& rng)
+{
+    PointCloud c;
+    c.resize(n);
+    std::uniform_real_distribution<float> u(0.0f, 3.0f);
+    std::uniform_real_distribution<double> o(-offset, offset);
+    for (auto& p : c.positions()) {
+        const float x = u(rng), y = u(rng);
+        p = {x, y, static_cast<float>(0.2 * std::sin(2.0 * x) * std::cos(y) + o(rng))};
+    }
+    return c;
+}
+
+//! Brute force of the documented neighbourhoods, closest first (ties by index):
+//! with k, the k nearest reference points of q; with a radius, the reference
+//! points within it of q's nearest reference point.
+std::vector<Eigen::Vector3d> neighbourhood(const PointCloud& reference, const Eigen::Vector3f& q, std::size_t k,
+                                           std::optional<float> radius = std::nullopt)
+{
+    const auto& r = reference.positions();
+    Eigen::Vector3f centre = q;
+    if (radius) {
+        std::size_t nearest = 0;
+        for (std::size_t j = 1; j < r.size(); ++j)
+            if ((r[j] - q).squaredNorm() < (r[nearest] - q).squaredNorm())
+                nearest = j;
+        centre = r[nearest];
+    }
+    std::vector<std::pair<float, std::size_t>> all;
+    for (std::size_t j = 0; j < r.size(); ++j)
+        all.emplace_back((r[j] - centre).squaredNorm(), j);
+    std::sort(all.begin(), all.end());
+    std::vector<Eigen::Vector3d> points;
+    for (std::size_t m = 0; m < all.size() && (radius ? all[m].first <= *radius * *radius : m < k); ++m)
+        points.push_back(r[all[m].second].cast<double>());
+    return points;
+}
+
+struct Plane
+{
+    Eigen::Vector3d centroid, normal, u, v;
+};
+
+Plane leastSquaresPlane(const std::vector<Eigen::Vector3d>& points)
+{
+    Plane plane;
+    plane.centroid = Eigen::Vector3d::Zero();
+    for (const auto& p : points)
+        plane.centroid += p;
+    plane.centroid /= static_cast<double>(points.size());
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (const auto& p : points)
+        covariance += (p - plane.centroid) * (p - plane.centroid).transpose();
+    // The model's frame: normal towards +Z (no normals, no sensor), u the main axis.
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(covariance);
+    plane.normal = solver.eigenvectors().col(0).normalized();
+    if (plane.normal.z() < 0)
+        plane.normal = -plane.normal;
+    plane.u = solver.eigenvectors().col(2).normalized();
+    plane.v = plane.normal.cross(plane.u);
+    return plane;
+}
+
+} // namespace
+
+TEST(CloudToCloud, PlaneIsFittedOnTheDocumentedNeighbourhood)
+{
+    // --knn: the compared point's k nearest reference points; --radius: the
+    // reference points within the radius of its nearest reference point. In
+    // the second case compared points with the same nearest point share one
+    // fit: each must still get the distance to the model of its own nearest point.
+    std::mt19937 rng(9);
+    const PointCloud reference = wavySamples(3000, 0.0, rng);
+    PointCloud compared = wavySamples(400, 0.03, rng);
+    // Several compared points on one reference point's doorstep: one shared model.
+    for (std::size_t i = 0; i < 20; ++i)
+        compared.positions()[i] = reference.positions()[7] + Eigen::Vector3f(0.002f * static_cast<float>(i % 5), 0.001f, 0.01f);
+    CloudToCloudParams params;
+    params.model = LocalModel::Plane;
+    for (int k : {6, 12, 0}) {
+        std::optional<float> radius;
+        if (k == 0)
+            radius = 0.15f;
+        params.neighbours = k == 0 ? 12 : k;
+        if (radius)
+            params.radius = *radius;
+        const CloudToCloudResult r = cloudToCloud(compared, reference, params);
+        EXPECT_EQ(r.modelFallbacks, 0u);
+        for (std::size_t i = 0; i < compared.size(); ++i) {
+            const Eigen::Vector3f& q = compared.positions()[i];
+            const Plane plane = leastSquaresPlane(neighbourhood(reference, q, static_cast<std::size_t>(k), radius));
+            const double expected = std::abs((q.cast<double>() - plane.centroid).dot(plane.normal));
+            ASSERT_NEAR(r.distance.values()[i], expected, 1e-6) << "k " << k << " point " << i;
+        }
+    }
+}
+
+TEST(CloudToCloud, DelaunayModelEqualsTheNearestTriangleOfABruteForceTriangulation)
+{
+    // The Delaunay model's triangles come from the Voronoi cell of the nearest
+    // reference point (or of the planar point nearest to the projection) when
+    // they decide, else from the whole triangulation; all must give the distance
+    // to the nearest triangle of the Delaunay triangulation of the neighbourhood
+    // projected on its plane, built here by brute force (every triangle whose
+    // circumcircle holds no other site).
+    std::mt19937 rng(10);
+    const PointCloud reference = wavySamples(3000, 0.0, rng);
+    PointCloud compared = wavySamples(300, 0.05, rng);
+    // Farther points, which the triangles around the nearest point cannot settle alone.
+    for (std::size_t i = 0; i < 30; ++i)
+        compared.positions()[i].z() += 0.3f;
+    CloudToCloudParams params;
+    params.model = LocalModel::Delaunay;
+    params.signedDistances = true;
+    for (int k : {5, 12, 20}) {
+        params.neighbours = k;
+        const CloudToCloudResult r = cloudToCloud(compared, reference, params);
+        EXPECT_EQ(r.modelFallbacks, 0u);
+        for (std::size_t i = 0; i < compared.size(); ++i) {
+            const Eigen::Vector3d q = compared.positions()[i].cast<double>();
+            const auto points = neighbourhood(reference, compared.positions()[i], static_cast<std::size_t>(k));
+            const Plane plane = leastSquaresPlane(points);
+            std::vector<Eigen::Vector2d> planar;
+            for (const auto& p : points)
+                planar.emplace_back((p - plane.centroid).dot(plane.u), (p - plane.centroid).dot(plane.v));
+            // The triangulation is built inside a super-triangle whose vertices
+            // count as sites (a very flat hull triangle whose circle reaches one
+            // of them is not in it): the same three sites here.
+            Eigen::Vector2d lo = planar[0], hi = planar[0];
+            for (const auto& x : planar) {
+                lo = lo.cwiseMin(x);
+                hi = hi.cwiseMax(x);
+            }
+            const double span = (hi - lo).maxCoeff();
+            const Eigen::Vector2d mid = 0.5 * (lo + hi);
+            std::vector<Eigen::Vector2d> sites = planar;
+            sites.emplace_back(mid.x() - 20 * span, mid.y() - span);
+            sites.emplace_back(mid.x(), mid.y() + 20 * span);
+            sites.emplace_back(mid.x() + 20 * span, mid.y() - span);
+            double best = std::numeric_limits<double>::infinity();
+            Eigen::Vector3d closest = Eigen::Vector3d::Zero();
+            const std::size_t m = points.size();
+            for (std::size_t a = 0; a < m; ++a)
+                for (std::size_t b = a + 1; b < m; ++b)
+                    for (std::size_t c = b + 1; c < m; ++c) {
+                        const Eigen::Vector2d pa = planar[a], pb = planar[b], pc = planar[c];
+                        const double area = (pb - pa).x() * (pc - pa).y() - (pb - pa).y() * (pc - pa).x();
+                        if (std::abs(area) < 1e-12)
+                            continue;
+                        bool empty = true;
+                        for (std::size_t d = 0; d < sites.size() && empty; ++d) {
+                            if (d == a || d == b || d == c)
+                                continue;
+                            const Eigen::Vector2d x = pa - sites[d], y = pb - sites[d], z = pc - sites[d];
+                            const double det = x.squaredNorm() * (y.x() * z.y() - z.x() * y.y()) -
+                                               y.squaredNorm() * (x.x() * z.y() - z.x() * x.y()) +
+                                               z.squaredNorm() * (x.x() * y.y() - y.x() * x.y());
+                            empty = area > 0 ? det <= 0 : det >= 0;
+                        }
+                        if (!empty)
+                            continue;
+                        const auto t = geometry::pointTriangleDistance(q, points[a], points[b], points[c]);
+                        if (t.squaredDistance < best) {
+                            best = t.squaredDistance;
+                            closest = t.closestPoint;
+                        }
+                    }
+            const double expected = std::sqrt(best) * ((q - closest).dot(plane.normal) < 0 ? -1.0 : 1.0);
+            ASSERT_NEAR(r.distance.values()[i], expected, 1e-6) << "k " << k << " point " << i;
+        }
+    }
 }

@@ -258,7 +258,7 @@ TEST(Octree, BatchNearestEqualsBruteForceAtEveryLevel)
         queries.insert(queries.end(), cloud.begin(), cloud.begin() + 150); // on the cloud, and duplicates
         queries.push_back({1e3f, 0, 0});                                      // far outside the cube
         for (int level = 1; level <= kMaxLevel; ++level) {
-            for (std::size_t k : {1u, 6u}) {
+            for (std::size_t k : {1u, 6u, 12u}) {
                 std::vector<Neighbour> got;
                 tree.nearestBatch(queries.data(), queries.size(), k, level, got);
                 ASSERT_EQ(got.size(), queries.size() * k);

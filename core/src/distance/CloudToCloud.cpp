@@ -62,6 +62,7 @@ struct Scratch
 {
     std::vector<octree::Neighbour> neighbours;
     std::vector<Eigen::Vector3d> points;
+    detail::FittedModel fitted;
     detail::ModelScratch model;
 };
 
@@ -110,26 +111,28 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
     // With a k-neighbourhood model, the k nearest reference points of each
     // compared point (§2.3.2: "its k nearest neighbours instead of only the
     // nearest one") come from the same batch query; the first is the nearest
-    // neighbour, so there is no separate NN pass.
+    // neighbour, so there is no separate NN pass. Levels whose cells hold about
+    // 30 reference points for NN (the batch prunes the neighbour cells a query
+    // cannot need; level sweep in docs/benchmarks.md) and about 1.5 k for k
+    // neighbours, so that the 27 cells around a query almost always settle it.
     const bool useModel = params.model != LocalModel::None;
-    const bool batchNeighbourhoods = useModel && !params.radius;
-    const std::size_t k = batchNeighbourhoods ? static_cast<std::size_t>(params.neighbours) : 1;
-    // Levels whose cells hold about 30 reference points for NN (the batch prunes
-    // the neighbour cells a query cannot need; level sweep in docs/benchmarks.md)
-    // and about 1.5 k for k neighbours, so that the 27 cells around a query
-    // almost always settle it.
-    const double targetPopulation = batchNeighbourhoods ? std::max(8.0, 1.5 * static_cast<double>(k)) : 30.0;
-    result.level = params.octreeLevel;
-    if (result.level == 0) {
+    const bool knnModel = useModel && !params.radius;
+    const std::size_t k = static_cast<std::size_t>(params.neighbours);
+    auto levelFor = [&](double targetPopulation) {
+        int best = 1;
         double bestGap = std::numeric_limits<double>::infinity();
         for (int level = 1; level <= octree::kMaxLevel; ++level) {
             const double gap = std::abs(std::log(tree.levelStatistics(level).meanPointsPerCell / targetPopulation));
             if (gap < bestGap) {
                 bestGap = gap;
-                result.level = level;
+                best = level;
             }
         }
-    }
+        return best;
+    };
+    result.level = params.octreeLevel != 0 ? params.octreeLevel
+                   : knnModel            ? levelFor(std::max(8.0, 1.5 * static_cast<double>(k)))
+                                         : levelFor(30.0);
 
     std::vector<VisibilityLabel> labels;
     if (!params.viewpoints.empty()) {
@@ -156,7 +159,39 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
     ProgressTicker ticker(progress, useModel ? "Distances with local models" : "Nearest-neighbour distances", n);
     constexpr std::size_t kChunk = 1 << 16;
     std::vector<Eigen::Vector3f> chunkQueries;
-    std::vector<octree::Neighbour> chunkNeighbours;
+    std::vector<octree::Neighbour> chunkNeighbours; // the nearest reference point of each chunk point
+    std::vector<octree::Neighbour> chunkLists;      // with --knn: the k nearest of each
+
+    // Writes the distance d of the compared point at position j of the order
+    // (maximum distance, closest point, components).
+    auto store = [&](std::size_t j, double d) {
+        const std::uint32_t i = order[j];
+        const octree::Neighbour nb = chunkNeighbours[j % kChunk];
+        if (params.maxDistance && std::abs(d) > *params.maxDistance) {
+            if (!params.clampBeyondMax)
+                return;
+            d = d < 0 ? -*params.maxDistance : *params.maxDistance;
+        }
+        if (params.closestPoints)
+            closestIndex[i] = nb.index;
+        result.distance.values()[i] = static_cast<float>(d);
+        if (params.splitComponents) {
+            const Eigen::Vector3f v = chunkQueries[j % kChunk] - refPoints[nb.index];
+            result.dx->values()[i] = v.x();
+            result.dy->values()[i] = v.y();
+            result.dz->values()[i] = v.z();
+        }
+    };
+
+    // With --radius, the compared points of a chunk are grouped by nearest
+    // reference point: the neighbourhood, the reference points within the
+    // radius of that point ([ISPRS05]), is a function of it alone, so the model
+    // is fitted once per group. On two samplings of one surface, about 6 in 10
+    // reference points are someone's nearest neighbour.
+    const bool radiusModel = useModel && params.radius;
+    std::vector<std::uint32_t> groupOf(radiusModel ? reference.size() : 0, kNone); // reference point -> group, within a chunk
+    std::vector<std::uint32_t> groupPoint, groupStart, members;
+
     for (std::size_t chunkBegin = 0; chunkBegin < n; chunkBegin += kChunk) {
         const std::size_t chunkEnd = std::min(n, chunkBegin + kChunk);
         chunkQueries.resize(chunkEnd - chunkBegin);
@@ -166,61 +201,128 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
             // A NaN query gets no neighbour: how hidden points are skipped cheaply.
             chunkQueries[j - chunkBegin] = hidden ? Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()) : queries[i];
         }
-        tree.nearestBatch(chunkQueries.data(), chunkQueries.size(), k, result.level, chunkNeighbours);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(chunkBegin, chunkEnd, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
-            Scratch& s = scratch.local();
-            std::size_t localFallbacks = 0;
-            for (std::size_t j = range.begin(); j != range.end(); ++j) {
-                const std::uint32_t i = order[j];
-                const octree::Neighbour* list = chunkNeighbours.data() + (j - chunkBegin) * k;
-                const octree::Neighbour nb = list[0];
-                if (nb.index == kNone)
-                    continue; // NaN query, or not comparable: the value stays NaN
-                const Eigen::Vector3f& q = chunkQueries[j - chunkBegin];
-                const Eigen::Vector3f& p = refPoints[nb.index];
-                double d = std::sqrt(static_cast<double>(nb.squaredDistance));
-                if (params.signedDistances && !useModel && reference.normals()[nb.index].dot(q - p) < 0)
-                    d = -d; // sign by the reference normal at the nearest neighbour
-                if (useModel) {
+        if (knnModel) {
+            tree.nearestBatch(chunkQueries.data(), chunkQueries.size(), k, result.level, chunkLists);
+            chunkNeighbours.resize(chunkQueries.size());
+            for (std::size_t j = 0; j < chunkQueries.size(); ++j)
+                chunkNeighbours[j] = chunkLists[j * k];
+        } else {
+            tree.nearestBatch(chunkQueries.data(), chunkQueries.size(), 1, result.level, chunkNeighbours);
+        }
+        // Which side of a model is "positive": the reference normal at the
+        // nearest point, else the scanner, else up.
+        auto orientationAt = [&](std::uint32_t r) -> Eigen::Vector3d {
+            if (reference.hasNormals())
+                return reference.normals()[r].cast<double>();
+            if (haveSensor)
+                return sensorPosition - refPoints[r].cast<double>();
+            return Eigen::Vector3d::UnitZ();
+        };
+        if (knnModel) {
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(chunkBegin, chunkEnd, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+                Scratch& s = scratch.local();
+                std::size_t localFallbacks = 0;
+                for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                    const octree::Neighbour* list = chunkLists.data() + (j - chunkBegin) * k;
+                    if (list[0].index == kNone)
+                        continue; // NaN query, or not comparable: the value stays NaN
                     s.points.clear();
-                    if (batchNeighbourhoods) {
-                        for (std::size_t r = 0; r < k && list[r].index != kNone; ++r)
-                            s.points.push_back(refPoints[list[r].index].cast<double>());
-                    } else {
-                        tree.withinRadius(p, static_cast<float>(*params.radius), result.level, s.neighbours);
-                        for (const auto& m : s.neighbours)
-                            s.points.push_back(refPoints[m.index].cast<double>());
-                    }
-                    // Which side is "positive": the reference normal, else the scanner, else up.
-                    Eigen::Vector3d orientation = Eigen::Vector3d::UnitZ();
-                    if (reference.hasNormals())
-                        orientation = reference.normals()[nb.index].cast<double>();
-                    else if (haveSensor)
-                        orientation = sensorPosition - p.cast<double>();
+                    for (std::size_t m = 0; m < k && list[m].index != kNone; ++m)
+                        s.points.push_back(refPoints[list[m].index].cast<double>());
+                    double d = std::sqrt(static_cast<double>(list[0].squaredDistance));
                     double modelSigned = 0;
-                    if (detail::modelDistance(params.model, s.points, q.cast<double>(), orientation, modelSigned, s.model))
+                    if (detail::fitModel(params.model, s.points, orientationAt(list[0].index), s.fitted, s.model) &&
+                        detail::modelDistance(s.fitted, s.points, chunkQueries[j - chunkBegin].cast<double>(), modelSigned, s.model))
                         d = params.signedDistances ? modelSigned : std::abs(modelSigned);
                     else
                         ++localFallbacks; // thesis: a degenerate neighbourhood is no worse than plain NN
+                    store(j, d);
                 }
-                if (params.maxDistance && std::abs(d) > *params.maxDistance) {
-                    if (!params.clampBeyondMax)
-                        continue;
-                    d = d < 0 ? -*params.maxDistance : *params.maxDistance;
+                fallbacks += localFallbacks;
+                ticker.step(range.size());
+            });
+            continue;
+        }
+        if (!useModel) {
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(chunkBegin, chunkEnd, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+                for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                    const octree::Neighbour nb = chunkNeighbours[j - chunkBegin];
+                    if (nb.index == kNone)
+                        continue; // NaN query, or not comparable: the value stays NaN
+                    double d = std::sqrt(static_cast<double>(nb.squaredDistance));
+                    if (params.signedDistances && reference.normals()[nb.index].dot(chunkQueries[j - chunkBegin] - refPoints[nb.index]) < 0)
+                        d = -d; // sign by the reference normal at the nearest neighbour
+                    store(j, d);
                 }
-                if (params.closestPoints)
-                    closestIndex[i] = nb.index;
-                result.distance.values()[i] = static_cast<float>(d);
-                if (params.splitComponents) {
-                    const Eigen::Vector3f v = q - p;
-                    result.dx->values()[i] = v.x();
-                    result.dy->values()[i] = v.y();
-                    result.dz->values()[i] = v.z();
+                ticker.step(range.size());
+            });
+            continue;
+        }
+
+        // --radius: groups by nearest reference point, in order of first appearance, as
+        // lists of positions in the chunk (a counting sort).
+        groupPoint.clear();
+        groupStart.clear();
+        for (std::size_t j = 0; j < chunkQueries.size(); ++j) {
+            const std::uint32_t r = chunkNeighbours[j].index;
+            if (r == kNone)
+                continue;
+            if (groupOf[r] == kNone) {
+                groupOf[r] = static_cast<std::uint32_t>(groupPoint.size());
+                groupPoint.push_back(r);
+                groupStart.push_back(0);
+            }
+            ++groupStart[groupOf[r]];
+        }
+        std::uint32_t running = 0;
+        for (auto& start : groupStart) {
+            const std::uint32_t size = start;
+            start = running;
+            running += size;
+        }
+        groupStart.push_back(running);
+        members.resize(running);
+        for (std::size_t j = 0; j < chunkQueries.size(); ++j) {
+            const std::uint32_t r = chunkNeighbours[j].index;
+            if (r != kNone)
+                members[groupStart[groupOf[r]]++] = static_cast<std::uint32_t>(j);
+        }
+        for (std::size_t g = groupPoint.size(); g > 0; --g) // the increments above moved each start to the next one's
+            groupStart[g] = groupStart[g - 1];
+        groupStart[0] = 0;
+        for (const std::uint32_t r : groupPoint)
+            groupOf[r] = kNone;
+
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groupPoint.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
+            Scratch& s = scratch.local();
+            std::size_t localFallbacks = 0, done = 0;
+            for (std::size_t g = range.begin(); g != range.end(); ++g) {
+                const std::uint32_t r = groupPoint[g];
+                const Eigen::Vector3f& p = refPoints[r];
+                s.points.clear();
+                tree.withinRadius(p, static_cast<float>(*params.radius), result.level, s.neighbours);
+                for (const auto& m : s.neighbours)
+                    s.points.push_back(refPoints[m.index].cast<double>());
+                const bool fitted = detail::fitModel(params.model, s.points, orientationAt(r), s.fitted, s.model);
+                for (std::uint32_t m = groupStart[g]; m < groupStart[g + 1]; ++m) {
+                    const std::size_t j = chunkBegin + members[m];
+                    const octree::Neighbour nb = chunkNeighbours[members[m]];
+                    const Eigen::Vector3f& q = chunkQueries[members[m]];
+                    double d = std::sqrt(static_cast<double>(nb.squaredDistance));
+                    double modelSigned = 0;
+                    if (fitted && detail::modelDistance(s.fitted, s.points, q.cast<double>(), modelSigned, s.model))
+                        d = params.signedDistances ? modelSigned : std::abs(modelSigned);
+                    else
+                        ++localFallbacks; // thesis: a degenerate neighbourhood is no worse than plain NN
+                    store(j, d);
                 }
+                done += groupStart[g + 1] - groupStart[g];
             }
             fallbacks += localFallbacks;
-            ticker.step(range.size());
+            ticker.step(done);
         });
+        // Points without a neighbour (NaN, hidden) count as done too.
+        ticker.step(chunkQueries.size() - members.size());
     }
     result.modelFallbacks = fallbacks;
 

@@ -12,11 +12,10 @@ namespace scandiff::detail {
 
 namespace {
 
-struct PlaneFrame
+double orient2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c)
 {
-    Eigen::Vector3d centroid;
-    Eigen::Vector3d u, v, normal;
-};
+    return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+}
 
 //! Least-squares plane through the points; false if they are (nearly) collinear.
 bool fitPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& orientation, PlaneFrame& frame)
@@ -47,12 +46,14 @@ bool fitPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d&
     return true;
 }
 
-bool quadricDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q, const PlaneFrame& f, double& out)
+//! The quadric's coefficients over the plane frame; false if the points do not determine one.
+bool fitQuadric(const std::vector<Eigen::Vector3d>& points, FittedModel& m)
 {
     // h = a u^2 + b uv + c v^2 + d u + e v + f0 over the plane, by linear least
     // squares (the thesis used gradient descent; the closed form is exact).
     // Normal equations in fixed 6x6 size: no allocation per point; u and v are
     // scaled by the neighbourhood's extent so the system stays well conditioned.
+    const PlaneFrame& f = m.frame;
     if (points.size() < 6)
         return false;
     double extent = 0;
@@ -75,38 +76,192 @@ bool quadricDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::Ve
     if (solver.info() != Eigen::Success || !solver.isPositive() ||
         solver.vectorD().minCoeff() <= 1e-12 * solver.vectorD().maxCoeff())
         return false; // the points do not determine a quadric (e.g. all on a line)
-    const Eigen::Matrix<double, 6, 1> c = solver.solve(rhs);
+    m.quadric = solver.solve(rhs);
+    m.extent = extent;
+    return true;
+}
+
+bool quadricDistance(const FittedModel& m, const Eigen::Vector3d& q, double& out)
+{
+    const PlaneFrame& f = m.frame;
+    const Eigen::Matrix<double, 6, 1>& c = m.quadric;
+    const double scale = 1.0 / m.extent;
     const Eigen::Vector3d d = q - f.centroid;
     const double u = d.dot(f.u) * scale, v = d.dot(f.v) * scale, hq = d.dot(f.normal) * scale;
     const double surface = c[0] * u * u + c[1] * u * v + c[2] * v * v + c[3] * u + c[4] * v + c[5];
     const double du = 2 * c[0] * u + c[1] * v + c[3], dv = c[1] * u + 2 * c[2] * v + c[4];
     // Height difference brought to the surface normal (first order), back in metres.
-    out = (hq - surface) / std::sqrt(1.0 + du * du + dv * dv) * extent;
+    out = (hq - surface) / std::sqrt(1.0 + du * du + dv * dv) * m.extent;
     return std::isfinite(out);
 }
 
-bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q, const PlaneFrame& f,
-                      double& out, ModelScratch& scratch)
+//! Squared distance from x to the segment [a, b] in the plane.
+double squaredSegmentDistance(const Eigen::Vector2d& x, const Eigen::Vector2d& a, const Eigen::Vector2d& b)
+{
+    const Eigen::Vector2d ab = b - a;
+    const double length2 = ab.squaredNorm();
+    const double t = length2 > 0 ? std::clamp((x - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+    return (a + t * ab - x).squaredNorm();
+}
+
+//! Whether planar point `i` coincides with an earlier one: the triangulation
+//! keeps only the first of coincident points (see delaunay2d).
+bool coincidesWithEarlier(const std::vector<Eigen::Vector2d>& p, std::size_t i, double span)
+{
+    for (std::size_t j = 0; j < i; ++j)
+        if ((p[j] - p[i]).squaredNorm() <= 1e-24 * span * span)
+            return true;
+    return false;
+}
+
+double nearestTriangle(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector2d>& planar,
+                       const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector3d& q,
+                       const Eigen::Vector2d& qPlanar, Eigen::Vector3d& closest);
+
+//! The triangles around planar point c in the Delaunay triangulation of the
+//! planar points and the super-triangle that delaunay2d uses: the dual of c's
+//! Voronoi cell, a convex polygon clipped out of a large square by the
+//! bisector of c and every other site; each remaining edge names a Delaunay
+//! neighbour, and two consecutive neighbours make a triangle with c. This
+//! costs one small polygon clip per site instead of a whole triangulation.
+//! Returns false when c is a skipped duplicate, touches the super-triangle (it
+//! is on the hull: the real triangles around it do not close) or the clip
+//! degenerates.
+bool starOf(ModelScratch& s, int c, std::vector<std::array<int, 3>>& star)
+{
+    const std::vector<Eigen::Vector2d>& p = s.planar;
+    const int n = static_cast<int>(p.size());
+    star.clear();
+    if (n < 3)
+        return false;
+    Eigen::Vector2d lo = p[0], hi = p[0];
+    for (const auto& x : p) {
+        lo = lo.cwiseMin(x);
+        hi = hi.cwiseMax(x);
+    }
+    const double span = std::max((hi - lo).maxCoeff(), 1e-12);
+    if (coincidesWithEarlier(p, static_cast<std::size_t>(c), span))
+        return false;
+    const Eigen::Vector2d mid = 0.5 * (lo + hi);
+    // The super-triangle's vertices, exactly as delaunay2d places them.
+    const Eigen::Vector2d super[3] = {{mid.x() - 20 * span, mid.y() - span},
+                                      {mid.x(), mid.y() + 20 * span},
+                                      {mid.x() + 20 * span, mid.y() - span}};
+    const Eigen::Vector2d& centre = p[static_cast<std::size_t>(c)];
+    // The cell, relative to c, counter-clockwise; generator[i] is the site
+    // across the edge from corner i to corner i + 1 (-1: the initial square).
+    const double r = 100 * span;
+    auto& cell = s.cell;
+    auto& generator = s.generator;
+    cell.assign({{-r, -r}, {r, -r}, {r, r}, {-r, r}});
+    generator.assign({-1, -1, -1, -1});
+    auto clip = [&](const Eigen::Vector2d& site, int id) {
+        // Keep the points x (relative to c) closer to c than to the site:
+        // 2 x . w <= |w|^2 with w the site relative to c.
+        const Eigen::Vector2d w = site - centre;
+        const double w2 = w.squaredNorm();
+        const std::size_t m = cell.size();
+        s.side.resize(m);
+        bool cut = false;
+        for (std::size_t i = 0; i < m; ++i) {
+            s.side[i] = 2 * cell[i].dot(w) - w2;
+            cut = cut || s.side[i] > 0;
+        }
+        if (!cut)
+            return;
+        s.nextCell.clear();
+        s.nextGenerator.clear();
+        for (std::size_t i = 0; i < m; ++i) {
+            const std::size_t j = (i + 1) % m;
+            const double fa = s.side[i], fb = s.side[j];
+            if (fa <= 0) {
+                s.nextCell.push_back(cell[i]);
+                s.nextGenerator.push_back(generator[i]);
+            }
+            if ((fa <= 0) != (fb <= 0)) {
+                s.nextCell.push_back(cell[i] + (cell[j] - cell[i]) * (fa / (fa - fb)));
+                s.nextGenerator.push_back(fa <= 0 ? id : generator[i]);
+            }
+        }
+        cell.swap(s.nextCell);
+        generator.swap(s.nextGenerator);
+    };
+    for (int i = 0; i < n; ++i)
+        if (i != c && !coincidesWithEarlier(p, static_cast<std::size_t>(i), span))
+            clip(p[static_cast<std::size_t>(i)], i);
+    for (int i = 0; i < 3; ++i)
+        clip(super[i], n + i);
+    const std::size_t m = generator.size();
+    if (m < 3)
+        return false;
+    for (std::size_t i = 0; i < m; ++i) {
+        const int a = generator[i], b = generator[(i + 1) % m];
+        if (a < 0 || a >= n || b < 0 || b >= n)
+            return false; // on the hull, or the square survived
+        if (a != b)
+            star.push_back({c, a, b});
+    }
+    return star.size() >= 3;
+}
+
+//! Whether the triangles around one point (starOf) settle q: true when q
+//! projects inside them, farther from their outer boundary than from the
+//! nearest of them. Every other triangle lies beyond that boundary, and the
+//! distance to a triangle is at least the in-plane distance to its projection;
+//! the small margin keeps rounding on the safe side.
+bool starSettles(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector2d>& p,
+                 const std::vector<std::array<int, 3>>& star, const Eigen::Vector3d& q, const Eigen::Vector2d& qPlanar,
+                 double& best, Eigen::Vector3d& closest)
+{
+    double boundary2 = std::numeric_limits<double>::infinity();
+    bool inside = false;
+    for (const auto& t : star) {
+        const Eigen::Vector2d& c = p[static_cast<std::size_t>(t[0])];
+        const Eigen::Vector2d& a = p[static_cast<std::size_t>(t[1])];
+        const Eigen::Vector2d& b = p[static_cast<std::size_t>(t[2])];
+        boundary2 = std::min(boundary2, squaredSegmentDistance(qPlanar, a, b));
+        inside = inside || (orient2d(c, a, qPlanar) >= 0 && orient2d(a, b, qPlanar) >= 0 && orient2d(b, c, qPlanar) >= 0);
+    }
+    if (!inside)
+        return false;
+    best = nearestTriangle(points, p, star, q, qPlanar, closest);
+    return best < boundary2 * (1 - 1e-9);
+}
+
+//! Prepares the Delaunay model: the planar coordinates, and the triangles
+//! around point 0 (starOf). The whole triangulation is only built
+//! (fullTriangulation) when a compared point needs more than those triangles,
+//! or when point 0 lies on the hull.
+bool fitDelaunay(const std::vector<Eigen::Vector3d>& points, const PlaneFrame& f, ModelScratch& scratch)
 {
     scratch.planar.clear();
     for (const auto& p : points) {
         const Eigen::Vector3d d = p - f.centroid;
         scratch.planar.emplace_back(d.dot(f.u), d.dot(f.v));
     }
-    std::vector<std::array<int, 3>>& triangles = scratch.keep;
-    delaunay2d(scratch.planar, triangles, scratch);
-    if (triangles.empty())
-        return false;
+    scratch.triangulated = false;
+    scratch.keep.clear();
+    scratch.starUsable = starOf(scratch, 0, scratch.star);
+    scratch.otherStarCentre = -1;
+    if (scratch.starUsable)
+        return true;
+    delaunay2d(scratch.planar, scratch.keep, scratch);
+    scratch.triangulated = true;
+    return !scratch.keep.empty();
+}
+
+//! Smallest squared distance from q to the given triangles, and the closest point.
+double nearestTriangle(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector2d>& planar,
+                       const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector3d& q,
+                       const Eigen::Vector2d& qPlanar, Eigen::Vector3d& closest)
+{
     double best = std::numeric_limits<double>::infinity();
-    Eigen::Vector3d closest = Eigen::Vector3d::Zero();
-    const Eigen::Vector3d dq = q - f.centroid;
-    const Eigen::Vector2d qPlanar(dq.dot(f.u), dq.dot(f.v));
     for (const auto& t : triangles) {
         // Projection onto the plane shortens distances, so the in-plane gap to
         // the triangle's box is a lower bound: skip triangles that cannot win.
-        const Eigen::Vector2d& a = scratch.planar[static_cast<std::size_t>(t[0])];
-        const Eigen::Vector2d& b = scratch.planar[static_cast<std::size_t>(t[1])];
-        const Eigen::Vector2d& c = scratch.planar[static_cast<std::size_t>(t[2])];
+        const Eigen::Vector2d& a = planar[static_cast<std::size_t>(t[0])];
+        const Eigen::Vector2d& b = planar[static_cast<std::size_t>(t[1])];
+        const Eigen::Vector2d& c = planar[static_cast<std::size_t>(t[2])];
         const Eigen::Vector2d lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
         const Eigen::Vector2d gap = (lo - qPlanar).cwiseMax(qPlanar - hi).cwiseMax(Eigen::Vector2d::Zero());
         if (gap.squaredNorm() > best)
@@ -119,8 +274,202 @@ bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::V
             closest = r.closestPoint;
         }
     }
+    return best;
+}
+
+bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q, const PlaneFrame& f,
+                      ModelScratch& scratch, double& out)
+{
+    const Eigen::Vector3d dq = q - f.centroid;
+    const Eigen::Vector2d qPlanar(dq.dot(f.u), dq.dot(f.v));
+    Eigen::Vector3d closest = Eigen::Vector3d::Zero();
+    double best = std::numeric_limits<double>::infinity();
+    bool settled = false;
+    // The triangles around point 0 usually decide; a compared point that
+    // projects beyond them (point 0's Voronoi cell reaches past its triangles
+    // where an angle at point 0 is obtuse) tries those around the other planar
+    // point nearest to its projection (kept for the next compared point of the group).
+    if (scratch.starUsable)
+        settled = starSettles(points, scratch.planar, scratch.star, q, qPlanar, best, closest);
+    if (!settled && !scratch.triangulated && scratch.planar.size() > 1) {
+        int nearest = 1;
+        for (std::size_t i = 2; i < scratch.planar.size(); ++i)
+            if ((scratch.planar[i] - qPlanar).squaredNorm() < (scratch.planar[static_cast<std::size_t>(nearest)] - qPlanar).squaredNorm())
+                nearest = static_cast<int>(i);
+        {
+            if (nearest != scratch.otherStarCentre) {
+                scratch.otherStarCentre = nearest;
+                scratch.otherStarUsable = starOf(scratch, nearest, scratch.otherStar);
+            }
+            if (scratch.otherStarUsable)
+                settled = starSettles(points, scratch.planar, scratch.otherStar, q, qPlanar, best, closest);
+        }
+    }
+    if (!settled) {
+        if (!scratch.triangulated) {
+            delaunay2d(scratch.planar, scratch.keep, scratch);
+            scratch.triangulated = true;
+        }
+        if (scratch.keep.empty())
+            return false;
+        best = nearestTriangle(points, scratch.planar, scratch.keep, q, qPlanar, closest);
+    }
     const double side = (q - closest).dot(f.normal);
     out = std::sqrt(best) * (side < 0 ? -1.0 : 1.0);
+    return true;
+}
+
+} // namespace
+
+namespace {
+
+//! Whether d lies strictly inside the circumcircle of the triangle t of p.
+bool inCircumcircle(const std::vector<Eigen::Vector2d>& p, const std::array<int, 3>& t, const Eigen::Vector2d& d)
+{
+    const Eigen::Vector2d a = p[static_cast<std::size_t>(t[0])] - d, b = p[static_cast<std::size_t>(t[1])] - d,
+                          c = p[static_cast<std::size_t>(t[2])] - d;
+    const double det = (a.squaredNorm()) * (b.x() * c.y() - c.x() * b.y()) -
+                       (b.squaredNorm()) * (a.x() * c.y() - c.x() * a.y()) +
+                       (c.squaredNorm()) * (a.x() * b.y() - b.x() * a.y());
+    const double orientation = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    return orientation > 0 ? det > 0 : det < 0;
+}
+
+//! The plain Bowyer-Watson insertion: every triangle is tested against every
+//! new point and the cavity's boundary is found by matching edges pairwise,
+//! O(n^2) per point. Used when the fast insertion meets a configuration its
+//! floating-point tests cannot walk through consistently (nearly cocircular or
+//! collinear points), where this version needs no adjacency to stay coherent.
+void delaunay2dQuadratic(std::vector<Eigen::Vector2d>& p, int n, std::vector<std::array<int, 3>>& work,
+                         std::vector<std::array<int, 2>>& edges, double span)
+{
+    work.assign(1, {n, n + 1, n + 2});
+    for (int i = 0; i < n; ++i) {
+        const Eigen::Vector2d& d = p[static_cast<std::size_t>(i)];
+        bool duplicate = false;
+        for (int j = 0; j < i && !duplicate; ++j)
+            duplicate = (p[static_cast<std::size_t>(j)] - d).squaredNorm() <= 1e-24 * span * span;
+        if (duplicate)
+            continue;
+        edges.clear();
+        std::size_t kept = 0;
+        for (std::size_t t = 0; t < work.size(); ++t) {
+            if (inCircumcircle(p, work[t], d)) {
+                for (int e = 0; e < 3; ++e)
+                    edges.push_back({work[t][static_cast<std::size_t>(e)], work[t][static_cast<std::size_t>((e + 1) % 3)]});
+            } else {
+                work[kept++] = work[t];
+            }
+        }
+        work.resize(kept);
+        for (std::size_t e = 0; e < edges.size(); ++e) {
+            bool shared = false;
+            for (std::size_t f = 0; f < edges.size() && !shared; ++f)
+                shared = f != e && edges[f][0] == edges[e][1] && edges[f][1] == edges[e][0];
+            if (!shared)
+                work.push_back({edges[e][0], edges[e][1], i});
+        }
+    }
+}
+
+//! Bowyer-Watson with triangle adjacency: a walk finds the triangle holding
+//! the new point, the cavity grows from it through neighbours only, and its
+//! boundary comes from the adjacency, so a point costs about the size of its
+//! cavity instead of the whole triangulation. Returns false (the caller then
+//! uses delaunay2dQuadratic) if a floating-point test contradicts the
+//! structure: a walk that does not end, a cavity that is not star-shaped.
+bool delaunay2dAdjacency(const std::vector<Eigen::Vector2d>& p, int n, ModelScratch& s, double span)
+{
+    auto& mesh = s.mesh;
+    mesh.clear();
+    // Counter-clockwise super-triangle (the vertices n, n+2, n+1 of the caller's layout).
+    mesh.push_back({{n, n + 2, n + 1}, {-1, -1, -1}, true});
+    const std::size_t vertices = static_cast<std::size_t>(n) + 3;
+    s.startAt.assign(vertices, -1);
+    s.startStamp.assign(vertices, -1);
+    int last = 0;
+    for (int i = 0; i < n; ++i) {
+        const Eigen::Vector2d& d = p[static_cast<std::size_t>(i)];
+        bool duplicate = false;
+        for (int j = 0; j < i && !duplicate; ++j)
+            duplicate = (p[static_cast<std::size_t>(j)] - d).squaredNorm() <= 1e-24 * span * span;
+        if (duplicate)
+            continue;
+        // Walk towards d: leave through an edge that d lies strictly beyond.
+        int t = last;
+        std::size_t steps = 0;
+        for (;; ++steps) {
+            if (steps > mesh.size())
+                return false;
+            const auto& tri = mesh[static_cast<std::size_t>(t)];
+            int next = -1;
+            for (int e = 0; e < 3; ++e) {
+                const auto a = static_cast<std::size_t>(tri.v[static_cast<std::size_t>(e)]);
+                const auto b = static_cast<std::size_t>(tri.v[static_cast<std::size_t>((e + 1) % 3)]);
+                if (orient2d(p[a], p[b], d) < 0) {
+                    next = tri.nb[static_cast<std::size_t>(e)];
+                    if (next < 0)
+                        return false; // beyond the super-triangle: cannot happen with exact tests
+                    break;
+                }
+            }
+            if (next < 0)
+                break;
+            t = next;
+        }
+        if (!inCircumcircle(p, mesh[static_cast<std::size_t>(t)].v, d))
+            return false;
+        // The cavity: the connected triangles whose circumcircle holds d.
+        s.cavity.clear();
+        s.cavity.push_back(t);
+        mesh[static_cast<std::size_t>(t)].alive = false;
+        for (std::size_t c = 0; c < s.cavity.size(); ++c) {
+            const auto& tri = mesh[static_cast<std::size_t>(s.cavity[c])];
+            for (int e = 0; e < 3; ++e) {
+                const int w = tri.nb[static_cast<std::size_t>(e)];
+                if (w >= 0 && mesh[static_cast<std::size_t>(w)].alive && inCircumcircle(p, mesh[static_cast<std::size_t>(w)].v, d)) {
+                    mesh[static_cast<std::size_t>(w)].alive = false;
+                    s.cavity.push_back(w);
+                }
+            }
+        }
+        // One new triangle (a, b, i) per boundary edge (a, b), linked to the
+        // triangle outside it; the new triangles are then linked to each other
+        // through the boundary vertex they share.
+        const std::size_t firstNew = mesh.size();
+        for (const int c : s.cavity) {
+            for (int e = 0; e < 3; ++e) {
+                const auto& tri = mesh[static_cast<std::size_t>(c)];
+                const int w = tri.nb[static_cast<std::size_t>(e)];
+                if (w >= 0 && !mesh[static_cast<std::size_t>(w)].alive)
+                    continue;
+                const int a = tri.v[static_cast<std::size_t>(e)], b = tri.v[static_cast<std::size_t>((e + 1) % 3)];
+                if (orient2d(p[static_cast<std::size_t>(a)], p[static_cast<std::size_t>(b)], d) <= 0)
+                    return false; // the cavity is not star-shaped from d
+                if (s.startStamp[static_cast<std::size_t>(a)] == i)
+                    return false; // two boundary edges leave a: not a simple cycle
+                const int created = static_cast<int>(mesh.size());
+                s.startAt[static_cast<std::size_t>(a)] = created;
+                s.startStamp[static_cast<std::size_t>(a)] = i;
+                mesh.push_back({{a, b, i}, {w, -1, -1}, true});
+                if (w >= 0) {
+                    auto& outside = mesh[static_cast<std::size_t>(w)];
+                    for (int f = 0; f < 3; ++f)
+                        if (outside.v[static_cast<std::size_t>(f)] == b && outside.v[static_cast<std::size_t>((f + 1) % 3)] == a)
+                            outside.nb[static_cast<std::size_t>(f)] = created;
+                }
+            }
+        }
+        for (std::size_t m = firstNew; m < mesh.size(); ++m) {
+            const auto b = static_cast<std::size_t>(mesh[m].v[1]);
+            if (s.startStamp[b] != i)
+                return false; // the boundary is not closed
+            const int following = s.startAt[b];
+            mesh[m].nb[1] = following;
+            mesh[static_cast<std::size_t>(following)].nb[2] = static_cast<int>(m);
+        }
+        last = static_cast<int>(mesh.size()) - 1;
+    }
     return true;
 }
 
@@ -146,66 +495,49 @@ void delaunay2d(const std::vector<Eigen::Vector2d>& input, std::vector<std::arra
     p.emplace_back(mid.x() - 20 * span, mid.y() - span);
     p.emplace_back(mid.x(), mid.y() + 20 * span);
     p.emplace_back(mid.x() + 20 * span, mid.y() - span);
-    std::vector<std::array<int, 3>>& work = scratch.triangles;
-    work.assign(1, {n, n + 1, n + 2});
-    auto inCircumcircle = [&](const std::array<int, 3>& t, const Eigen::Vector2d& d) {
-        const Eigen::Vector2d a = p[static_cast<std::size_t>(t[0])] - d, b = p[static_cast<std::size_t>(t[1])] - d,
-                              c = p[static_cast<std::size_t>(t[2])] - d;
-        const double det = (a.squaredNorm()) * (b.x() * c.y() - c.x() * b.y()) -
-                           (b.squaredNorm()) * (a.x() * c.y() - c.x() * a.y()) +
-                           (c.squaredNorm()) * (a.x() * b.y() - b.x() * a.y());
-        const double orientation = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-        return orientation > 0 ? det > 0 : det < 0;
-    };
-    std::vector<std::array<int, 2>>& edges = scratch.edges;
-    for (int i = 0; i < n; ++i) {
-        const Eigen::Vector2d& d = p[static_cast<std::size_t>(i)];
-        // Coincident points add nothing to a triangulation.
-        bool duplicate = false;
-        for (int j = 0; j < i && !duplicate; ++j)
-            duplicate = (p[static_cast<std::size_t>(j)] - d).squaredNorm() <= 1e-24 * span * span;
-        if (duplicate)
-            continue;
-        edges.clear();
-        std::size_t kept = 0;
-        for (std::size_t t = 0; t < work.size(); ++t) {
-            if (inCircumcircle(work[t], d)) {
-                for (int e = 0; e < 3; ++e)
-                    edges.push_back({work[t][static_cast<std::size_t>(e)], work[t][static_cast<std::size_t>((e + 1) % 3)]});
-            } else {
-                work[kept++] = work[t];
-            }
-        }
-        work.resize(kept);
-        // Edges seen once bound the cavity; re-triangulate it around the new point.
-        for (std::size_t e = 0; e < edges.size(); ++e) {
-            bool shared = false;
-            for (std::size_t f = 0; f < edges.size() && !shared; ++f)
-                shared = f != e && edges[f][0] == edges[e][1] && edges[f][1] == edges[e][0];
-            if (!shared)
-                work.push_back({edges[e][0], edges[e][1], i});
-        }
+    if (delaunay2dAdjacency(p, n, scratch, span)) {
+        for (const auto& t : scratch.mesh)
+            if (t.alive && t.v[0] < n && t.v[1] < n && t.v[2] < n)
+                triangles.push_back(t.v);
+    } else {
+        delaunay2dQuadratic(p, n, scratch.triangles, scratch.edges, span);
+        for (const auto& t : scratch.triangles)
+            if (t[0] < n && t[1] < n && t[2] < n)
+                triangles.push_back(t);
     }
-    for (const auto& t : work)
-        if (t[0] < n && t[1] < n && t[2] < n)
-            triangles.push_back(t);
     p.resize(static_cast<std::size_t>(n));
 }
 
-bool modelDistance(LocalModel model, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q,
-                   const Eigen::Vector3d& orientation, double& signedDistance, ModelScratch& scratch)
+bool fitModel(LocalModel model, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& orientation,
+              FittedModel& fitted, ModelScratch& scratch)
 {
-    PlaneFrame frame;
-    if (!fitPlane(points, orientation, frame))
+    fitted.model = model;
+    if (!fitPlane(points, orientation, fitted.frame))
         return false;
     switch (model) {
     case LocalModel::Plane:
-        signedDistance = (q - frame.centroid).dot(frame.normal);
         return true;
     case LocalModel::Quadric:
-        return quadricDistance(points, q, frame, signedDistance);
+        return fitQuadric(points, fitted);
     case LocalModel::Delaunay:
-        return delaunayDistance(points, q, frame, signedDistance, scratch);
+        return fitDelaunay(points, fitted.frame, scratch);
+    case LocalModel::None:
+        break;
+    }
+    return false;
+}
+
+bool modelDistance(const FittedModel& fitted, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q,
+                   double& signedDistance, ModelScratch& scratch)
+{
+    switch (fitted.model) {
+    case LocalModel::Plane:
+        signedDistance = (q - fitted.frame.centroid).dot(fitted.frame.normal);
+        return true;
+    case LocalModel::Quadric:
+        return quadricDistance(fitted, q, signedDistance);
+    case LocalModel::Delaunay:
+        return delaunayDistance(points, q, fitted.frame, scratch, signedDistance);
     case LocalModel::None:
         break;
     }

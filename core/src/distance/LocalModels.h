@@ -12,24 +12,75 @@
 
 namespace scandiff::detail {
 
+//! A triangle of the 2D triangulation under construction: its vertices counter-
+//! clockwise and, across each edge (v[e], v[e+1]), the neighbouring triangle (-1: none).
+struct DelaunayTriangle
+{
+    std::array<int, 3> v;
+    std::array<int, 3> nb;
+    bool alive;
+};
+
+//! Buffers reused from point to point, so that a model costs no allocation.
 struct ModelScratch
 {
     std::vector<Eigen::Vector2d> planar;
     std::vector<std::array<int, 3>> triangles;
     std::vector<std::array<int, 3>> keep;
     std::vector<std::array<int, 2>> edges;
+    std::vector<DelaunayTriangle> mesh;
+    std::vector<int> cavity, startAt, startStamp;
+    //! The Delaunay model: the triangles around point 0 and around another
+    //! point, and whether they can be used; whether `keep` holds the whole
+    //! triangulation of `planar`.
+    std::vector<std::array<int, 3>> star, otherStar;
+    bool starUsable = false, triangulated = false;
+    int otherStarCentre = -1; //!< the point otherStar surrounds (-1: none yet)
+    bool otherStarUsable = false;
+    std::vector<Eigen::Vector2d> cell, nextCell; //!< point 0's Voronoi cell while it is clipped
+    std::vector<int> generator, nextGenerator;
+    std::vector<double> side;
 };
 
-//! Signed distance from q to the model of `points` (positive on the side of the
-//! model normal, oriented to agree with `orientation`). Returns false when the
-//! neighbourhood is too small or degenerate (collinear, coincident) for the model.
-bool modelDistance(LocalModel model, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q,
-                   const Eigen::Vector3d& orientation, double& signedDistance, ModelScratch& scratch);
+//! The least-squares plane of a neighbourhood: centroid, normal (the smallest
+//! principal axis, oriented to agree with the caller's orientation) and two
+//! in-plane axes (u the largest principal axis, v = normal x u).
+struct PlaneFrame
+{
+    Eigen::Vector3d centroid;
+    Eigen::Vector3d u, v, normal;
+};
 
-//! 2D Delaunay triangulation (Bowyer-Watson) of up to a few hundred points, the
-//! size of a local neighbourhood. Written here because core may not use CGAL
-//! (it lives in the GPL plugins), and for so few points a direct O(n^2)
-//! insertion is faster than setting up a general-purpose triangulation.
+//! A model fitted on one neighbourhood; the Delaunay triangles live in the
+//! ModelScratch that fitted it until the next fit.
+struct FittedModel
+{
+    LocalModel model = LocalModel::None;
+    PlaneFrame frame;
+    Eigen::Matrix<double, 6, 1> quadric; //!< a u^2 + b uv + c v^2 + d u + e v + f, u and v divided by extent
+    double extent = 0;
+};
+
+//! Fits `model` on `points`. Returns false when the neighbourhood is too small
+//! or degenerate (collinear, coincident) for the model. The model depends on the
+//! points and their order only, so one fit serves every compared point that has
+//! the same neighbourhood.
+bool fitModel(LocalModel model, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& orientation,
+              FittedModel& fitted, ModelScratch& scratch);
+
+//! Signed distance from q to a fitted model (positive on the side of the model
+//! normal); `points` and `scratch` are those of the fit (the Delaunay model may
+//! complete its triangulation in `scratch` on demand). False if not finite.
+//! For the Delaunay model, q should lie near point 0, the neighbourhood's
+//! centre: the triangles around it then decide alone (faster, same result).
+bool modelDistance(const FittedModel& fitted, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q,
+                   double& signedDistance, ModelScratch& scratch);
+
+//! 2D Delaunay triangulation (Bowyer-Watson in a super-triangle, points inserted
+//! in their given order, coincident points skipped) of up to a few hundred
+//! points, the size of a local neighbourhood. Written here because core may not
+//! use CGAL (it lives in the GPL plugins), and for so few points a direct
+//! incremental insertion is faster than setting up a general-purpose triangulation.
 void delaunay2d(const std::vector<Eigen::Vector2d>& points, std::vector<std::array<int, 3>>& triangles, ModelScratch& scratch);
 
 } // namespace scandiff::detail
