@@ -80,6 +80,12 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
     statusBar()->showMessage(tr("Open clouds or meshes (File > Open, or drop files here)"));
 }
 
+MainWindow::~MainWindow()
+{
+    disconnect(&document_, nullptr, this, nullptr);
+    view_->clear();
+}
+
 template <class Controller> void MainWindow::report(Controller* controller)
 {
     connect(controller, &Controller::finished, this, [this](const QString& summary) {

@@ -32,6 +32,9 @@ class MainWindow : public QMainWindow
     Q_OBJECT
 public:
     explicit MainWindow(const PluginRegistry& registry, QWidget* parent = nullptr);
+    //! Empties the view first: its VTK arrays read the document's points, and the
+    //! document (a member) goes before the view (a child widget).
+    ~MainWindow() override;
 
     //! Loads files (errors in a message box, or with `quiet` only in the console).
     //! Returns how many loaded.
