@@ -474,6 +474,20 @@ int Octree::levelForMeanPopulation(double maxMeanPointsPerCell) const
     return kMaxLevel;
 }
 
+int Octree::levelNearestMeanPopulation(double targetPointsPerCell) const
+{
+    int best = 1;
+    double bestGap = std::numeric_limits<double>::infinity();
+    for (int level = 1; level <= kMaxLevel; ++level) {
+        const double gap = std::abs(std::log(stats_[static_cast<std::size_t>(level)].meanPointsPerCell / targetPointsPerCell));
+        if (gap < bestGap) {
+            bestGap = gap;
+            best = level;
+        }
+    }
+    return best;
+}
+
 std::vector<MortonCode> Octree::neighbourCells(MortonCode cellCode, int level, Connectivity connectivity) const
 {
     if (level < 1 || level > kMaxLevel)
@@ -662,18 +676,20 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                 const Eigen::Vector3f& q = queries[qi];
                 s.heap.clear();
                 const std::size_t m = s.indices.size();
+                // Squared gap from q to the near face of the neighbour cell at
+                // offset -1 / 0 / +1 along each axis; a cell's gap is their sum.
+                const Eigen::Vector3d local = q.cast<double>() - centre;
+                double faceGap2[3][3];
+                for (int a = 0; a < 3; ++a) {
+                    const double below = 0.5 * l + local[a], above = 0.5 * l - local[a];
+                    faceGap2[a][0] = below * below;
+                    faceGap2[a][1] = 0.0;
+                    faceGap2[a][2] = above * above;
+                }
                 if (k == 1) {
                     // The common case (cloud/cloud distance): a running minimum, no
                     // heap, and a cell is skipped when its box is already farther
                     // than the best distance (ties are still scanned).
-                    const Eigen::Vector3d local = q.cast<double>() - centre;
-                    double faceGap2[3][3];
-                    for (int a = 0; a < 3; ++a) {
-                        const double below = 0.5 * l + local[a], above = 0.5 * l - local[a];
-                        faceGap2[a][0] = below * below;
-                        faceGap2[a][1] = 0.0;
-                        faceGap2[a][2] = above * above;
-                    }
                     // Per cell: the distances (vectorised), their minimum (a
                     // vectorised reduction, no dependent compare-and-branch per
                     // candidate); the index tie-break is a second pass over the
@@ -712,14 +728,6 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                     // than its last entry cannot contribute, and neither can any
                     // later cell. With cells of about k points, a query usually
                     // scans two or three of them instead of the whole neighbourhood.
-                    const Eigen::Vector3d local = q.cast<double>() - centre;
-                    double faceGap2[3][3];
-                    for (int a = 0; a < 3; ++a) {
-                        const double below = 0.5 * l + local[a], above = 0.5 * l - local[a];
-                        faceGap2[a][0] = below * below;
-                        faceGap2[a][1] = 0.0;
-                        faceGap2[a][2] = above * above;
-                    }
                     std::array<std::pair<double, int>, 27> byGap;
                     for (int c = 0; c < s.cellCount; ++c) {
                         const auto& o = s.cellOffset[static_cast<std::size_t>(c)];
@@ -762,7 +770,7 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                     s.statistics.distances += scanned;
                 }
                 // Inscribed sphere of the 27 cells around q (eq. 4.1 with j = 1).
-                const double inner = 0.5 * l - (q.cast<double>() - centre).cwiseAbs().maxCoeff();
+                const double inner = 0.5 * l - local.cwiseAbs().maxCoeff();
                 const double inscribed = l + inner;
                 // k = 1 leaves its single entry in s.heap, k > 1 a sorted list: either
                 // way the k-th distance is the last entry.

@@ -248,6 +248,19 @@ TEST(Octree, LevelRuleOfIsprs2005)
     EXPECT_GT(tree.levelStatistics(level - 1).meanPointsPerCell, 10.0);
 }
 
+TEST(Octree, LevelNearestATargetPopulation)
+{
+    std::mt19937 rng(2);
+    const Cloud cloud = randomCloud(4096, rng);
+    const Octree tree(cloud.data(), cloud.size());
+    for (double target : {1.0, 8.0, 30.0, 500.0}) {
+        const int level = tree.levelNearestMeanPopulation(target);
+        const double gap = std::abs(std::log(tree.levelStatistics(level).meanPointsPerCell / target));
+        for (int other = 1; other <= kMaxLevel; ++other)
+            EXPECT_LE(gap, std::abs(std::log(tree.levelStatistics(other).meanPointsPerCell / target))) << target << " " << other;
+    }
+}
+
 TEST(Octree, BatchNearestEqualsBruteForceAtEveryLevel)
 {
     std::mt19937 rng(17);

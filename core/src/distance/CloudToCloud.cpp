@@ -118,21 +118,9 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
     const bool useModel = params.model != LocalModel::None;
     const bool knnModel = useModel && !params.radius;
     const std::size_t k = static_cast<std::size_t>(params.neighbours);
-    auto levelFor = [&](double targetPopulation) {
-        int best = 1;
-        double bestGap = std::numeric_limits<double>::infinity();
-        for (int level = 1; level <= octree::kMaxLevel; ++level) {
-            const double gap = std::abs(std::log(tree.levelStatistics(level).meanPointsPerCell / targetPopulation));
-            if (gap < bestGap) {
-                bestGap = gap;
-                best = level;
-            }
-        }
-        return best;
-    };
     result.level = params.octreeLevel != 0 ? params.octreeLevel
-                   : knnModel            ? levelFor(std::max(8.0, 1.5 * static_cast<double>(k)))
-                                         : levelFor(30.0);
+                   : knnModel            ? tree.levelNearestMeanPopulation(std::max(8.0, 1.5 * static_cast<double>(k)))
+                                         : tree.levelNearestMeanPopulation(30.0);
 
     std::vector<VisibilityLabel> labels;
     if (!params.viewpoints.empty()) {

@@ -346,10 +346,7 @@ void delaunay2dQuadratic(std::vector<Eigen::Vector2d>& p, int n, std::vector<std
     work.assign(1, {n, n + 1, n + 2});
     for (int i = 0; i < n; ++i) {
         const Eigen::Vector2d& d = p[static_cast<std::size_t>(i)];
-        bool duplicate = false;
-        for (int j = 0; j < i && !duplicate; ++j)
-            duplicate = (p[static_cast<std::size_t>(j)] - d).squaredNorm() <= 1e-24 * span * span;
-        if (duplicate)
+        if (coincidesWithEarlier(p, static_cast<std::size_t>(i), span))
             continue;
         edges.clear();
         std::size_t kept = 0;
@@ -390,10 +387,7 @@ bool delaunay2dAdjacency(const std::vector<Eigen::Vector2d>& p, int n, ModelScra
     int last = 0;
     for (int i = 0; i < n; ++i) {
         const Eigen::Vector2d& d = p[static_cast<std::size_t>(i)];
-        bool duplicate = false;
-        for (int j = 0; j < i && !duplicate; ++j)
-            duplicate = (p[static_cast<std::size_t>(j)] - d).squaredNorm() <= 1e-24 * span * span;
-        if (duplicate)
+        if (coincidesWithEarlier(p, static_cast<std::size_t>(i), span))
             continue;
         // Walk towards d: leave through an edge that d lies strictly beyond.
         int t = last;

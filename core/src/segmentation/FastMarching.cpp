@@ -187,7 +187,7 @@ GradientResult gradientNorm(const PointCloud& cloud, const std::string& fieldNam
     checkCloud(cloud, "gradient");
     const octree::Octree tree = buildOctree(cloud);
     GradientResult result;
-    result.radius = params.radius > 0 ? params.radius : tree.cellSize(detail::levelForPopulation(tree, 16.0));
+    result.radius = params.radius > 0 ? params.radius : tree.cellSize(tree.levelNearestMeanPopulation(16.0));
     const std::size_t n = cloud.size();
     const auto& positions = cloud.positions();
     // The level whose cells are about as wide as the search sphere.
@@ -285,7 +285,7 @@ FastMarchingResult fastMarching(const PointCloud& cloud, const std::vector<std::
     checkCloud(cloud, "fast marching");
     const octree::Octree tree = buildOctree(cloud);
     FastMarchingResult result;
-    result.level = params.level > 0 ? params.level : detail::levelForPopulation(tree, 4.0);
+    result.level = params.level > 0 ? params.level : tree.levelNearestMeanPopulation(4.0);
     const CellGrid grid = makeGrid(tree, result.level);
     result.cellSize = grid.h;
     result.cellCount = grid.cells.size();
@@ -367,7 +367,7 @@ PropagationResult propagationSegmentation(const PointCloud& cloud, const std::st
     PropagationResult result;
     result.gradient = gradientNorm(cloud, fieldName, params.gradient, progress).norm;
     const octree::Octree tree = buildOctree(cloud);
-    result.level = params.level > 0 ? params.level : detail::levelForPopulation(tree, 8.0);
+    result.level = params.level > 0 ? params.level : tree.levelNearestMeanPopulation(8.0);
     const CellGrid grid = makeGrid(tree, result.level);
     result.cellSize = grid.h;
     const std::size_t cellCount = grid.cells.size();

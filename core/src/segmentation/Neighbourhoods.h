@@ -16,22 +16,6 @@
 
 namespace scandiff::detail {
 
-//! The level whose mean cell population is nearest `target` (log scale): the
-//! batch k-NN query settles most queries from a cell's 27-neighbourhood then.
-inline int levelForPopulation(const octree::Octree& tree, double target)
-{
-    int best = 1;
-    double bestGap = std::numeric_limits<double>::infinity();
-    for (int level = 1; level <= octree::kMaxLevel; ++level) {
-        const double gap = std::abs(std::log(tree.levelStatistics(level).meanPointsPerCell / target));
-        if (gap < bestGap) {
-            bestGap = gap;
-            best = level;
-        }
-    }
-    return best;
-}
-
 //! Calls visit(i, neighbours, count) for every point i of the octree's array,
 //! with its k nearest points (itself first, closest first; count < k only when
 //! the cloud is smaller than k). Runs in Morton-ordered chunks so the neighbour

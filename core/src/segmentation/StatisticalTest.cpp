@@ -305,7 +305,7 @@ LocalChiSquareResult localChiSquareTest(const PointCloud& cloud, const std::stri
 
     const octree::Octree tree = buildOctree(cloud);
     const int level = params.octreeLevel > 0 ? params.octreeLevel
-                                             : detail::levelForPopulation(tree, std::max(8.0, 1.5 * static_cast<double>(n)));
+                                             : tree.levelNearestMeanPopulation(std::max(8.0, 1.5 * static_cast<double>(n)));
     result.chiSquare = ScalarField(fields::kChiSquare, size);
     result.changed = ScalarField(fields::kChanged, size);
     std::atomic<std::size_t> changedCount{0};

@@ -139,6 +139,11 @@ public:
     //! number of points per non-empty cell is at most `maxMeanPointsPerCell`.
     int levelForMeanPopulation(double maxMeanPointsPerCell) const;
 
+    //! The level whose mean number of points per non-empty cell is nearest
+    //! `targetPointsPerCell` on a log scale (the shallowest on a tie): what the
+    //! batch queries use so that a cell's 27-neighbourhood settles most queries.
+    int levelNearestMeanPopulation(double targetPointsPerCell) const;
+
 private:
     std::array<std::int64_t, 3> cellOf(const Eigen::Vector3f& q, int level) const;
     double squaredGap(MortonCode cell, int level, const Eigen::Vector3f& q) const;
