@@ -2,8 +2,13 @@
 #include <scandiff/octree/Octree.h>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_sort.h>
+
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include <algorithm>
 #include <atomic>
@@ -61,14 +66,28 @@ static_assert(sizeof(KeyedIndex) == 12, "KeyedIndex must stay packed");
 //! scatter, so equal codes keep their index order; passes whose digit is the
 //! same for every key (common in the high bits of a flat cloud) are skipped.
 //! About twice as fast as a comparison sort on two cores for 10 M points.
-void radixSort(std::vector<KeyedIndex>& keys)
+//! Only the low significantBits of the codes are sorted on (the caller knows
+//! the rest are zero: a batch's codes at level L have 3L bits); keys already in
+//! order are left as they are after one parallel check.
+void radixSort(std::vector<KeyedIndex>& keys, int significantBits = 64)
 {
     const std::size_t n = keys.size();
+    const bool sorted = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(1, std::max<std::size_t>(n, 1), 1 << 16), true,
+        [&](const tbb::blocked_range<std::size_t>& r, bool inOrder) {
+            for (std::size_t i = r.begin(); i != r.end() && inOrder; ++i)
+                inOrder = keys[i - 1].code <= keys[i].code;
+            return inOrder;
+        },
+        [](bool a, bool b) { return a && b; });
+    if (sorted)
+        return;
+    const int passes = (std::clamp(significantBits, 1, 64) + 7) / 8;
     const std::size_t blocks = std::max<std::size_t>(1, std::min<std::size_t>(64, n / 65536));
     const std::size_t blockSize = (n + blocks - 1) / blocks;
     std::vector<KeyedIndex> buffer(n);
     std::vector<std::array<std::size_t, 256>> counts(blocks);
-    for (int pass = 0; pass < 8; ++pass) {
+    for (int pass = 0; pass < passes; ++pass) {
         const int shift = 8 * pass;
         tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
             auto& c = counts[b];
@@ -518,22 +537,39 @@ std::vector<MortonCode> Octree::neighbourCells(MortonCode cellCode, int level, C
 
 namespace {
 
-//! Per-thread scratch of nearestBatch: the candidates of one query cell, copied
-//! contiguously so the inner loop streams through memory.
+//! Per-thread scratch of nearestBatch: the candidates of one query cell's
+//! neighbourhood, copied contiguously so the inner loops stream through memory.
+//! A neighbour cell is looked up and copied only when a query of the group
+//! first needs it (its box is nearer than the query's best distance so far):
+//! most groups never touch their corner cells.
 struct BatchScratch
 {
+    enum : std::uint8_t { kUnknown, kEmpty, kGathered };
+
     //! Candidate coordinates as three arrays (structure of arrays), so that the
     //! distances of a cell's candidates are computed four at a time.
     std::vector<float> x, y, z;
     std::vector<std::uint32_t> indices;
-    std::vector<float> distances; //!< one cell's squared distances
+    std::vector<float> distances; //!< one cell's squared distances (k > 1)
     std::vector<Neighbour> heap;
-    //! Where each gathered cell's points start in positions/indices, and its
-    //! offset from the query cell: the queries skip the cells they cannot need.
-    std::array<std::uint32_t, 28> cellStart{};
-    std::array<std::array<int, 3>, 27> cellOffset{};
-    int cellCount = 0;
+    std::uint32_t used = 0; //!< candidates gathered for the current group
+    //! Per neighbour offset (neighbourhoodOffsets() order): state and the
+    //! candidates' range in the arrays once gathered.
+    std::array<std::uint8_t, 27> cellState{};
+    std::array<std::uint32_t, 27> cellBegin{}, cellEnd{};
     QueryStatistics statistics;
+
+    void reserve(std::size_t size)
+    {
+        if (x.size() >= size)
+            return;
+        const std::size_t grown = std::max(size, 2 * x.size());
+        x.resize(grown);
+        y.resize(grown);
+        z.resize(grown);
+        indices.resize(grown);
+        distances.resize(grown);
+    }
 
     //! Squared distances from q to candidates [begin, begin + count) into d2,
     //! with the float operations of Eigen's squaredNorm(), x^2 + (y^2 + z^2),
@@ -545,6 +581,56 @@ struct BatchScratch
         Eigen::Map<Eigen::ArrayXf>(d2, n) = (Column(x.data() + begin, n) - q.x()).square() +
                                             ((Column(y.data() + begin, n) - q.y()).square() +
                                              (Column(z.data() + begin, n) - q.z()).square());
+    }
+
+    //! Folds candidates [begin, end) into (bestDistance, bestIndex): the
+    //! smallest squared distance, ties to the smallest point index, exactly as
+    //! brute force decides. One pass, four candidates per step where SSE2 is
+    //! available (every x86-64), with the float operations of squaredDistances.
+    void foldNearest(const Eigen::Vector3f& q, std::uint32_t begin, std::uint32_t end, float& bestDistance,
+                     std::uint32_t& bestIndex) const
+    {
+        std::uint32_t j = begin;
+        auto better = [](float d, std::uint32_t i, float bd, std::uint32_t bi) { return d < bd || (d == bd && i < bi); };
+#ifdef __SSE2__
+        if (end - begin >= 8) {
+            const __m128 qx = _mm_set1_ps(q.x()), qy = _mm_set1_ps(q.y()), qz = _mm_set1_ps(q.z());
+            // Indices compared as signed integers after flipping the sign bit,
+            // which orders them as unsigned (SSE2 has no unsigned compare).
+            const __m128i bias = _mm_set1_epi32(static_cast<int>(0x80000000u));
+            __m128 laneDistance = _mm_set1_ps(bestDistance);
+            __m128i laneIndex = _mm_xor_si128(_mm_set1_epi32(static_cast<int>(bestIndex)), bias);
+            for (; j + 4 <= end; j += 4) {
+                const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x.data() + j), qx);
+                const __m128 dy = _mm_sub_ps(_mm_loadu_ps(y.data() + j), qy);
+                const __m128 dz = _mm_sub_ps(_mm_loadu_ps(z.data() + j), qz);
+                const __m128 d = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_add_ps(_mm_mul_ps(dy, dy), _mm_mul_ps(dz, dz)));
+                const __m128i i = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(indices.data() + j)), bias);
+                const __m128 take = _mm_or_ps(_mm_cmplt_ps(d, laneDistance),
+                                              _mm_and_ps(_mm_cmpeq_ps(d, laneDistance), _mm_castsi128_ps(_mm_cmplt_epi32(i, laneIndex))));
+                laneDistance = _mm_or_ps(_mm_and_ps(take, d), _mm_andnot_ps(take, laneDistance));
+                const __m128i takeIndex = _mm_castps_si128(take);
+                laneIndex = _mm_or_si128(_mm_and_si128(takeIndex, i), _mm_andnot_si128(takeIndex, laneIndex));
+            }
+            alignas(16) float lanes[4];
+            alignas(16) std::uint32_t laneIndices[4];
+            _mm_store_ps(lanes, laneDistance);
+            _mm_store_si128(reinterpret_cast<__m128i*>(laneIndices), _mm_xor_si128(laneIndex, bias));
+            for (int lane = 0; lane < 4; ++lane)
+                if (better(lanes[lane], laneIndices[lane], bestDistance, bestIndex)) {
+                    bestDistance = lanes[lane];
+                    bestIndex = laneIndices[lane];
+                }
+        }
+#endif
+        for (; j < end; ++j) {
+            const float dx = x[j] - q.x(), dy = y[j] - q.y(), dz = z[j] - q.z();
+            const float d = dx * dx + (dy * dy + dz * dz);
+            if (better(d, indices[j], bestDistance, bestIndex)) {
+                bestDistance = d;
+                bestIndex = indices[j];
+            }
+        }
     }
 };
 
@@ -579,10 +665,11 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
         return;
 
     // Morton order of the queries at this level; queries outside the cube get
-    // their own group each (their cell does not exist) and a full search.
+    // their own group each (their cell does not exist) and a full search. Their
+    // code is one past the level's last cell, so the sort needs 3 * level + 1 bits.
     const double l = cellSize(level);
     const std::int64_t n = std::int64_t(1) << level;
-    constexpr MortonCode kOutside = std::numeric_limits<MortonCode>::max();
+    const MortonCode kOutside = MortonCode(1) << (3 * level);
     std::vector<KeyedIndex> order(count);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -599,7 +686,7 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                         static_cast<std::uint32_t>(i)};
         }
     });
-    radixSort(order);
+    radixSort(order, 3 * level + 1);
 
     // Groups of queries sharing a cell.
     std::vector<std::size_t> groupStart;
@@ -621,6 +708,7 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
     };
 
     tbb::enumerable_thread_specific<BatchScratch> scratch;
+    const auto& offsets = neighbourhoodOffsets();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groupStart.size() - 1, 16), [&](const tbb::blocked_range<std::size_t>& range) {
         BatchScratch& s = scratch.local();
         for (std::size_t g = range.begin(); g != range.end(); ++g) {
@@ -637,45 +725,51 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                 }
                 continue;
             }
-            // Gather the 27-neighbourhood once for every query of the cell.
             const CellCoordinates cellCoordinates = decodeCell(cell);
             // Signed copies: the neighbourhood of a cell on the cube's low faces starts at -1.
             const std::int64_t cx = cellCoordinates.x, cy = cellCoordinates.y, cz = cellCoordinates.z;
-            s.x.clear();
-            s.y.clear();
-            s.z.clear();
-            s.indices.clear();
-            s.cellCount = 0;
-            for (const auto& offset : neighbourhoodOffsets()) {
-                const std::int64_t x = cx + offset[0], y = cy + offset[1], z = cz + offset[2];
-                if (x < 0 || y < 0 || z < 0 || x >= n || y >= n || z >= n)
-                    continue;
-                const auto [b, e] = lookup(encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                                                      static_cast<std::uint32_t>(z)));
-                ++s.statistics.cellLookups;
-                if (b == e)
-                    continue;
-                s.cellStart[static_cast<std::size_t>(s.cellCount)] = static_cast<std::uint32_t>(s.indices.size());
-                s.cellOffset[static_cast<std::size_t>(s.cellCount)] = offset;
-                ++s.cellCount;
-                for (std::size_t i = b; i < e; ++i) {
-                    const Eigen::Vector3f& p = points_[indices_[i]];
-                    s.indices.push_back(indices_[i]);
-                    s.x.push_back(p.x());
-                    s.y.push_back(p.y());
-                    s.z.push_back(p.z());
-                }
+            s.used = 0;
+            for (std::size_t c = 0; c < offsets.size(); ++c) {
+                const std::int64_t x = cx + offsets[c][0], y = cy + offsets[c][1], z = cz + offsets[c][2];
+                const bool inCube = x >= 0 && y >= 0 && z >= 0 && x < n && y < n && z < n;
+                s.cellState[c] = inCube ? BatchScratch::kUnknown : BatchScratch::kEmpty;
             }
-            s.cellStart[static_cast<std::size_t>(s.cellCount)] = static_cast<std::uint32_t>(s.indices.size());
-            if (s.distances.size() < s.indices.size())
-                s.distances.resize(s.indices.size());
+            // Looks up and copies neighbour cell c on first use; false if it is empty.
+            auto gathered = [&](std::size_t c) {
+                if (s.cellState[c] == BatchScratch::kUnknown) {
+                    const auto [b, e] = lookup(encodeCell(static_cast<std::uint32_t>(cx + offsets[c][0]),
+                                                          static_cast<std::uint32_t>(cy + offsets[c][1]),
+                                                          static_cast<std::uint32_t>(cz + offsets[c][2])));
+                    ++s.statistics.cellLookups;
+                    if (b == e) {
+                        s.cellState[c] = BatchScratch::kEmpty;
+                    } else {
+                        s.reserve(s.used + (e - b));
+                        float *px = s.x.data(), *py = s.y.data(), *pz = s.z.data();
+                        std::uint32_t* gatheredIndices = s.indices.data();
+                        std::uint32_t j = s.used;
+                        for (std::size_t i = b; i < e; ++i, ++j) {
+                            const std::uint32_t index = indices_[i];
+                            const Eigen::Vector3f& p = points_[index];
+                            gatheredIndices[j] = index;
+                            px[j] = p.x();
+                            py[j] = p.y();
+                            pz[j] = p.z();
+                        }
+                        s.cellBegin[c] = s.used;
+                        s.cellEnd[c] = j;
+                        s.used = j;
+                        s.cellState[c] = BatchScratch::kGathered;
+                    }
+                }
+                return s.cellState[c] == BatchScratch::kGathered;
+            };
             const Eigen::Vector3d centre =
                 box_.min + (Eigen::Vector3d(double(cx), double(cy), double(cz)).array() + 0.5).matrix() * l;
             for (std::size_t i = first; i < last; ++i) {
                 const std::uint32_t qi = order[i].index;
                 const Eigen::Vector3f& q = queries[qi];
                 s.heap.clear();
-                const std::size_t m = s.indices.size();
                 // Squared gap from q to the near face of the neighbour cell at
                 // offset -1 / 0 / +1 along each axis; a cell's gap is their sum.
                 const Eigen::Vector3d local = q.cast<double>() - centre;
@@ -686,41 +780,38 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                     faceGap2[a][1] = 0.0;
                     faceGap2[a][2] = above * above;
                 }
+                auto gapTo = [&](std::size_t c) {
+                    return faceGap2[0][offsets[c][0] + 1] + faceGap2[1][offsets[c][1] + 1] + faceGap2[2][offsets[c][2] + 1];
+                };
                 if (k == 1) {
-                    // The common case (cloud/cloud distance): a running minimum, no
-                    // heap, and a cell is skipped when its box is already farther
-                    // than the best distance (ties are still scanned).
-                    // Per cell: the distances (vectorised), their minimum (a
-                    // vectorised reduction, no dependent compare-and-branch per
-                    // candidate); the index tie-break is a second pass over the
-                    // scanned cells, which rarely finds more than one equal.
+                    // The common case (cloud/cloud distance): a running minimum in
+                    // one pass per cell, the own cell first, then faces, edges and
+                    // corners; a cell whose box is already farther than the best
+                    // distance is skipped (ties are still scanned).
+                    // The offsets come as 1 own cell, 6 faces, 12 edges, 8 corners;
+                    // each group's nearest box is at least the sum of the 1, 2 or
+                    // 3 smallest per-axis face gaps, so once that exceeds the best
+                    // distance the remaining groups are skipped without a look.
+                    std::array<double, 3> axisGap2;
+                    for (int a = 0; a < 3; ++a)
+                        axisGap2[static_cast<std::size_t>(a)] = std::min(faceGap2[a][0], faceGap2[a][2]);
+                    std::sort(axisGap2.begin(), axisGap2.end());
+                    const double groupGap2[3] = {axisGap2[0], axisGap2[0] + axisGap2[1], axisGap2[0] + axisGap2[1] + axisGap2[2]};
                     float bestDistance = std::numeric_limits<float>::infinity();
+                    std::uint32_t bestIndex = std::numeric_limits<std::uint32_t>::max();
                     std::size_t scanned = 0;
-                    std::uint32_t scannedCells = 0; // bit c: cell c was scanned
-                    float* d2 = s.distances.data();
-                    for (int c = 0; c < s.cellCount; ++c) {
-                        const auto& o = s.cellOffset[static_cast<std::size_t>(c)];
-                        const double gap2 = faceGap2[0][o[0] + 1] + faceGap2[1][o[1] + 1] + faceGap2[2][o[2] + 1];
-                        if (gap2 > static_cast<double>(bestDistance) * (1 + kSlack))
+                    for (std::size_t c = 0; c < offsets.size(); ++c) {
+                        const int group = c == 1 ? 0 : c == 7 ? 1 : c == 19 ? 2 : -1;
+                        if (group >= 0 && groupGap2[group] > static_cast<double>(bestDistance) * (1 + kSlack))
+                            break;
+                        if (s.cellState[c] == BatchScratch::kEmpty ||
+                            gapTo(c) > static_cast<double>(bestDistance) * (1 + kSlack) || !gathered(c))
                             continue;
-                        const std::uint32_t begin = s.cellStart[static_cast<std::size_t>(c)];
-                        const std::uint32_t end = s.cellStart[static_cast<std::size_t>(c) + 1];
-                        s.squaredDistances(q, begin, end - begin, d2 + begin);
-                        bestDistance = std::min(bestDistance, Eigen::Map<const Eigen::ArrayXf>(d2 + begin, end - begin).minCoeff());
-                        scannedCells |= std::uint32_t(1) << c;
-                        scanned += end - begin;
+                        s.foldNearest(q, s.cellBegin[c], s.cellEnd[c], bestDistance, bestIndex);
+                        scanned += s.cellEnd[c] - s.cellBegin[c];
                     }
-                    Neighbour best{std::numeric_limits<std::uint32_t>::max(), bestDistance};
-                    for (int c = 0; c < s.cellCount; ++c) {
-                        if (!(scannedCells >> c & 1))
-                            continue;
-                        const std::uint32_t end = s.cellStart[static_cast<std::size_t>(c) + 1];
-                        for (std::uint32_t j = s.cellStart[static_cast<std::size_t>(c)]; j < end; ++j)
-                            if (d2[j] == bestDistance)
-                                best.index = std::min(best.index, s.indices[j]);
-                    }
-                    if (m > 0)
-                        s.heap.push_back(best);
+                    if (bestIndex != std::numeric_limits<std::uint32_t>::max())
+                        s.heap.push_back(Neighbour{bestIndex, bestDistance});
                     s.statistics.distances += scanned;
                 } else {
                     // The cells by increasing gap to q, then a sorted list of the k
@@ -728,24 +819,27 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                     // than its last entry cannot contribute, and neither can any
                     // later cell. With cells of about k points, a query usually
                     // scans two or three of them instead of the whole neighbourhood.
-                    std::array<std::pair<double, int>, 27> byGap;
-                    for (int c = 0; c < s.cellCount; ++c) {
-                        const auto& o = s.cellOffset[static_cast<std::size_t>(c)];
-                        const double gap2 = faceGap2[0][o[0] + 1] + faceGap2[1][o[1] + 1] + faceGap2[2][o[2] + 1];
-                        int j = c;
-                        for (; j > 0 && byGap[static_cast<std::size_t>(j - 1)].first > gap2; --j)
-                            byGap[static_cast<std::size_t>(j)] = byGap[static_cast<std::size_t>(j - 1)];
-                        byGap[static_cast<std::size_t>(j)] = {gap2, c};
+                    std::array<std::pair<double, std::size_t>, 27> byGap;
+                    std::size_t candidates = 0;
+                    for (std::size_t c = 0; c < offsets.size(); ++c) {
+                        if (s.cellState[c] == BatchScratch::kEmpty)
+                            continue;
+                        const double gap2 = gapTo(c);
+                        std::size_t j = candidates++;
+                        for (; j > 0 && byGap[j - 1].first > gap2; --j)
+                            byGap[j] = byGap[j - 1];
+                        byGap[j] = {gap2, c};
                     }
                     std::vector<Neighbour>& top = s.heap; // the k best so far, sorted
                     std::size_t scanned = 0;
-                    for (int r = 0; r < s.cellCount; ++r) {
-                        const auto [gap2, c] = byGap[static_cast<std::size_t>(r)];
+                    for (std::size_t r = 0; r < candidates; ++r) {
+                        const auto [gap2, c] = byGap[r];
                         if (top.size() == k && gap2 > static_cast<double>(top.back().squaredDistance) * (1 + kSlack))
                             break;
-                        const std::uint32_t begin = s.cellStart[static_cast<std::size_t>(c)];
-                        const std::uint32_t end = s.cellStart[static_cast<std::size_t>(c) + 1];
-                        const std::size_t count = end - begin;
+                        if (!gathered(c))
+                            continue;
+                        const std::uint32_t begin = s.cellBegin[c];
+                        const std::size_t count = s.cellEnd[c] - begin;
                         float* d2 = s.distances.data();
                         s.squaredDistances(q, begin, count, d2);
                         for (std::size_t j = 0; j < count; ++j) {
