@@ -45,6 +45,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -472,6 +473,74 @@ void NN_PclOctree(benchmark::State& state)
     state.counters["pts/leaf"] = static_cast<double>(kQueryPoints) / static_cast<double>(tree->getLeafCount());
 }
 
+// ---------------------------------------------------------------------------
+// k nearest neighbours (k = 12, the local models' default) of the 1 M compared
+// points, queries in Morton order (as cloudToCloud submits them).
+
+constexpr std::size_t kNeighbours = 12;
+
+//! scandiff nearestBatch(k = 12). Arguments: level offset from the level
+//! cloudToCloud uses for k neighbours (cells of about 3 k points), threads.
+//! The k distances of every query are checked against PCL's kd-tree.
+void KNN_Scandiff(benchmark::State& state)
+{
+    const QuerySetting& s = setting();
+    const int level = s.refTree->levelNearestMeanPopulation(3.0 * kNeighbours) + static_cast<int>(state.range(0));
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(1)));
+    std::vector<Neighbour> out;
+    QueryStatistics stats;
+    for (auto _ : state) {
+        s.refTree->nearestBatch(s.queries[1].data(), kQueryPoints, kNeighbours, level, out, &stats);
+        benchmark::DoNotOptimize(out.data());
+    }
+    // Check against PCL (outside the timing).
+    pcl::KdTreeFLANN<pcl::PointXYZ> kdtree;
+    kdtree.setInputCloud(s.ref->pcl);
+    std::atomic<bool> mismatch{false};
+    tbb::parallel_for(std::size_t(0), kQueryPoints, [&](std::size_t i) {
+        pcl::Indices idx(kNeighbours);
+        std::vector<float> d2(kNeighbours);
+        kdtree.nearestKSearch((*s.pclQueries[1])[i], static_cast<int>(kNeighbours), idx, d2);
+        for (std::size_t m = 0; m < kNeighbours; ++m)
+            if (!sameUpToRounding(out[i * kNeighbours + m].squaredDistance, d2[m]))
+                mismatch = true;
+    });
+    if (mismatch) {
+        std::fprintf(stderr, "MISMATCH: scandiff k-NN distances differ from PCL kd-tree's\n");
+        std::abort();
+    }
+    state.counters["level"] = level;
+    state.counters["ref_pts/cell"] = s.refTree->levelStatistics(level).meanPointsPerCell;
+    state.counters["dist/query"] = static_cast<double>(stats.distances) / kQueryPoints;
+    state.counters["full_search_%"] = 100.0 * static_cast<double>(stats.fullSearches) / kQueryPoints;
+}
+
+//! PCL KdTreeFLANN::nearestKSearch(point, 12) per query, Morton-ordered queries. Argument: threads.
+void KNN_PclKdTree(benchmark::State& state)
+{
+    const QuerySetting& s = setting();
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(0)));
+    pcl::KdTreeFLANN<pcl::PointXYZ> kdtree;
+    kdtree.setInputCloud(s.ref->pcl);
+    struct Scratch
+    {
+        pcl::Indices idx = pcl::Indices(kNeighbours);
+        std::vector<float> d2 = std::vector<float>(kNeighbours);
+    };
+    std::vector<float> firstDistance(kQueryPoints);
+    for (auto _ : state) {
+        tbb::enumerable_thread_specific<Scratch> scratch;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, kQueryPoints, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+            Scratch& t = scratch.local();
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                kdtree.nearestKSearch((*s.pclQueries[1])[i], static_cast<int>(kNeighbours), t.idx, t.d2);
+                firstDistance[i] = t.d2[0];
+            }
+        });
+        benchmark::DoNotOptimize(firstDistance.data());
+    }
+}
+
 //! What choosing the level costs in the cloud/cloud setting: the query octree
 //! (on the common cube) and bestLevelFor. Not part of the NN timings above.
 void LevelChoice(benchmark::State& state)
@@ -512,6 +581,11 @@ BENCHMARK(NN_PclOctree)
     // PCL's octree at half and twice the default leaf size (0.22 m for 1 M points), to show it at its best.
     ->Args({1, kThreads, 110})->Args({1, kThreads, 440})
     ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(KNN_Scandiff)
+    ->ArgNames({"level_offset", "threads"})
+    ->Args({-1, kThreads})->Args({0, kThreads})->Args({1, kThreads})
+    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
+BENCHMARK(KNN_PclKdTree)->ArgName("threads")->Arg(kThreads)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 BENCHMARK(LevelChoice)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 
 int main(int argc, char** argv)

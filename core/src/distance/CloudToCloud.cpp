@@ -113,13 +113,14 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
     // nearest one") come from the same batch query; the first is the nearest
     // neighbour, so there is no separate NN pass. Levels whose cells hold about
     // 30 reference points for NN (the batch prunes the neighbour cells a query
-    // cannot need; level sweep in docs/benchmarks.md) and about 1.5 k for k
-    // neighbours, so that the 27 cells around a query almost always settle it.
+    // cannot need; level sweep in docs/benchmarks.md) and about 3 k for k
+    // neighbours (the 27 cells around a query almost always settle it, and the
+    // batch's guessed radius rarely reaches beyond the first few cells).
     const bool useModel = params.model != LocalModel::None;
     const bool knnModel = useModel && !params.radius;
     const std::size_t k = static_cast<std::size_t>(params.neighbours);
     result.level = params.octreeLevel != 0 ? params.octreeLevel
-                   : knnModel            ? tree.levelNearestMeanPopulation(std::max(8.0, 1.5 * static_cast<double>(k)))
+                   : knnModel            ? tree.levelNearestMeanPopulation(std::max(8.0, 3.0 * static_cast<double>(k)))
                                          : tree.levelNearestMeanPopulation(30.0);
 
     std::vector<VisibilityLabel> labels;

@@ -126,72 +126,87 @@ double nearestTriangle(const std::vector<Eigen::Vector3d>& points, const std::ve
 //! costs one small polygon clip per site instead of a whole triangulation.
 //! Returns false when c is a skipped duplicate, touches the super-triangle (it
 //! is on the hull: the real triangles around it do not close) or the clip
-//! degenerates.
+//! degenerates. Uses the span, super-triangle and duplicates fitDelaunay prepared.
 bool starOf(ModelScratch& s, int c, std::vector<std::array<int, 3>>& star)
 {
     const std::vector<Eigen::Vector2d>& p = s.planar;
     const int n = static_cast<int>(p.size());
     star.clear();
-    if (n < 3)
+    if (n < 3 || s.duplicate[static_cast<std::size_t>(c)])
         return false;
-    Eigen::Vector2d lo = p[0], hi = p[0];
-    for (const auto& x : p) {
-        lo = lo.cwiseMin(x);
-        hi = hi.cwiseMax(x);
-    }
-    const double span = std::max((hi - lo).maxCoeff(), 1e-12);
-    if (coincidesWithEarlier(p, static_cast<std::size_t>(c), span))
-        return false;
-    const Eigen::Vector2d mid = 0.5 * (lo + hi);
-    // The super-triangle's vertices, exactly as delaunay2d places them.
-    const Eigen::Vector2d super[3] = {{mid.x() - 20 * span, mid.y() - span},
-                                      {mid.x(), mid.y() + 20 * span},
-                                      {mid.x() + 20 * span, mid.y() - span}};
+    const Eigen::Vector2d* super = s.superVertices.data();
     const Eigen::Vector2d& centre = p[static_cast<std::size_t>(c)];
     // The cell, relative to c, counter-clockwise; generator[i] is the site
     // across the edge from corner i to corner i + 1 (-1: the initial square).
-    const double r = 100 * span;
-    auto& cell = s.cell;
-    auto& generator = s.generator;
-    cell.assign({{-r, -r}, {r, -r}, {r, r}, {-r, r}});
-    generator.assign({-1, -1, -1, -1});
-    auto clip = [&](const Eigen::Vector2d& site, int id) {
+    const double r = 100 * s.span;
+    // A convex polygon cut by a half-plane gains at most one corner: the
+    // buffers are sized once, and the corners are counted in `m`.
+    const std::size_t capacity = static_cast<std::size_t>(n) + 8;
+    for (auto* buffer : {&s.cell, &s.nextCell})
+        if (buffer->size() < capacity)
+            buffer->resize(capacity);
+    for (auto* buffer : {&s.generator, &s.nextGenerator})
+        if (buffer->size() < capacity)
+            buffer->resize(capacity);
+    if (s.side.size() < capacity)
+        s.side.resize(capacity);
+    Eigen::Vector2d* cell = s.cell.data();
+    Eigen::Vector2d* nextCell = s.nextCell.data();
+    int* generator = s.generator.data();
+    int* nextGenerator = s.nextGenerator.data();
+    double* side = s.side.data();
+    std::size_t m = 4;
+    cell[0] = {-r, -r};
+    cell[1] = {r, -r};
+    cell[2] = {r, r};
+    cell[3] = {-r, r};
+    std::fill(generator, generator + 4, -1);
+    double cellRadius2 = 2 * r * r; // the largest squared norm of a corner
+    auto clip = [&](const Eigen::Vector2d& w, double w2, int id) {
         // Keep the points x (relative to c) closer to c than to the site:
         // 2 x . w <= |w|^2 with w the site relative to c.
-        const Eigen::Vector2d w = site - centre;
-        const double w2 = w.squaredNorm();
-        const std::size_t m = cell.size();
-        s.side.resize(m);
         bool cut = false;
         for (std::size_t i = 0; i < m; ++i) {
-            s.side[i] = 2 * cell[i].dot(w) - w2;
-            cut = cut || s.side[i] > 0;
+            side[i] = 2 * cell[i].dot(w) - w2;
+            cut = cut || side[i] > 0;
         }
         if (!cut)
             return;
-        s.nextCell.clear();
-        s.nextGenerator.clear();
+        std::size_t next = 0;
         for (std::size_t i = 0; i < m; ++i) {
-            const std::size_t j = (i + 1) % m;
-            const double fa = s.side[i], fb = s.side[j];
+            const std::size_t j = i + 1 == m ? 0 : i + 1;
+            const double fa = side[i], fb = side[j];
             if (fa <= 0) {
-                s.nextCell.push_back(cell[i]);
-                s.nextGenerator.push_back(generator[i]);
+                nextCell[next] = cell[i];
+                nextGenerator[next++] = generator[i];
             }
             if ((fa <= 0) != (fb <= 0)) {
-                s.nextCell.push_back(cell[i] + (cell[j] - cell[i]) * (fa / (fa - fb)));
-                s.nextGenerator.push_back(fa <= 0 ? id : generator[i]);
+                nextCell[next] = cell[i] + (cell[j] - cell[i]) * (fa / (fa - fb));
+                nextGenerator[next++] = fa <= 0 ? id : generator[i];
             }
         }
-        cell.swap(s.nextCell);
-        generator.swap(s.nextGenerator);
+        std::swap(cell, nextCell);
+        std::swap(generator, nextGenerator);
+        m = next;
+        cellRadius2 = 0;
+        for (std::size_t i = 0; i < m; ++i)
+            cellRadius2 = std::max(cellRadius2, cell[i].squaredNorm());
+    };
+    // A site farther than twice the cell's farthest corner cannot cut it
+    // (2 x.w <= 2 |x| |w| < |w|^2) and is passed over. The neighbourhood comes
+    // nearest to the compared point first, which is near point 0, so the near
+    // sites usually shrink the cell at once and most of the others are passed.
+    auto clipBy = [&](const Eigen::Vector2d& site, int id) {
+        const Eigen::Vector2d w = site - centre;
+        const double w2 = w.squaredNorm();
+        if (w2 <= 4 * cellRadius2 * (1 + 1e-6))
+            clip(w, w2, id);
     };
     for (int i = 0; i < n; ++i)
-        if (i != c && !coincidesWithEarlier(p, static_cast<std::size_t>(i), span))
-            clip(p[static_cast<std::size_t>(i)], i);
+        if (i != c && !s.duplicate[static_cast<std::size_t>(i)])
+            clipBy(p[static_cast<std::size_t>(i)], i);
     for (int i = 0; i < 3; ++i)
-        clip(super[i], n + i);
-    const std::size_t m = generator.size();
+        clipBy(super[i], n + i);
     if (m < 3)
         return false;
     for (std::size_t i = 0; i < m; ++i) {
@@ -239,6 +254,24 @@ bool fitDelaunay(const std::vector<Eigen::Vector3d>& points, const PlaneFrame& f
         const Eigen::Vector3d d = p - f.centroid;
         scratch.planar.emplace_back(d.dot(f.u), d.dot(f.v));
     }
+    // What every star of this fit shares: the span, the super-triangle's
+    // vertices exactly as delaunay2d places them, the skipped duplicates.
+    const std::vector<Eigen::Vector2d>& p = scratch.planar;
+    if (p.size() < 3)
+        return false;
+    Eigen::Vector2d lo = p[0], hi = p[0];
+    for (const auto& x : p) {
+        lo = lo.cwiseMin(x);
+        hi = hi.cwiseMax(x);
+    }
+    const double span = std::max((hi - lo).maxCoeff(), 1e-12);
+    const Eigen::Vector2d mid = 0.5 * (lo + hi);
+    scratch.span = span;
+    scratch.superVertices = {Eigen::Vector2d(mid.x() - 20 * span, mid.y() - span), Eigen::Vector2d(mid.x(), mid.y() + 20 * span),
+                             Eigen::Vector2d(mid.x() + 20 * span, mid.y() - span)};
+    scratch.duplicate.resize(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i)
+        scratch.duplicate[i] = coincidesWithEarlier(p, i, span);
     scratch.triangulated = false;
     scratch.keep.clear();
     scratch.starUsable = starOf(scratch, 0, scratch.star);

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <utility>
 #include <vector>
 
 namespace scandiff::detail {
@@ -40,6 +41,11 @@ struct ModelScratch
     std::vector<Eigen::Vector2d> cell, nextCell; //!< point 0's Voronoi cell while it is clipped
     std::vector<int> generator, nextGenerator;
     std::vector<double> side;
+    //! Shared by the stars of one fit: the planar points' span, the super-
+    //! triangle's vertices, and which points repeat an earlier one (skipped).
+    double span = 0;
+    std::array<Eigen::Vector2d, 3> superVertices;
+    std::vector<char> duplicate;
 };
 
 //! The least-squares plane of a neighbourhood: centroid, normal (the smallest
