@@ -116,7 +116,7 @@ bool coincidesWithEarlier(const std::vector<Eigen::Vector2d>& p, std::size_t i, 
 
 double nearestTriangle(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector2d>& planar,
                        const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector3d& q,
-                       const Eigen::Vector2d& qPlanar, Eigen::Vector3d& closest);
+                       const Eigen::Vector2d& qPlanar, Eigen::Vector3d& closest, std::size_t first = 0);
 
 //! The triangles around planar point c in the Delaunay triangulation of the
 //! planar points and the super-triangle that delaunay2d uses: the dual of c's
@@ -229,17 +229,19 @@ bool starSettles(const std::vector<Eigen::Vector3d>& points, const std::vector<E
                  double& best, Eigen::Vector3d& closest)
 {
     double boundary2 = std::numeric_limits<double>::infinity();
-    bool inside = false;
-    for (const auto& t : star) {
+    std::size_t under = star.size(); // the triangle q projects into
+    for (std::size_t i = 0; i < star.size(); ++i) {
+        const auto& t = star[i];
         const Eigen::Vector2d& c = p[static_cast<std::size_t>(t[0])];
         const Eigen::Vector2d& a = p[static_cast<std::size_t>(t[1])];
         const Eigen::Vector2d& b = p[static_cast<std::size_t>(t[2])];
         boundary2 = std::min(boundary2, squaredSegmentDistance(qPlanar, a, b));
-        inside = inside || (orient2d(c, a, qPlanar) >= 0 && orient2d(a, b, qPlanar) >= 0 && orient2d(b, c, qPlanar) >= 0);
+        if (under == star.size() && orient2d(c, a, qPlanar) >= 0 && orient2d(a, b, qPlanar) >= 0 && orient2d(b, c, qPlanar) >= 0)
+            under = i;
     }
-    if (!inside)
+    if (under == star.size())
         return false;
-    best = nearestTriangle(points, p, star, q, qPlanar, closest);
+    best = nearestTriangle(points, p, star, q, qPlanar, closest, under);
     return best < boundary2 * (1 - 1e-9);
 }
 
@@ -286,10 +288,14 @@ bool fitDelaunay(const std::vector<Eigen::Vector3d>& points, const PlaneFrame& f
 //! Smallest squared distance from q to the given triangles, and the closest point.
 double nearestTriangle(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector2d>& planar,
                        const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector3d& q,
-                       const Eigen::Vector2d& qPlanar, Eigen::Vector3d& closest)
+                       const Eigen::Vector2d& qPlanar, Eigen::Vector3d& closest, std::size_t first)
 {
+    // Triangle `first` (the caller's best guess, e.g. the one under q) is
+    // measured first, so that its distance prunes the others early.
     double best = std::numeric_limits<double>::infinity();
-    for (const auto& t : triangles) {
+    const std::size_t count = triangles.size();
+    for (std::size_t step = 0; step < count; ++step) {
+        const auto& t = triangles[(first + step) % count];
         // Projection onto the plane shortens distances, so the in-plane gap to
         // the triangle's box is a lower bound: skip triangles that cannot win.
         const Eigen::Vector2d& a = planar[static_cast<std::size_t>(t[0])];
