@@ -580,6 +580,45 @@ struct BatchScratch
         survivorIndices.resize(grown);
     }
 
+    //! Appends the candidates of [begin, end) within squared distance `limit`
+    //! of q to the survivors, from position m; returns the new count. Most
+    //! candidates fall outside, so four are tested at once where SSE2 is
+    //! available and a group of four with none inside costs one branch. The
+    //! float operations are those of squaredDistances.
+    std::size_t keepWithin(const Eigen::Vector3f& q, std::uint32_t begin, std::uint32_t end, float limit, std::size_t m)
+    {
+        float* survivorDistance = survivorDistances.data();
+        std::uint32_t* survivorIndex = survivorIndices.data();
+        std::uint32_t j = begin;
+#ifdef __SSE2__
+        const __m128 qx = _mm_set1_ps(q.x()), qy = _mm_set1_ps(q.y()), qz = _mm_set1_ps(q.z()), bound = _mm_set1_ps(limit);
+        for (; j + 4 <= end; j += 4) {
+            const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x.data() + j), qx);
+            const __m128 dy = _mm_sub_ps(_mm_loadu_ps(y.data() + j), qy);
+            const __m128 dz = _mm_sub_ps(_mm_loadu_ps(z.data() + j), qz);
+            const __m128 d = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_add_ps(_mm_mul_ps(dy, dy), _mm_mul_ps(dz, dz)));
+            int inside = _mm_movemask_ps(_mm_cmple_ps(d, bound));
+            if (inside == 0)
+                continue;
+            alignas(16) float lanes[4];
+            _mm_store_ps(lanes, d);
+            for (; inside != 0; inside &= inside - 1) {
+                const int lane = __builtin_ctz(static_cast<unsigned>(inside));
+                survivorDistance[m] = lanes[lane];
+                survivorIndex[m++] = indices[j + static_cast<std::uint32_t>(lane)];
+            }
+        }
+#endif
+        for (; j < end; ++j) {
+            const float dx = x[j] - q.x(), dy = y[j] - q.y(), dz = z[j] - q.z();
+            const float d = dx * dx + (dy * dy + dz * dz);
+            survivorDistance[m] = d;
+            survivorIndex[m] = indices[j];
+            m += d <= limit;
+        }
+        return m;
+    }
+
     //! The k nearest among the candidates within squared distance `limit` of q,
     //! into heap (sorted), if there are at least k; false (heap untouched) if
     //! not. Cells are skipped by their gap (gapTo) or their group (beyond);
@@ -597,15 +636,7 @@ struct BatchScratch
             if (cellState[c] == kEmpty || gapTo(c) > reach || !gathered(c))
                 continue;
             const std::uint32_t begin = cellBegin[c], end = cellEnd[c];
-            float* d2 = distances.data() + begin;
-            squaredDistances(q, begin, end - begin, d2);
-            float* survivorDistance = survivorDistances.data();
-            std::uint32_t* survivorIndex = survivorIndices.data();
-            for (std::uint32_t j = begin; j < end; ++j) {
-                survivorDistance[m] = d2[j - begin];
-                survivorIndex[m] = indices[j];
-                m += d2[j - begin] <= limit;
-            }
+            m = keepWithin(q, begin, end, limit, m);
             scanned += end - begin;
         }
         if (m < k)
