@@ -246,9 +246,8 @@ bool starSettles(const std::vector<Eigen::Vector3d>& points, const std::vector<E
 }
 
 //! Prepares the Delaunay model: the planar coordinates, and the triangles
-//! around point 0 (starOf). The whole triangulation is only built
-//! (fullTriangulation) when a compared point needs more than those triangles,
-//! or when point 0 lies on the hull.
+//! around point 0 (starOf). The whole triangulation is only built when a
+//! compared point needs more than the triangles around one point.
 bool fitDelaunay(const std::vector<Eigen::Vector3d>& points, const PlaneFrame& f, ModelScratch& scratch)
 {
     scratch.planar.clear();
@@ -278,11 +277,10 @@ bool fitDelaunay(const std::vector<Eigen::Vector3d>& points, const PlaneFrame& f
     scratch.keep.clear();
     scratch.starUsable = starOf(scratch, 0, scratch.star);
     scratch.otherStarCentre = -1;
-    if (scratch.starUsable)
-        return true;
-    delaunay2d(scratch.planar, scratch.keep, scratch);
-    scratch.triangulated = true;
-    return !scratch.keep.empty();
+    // When point 0 is on the hull the star of the planar point nearest to the
+    // compared point may still settle it (delaunayDistance tries it first); the
+    // whole triangulation is built only if that fails too.
+    return true;
 }
 
 //! Smallest squared distance from q to the given triangles, and the closest point.
