@@ -213,6 +213,15 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
                 std::size_t localFallbacks = 0;
                 for (std::size_t j = range.begin(); j != range.end(); ++j) {
                     const octree::Neighbour* list = chunkLists.data() + (j - chunkBegin) * k;
+                    // The reference points lie in file order, scattered in memory:
+                    // ask for the next point's neighbours while this one is fitted.
+                    if (j + 1 != range.end()) {
+                        const octree::Neighbour* next = list + k;
+                        for (std::size_t m = 0; m < k; ++m)
+                            if (next[m].index != kNone)
+                                __builtin_prefetch(&refPoints[next[m].index]);
+                        __builtin_prefetch(&result.distance.values()[order[j + 1]], 1);
+                    }
                     if (list[0].index == kNone)
                         continue; // NaN query, or not comparable: the value stays NaN
                     s.points.clear();

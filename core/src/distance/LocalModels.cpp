@@ -22,15 +22,33 @@ bool fitPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d&
 {
     if (points.size() < 3)
         return false;
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const auto& p : points)
-        centroid += p;
-    centroid /= static_cast<double>(points.size());
-    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    // One pass: the sums of the points and of their products, taken relative
+    // to the first point so that georeferenced magnitudes cancel before the
+    // squares; only the six distinct products are accumulated.
+    const Eigen::Vector3d origin = points.front();
+    double sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
     for (const auto& p : points) {
-        const Eigen::Vector3d d = p - centroid;
-        covariance += d * d.transpose();
+        const double x = p.x() - origin.x(), y = p.y() - origin.y(), z = p.z() - origin.z();
+        sx += x;
+        sy += y;
+        sz += z;
+        sxx += x * x;
+        sxy += x * y;
+        sxz += x * z;
+        syy += y * y;
+        syz += y * z;
+        szz += z * z;
     }
+    const double count = static_cast<double>(points.size());
+    const Eigen::Vector3d mean(sx / count, sy / count, sz / count);
+    const Eigen::Vector3d centroid = origin + mean;
+    Eigen::Matrix3d covariance;
+    covariance(0, 0) = sxx - sx * mean.x();
+    covariance(1, 0) = covariance(0, 1) = sxy - sx * mean.y();
+    covariance(2, 0) = covariance(0, 2) = sxz - sx * mean.z();
+    covariance(1, 1) = syy - sy * mean.y();
+    covariance(2, 1) = covariance(1, 2) = syz - sy * mean.z();
+    covariance(2, 2) = szz - sz * mean.z();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
     solver.computeDirect(covariance);
     const Eigen::Vector3d values = solver.eigenvalues(); // increasing
