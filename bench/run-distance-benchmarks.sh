@@ -30,8 +30,12 @@ for i in $(seq "$runs"); do
   timed "scandiff c2c" "$cli" c2c --reference "$reference" --compared "$compared"
   timed "CloudCompare c2c" "${cloudcompare[@]}" -O "$compared" -O "$reference" -C2C_DIST
 done
-for model in plane quadric delaunay; do
-  timed "scandiff c2c --model $model" "$cli" c2c --reference "$reference" --compared "$compared" --model "$model"
+# Local models against plain NN: rounds of all four, so that each ratio is
+# taken within a round (this machine's speed drifts by 10-20 % over minutes).
+for i in $(seq "$runs"); do
+  for model in none plane quadric delaunay; do
+    timed "scandiff c2c --model $model" "$cli" c2c --reference "$reference" --compared "$compared" --model "$model"
+  done
 done
 if "$cli" c2m --help > /dev/null 2>&1; then
   for i in $(seq "$runs"); do

@@ -113,23 +113,18 @@ bool quadricDistance(const FittedModel& m, const Eigen::Vector3d& q, double& out
     return std::isfinite(out);
 }
 
-//! Squared distance from x to the segment [a, b] in the plane.
-double squaredSegmentDistance(const Eigen::Vector2d& x, const Eigen::Vector2d& a, const Eigen::Vector2d& b)
-{
-    const Eigen::Vector2d ab = b - a;
-    const double length2 = ab.squaredNorm();
-    const double t = length2 > 0 ? std::clamp((x - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-    return (a + t * ab - x).squaredNorm();
-}
-
 //! Whether planar point `i` coincides with an earlier one: the triangulation
 //! keeps only the first of coincident points (see delaunay2d).
 bool coincidesWithEarlier(const std::vector<Eigen::Vector2d>& p, std::size_t i, double span)
 {
-    for (std::size_t j = 0; j < i; ++j)
-        if ((p[j] - p[i]).squaredNorm() <= 1e-24 * span * span)
-            return true;
-    return false;
+    // Without an early exit (coincident points are rare), so the loop vectorises.
+    const double tolerance2 = 1e-24 * span * span;
+    bool coincides = false;
+    for (std::size_t j = 0; j < i; ++j) {
+        const double dx = p[j].x() - p[i].x(), dy = p[j].y() - p[i].y();
+        coincides |= dx * dx + dy * dy <= tolerance2;
+    }
+    return coincides;
 }
 
 double nearestTriangle(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector2d>& planar,
@@ -246,21 +241,30 @@ bool starSettles(const std::vector<Eigen::Vector3d>& points, const std::vector<E
                  const std::vector<std::array<int, 3>>& star, const Eigen::Vector3d& q, const Eigen::Vector2d& qPlanar,
                  double& best, Eigen::Vector3d& closest)
 {
-    double boundary2 = std::numeric_limits<double>::infinity();
     std::size_t under = star.size(); // the triangle q projects into
-    for (std::size_t i = 0; i < star.size(); ++i) {
+    for (std::size_t i = 0; i < star.size() && under == star.size(); ++i) {
         const auto& t = star[i];
         const Eigen::Vector2d& c = p[static_cast<std::size_t>(t[0])];
         const Eigen::Vector2d& a = p[static_cast<std::size_t>(t[1])];
         const Eigen::Vector2d& b = p[static_cast<std::size_t>(t[2])];
-        boundary2 = std::min(boundary2, squaredSegmentDistance(qPlanar, a, b));
-        if (under == star.size() && orient2d(c, a, qPlanar) >= 0 && orient2d(a, b, qPlanar) >= 0 && orient2d(b, c, qPlanar) >= 0)
+        if (orient2d(c, a, qPlanar) >= 0 && orient2d(a, b, qPlanar) >= 0 && orient2d(b, c, qPlanar) >= 0)
             under = i;
     }
     if (under == star.size())
         return false;
     best = nearestTriangle(points, p, star, q, qPlanar, closest, under);
-    return best < boundary2 * (1 - 1e-9);
+    // The outer boundary is at least as far as each outer edge's line (the
+    // segment lies on it): |(b - a) x (q - a)|^2 / |b - a|^2, compared without
+    // dividing. A bound a little short of the segment's distance only sends a
+    // rare point on to the slower, equally exact paths.
+    for (const auto& t : star) {
+        const Eigen::Vector2d& a = p[static_cast<std::size_t>(t[1])];
+        const Eigen::Vector2d& b = p[static_cast<std::size_t>(t[2])];
+        const double cross = orient2d(a, b, qPlanar);
+        if (!(best < cross * cross / (b - a).squaredNorm() * (1 - 1e-9)))
+            return false;
+    }
+    return true;
 }
 
 //! Prepares the Delaunay model: the planar coordinates, and the triangles
