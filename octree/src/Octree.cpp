@@ -761,9 +761,18 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
     if (level < 1 || level > kMaxLevel)
         throw std::invalid_argument("octree level must be in 1.." + std::to_string(kMaxLevel));
     const Neighbour missing{std::numeric_limits<std::uint32_t>::max(), std::numeric_limits<float>::infinity()};
-    out.assign(count * k, missing);
+    // Every slot is written by the worker that answers its query (padded with
+    // `missing`), so a caller's buffer of the right size is reused as it is,
+    // without a serial pass over it.
+    if (out.size() != count * k)
+        out.resize(count * k);
     if (count == 0 || k == 0)
         return;
+    auto store = [&](std::uint32_t query, const std::vector<Neighbour>& found) {
+        const auto at = out.begin() + static_cast<std::ptrdiff_t>(std::size_t(query) * k);
+        std::copy(found.begin(), found.end(), at);
+        std::fill(at + static_cast<std::ptrdiff_t>(found.size()), at + static_cast<std::ptrdiff_t>(k), missing);
+    };
 
     // Morton order of the queries at this level; queries outside the cube get
     // their own group each (their cell does not exist) and a full search. Their
@@ -823,10 +832,13 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
             if (cell == kOutside) {
                 for (std::size_t i = first; i < last; ++i) {
                     const std::uint32_t qi = order[i].index;
-                    if (!queries[qi].allFinite())
-                        continue; // no neighbour for a NaN query
+                    if (!queries[qi].allFinite()) {
+                        s.heap.clear();
+                        store(qi, s.heap); // no neighbour for a NaN query
+                        continue;
+                    }
                     nearest(queries[qi], k, level, s.heap);
-                    std::copy(s.heap.begin(), s.heap.end(), out.begin() + static_cast<std::ptrdiff_t>(qi * k));
+                    store(qi, s.heap);
                     ++s.statistics.fullSearches;
                 }
                 continue;
@@ -1025,7 +1037,7 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                     nearest(q, k, level, s.heap);
                     ++s.statistics.fullSearches;
                 }
-                std::copy(s.heap.begin(), s.heap.end(), out.begin() + static_cast<std::ptrdiff_t>(qi * k));
+                store(qi, s.heap);
             }
         }
     });
