@@ -666,6 +666,76 @@ struct BatchScratch
         return true;
     }
 
+    //! The k nearest of q into heap (sorted; fewer if the neighbourhood holds
+    //! fewer), when no guess settled it: the own cell first, then the other
+    //! cells by increasing gap to q, into a sorted list of the k best so far.
+    //! Once the list is full, a cell whose box lies farther than its last
+    //! entry cannot contribute, and neither can any later cell; cells already
+    //! beyond the own cell's k-th distance are not even sorted.
+    template <typename Gap, typename Gather>
+    void selectInGapOrder(const Eigen::Vector3f& q, std::size_t k, Gap&& gapTo, Gather&& gathered, std::size_t cells,
+                          std::size_t& scanned)
+    {
+        // The list in a plain array, its size and k-th distance in locals
+        // (registers), not in a vector's fields.
+        if (top.size() < k)
+            top.resize(k);
+        Neighbour* best = top.data();
+        std::size_t size = 0;
+        float worst = std::numeric_limits<float>::infinity(); // k-th distance once full
+        auto scan = [&](std::size_t c) {
+            const std::uint32_t begin = cellBegin[c];
+            const std::size_t count = cellEnd[c] - begin;
+            float* d2 = distances.data();
+            squaredDistances(q, begin, count, d2);
+            for (std::size_t j = 0; j < count; ++j) {
+                if (d2[j] > worst)
+                    continue;
+                const Neighbour candidate{indices[begin + j], d2[j]};
+                std::size_t at;
+                if (size == k) {
+                    if (!(candidate < best[k - 1]))
+                        continue; // a tie at the k-th distance with a larger index
+                    at = k - 1;
+                } else {
+                    at = size++;
+                }
+                // Insertion from the back: for a dozen entries, cheaper than a
+                // binary search's unpredictable branches.
+                for (; at > 0 && candidate < best[at - 1]; --at)
+                    best[at] = best[at - 1];
+                best[at] = candidate;
+                if (size == k)
+                    worst = best[k - 1].squaredDistance;
+            }
+            scanned += count;
+        };
+        if (cellState[0] != kEmpty && gathered(0))
+            scan(0);
+        const double bound = static_cast<double>(worst) * (1 + kSlack); // +inf until k are found
+        std::array<std::pair<double, std::size_t>, 26> byGap;
+        std::size_t candidates = 0;
+        for (std::size_t c = 1; c < cells; ++c) {
+            if (cellState[c] == kEmpty)
+                continue;
+            const double gap2 = gapTo(c);
+            if (gap2 > bound)
+                continue;
+            std::size_t j = candidates++;
+            for (; j > 0 && byGap[j - 1].first > gap2; --j)
+                byGap[j] = byGap[j - 1];
+            byGap[j] = {gap2, c};
+        }
+        for (std::size_t r = 0; r < candidates; ++r) {
+            const auto [gap2, c] = byGap[r];
+            if (gap2 > static_cast<double>(worst) * (1 + kSlack))
+                break;
+            if (gathered(c))
+                scan(c);
+        }
+        heap.assign(best, best + size);
+    }
+
     //! Squared distances from q to candidates [begin, begin + count) into d2,
     //! with the float operations of Eigen's squaredNorm(), x^2 + (y^2 + z^2),
     //! so that the results are bitwise those of nearest() and brute force.
@@ -731,8 +801,9 @@ struct BatchScratch
 
 //! k > 1: the squared radius a query first tries, relative to the previous
 //! query's squared k-th distance in the same cell (1.5: measured best of 1.2,
-//! 1.5, 2 and 3 on the benchmark's surface; a guess that holds fewer than k
-//! candidates costs one ordinary search more).
+//! 1.5, 2 and 3 on the benchmark's surface, no difference between 1.25, 1.5
+//! and 2 on the c2c data; a guess that holds fewer than k candidates costs
+//! one ordinary search more).
 constexpr float kGuessFactor = 1.5f;
 
 //! The 27 cell offsets, the own cell first, then faces, edges and corners, so
@@ -947,82 +1018,18 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                 } else {
                     std::size_t scanned = 0;
                     // First try: every candidate within a radius guessed from the
-                    // previous query of the cell (kGuessFactor times its squared k-th distance),
-                    // selected without ordering them one by one. Exact whenever at
-                    // least k candidates fall within the guess: every point left
-                    // out is farther than the guess, hence than the k-th.
+                    // previous query of the cell (kGuessFactor times its squared
+                    // k-th distance), selected without ordering them one by one.
+                    // Exact whenever at least k candidates fall within the guess:
+                    // every point left out is farther than the guess, hence than
+                    // the k-th. Else the cells in order of their gap.
                     bool selected = false;
                     if (s.guess < std::numeric_limits<float>::infinity())
                         selected = s.selectWithin(q, kGuessFactor * s.guess, k, [&](std::size_t c, double limit) {
                             return groupBeyond(c, limit);
                         }, gapTo, gathered, offsets.size(), scanned);
-                    if (!selected) {
-                    // The own cell first, then the other cells by increasing gap
-                    // to q, into a sorted list of the k best so far: once it is
-                    // full, a cell whose box lies farther than its last entry
-                    // cannot contribute, and neither can any later cell. Cells
-                    // already beyond the own cell's k-th distance are not even
-                    // sorted. With cells of about k points, a query usually scans
-                    // two or three of them instead of the whole neighbourhood.
-                    // The k best so far, sorted, in a plain array with its size and
-                    // k-th distance in locals (registers), not in a vector's fields.
-                    if (s.top.size() < k)
-                        s.top.resize(k);
-                    Neighbour* top = s.top.data();
-                    std::size_t size = 0;
-                    float worst = std::numeric_limits<float>::infinity(); // k-th distance once full
-                    auto scanCellK = [&](std::size_t c) {
-                        const std::uint32_t begin = s.cellBegin[c];
-                        const std::size_t count = s.cellEnd[c] - begin;
-                        float* d2 = s.distances.data();
-                        s.squaredDistances(q, begin, count, d2);
-                        for (std::size_t j = 0; j < count; ++j) {
-                            if (d2[j] > worst)
-                                continue;
-                            const Neighbour candidate{s.indices[begin + j], d2[j]};
-                            std::size_t at;
-                            if (size == k) {
-                                if (!(candidate < top[k - 1]))
-                                    continue; // a tie at the k-th distance with a larger index
-                                at = k - 1;
-                            } else {
-                                at = size++;
-                            }
-                            // Insertion from the back: for a dozen entries, cheaper
-                            // than a binary search's unpredictable branches.
-                            for (; at > 0 && candidate < top[at - 1]; --at)
-                                top[at] = top[at - 1];
-                            top[at] = candidate;
-                            if (size == k)
-                                worst = top[k - 1].squaredDistance;
-                        }
-                        scanned += count;
-                    };
-                    if (s.cellState[0] != BatchScratch::kEmpty && gathered(0))
-                        scanCellK(0);
-                    const double bound = static_cast<double>(worst) * (1 + kSlack); // +inf until k are found
-                    std::array<std::pair<double, std::size_t>, 26> byGap;
-                    std::size_t candidates = 0;
-                    for (std::size_t c = 1; c < offsets.size(); ++c) {
-                        if (s.cellState[c] == BatchScratch::kEmpty)
-                            continue;
-                        const double gap2 = gapTo(c);
-                        if (gap2 > bound)
-                            continue;
-                        std::size_t j = candidates++;
-                        for (; j > 0 && byGap[j - 1].first > gap2; --j)
-                            byGap[j] = byGap[j - 1];
-                        byGap[j] = {gap2, c};
-                    }
-                    for (std::size_t r = 0; r < candidates; ++r) {
-                        const auto [gap2, c] = byGap[r];
-                        if (gap2 > static_cast<double>(worst) * (1 + kSlack))
-                            break;
-                        if (gathered(c))
-                            scanCellK(c);
-                    }
-                    s.heap.assign(top, top + size);
-                    }
+                    if (!selected)
+                        s.selectInGapOrder(q, k, gapTo, gathered, offsets.size(), scanned);
                     s.guess = s.heap.size() == k ? s.heap.back().squaredDistance : std::numeric_limits<float>::infinity();
                     s.statistics.distances += scanned;
                 }
