@@ -152,9 +152,14 @@ bool starOf(ModelScratch& s, int c, std::vector<std::array<int, 3>>& star)
     // The cell, relative to c, counter-clockwise; generator[i] is the site
     // across the edge from corner i to corner i + 1 (-1: the initial square).
     const double r = 100 * s.span;
-    // A convex polygon cut by a half-plane gains at most one corner: the
-    // buffers are sized once, and the corners are counted in `m`.
-    const std::size_t capacity = static_cast<std::size_t>(n) + 8;
+    // A convex polygon cut by a half-plane gains at most one corner, so the
+    // cell never has more than n + 6; one clip of a cell of m corners writes
+    // at most 2 m even when rounding makes the cut inconsistent, and a cell
+    // grown past n + 8 (only possible then) abandons the star. The buffers are
+    // sized once, and the corners are counted in `m`.
+    const std::size_t maxCorners = static_cast<std::size_t>(n) + 8;
+    const std::size_t capacity = 2 * maxCorners;
+    bool degenerate = false;
     for (auto* buffer : {&s.cell, &s.nextCell})
         if (buffer->size() < capacity)
             buffer->resize(capacity);
@@ -201,6 +206,10 @@ bool starOf(ModelScratch& s, int c, std::vector<std::array<int, 3>>& star)
         std::swap(cell, nextCell);
         std::swap(generator, nextGenerator);
         m = next;
+        if (m > maxCorners) {
+            degenerate = true;
+            m = 0; // no corner left: later sites pass over, the star is refused below
+        }
         cellRadius2 = 0;
         for (std::size_t i = 0; i < m; ++i)
             cellRadius2 = std::max(cellRadius2, cell[i].squaredNorm());
@@ -220,7 +229,7 @@ bool starOf(ModelScratch& s, int c, std::vector<std::array<int, 3>>& star)
             clipBy(p[static_cast<std::size_t>(i)], i);
     for (int i = 0; i < 3; ++i)
         clipBy(super[i], n + i);
-    if (m < 3)
+    if (degenerate || m < 3)
         return false;
     for (std::size_t i = 0; i < m; ++i) {
         const int a = generator[i], b = generator[(i + 1) % m];
