@@ -232,7 +232,7 @@ bool starOf(ModelScratch& s, int c, std::vector<std::array<int, 3>>& star)
     if (degenerate || m < 3)
         return false;
     for (std::size_t i = 0; i < m; ++i) {
-        const int a = generator[i], b = generator[(i + 1) % m];
+        const int a = generator[i], b = generator[i + 1 == m ? 0 : i + 1];
         if (a < 0 || a >= n || b < 0 || b >= n)
             return false; // on the hull, or the square survived
         if (a != b)
@@ -324,7 +324,8 @@ double nearestTriangle(const std::vector<Eigen::Vector3d>& points, const std::ve
     double best = std::numeric_limits<double>::infinity();
     const std::size_t count = triangles.size();
     for (std::size_t step = 0; step < count; ++step) {
-        const auto& t = triangles[(first + step) % count];
+        const std::size_t at = first + step < count ? first + step : first + step - count;
+        const auto& t = triangles[at];
         // Projection onto the plane shortens distances, so the in-plane gap to
         // the triangle's box is a lower bound: skip triangles that cannot win.
         const Eigen::Vector2d& a = planar[static_cast<std::size_t>(t[0])];
