@@ -263,9 +263,9 @@ bool starSettles(const std::vector<Eigen::Vector3d>& points, const std::vector<E
         return false;
     best = nearestTriangle(points, p, star, q, qPlanar, closest, under);
     // The outer boundary is at least as far as each outer edge's line (the
-    // segment lies on it): |(b - a) x (q - a)|^2 / |b - a|^2, compared without
-    // dividing. A bound a little short of the segment's distance only sends a
-    // rare point on to the slower, equally exact paths.
+    // segment lies on it): |(b - a) x (q - a)|^2 / |b - a|^2 (a zero-length
+    // edge gives NaN, which refuses). A bound a little short of the segment's
+    // distance only sends a rare point on to the slower, equally exact paths.
     for (const auto& t : star) {
         const Eigen::Vector2d& a = p[static_cast<std::size_t>(t[1])];
         const Eigen::Vector2d& b = p[static_cast<std::size_t>(t[2])];
@@ -286,8 +286,8 @@ bool fitDelaunay(const std::vector<Eigen::Vector3d>& points, const PlaneFrame& f
         const Eigen::Vector3d d = p - f.centroid;
         scratch.planar.emplace_back(d.dot(f.u), d.dot(f.v));
     }
-    // What every star of this fit shares: the span, the super-triangle's
-    // vertices exactly as delaunay2d places them, the skipped duplicates.
+    // What the stars and the whole triangulation of this fit share: the span,
+    // the super-triangle's vertices, the duplicates they skip.
     const std::vector<Eigen::Vector2d>& p = scratch.planar;
     if (p.size() < 3)
         return false;
@@ -376,7 +376,7 @@ bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::V
     }
     if (!settled) {
         if (!scratch.triangulated) {
-            delaunay2d(scratch.planar, scratch.keep, scratch);
+            delaunay2d(scratch, scratch.keep);
             scratch.triangulated = true;
         }
         if (scratch.keep.empty())
@@ -409,13 +409,13 @@ bool inCircumcircle(const std::vector<Eigen::Vector2d>& p, const std::array<int,
 //! O(n^2) per point. Used when the fast insertion meets a configuration its
 //! floating-point tests cannot walk through consistently (nearly cocircular or
 //! collinear points), where this version needs no adjacency to stay coherent.
-void delaunay2dQuadratic(std::vector<Eigen::Vector2d>& p, int n, std::vector<std::array<int, 3>>& work,
-                         std::vector<std::array<int, 2>>& edges, double span)
+void delaunay2dQuadratic(const std::vector<Eigen::Vector2d>& p, int n, const std::vector<char>& duplicate,
+                         std::vector<std::array<int, 3>>& work, std::vector<std::array<int, 2>>& edges)
 {
     work.assign(1, {n, n + 1, n + 2});
     for (int i = 0; i < n; ++i) {
         const Eigen::Vector2d& d = p[static_cast<std::size_t>(i)];
-        if (coincidesWithEarlier(p, static_cast<std::size_t>(i), span))
+        if (duplicate[static_cast<std::size_t>(i)])
             continue;
         edges.clear();
         std::size_t kept = 0;
@@ -444,7 +444,7 @@ void delaunay2dQuadratic(std::vector<Eigen::Vector2d>& p, int n, std::vector<std
 //! cavity instead of the whole triangulation. Returns false (the caller then
 //! uses delaunay2dQuadratic) if a floating-point test contradicts the
 //! structure: a walk that does not end, a cavity that is not star-shaped.
-bool delaunay2dAdjacency(const std::vector<Eigen::Vector2d>& p, int n, ModelScratch& s, double span)
+bool delaunay2dAdjacency(const std::vector<Eigen::Vector2d>& p, int n, ModelScratch& s)
 {
     auto& mesh = s.mesh;
     mesh.clear();
@@ -456,7 +456,7 @@ bool delaunay2dAdjacency(const std::vector<Eigen::Vector2d>& p, int n, ModelScra
     int last = 0;
     for (int i = 0; i < n; ++i) {
         const Eigen::Vector2d& d = p[static_cast<std::size_t>(i)];
-        if (coincidesWithEarlier(p, static_cast<std::size_t>(i), span))
+        if (s.duplicate[static_cast<std::size_t>(i)])
             continue;
         // Walk towards d: leave through an edge that d lies strictly beyond.
         int t = last;
@@ -538,32 +538,21 @@ bool delaunay2dAdjacency(const std::vector<Eigen::Vector2d>& p, int n, ModelScra
 
 } // namespace
 
-void delaunay2d(const std::vector<Eigen::Vector2d>& input, std::vector<std::array<int, 3>>& triangles, ModelScratch& scratch)
+void delaunay2d(ModelScratch& scratch, std::vector<std::array<int, 3>>& triangles)
 {
     triangles.clear();
-    const int n = static_cast<int>(input.size());
+    const int n = static_cast<int>(scratch.planar.size());
     if (n < 3)
         return;
-    // Work on a copy with three far vertices of a super-triangle appended.
+    // The super-triangle's vertices appended for the insertion, removed after.
     std::vector<Eigen::Vector2d>& p = scratch.planar;
-    if (&p != &input)
-        p = input;
-    Eigen::Vector2d lo = p[0], hi = p[0];
-    for (int i = 0; i < n; ++i) {
-        lo = lo.cwiseMin(p[static_cast<std::size_t>(i)]);
-        hi = hi.cwiseMax(p[static_cast<std::size_t>(i)]);
-    }
-    const double span = std::max((hi - lo).maxCoeff(), 1e-12);
-    const Eigen::Vector2d mid = 0.5 * (lo + hi);
-    p.emplace_back(mid.x() - 20 * span, mid.y() - span);
-    p.emplace_back(mid.x(), mid.y() + 20 * span);
-    p.emplace_back(mid.x() + 20 * span, mid.y() - span);
-    if (delaunay2dAdjacency(p, n, scratch, span)) {
+    p.insert(p.end(), scratch.superVertices.begin(), scratch.superVertices.end());
+    if (delaunay2dAdjacency(p, n, scratch)) {
         for (const auto& t : scratch.mesh)
             if (t.alive && t.v[0] < n && t.v[1] < n && t.v[2] < n)
                 triangles.push_back(t.v);
     } else {
-        delaunay2dQuadratic(p, n, scratch.triangles, scratch.edges, span);
+        delaunay2dQuadratic(p, n, scratch.duplicate, scratch.triangles, scratch.edges);
         for (const auto& t : scratch.triangles)
             if (t[0] < n && t[1] < n && t[2] < n)
                 triangles.push_back(t);

@@ -41,8 +41,9 @@ struct ModelScratch
     std::vector<Eigen::Vector2d> cell, nextCell; //!< point 0's Voronoi cell while it is clipped
     std::vector<int> generator, nextGenerator;
     std::vector<double> side;
-    //! Shared by the stars of one fit: the planar points' span, the super-
-    //! triangle's vertices, and which points repeat an earlier one (skipped).
+    //! Shared by the stars and the whole triangulation of one fit: the planar
+    //! points' span, the super-triangle's vertices, and which points repeat an
+    //! earlier one (skipped).
     double span = 0;
     std::array<Eigen::Vector2d, 3> superVertices;
     std::vector<char> duplicate;
@@ -82,11 +83,12 @@ bool fitModel(LocalModel model, const std::vector<Eigen::Vector3d>& points, cons
 bool modelDistance(const FittedModel& fitted, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& q,
                    double& signedDistance, ModelScratch& scratch);
 
-//! 2D Delaunay triangulation (Bowyer-Watson in a super-triangle, points inserted
-//! in their given order, coincident points skipped) of up to a few hundred
-//! points, the size of a local neighbourhood. Written here because core may not
-//! use CGAL (it lives in the GPL plugins), and for so few points a direct
-//! incremental insertion is faster than setting up a general-purpose triangulation.
-void delaunay2d(const std::vector<Eigen::Vector2d>& points, std::vector<std::array<int, 3>>& triangles, ModelScratch& scratch);
+//! 2D Delaunay triangulation of scratch.planar (Bowyer-Watson in the super-
+//! triangle fitModel placed, points inserted in their given order, the
+//! duplicates it marked skipped) of up to a few hundred points, the size of a
+//! local neighbourhood. Written here because core may not use CGAL (it lives in
+//! the GPL plugins), and for so few points a direct incremental insertion is
+//! faster than setting up a general-purpose triangulation.
+void delaunay2d(ModelScratch& scratch, std::vector<std::array<int, 3>>& triangles);
 
 } // namespace scandiff::detail
