@@ -580,11 +580,29 @@ struct BatchScratch
         survivorIndices.resize(grown);
     }
 
+    //! The squared distance from q to candidate j, with the float operations
+    //! of Eigen's squaredNorm(), x^2 + (y^2 + z^2), so that the results are
+    //! bitwise those of nearest() and brute force; and the same for candidates
+    //! j .. j + 3 (q given per coordinate, broadcast).
+    float squaredDistance(const Eigen::Vector3f& q, std::uint32_t j) const
+    {
+        const float dx = x[j] - q.x(), dy = y[j] - q.y(), dz = z[j] - q.z();
+        return dx * dx + (dy * dy + dz * dz);
+    }
+#ifdef __SSE2__
+    __m128 squaredDistances4(__m128 qx, __m128 qy, __m128 qz, std::uint32_t j) const
+    {
+        const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x.data() + j), qx);
+        const __m128 dy = _mm_sub_ps(_mm_loadu_ps(y.data() + j), qy);
+        const __m128 dz = _mm_sub_ps(_mm_loadu_ps(z.data() + j), qz);
+        return _mm_add_ps(_mm_mul_ps(dx, dx), _mm_add_ps(_mm_mul_ps(dy, dy), _mm_mul_ps(dz, dz)));
+    }
+#endif
+
     //! Appends the candidates of [begin, end) within squared distance `limit`
     //! of q to the survivors, from position m; returns the new count. Most
     //! candidates fall outside, so four are tested at once where SSE2 is
-    //! available and a group of four with none inside costs one branch. The
-    //! float operations are those of squaredDistances.
+    //! available and a group of four with none inside costs one branch.
     std::size_t keepWithin(const Eigen::Vector3f& q, std::uint32_t begin, std::uint32_t end, float limit, std::size_t m)
     {
         float* survivorDistance = survivorDistances.data();
@@ -593,10 +611,7 @@ struct BatchScratch
 #ifdef __SSE2__
         const __m128 qx = _mm_set1_ps(q.x()), qy = _mm_set1_ps(q.y()), qz = _mm_set1_ps(q.z()), bound = _mm_set1_ps(limit);
         for (; j + 4 <= end; j += 4) {
-            const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x.data() + j), qx);
-            const __m128 dy = _mm_sub_ps(_mm_loadu_ps(y.data() + j), qy);
-            const __m128 dz = _mm_sub_ps(_mm_loadu_ps(z.data() + j), qz);
-            const __m128 d = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_add_ps(_mm_mul_ps(dy, dy), _mm_mul_ps(dz, dz)));
+            const __m128 d = squaredDistances4(qx, qy, qz, j);
             int inside = _mm_movemask_ps(_mm_cmple_ps(d, bound));
             if (inside == 0)
                 continue;
@@ -610,8 +625,7 @@ struct BatchScratch
         }
 #endif
         for (; j < end; ++j) {
-            const float dx = x[j] - q.x(), dy = y[j] - q.y(), dz = z[j] - q.z();
-            const float d = dx * dx + (dy * dy + dz * dz);
+            const float d = squaredDistance(q, j);
             survivorDistance[m] = d;
             survivorIndex[m] = indices[j];
             m += d <= limit;
@@ -751,7 +765,7 @@ struct BatchScratch
     //! Folds candidates [begin, end) into (bestDistance, bestIndex): the
     //! smallest squared distance, ties to the smallest point index, exactly as
     //! brute force decides. One pass, four candidates per step where SSE2 is
-    //! available (every x86-64), with the float operations of squaredDistances.
+    //! available (every x86-64).
     void foldNearest(const Eigen::Vector3f& q, std::uint32_t begin, std::uint32_t end, float& bestDistance,
                      std::uint32_t& bestIndex) const
     {
@@ -766,10 +780,7 @@ struct BatchScratch
             __m128 laneDistance = _mm_set1_ps(bestDistance);
             __m128i laneIndex = _mm_xor_si128(_mm_set1_epi32(static_cast<int>(bestIndex)), bias);
             for (; j + 4 <= end; j += 4) {
-                const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x.data() + j), qx);
-                const __m128 dy = _mm_sub_ps(_mm_loadu_ps(y.data() + j), qy);
-                const __m128 dz = _mm_sub_ps(_mm_loadu_ps(z.data() + j), qz);
-                const __m128 d = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_add_ps(_mm_mul_ps(dy, dy), _mm_mul_ps(dz, dz)));
+                const __m128 d = squaredDistances4(qx, qy, qz, j);
                 const __m128i i = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(indices.data() + j)), bias);
                 const __m128 take = _mm_or_ps(_mm_cmplt_ps(d, laneDistance),
                                               _mm_and_ps(_mm_cmpeq_ps(d, laneDistance), _mm_castsi128_ps(_mm_cmplt_epi32(i, laneIndex))));
@@ -789,8 +800,7 @@ struct BatchScratch
         }
 #endif
         for (; j < end; ++j) {
-            const float dx = x[j] - q.x(), dy = y[j] - q.y(), dz = z[j] - q.z();
-            const float d = dx * dx + (dy * dy + dz * dz);
+            const float d = squaredDistance(q, j);
             if (better(d, indices[j], bestDistance, bestIndex)) {
                 bestDistance = d;
                 bestIndex = indices[j];
