@@ -257,6 +257,22 @@ private slots:
         const PointCloud all = io::readPointCloud(registry.formats, dir.filePath("regions.ply").toStdString());
         QCOMPARE(all.size(), report[0].pointCount + report[1].pointCount);
         QVERIFY(all.field("region_id"));
+        // The DXF holds outlines and labels; with the points option, one POINT
+        // entity per region point too.
+        auto dxfPoints = [](const QString& path) {
+            QFile dxf(path);
+            if (!dxf.open(QIODevice::ReadOnly))
+                return std::size_t(-1);
+            const QStringList lines = QString(dxf.readAll()).split('\n');
+            std::size_t count = 0;
+            for (int i = 0; i + 1 < lines.size(); ++i)
+                count += lines[i].trimmed() == "0" && lines[i + 1].trimmed() == "POINT";
+            return count;
+        };
+        QCOMPARE(dxfPoints(dir.filePath("regions.dxf")), std::size_t(0));
+        QTemporaryDir withPoints;
+        QVERIFY(window.segmentation()->exportRegions(compared, withPoints.path(), true));
+        QCOMPARE(dxfPoints(withPoints.filePath("regions.dxf")), report[0].pointCount + report[1].pointCount);
     }
 
     void dropRecentAndDecimation()

@@ -8,7 +8,9 @@
 #include <scandiff/core/segmentation/SegmentationParameters.h>
 #include <scandiff/io/RegionExport.h>
 
+#include <QCheckBox>
 #include <QComboBox>
+#include <QPushButton>
 #include <QElapsedTimer>
 #include <QFileDialog>
 #include <QFormLayout>
@@ -170,7 +172,7 @@ const std::vector<RegionStatistics>& SegmentationController::report(EntityId id)
     return it == reports_.end() ? none : it->second;
 }
 
-bool SegmentationController::exportRegions(EntityId id, const QString& folder)
+bool SegmentationController::exportRegions(EntityId id, const QString& folder, bool dxfPoints)
 {
     const Document::Item* item = document_.find(id);
     if (!item || !item->cloud() || !item->points().field("region_id")) {
@@ -191,16 +193,18 @@ bool SegmentationController::exportRegions(EntityId id, const QString& folder)
             report = regionReport(cloud, params, &progress);
         io::RegionExportOptions options;
         options.write.progress = &progress;
+        options.dxf.includePoints = dxfPoints;
         files = io::exportRegions(registry_.formats, cloud, report, folder.toStdString(), options);
     });
     if (outcome.outcome != TaskOutcome::Done) {
         emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("Export was cancelled") : outcome.error);
         return false;
     }
-    emit finished(tr("exported %1 regions of %2 to %3: regions.ply, %4 region files, regions.dxf, regions.csv")
+    emit finished(tr("exported %1 regions of %2 to %3: regions.ply, %4 region files, regions.dxf%5, regions.csv")
                       .arg(report.size())
                       .arg(item->name, folder)
-                      .arg(files.regionClouds.size()));
+                      .arg(files.regionClouds.size())
+                      .arg(dxfPoints ? tr(" (outlines, labels and points)") : QString()));
     return true;
 }
 
@@ -211,8 +215,21 @@ void SegmentationController::exportRegionsWithDialog(EntityId id)
         if (std::find(children.begin(), children.end(), id) != children.end())
             id = parent;
     const QString folder = QFileDialog::getExistingDirectory(parentWindow_, tr("Export the regions (PLY, DXF, CSV) into"));
-    if (!folder.isEmpty())
-        exportRegions(id, folder);
+    if (folder.isEmpty())
+        return;
+    // The DXF holds each region's outlines and label; its points are an option
+    // (the CLI's --dxf-points), since they can make a CAD file heavy.
+    QMessageBox confirm(QMessageBox::Question, tr("Export regions"),
+                        tr("Write regions.ply, one PLY per region, regions.dxf and regions.csv into\n%1?").arg(folder),
+                        QMessageBox::Ok | QMessageBox::Cancel, parentWindow_);
+    confirm.button(QMessageBox::Ok)->setText(tr("Export"));
+    auto* points = new QCheckBox(tr("Also draw each region's points in the DXF"));
+    points->setChecked(dxfPointsChoice_);
+    confirm.setCheckBox(points);
+    if (confirm.exec() != QMessageBox::Ok)
+        return;
+    dxfPointsChoice_ = points->isChecked();
+    exportRegions(id, folder, dxfPointsChoice_);
 }
 
 } // namespace scandiff::gui

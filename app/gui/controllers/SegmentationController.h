@@ -57,8 +57,10 @@ public:
     //! The report of the last run on `id` (empty if none).
     const std::vector<RegionStatistics>& report(EntityId id) const;
     //! Writes regions.ply, region_NNNN.ply, regions.dxf and regions.csv of the
-    //! cloud `id` (which must hold region_id) into `folder`.
-    bool exportRegions(EntityId id, const QString& folder);
+    //! cloud `id` (which must hold region_id) into `folder`; with dxfPoints the
+    //! DXF also draws each region's points (as `segment --dxf-points` does).
+    bool exportRegions(EntityId id, const QString& folder, bool dxfPoints = false);
+    //! Asks for the folder, then whether the DXF should hold the points too.
     void exportRegionsWithDialog(EntityId id);
 
     static constexpr std::size_t kMaxRegionEntities = 100;
@@ -75,6 +77,7 @@ private:
     std::map<EntityId, std::vector<RegionStatistics>> reports_;
     std::map<EntityId, std::string> distanceFields_;
     std::map<EntityId, std::vector<EntityId>> regionEntities_; //!< the region entities listed under each cloud
+    bool dxfPointsChoice_ = false; //!< the export dialog's last answer, offered again
 };
 
 } // namespace scandiff::gui
