@@ -13,6 +13,7 @@
 #include <scandiff/io/FileIO.h>
 #include <scandiff/io/RegionExport.h>
 
+#include "DxfCheck.h"
 #include "SyntheticScene.h"
 #include "TestSupport.h"
 
@@ -20,13 +21,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <map>
-#include <regex>
-#include <sys/wait.h>
 
 using namespace scandiff;
+using test::checkDxf;
+using test::DxfCheck;
 
 namespace {
 
@@ -103,37 +103,6 @@ void expectThreeChangesFound(const PointCloud& cloud, const ScalarField& regionI
         }
         EXPECT_GE(static_cast<double>(found), 0.95 * clear) << "change " << change;
     }
-}
-
-struct DxfCheck
-{
-    int exitStatus = -1;
-    std::map<std::string, int> counts;
-    int count(const std::string& key) const
-    {
-        const auto it = counts.find(key);
-        return it == counts.end() ? 0 : it->second;
-    }
-};
-
-DxfCheck checkDxf(const std::filesystem::path& file)
-{
-    const std::string command = "python3 '" + (std::filesystem::path(SCANDIFF_TEST_SCRIPTS_DIR) / "check_dxf.py").string() + "' '" +
-                                file.string() + "'";
-    DxfCheck check;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (!pipe)
-        return check;
-    std::string output;
-    char buffer[4096];
-    while (const std::size_t n = std::fread(buffer, 1, sizeof buffer, pipe))
-        output.append(buffer, n);
-    const int status = ::pclose(pipe);
-    check.exitStatus = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    static const std::regex number("\"([^\"]+)\": (\\d+)");
-    for (auto it = std::sregex_iterator(output.begin(), output.end(), number); it != std::sregex_iterator(); ++it)
-        check.counts[(*it)[1].str()] = std::stoi((*it)[2].str());
-    return check;
 }
 
 } // namespace
