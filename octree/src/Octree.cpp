@@ -558,7 +558,8 @@ struct BatchScratch
     std::vector<float> survivorDistances;
     std::vector<std::uint32_t> survivorIndices;
     std::vector<Neighbour> ordered;
-    float guess = 0; //!< k > 1: the previous query's squared k-th distance in this cell
+    //! k > 1: the previous query's squared k-th distance (in this cell, or the worker's previous one)
+    float guess = std::numeric_limits<float>::infinity();
     std::uint32_t used = 0; //!< candidates gathered for the current group
     //! Per neighbour offset (neighbourhoodOffsets() order): state and the
     //! candidates' range in the arrays once gathered.
@@ -928,7 +929,11 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
             // Signed copies: the neighbourhood of a cell on the cube's low faces starts at -1.
             const std::int64_t cx = cellCoordinates.x, cy = cellCoordinates.y, cz = cellCoordinates.z;
             s.used = 0;
-            s.guess = std::numeric_limits<float>::infinity();
+            // s.guess carries over from the previous cell of this worker, a
+            // near one in Morton order with about the same density: the
+            // group's first query then tries it too instead of the slower
+            // search in gap order (it falls back to that if the guess holds
+            // fewer than k candidates).
             auto clampedCode = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
                 auto clamp = [&](std::int64_t v) { return static_cast<std::uint32_t>(std::clamp<std::int64_t>(v, 0, n - 1)); };
                 return encodeCell(clamp(x), clamp(y), clamp(z));
