@@ -494,3 +494,72 @@ TEST(CloudToCloud, DelaunayModelEqualsTheNearestTriangleOfABruteForceTriangulati
         }
     }
 }
+
+TEST(CloudToCloud, PlaneAxesOfVolumetricNeighbourhoods)
+{
+    // Neighbourhoods of a volume have three eigenvalues of one order, where the
+    // plane fit's Newton iteration (tuned for surfaces, one eigenvalue far
+    // below the others) takes more steps or hands over to Eigen's closed form:
+    // the plane must still be the least-squares plane of brute force.
+    std::mt19937 rng(11);
+    const PointCloud reference = randomCloud(3000, rng, 1.0f);
+    const PointCloud compared = randomCloud(300, rng, 1.0f);
+    CloudToCloudParams params;
+    params.model = LocalModel::Plane;
+    params.signedDistances = true;
+    const CloudToCloudResult r = cloudToCloud(compared, reference, params);
+    EXPECT_EQ(r.modelFallbacks, 0u);
+    for (std::size_t i = 0; i < compared.size(); ++i) {
+        const Eigen::Vector3f& q = compared.positions()[i];
+        const Plane plane = leastSquaresPlane(neighbourhood(reference, q, 12));
+        ASSERT_NEAR(r.distance.values()[i], (q.cast<double>() - plane.centroid).dot(plane.normal), 1e-6) << "point " << i;
+    }
+    // The corners of a cube: three equal eigenvalues (a triple root, which
+    // Newton's method approaches too slowly), so Eigen decides, and every
+    // axis is as good as another; its choice is brute force's too.
+    PointCloud cube;
+    cube.resize(8);
+    for (int corner = 0; corner < 8; ++corner)
+        cube.positions()[static_cast<std::size_t>(corner)] = {float(corner & 1), float((corner >> 1) & 1), float((corner >> 2) & 1)};
+    PointCloud inside;
+    inside.resize(2);
+    inside.positions()[0] = {0.6f, 0.45f, 0.3f};
+    inside.positions()[1] = {0.2f, 0.7f, 0.55f};
+    params.neighbours = 8;
+    const CloudToCloudResult corners = cloudToCloud(inside, cube, params);
+    for (std::size_t i = 0; i < inside.size(); ++i) {
+        const Eigen::Vector3f& q = inside.positions()[i];
+        const Plane plane = leastSquaresPlane(neighbourhood(cube, q, 8));
+        EXPECT_NEAR(corners.distance.values()[i], (q.cast<double>() - plane.centroid).dot(plane.normal), 1e-6) << "point " << i;
+    }
+}
+
+TEST(CloudToCloud, DuplicatedReferencePointsCountOnceInTheModels)
+{
+    // Every reference point stored twice (a scan merged with itself): the 12
+    // nearest are 6 distinct points, each twice. The plane is the same and
+    // the triangulation skips the second copies, so both models give what
+    // they give with the 6 nearest of the cloud without copies.
+    std::mt19937 rng(12);
+    const PointCloud single = wavySamples(2000, 0.0, rng);
+    PointCloud doubled;
+    doubled.resize(2 * single.size());
+    for (std::size_t i = 0; i < single.size(); ++i)
+        doubled.positions()[2 * i] = doubled.positions()[2 * i + 1] = single.positions()[i];
+    PointCloud compared = wavySamples(300, 0.05, rng);
+    for (std::size_t i = 0; i < 30; ++i)
+        compared.positions()[i].z() += 0.3f; // beyond what one triangle settles
+    for (LocalModel model : {LocalModel::Plane, LocalModel::Delaunay}) {
+        CloudToCloudParams params;
+        params.model = model;
+        params.signedDistances = true;
+        params.neighbours = 12;
+        const CloudToCloudResult withCopies = cloudToCloud(compared, doubled, params);
+        params.neighbours = 6;
+        const CloudToCloudResult without = cloudToCloud(compared, single, params);
+        EXPECT_EQ(withCopies.modelFallbacks, without.modelFallbacks) << localModelName(model);
+        for (std::size_t i = 0; i < compared.size(); ++i)
+            ASSERT_NEAR(withCopies.distance.values()[i], without.distance.values()[i], 1e-6)
+                << localModelName(model) << " point " << i;
+    }
+}

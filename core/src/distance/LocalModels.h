@@ -35,18 +35,23 @@ struct ModelScratch
     //! point, and whether they can be used; whether `keep` holds the whole
     //! triangulation of `planar`.
     std::vector<std::array<int, 3>> star, otherStar;
-    bool starUsable = false, triangulated = false;
+    bool starComputed = false, starUsable = false, triangulated = false;
     int otherStarCentre = -1; //!< the point otherStar surrounds (-1: none yet)
     bool otherStarUsable = false;
     std::vector<Eigen::Vector2d> cell, nextCell; //!< point 0's Voronoi cell while it is clipped
     std::vector<int> generator, nextGenerator;
     std::vector<double> side;
+    //! The half-planes wx x + wy y <= h of point 0's Voronoi cell met so far
+    //! by the corner search (wedgeTriangle), and the site each comes from.
+    std::vector<double> planeX, planeY, planeH;
+    std::vector<int> planeSite;
     //! Shared by the stars and the whole triangulation of one fit: the planar
     //! points' span, the super-triangle's vertices, and which points repeat an
-    //! earlier one (skipped).
+    //! earlier one (skipped; marked on first need, see markDuplicates).
     double span = 0;
     std::array<Eigen::Vector2d, 3> superVertices;
     std::vector<char> duplicate;
+    bool duplicatesMarked = false;
 };
 
 //! The least-squares plane of a neighbourhood: centroid, normal (the smallest
@@ -85,7 +90,7 @@ bool modelDistance(const FittedModel& fitted, const std::vector<Eigen::Vector3d>
 
 //! 2D Delaunay triangulation of scratch.planar (Bowyer-Watson in the super-
 //! triangle fitModel placed, points inserted in their given order, the
-//! duplicates it marked skipped) of up to a few hundred points, the size of a
+//! duplicates skipped) of up to a few hundred points, the size of a
 //! local neighbourhood. Written here because core may not use CGAL (it lives in
 //! the GPL plugins), and for so few points a direct incremental insertion is
 //! faster than setting up a general-purpose triangulation.
