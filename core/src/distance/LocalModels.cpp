@@ -211,7 +211,8 @@ double nearestTriangle(const std::vector<Eigen::Vector3d>& points, const std::ve
 
 //! Marks the planar points that coincide with an earlier one, once per fit:
 //! the stars and the whole triangulation skip them. Only a fit that needs
-//! more than one triangle pays for this (wedgeTriangle checks point 0 alone).
+//! more than one triangle pays for this (wedgeTriangle passes over the sites
+//! on its centre alone).
 void markDuplicates(ModelScratch& s)
 {
     if (s.duplicatesMarked)
@@ -370,8 +371,8 @@ bool starSettles(const std::vector<Eigen::Vector3d>& points, const std::vector<E
 }
 
 //! The triangle around planar point c whose angle at c holds the direction
-//! `towards` (from c): the corner of c's Voronoi cell
-//! farthest along that direction is the circumcentre of that triangle, and
+//! `towards` (from c): the corner of c's Voronoi cell farthest along that
+//! direction is the circumcentre of that triangle, and
 //! the two cell edges meeting there name its other vertices. The corner is a
 //! two-variable linear program (maximise x . towards over the cell, one half-
 //! plane per site), solved incrementally (Seidel): a site whose half-plane
@@ -387,7 +388,7 @@ bool wedgeTriangle(ModelScratch& s, int c, const Eigen::Vector2d& towards, int& 
     const int n = static_cast<int>(p.size());
     if (n < 3 || towards.x() == 0 || towards.y() == 0)
         return false;
-    // The cell starts as the square |x|, |y| <= r around point 0 (sites -1..-4),
+    // The cell starts as the square |x|, |y| <= r around c (sites -1..-4),
     // as in starOf; its corner farthest along `towards` is fixed by two sides.
     // At most n + 6 half-planes: the buffers are sized once.
     const double r = 100 * s.span;
@@ -502,9 +503,10 @@ bool triangleSettles(const std::vector<Eigen::Vector3d>& points, const std::vect
     return true;
 }
 
-//! Prepares the Delaunay model: the planar coordinates, and the triangles
-//! around point 0 (starOf). The whole triangulation is only built when a
-//! compared point needs more than the triangles around one point.
+//! Prepares the Delaunay model: the planar coordinates, their span and the
+//! super-triangle. The triangles are found per compared point
+//! (delaunayDistance): one or two, usually; the stars and the whole
+//! triangulation only when those do not settle it.
 bool fitDelaunay(const std::vector<Eigen::Vector3d>& points, const PlaneFrame& f, ModelScratch& scratch)
 {
     scratch.planar.clear();
@@ -606,14 +608,12 @@ bool delaunayDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::V
     if (scratch.starUsable)
         settled = starSettles(points, scratch.planar, scratch.star, q, qPlanar, best, closest);
     if (!settled && !scratch.triangulated && nearest >= 0) {
-        {
-            if (nearest != scratch.otherStarCentre) {
-                scratch.otherStarCentre = nearest;
-                scratch.otherStarUsable = starOf(scratch, nearest, scratch.otherStar);
-            }
-            if (scratch.otherStarUsable)
-                settled = starSettles(points, scratch.planar, scratch.otherStar, q, qPlanar, best, closest);
+        if (nearest != scratch.otherStarCentre) {
+            scratch.otherStarCentre = nearest;
+            scratch.otherStarUsable = starOf(scratch, nearest, scratch.otherStar);
         }
+        if (scratch.otherStarUsable)
+            settled = starSettles(points, scratch.planar, scratch.otherStar, q, qPlanar, best, closest);
     }
     if (!settled) {
         if (!scratch.triangulated) {

@@ -41,7 +41,7 @@ struct ModelScratch
     std::vector<Eigen::Vector2d> cell, nextCell; //!< point 0's Voronoi cell while it is clipped
     std::vector<int> generator, nextGenerator;
     std::vector<double> side;
-    //! The half-planes wx x + wy y <= h of point 0's Voronoi cell met so far
+    //! The half-planes wx x + wy y <= h of a point's Voronoi cell met so far
     //! by the corner search (wedgeTriangle), and the site each comes from.
     std::vector<double> planeX, planeY, planeH;
     std::vector<int> planeSite;
