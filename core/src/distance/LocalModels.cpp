@@ -335,6 +335,16 @@ bool starOf(ModelScratch& s, int c, std::vector<std::array<int, 3>>& star)
     return star.size() >= 3;
 }
 
+//! Whether a squared 3D distance is below the squared in-plane distance from
+//! a point to the line through a and b, given cross = orient2d(a, b, point):
+//! |cross|^2 / |b - a|^2 (a zero-length edge gives NaN, which refuses). A
+//! bound a little short of the line's distance keeps rounding on the safe
+//! side and only sends a rare point on to the slower, equally exact paths.
+bool nearerThanEdgeLine(double squaredDistance, double cross, const Eigen::Vector2d& a, const Eigen::Vector2d& b)
+{
+    return squaredDistance < cross * cross / (b - a).squaredNorm() * (1 - 1e-9);
+}
+
 //! Whether the triangles around one point (starOf) settle q: true when q
 //! projects inside them, farther from their outer boundary than from the
 //! nearest of them. Every other triangle lies beyond that boundary, and the
@@ -357,14 +367,11 @@ bool starSettles(const std::vector<Eigen::Vector3d>& points, const std::vector<E
         return false;
     best = nearestTriangle(points, p, star, q, qPlanar, closest, under);
     // The outer boundary is at least as far as each outer edge's line (the
-    // segment lies on it): |(b - a) x (q - a)|^2 / |b - a|^2 (a zero-length
-    // edge gives NaN, which refuses). A bound a little short of the segment's
-    // distance only sends a rare point on to the slower, equally exact paths.
+    // segment lies on it).
     for (const auto& t : star) {
         const Eigen::Vector2d& a = p[static_cast<std::size_t>(t[1])];
         const Eigen::Vector2d& b = p[static_cast<std::size_t>(t[2])];
-        const double cross = orient2d(a, b, qPlanar);
-        if (!(best < cross * cross / (b - a).squaredNorm() * (1 - 1e-9)))
+        if (!nearerThanEdgeLine(best, orient2d(a, b, qPlanar), a, b))
             return false;
     }
     return true;
@@ -496,7 +503,7 @@ bool triangleSettles(const std::vector<Eigen::Vector3d>& points, const std::vect
     }
     const geometry::PointTriangleResult r = geometry::pointTriangleDistance(q, points[t[0]], points[t[1]], points[t[2]]);
     for (std::size_t e = 0; e < 3; ++e)
-        if (!(r.squaredDistance < cross[e] * cross[e] / (p[t[(e + 1) % 3]] - p[t[e]]).squaredNorm() * (1 - 1e-9)))
+        if (!nearerThanEdgeLine(r.squaredDistance, cross[e], p[t[e]], p[t[(e + 1) % 3]]))
             return false;
     best = r.squaredDistance;
     closest = r.closestPoint;
