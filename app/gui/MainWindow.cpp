@@ -7,6 +7,7 @@
 #include "controllers/SessionController.h"
 #include "controllers/SplitController.h"
 #include "controllers/ToolController.h"
+#include "tools/TableDialog.h"
 #include "panels/ConsolePanel.h"
 #include "panels/EntityTree.h"
 #include "panels/PropertiesPanel.h"
@@ -61,6 +62,10 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
         tree_->selectEntity(id);
     });
     connect(&document_, &Document::removed, view_, &CloudView::removeEntity);
+    // A tool changed an entity's data: the view drops the old arrays before
+    // they go, then uploads the new ones.
+    connect(&document_, &Document::aboutToReplaceData, view_, &CloudView::removeEntity);
+    connect(&document_, &Document::dataReplaced, this, [this](EntityId id) { view_->addEntity(document_.item(id)); });
     connect(&document_, &Document::cleared, view_, &CloudView::clear);
     connect(&document_, &Document::displayChanged, this, [this](EntityId id) {
         view_->refreshEntity(document_.item(id));
@@ -234,11 +239,27 @@ void MainWindow::buildToolsMenu(QMenu* toolsMenu)
         auto* controller = new ToolController(tool, document_, this);
         tools_[tool.name] = controller;
         QAction* action = menu->addAction(QString::fromStdString(tool.title) + "...", this,
-                                          [this, controller] { controller->runInteractively(tree_->currentEntity()); });
+                                          [this, controller] { controller->runInteractively(toolSelection()); });
         action->setStatusTip(QString::fromStdString(tool.description));
         report(controller);
         connect(controller, &ToolController::resultReady, tree_, &EntityTree::selectEntity);
+        connect(controller, &ToolController::tableReady, this, [this](const QString& title, const Table& table) {
+            auto* window = new TableDialog(title, table, this);
+            window->show();
+        });
     }
+}
+
+std::vector<EntityId> MainWindow::toolSelection() const
+{
+    std::vector<EntityId> selection;
+    const EntityId current = tree_->currentEntity();
+    if (current != kNoEntity)
+        selection.push_back(current);
+    for (EntityId id : tree_->selectedEntities(false))
+        if (id != current)
+            selection.push_back(id);
+    return selection;
 }
 
 ToolController* MainWindow::toolController(const std::string& toolName) const

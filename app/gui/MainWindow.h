@@ -62,6 +62,8 @@ private:
     void buildDocks();
     void buildMenus();
     void buildToolsMenu(QMenu* toolsMenu);
+    //! The tree's current entity, then the other selected ones: what a tool proposes as its inputs.
+    std::vector<EntityId> toolSelection() const;
     //! Console + status bar for a controller's finished/failed signals.
     template <class Controller> void report(Controller* controller);
     void onCurrentEntityChanged(EntityId id);

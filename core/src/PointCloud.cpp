@@ -17,6 +17,7 @@ PointCloud PointCloud::clone() const
     copy.normals_ = normals_;
     copy.fields_ = fields_;
     copy.sensors_ = sensors_;
+    copy.history_ = history_;
     return copy;
 }
 
@@ -130,6 +131,7 @@ PointCloud PointCloud::subset(const std::vector<std::size_t>& indices) const
     out.name = name;
     out.origin_ = origin_;
     out.sensors_ = sensors_;
+    out.history_ = history_;
     out.positions_.reserve(indices.size());
     for (std::size_t i : indices) {
         if (i >= positions_.size())

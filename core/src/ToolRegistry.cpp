@@ -108,6 +108,13 @@ ParameterSpec ParameterSpec::asOptional() const
     return s;
 }
 
+ParameterSpec ParameterSpec::asAlternative(std::string group) const
+{
+    ParameterSpec s = asOptional();
+    s.alternativeGroup = std::move(group);
+    return s;
+}
+
 ParameterValue ParameterSpec::parse(const std::string& text) const
 {
     ParameterValue value;
@@ -217,6 +224,147 @@ const ParameterSpec* ToolSpec::parameter(const std::string& parameterName) const
     return nullptr;
 }
 
+const InputSpec* ToolSpec::input(const std::string& role) const
+{
+    for (const auto& i : inputs)
+        if (i.role == role)
+            return &i;
+    return nullptr;
+}
+
+const OutputSpec* ToolSpec::output(const std::string& role) const
+{
+    for (const auto& o : outputs)
+        if (o.role == role)
+            return &o;
+    return nullptr;
+}
+
+void ToolSpec::checkInputs(const ToolInputs& given) const
+{
+    for (const auto& spec : inputs) {
+        const std::size_t n = given.count(spec.role);
+        if (n == 0 && !spec.optional)
+            throw Error(ErrorCode::InvalidArgument, "tool '" + name + "' needs " +
+                                                        (spec.kind == DataKind::Mesh ? "a mesh" : "a point cloud") +
+                                                        " as '" + spec.role + "' (" + spec.label + ")");
+        if (n > 1 && !spec.repeated)
+            throw Error(ErrorCode::InvalidArgument,
+                        "tool '" + name + "' takes one entity as '" + spec.role + "', not " + std::to_string(n));
+        if (spec.kind == DataKind::Mesh)
+            for (std::size_t i = 0; i < n; ++i)
+                if (!given.meshOrNull(spec.role, i))
+                    throw Error(ErrorCode::InvalidArgument, "tool '" + name + "' needs a mesh as '" + spec.role +
+                                                                "', and '" + given.cloud(spec.role, i).name + "' is a point cloud");
+    }
+}
+
+ToolResult ToolSpec::execute(const ToolInputs& given, const ParameterValues& values, ProgressObserver* progress) const
+{
+    checkInputs(given);
+    return run(given, values, progress);
+}
+
+ToolInputs& ToolInputs::add(const std::string& role, const PointCloud& cloud)
+{
+    entities_[role].emplace_back(&cloud);
+    return *this;
+}
+
+ToolInputs& ToolInputs::add(const std::string& role, const Mesh& mesh)
+{
+    entities_[role].emplace_back(&mesh);
+    return *this;
+}
+
+ToolInputs& ToolInputs::add(const std::string& role, const Entity& entity)
+{
+    if (const auto* mesh = std::get_if<Mesh>(&entity))
+        return add(role, *mesh);
+    return add(role, std::get<PointCloud>(entity));
+}
+
+std::size_t ToolInputs::count(const std::string& role) const
+{
+    const auto it = entities_.find(role);
+    return it == entities_.end() ? 0 : it->second.size();
+}
+
+const ToolInputs::Ref& ToolInputs::at(const std::string& role, std::size_t index) const
+{
+    const auto it = entities_.find(role);
+    if (it == entities_.end() || index >= it->second.size())
+        throw Error(ErrorCode::InvalidArgument, "no entity was given as '" + role + "'");
+    return it->second[index];
+}
+
+const PointCloud& ToolInputs::cloud(const std::string& role, std::size_t index) const
+{
+    const Ref& ref = at(role, index);
+    if (const auto* mesh = std::get_if<const Mesh*>(&ref))
+        return (*mesh)->vertices;
+    return *std::get<const PointCloud*>(ref);
+}
+
+const Mesh& ToolInputs::mesh(const std::string& role, std::size_t index) const
+{
+    const Mesh* mesh = meshOrNull(role, index);
+    if (!mesh)
+        throw Error(ErrorCode::InvalidArgument, "'" + cloud(role, index).name + "' is a point cloud, a mesh is needed as '" + role + "'");
+    return *mesh;
+}
+
+const Mesh* ToolInputs::meshOrNull(const std::string& role, std::size_t index) const
+{
+    const Ref& ref = at(role, index);
+    const auto* mesh = std::get_if<const Mesh*>(&ref);
+    return mesh ? *mesh : nullptr;
+}
+
+ToolResult& ToolResult::add(std::string role, OutputData data)
+{
+    outputs.push_back({std::move(role), std::move(data)});
+    return *this;
+}
+
+const ToolOutput* ToolResult::find(const std::string& role) const
+{
+    for (const auto& o : outputs)
+        if (o.role == role)
+            return &o;
+    return nullptr;
+}
+
+ToolOutput* ToolResult::find(const std::string& role)
+{
+    for (auto& o : outputs)
+        if (o.role == role)
+            return &o;
+    return nullptr;
+}
+
+namespace {
+
+template <typename T>
+const T& outputAs(const ToolResult& result, const std::string& role, const char* what)
+{
+    const ToolOutput* output = result.find(role);
+    const T* data = output ? std::get_if<T>(&output->data) : nullptr;
+    if (!data)
+        throw Error(ErrorCode::Internal, "the tool gave no " + std::string(what) + " as output '" + role + "'");
+    return *data;
+}
+
+} // namespace
+
+const PointCloud& ToolResult::cloud(const std::string& role) const { return outputAs<PointCloud>(*this, role, "point cloud"); }
+const Mesh& ToolResult::mesh(const std::string& role) const { return outputAs<Mesh>(*this, role, "mesh"); }
+const Table& ToolResult::table(const std::string& role) const { return outputAs<Table>(*this, role, "table"); }
+const Eigen::Matrix4d& ToolResult::transform(const std::string& role) const
+{
+    return outputAs<Eigen::Matrix4d>(*this, role, "transformation");
+}
+
 ParameterValues ToolSpec::defaults() const
 {
     return resolveParameters(parameters, {}, name);
@@ -239,6 +387,16 @@ ParameterValues resolveParameters(const std::vector<ParameterSpec>& parameters,
         if (spec == parameters.end())
             throw Error(ErrorCode::InvalidArgument, owner + " has no parameter '" + key + "'");
         values.set(key, spec->parse(text));
+    }
+    // Alternatives: at most one of a group may be given.
+    std::map<std::string, std::string> givenInGroup;
+    for (const auto& p : parameters) {
+        if (p.alternativeGroup.empty() || !userText.count(p.name))
+            continue;
+        auto [it, first] = givenInGroup.emplace(p.alternativeGroup, p.name);
+        if (!first)
+            throw Error(ErrorCode::InvalidArgument,
+                        owner + ": give only one of --" + it->second + " and --" + p.name + " (they are alternatives)");
     }
     return values;
 }

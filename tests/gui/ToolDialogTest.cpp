@@ -30,7 +30,8 @@ private slots:
         const PluginRegistry registry = makePluginRegistry();
         const ToolSpec* tool = registry.tools.find("sor-filter");
         QVERIFY(tool);
-        gui::ToolDialog dialog(*tool);
+        gui::Document document;
+        gui::ToolDialog dialog(*tool, document, {});
         auto* k = qobject_cast<QSpinBox*>(dialog.editor("k"));
         auto* sigma = qobject_cast<QDoubleSpinBox*>(dialog.editor("n-sigma"));
         QVERIFY(k && sigma);
@@ -48,7 +49,8 @@ private slots:
     {
         const PluginRegistry registry = makePluginRegistry();
         const ToolSpec* tool = registry.tools.find("sor-filter");
-        gui::ToolDialog dialog(*tool);
+        gui::Document document;
+        gui::ToolDialog dialog(*tool, document, {});
         auto* k = qobject_cast<QSpinBox*>(dialog.editor("k"));
         k->selectAll();
         QTest::keyClicks(k, "12");
@@ -94,7 +96,7 @@ private slots:
         ToolSpec slow;
         slow.name = "slow";
         slow.title = "Slow tool";
-        slow.run = [](const PointCloud&, const ParameterValues&, ProgressObserver* progress) -> ToolResult {
+        slow.run = [](const ToolInputs&, const ParameterValues&, ProgressObserver* progress) -> ToolResult {
             ProgressTicker ticker(progress, "waiting", 1000000);
             for (;;) {
                 ticker.checkCancel();

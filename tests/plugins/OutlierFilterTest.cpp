@@ -65,14 +65,15 @@ TEST(OutlierFilter, ToolKeepsAttributesAndLeavesInputUntouched)
     const PluginRegistry registry = makePluginRegistry();
     const ToolSpec* tool = registry.tools.find("sor-filter");
     ASSERT_NE(tool, nullptr);
-    const ToolResult result = tool->run(cloud, tool->resolve({{"k", "6"}, {"n-sigma", "1.5"}}), nullptr);
+    const ToolResult result = tool->execute(ToolInputs().add("input", cloud), tool->resolve({{"k", "6"}, {"n-sigma", "1.5"}}), nullptr);
+    const PointCloud& kept = result.cloud();
     EXPECT_EQ(cloud.size(), 503u);
-    EXPECT_LT(result.cloud.size(), 503u);
-    ASSERT_NE(result.cloud.field("id"), nullptr);
-    ASSERT_NE(result.cloud.field("sor_mean_distance"), nullptr);
-    for (std::size_t i = 0; i < result.cloud.size(); ++i) {
-        const auto original = static_cast<std::size_t>(result.cloud.field("id")->values()[i]);
-        EXPECT_EQ(result.cloud.positions()[i], cloud.positions()[original]);
+    EXPECT_LT(kept.size(), 503u);
+    ASSERT_NE(kept.field("id"), nullptr);
+    ASSERT_NE(kept.field("sor_mean_distance"), nullptr);
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+        const auto original = static_cast<std::size_t>(kept.field("id")->values()[i]);
+        EXPECT_EQ(kept.positions()[i], cloud.positions()[original]);
     }
     EXPECT_NE(result.summary.find("kept"), std::string::npos);
 }

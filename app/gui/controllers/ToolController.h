@@ -1,10 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! Runs a plugin tool from the GUI: its generated dialog, then the tool's own
-//! run function on a worker thread with progress and Cancel; the result is
-//! added to the document under its input. No algorithm code lives here.
+//! Runs a tool from the GUI, whatever its shape: the generated dialog (input
+//! pickers and parameters), then the tool's own run function on a worker
+//! thread with progress and Cancel; each output goes where its declaration
+//! says: a cloud or mesh under the first input (or in its place when it
+//! updates it), a table to a table window, a transformation to the console.
+//! No algorithm code lives here.
 
 #include "document/Document.h"
+#include "tools/ToolDialog.h"
 
 #include <scandiff/core/ToolRegistry.h>
 
@@ -20,18 +24,28 @@ class ToolController : public QObject
 public:
     ToolController(const ToolSpec& tool, Document& document, QWidget* parentWindow);
 
-    //! Asks for the parameters, then runs on `input` (else the last cloud).
-    void runInteractively(EntityId input);
-    //! Runs with the given parameter text (the dialog's or a test's) on `input`.
-    //! Returns false and emits failed() on error or cancellation.
+    const ToolSpec& tool() const { return tool_; }
+    //! Asks for the inputs (proposed from `selection`, the tree's selected
+    //! entities, current first) and the parameters, then runs.
+    void runInteractively(const std::vector<EntityId>& selection);
+    //! Runs with the given parameter text (the dialog's or a test's) on `input`
+    //! as the tool's first input. Returns false and emits failed() on error or cancellation.
     bool run(EntityId input, const std::map<std::string, std::string>& parameters);
+    //! The same with entities for every role.
+    bool run(const ToolInputChoice& inputs, const std::map<std::string, std::string>& parameters);
 
 signals:
     void finished(const QString& summary);
     void failed(const QString& message);
+    //! The entity the run created or changed last (the tree selects it).
     void resultReady(EntityId id);
+    //! A table output, for the window that shows it (and saves it as CSV).
+    void tableReady(const QString& title, const scandiff::Table& table);
 
 private:
+    //! "scandiff-cli TOOL IN --role FILE ... --param value": what the console shows.
+    QString commandLine(const ToolInputChoice& inputs, const std::map<std::string, std::string>& parameters) const;
+
     const ToolSpec& tool_;
     Document& document_;
     QWidget* parentWindow_;

@@ -90,6 +90,39 @@ EntityId Document::lastCloudId() const
     return kNoEntity;
 }
 
+void Document::replaceData(EntityId id, io::Entity entity)
+{
+    Item* item = findMutable(id);
+    if (!item)
+        return;
+    std::vector<std::string> oldFields;
+    for (const auto& f : item->points().fields())
+        oldFields.push_back(f.name());
+    emit aboutToReplaceData(id);
+    Mesh* mesh = std::get_if<Mesh>(&item->entity);
+    PointCloud* cloud = std::get_if<PointCloud>(&entity);
+    if (mesh && cloud && cloud->size() == mesh->vertices.size())
+        mesh->vertices = std::move(*cloud);
+    else
+        item->entity = std::move(entity);
+    const auto& fields = item->points().fields();
+    const auto has = [&](const std::string& name) {
+        return std::any_of(fields.begin(), fields.end(), [&](const ScalarField& f) { return f.name() == name; });
+    };
+    for (auto it = item->display.fields.begin(); it != item->display.fields.end();)
+        it = has(it->first) ? std::next(it) : item->display.fields.erase(it);
+    for (const auto& f : fields)
+        if (std::find(oldFields.begin(), oldFields.end(), f.name()) == oldFields.end()) {
+            item->display.activeField = f.name();
+            break;
+        }
+    if (!item->display.activeField.empty() && !has(item->display.activeField))
+        item->display.activeField = fields.empty() ? std::string() : fields.front().name();
+    emit dataReplaced(id);
+    emit fieldsChanged(id);
+    emit displayChanged(id);
+}
+
 void Document::addField(EntityId id, ScalarField field)
 {
     Item* item = findMutable(id);

@@ -77,6 +77,14 @@ public:
     const PointCloud* lastCloud() const;
     EntityId lastCloudId() const;
 
+    //! Replaces the data of an entity, keeping its id, name, place in the tree
+    //! and the display of the fields it still has (a tool that added normals,
+    //! fields or moved the points). A point cloud given for a mesh of the same
+    //! size replaces its vertices and keeps its triangles. The first field the
+    //! new data has and the old had not becomes active. Observers see
+    //! aboutToReplaceData (drop references to the old data) then dataReplaced.
+    void replaceData(EntityId id, io::Entity entity);
+
     //! Adds (or replaces) a scalar field of a cloud and makes it active.
     void addField(EntityId id, ScalarField field);
     void setVisible(EntityId id, bool visible);
@@ -96,6 +104,8 @@ signals:
     void displayChanged(EntityId id);
     void renamed(EntityId id);
     void cleared();
+    void aboutToReplaceData(EntityId id);
+    void dataReplaced(EntityId id);
 
 private:
     Item* findMutable(EntityId id);

@@ -119,6 +119,23 @@ ParameterForm::ParameterForm(const std::vector<ParameterSpec>& parameters, QWidg
         enablers_[p.name] = enabler;
         form->addRow(QString::fromStdString(p.label), row);
     }
+    // Alternatives ("--radius R | --knn K"): switching one on switches the
+    // others of its group off, and the group's first is proposed.
+    std::map<std::string, std::vector<QCheckBox*>> groups;
+    for (const ParameterSpec& p : parameters_)
+        if (p.optional && !p.alternativeGroup.empty())
+            groups[p.alternativeGroup].push_back(enablers_.at(p.name));
+    for (const auto& [group, members] : groups) {
+        for (QCheckBox* member : members)
+            connect(member, &QCheckBox::toggled, this, [member, members](bool on) {
+                if (!on)
+                    return;
+                for (QCheckBox* other : members)
+                    if (other != member)
+                        other->setChecked(false);
+            });
+        members.front()->setChecked(true);
+    }
 }
 
 std::map<std::string, std::string> ParameterForm::values() const

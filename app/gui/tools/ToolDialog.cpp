@@ -3,23 +3,122 @@
 
 #include "tools/ParameterForm.h"
 
+#include <QComboBox>
+#include <QFormLayout>
+#include <QGroupBox>
 #include <QLabel>
+#include <QListWidget>
 #include <QVBoxLayout>
+
+#include <algorithm>
 
 namespace scandiff::gui {
 
-ToolDialog::ToolDialog(const ToolSpec& tool, QWidget* parent) : QDialog(parent)
+std::vector<EntityId> acceptedEntities(const Document& document, const InputSpec& input)
+{
+    std::vector<EntityId> out;
+    for (EntityId id : document.ids())
+        if (input.kind != DataKind::Mesh || document.item(id).mesh())
+            out.push_back(id);
+    return out;
+}
+
+ToolInputChoice proposeInputs(const Document& document, const ToolSpec& tool, const std::vector<EntityId>& selection)
+{
+    ToolInputChoice choice;
+    std::vector<EntityId> used;
+    const auto isUsed = [&](EntityId id) { return std::find(used.begin(), used.end(), id) != used.end(); };
+    for (const InputSpec& input : tool.inputs) {
+        const std::vector<EntityId> accepted = acceptedEntities(document, input);
+        const auto accepts = [&](EntityId id) { return std::find(accepted.begin(), accepted.end(), id) != accepted.end(); };
+        std::vector<EntityId>& picked = choice[input.role];
+        for (EntityId id : selection)
+            if (accepts(id) && !isUsed(id)) {
+                picked.push_back(id);
+                used.push_back(id);
+                if (!input.repeated)
+                    break;
+            }
+        if (picked.empty() && !input.optional)
+            for (auto it = accepted.rbegin(); it != accepted.rend(); ++it)
+                if (!isUsed(*it)) {
+                    picked.push_back(*it);
+                    used.push_back(*it);
+                    break;
+                }
+    }
+    return choice;
+}
+
+ToolDialog::ToolDialog(const ToolSpec& tool, const Document& document, const ToolInputChoice& proposed, QWidget* parent)
+    : QDialog(parent)
 {
     setWindowTitle(QString::fromStdString(tool.title));
     auto* layout = new QVBoxLayout(this);
     auto* description = new QLabel(QString::fromStdString(tool.description), this);
     description->setWordWrap(true);
     layout->addWidget(description);
+
+    auto* inputsBox = new QGroupBox(tr("Inputs"), this);
+    auto* inputsForm = new QFormLayout(inputsBox);
+    for (const InputSpec& input : tool.inputs) {
+        Picker picker;
+        picker.role = input.role;
+        const auto it = proposed.find(input.role);
+        const std::vector<EntityId> chosen = it == proposed.end() ? std::vector<EntityId>{} : it->second;
+        const QString tip = QString::fromStdString(input.description);
+        if (input.repeated) {
+            picker.several = new QListWidget(inputsBox);
+            for (EntityId id : acceptedEntities(document, input)) {
+                auto* row = new QListWidgetItem(document.item(id).name, picker.several);
+                row->setData(Qt::UserRole, id);
+                row->setFlags(row->flags() | Qt::ItemIsUserCheckable);
+                const bool on = std::find(chosen.begin(), chosen.end(), id) != chosen.end();
+                row->setCheckState(on ? Qt::Checked : Qt::Unchecked);
+            }
+            picker.several->setMaximumHeight(120);
+            picker.several->setObjectName(QString::fromStdString("input-" + input.role));
+            picker.several->setToolTip(tip);
+            inputsForm->addRow(QString::fromStdString(input.label), picker.several);
+        } else {
+            picker.single = new QComboBox(inputsBox);
+            if (input.optional)
+                picker.single->addItem(tr("(none)"), kNoEntity);
+            for (EntityId id : acceptedEntities(document, input))
+                picker.single->addItem(document.item(id).name + (document.item(id).mesh() ? tr(" (mesh)") : QString()), id);
+            if (!chosen.empty())
+                picker.single->setCurrentIndex(std::max(0, picker.single->findData(chosen.front())));
+            picker.single->setObjectName(QString::fromStdString("input-" + input.role));
+            picker.single->setToolTip(tip);
+            inputsForm->addRow(QString::fromStdString(input.label), picker.single);
+        }
+        pickers_.push_back(picker);
+    }
+    layout->addWidget(inputsBox);
+
     form_ = new ParameterForm(tool.parameters, this);
     addFormAndButtons(*this, *layout, form_);
 }
 
 std::map<std::string, std::string> ToolDialog::values() const { return form_->values(); }
+
+ToolInputChoice ToolDialog::inputs() const
+{
+    ToolInputChoice choice;
+    for (const Picker& picker : pickers_) {
+        std::vector<EntityId>& ids = choice[picker.role];
+        if (picker.single) {
+            const EntityId id = picker.single->currentData().toInt();
+            if (id != kNoEntity && picker.single->currentIndex() >= 0)
+                ids.push_back(id);
+        } else {
+            for (int r = 0; r < picker.several->count(); ++r)
+                if (picker.several->item(r)->checkState() == Qt::Checked)
+                    ids.push_back(picker.several->item(r)->data(Qt::UserRole).toInt());
+        }
+    }
+    return choice;
+}
 
 QWidget* ToolDialog::editor(const std::string& parameterName) const { return form_->editor(parameterName); }
 

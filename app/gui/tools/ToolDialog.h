@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! A plugin tool's parameter dialog: its description above a ParameterForm
-//! generated from the tool's declarations (ToolSpec).
+//! A tool's dialog: its description, one picker per declared input (a list of
+//! the open entities of the right kind, several ticked for a repeated input),
+//! and a ParameterForm generated from the tool's declarations (ToolSpec).
+
+#include "document/Document.h"
 
 #include <scandiff/core/ToolRegistry.h>
 
@@ -9,25 +12,51 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
+class QComboBox;
+class QListWidget;
 class QWidget;
 
 namespace scandiff::gui {
 
 class ParameterForm;
 
+//! The entities chosen for each input role of a tool.
+using ToolInputChoice = std::map<std::string, std::vector<EntityId>>;
+
+//! Entities of `document` a tool's input accepts (meshes only for a Mesh input,
+//! clouds and meshes for a Cloud input), in the document's order.
+std::vector<EntityId> acceptedEntities(const Document& document, const InputSpec& input);
+
+//! The inputs a tool proposes when started with `selection` (the tree's
+//! selected entities, current first): each role takes the first accepted
+//! selected entity not used by an earlier role, else the last accepted one
+//! added; a repeated role takes every accepted selected entity left.
+ToolInputChoice proposeInputs(const Document& document, const ToolSpec& tool, const std::vector<EntityId>& selection);
+
 class ToolDialog : public QDialog
 {
     Q_OBJECT
 public:
-    explicit ToolDialog(const ToolSpec& tool, QWidget* parent = nullptr);
+    ToolDialog(const ToolSpec& tool, const Document& document, const ToolInputChoice& proposed, QWidget* parent = nullptr);
 
     //! The widgets' values as text, keyed by parameter name (the CLI's form).
     std::map<std::string, std::string> values() const;
+    //! The entities picked for each role.
+    ToolInputChoice inputs() const;
     //! The widget editing `parameterName` (tests drive it), null if unknown.
     QWidget* editor(const std::string& parameterName) const;
+    ParameterForm* form() const { return form_; }
 
 private:
+    struct Picker
+    {
+        std::string role;
+        QComboBox* single = nullptr;
+        QListWidget* several = nullptr;
+    };
+    std::vector<Picker> pickers_;
     ParameterForm* form_;
 };
 

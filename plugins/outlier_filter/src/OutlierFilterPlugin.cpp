@@ -26,7 +26,9 @@ void scandiff_register_plugin_outlier_filter(scandiff::PluginRegistry& registry)
                             "Points farther than mean + n-sigma standard deviations are outliers", defaults.nSigma, 0.0,
                             100.0),
     };
-    tool.run = [](const PointCloud& input, const ParameterValues& values, ProgressObserver* progress) {
+    tool.outputs = {OutputSpec{"output", "Inliers", DataKind::Cloud, false}};
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        const PointCloud& input = inputs.cloud();
         plugins::OutlierFilterParams params;
         params.neighbours = static_cast<int>(values.integer("k"));
         params.nSigma = values.real("n-sigma");
@@ -35,11 +37,12 @@ void scandiff_register_plugin_outlier_filter(scandiff::PluginRegistry& registry)
         // The field is attached to a scratch copy's subset, so the input stays untouched.
         ScalarField meanField("sor_mean_distance", 0);
         meanField.values() = std::move(filtered.meanDistances);
-        result.cloud = input.subset(filtered.inliers);
-        ScalarField& kept = result.cloud.addField("sor_mean_distance");
+        PointCloud inliers = input.subset(filtered.inliers);
+        ScalarField& kept = inliers.addField("sor_mean_distance");
         for (std::size_t j = 0; j < filtered.inliers.size(); ++j)
             kept.values()[j] = meanField.values()[filtered.inliers[j]];
-        result.cloud.name = input.name + "_sor";
+        inliers.name = input.name + "_sor";
+        result.add("output", std::move(inliers));
         std::ostringstream summary;
         summary << "kept " << filtered.inliers.size() << " of " << input.size() << " points (removed "
                 << input.size() - filtered.inliers.size() << "); mean distance " << filtered.mean << ", sigma "

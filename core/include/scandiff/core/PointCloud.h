@@ -28,6 +28,15 @@ struct Rgb8
     friend bool operator==(const Rgb8& a, const Rgb8& b) { return a.r == b.r && a.g == b.g && a.b == b.b; }
 };
 
+//! A transformation applied to a cloud's global coordinates (global' = M *
+//! global, homogeneous), kept in the cloud's history so the user sees how it
+//! got where it is and can undo a step with the inverse.
+struct AppliedTransform
+{
+    Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity();
+    std::string description; //!< "rotate z 30 deg about 0,0,0", "matrix from T.txt"...
+};
+
 struct BoundingBox
 {
     Eigen::Vector3d min = Eigen::Vector3d::Constant(0.0);
@@ -91,6 +100,11 @@ public:
     std::vector<SensorPose>& sensors() { return sensors_; }
     const std::vector<SensorPose>& sensors() const { return sensors_; }
 
+    //! The transformations applied to this cloud, oldest first (clone() and
+    //! subset() keep them; readers start with none).
+    std::vector<AppliedTransform>& transformHistory() { return history_; }
+    const std::vector<AppliedTransform>& transformHistory() const { return history_; }
+
     //! Bounding box of the global coordinates, ignoring non-finite positions.
     BoundingBox bounds() const;
 
@@ -112,6 +126,7 @@ private:
     std::vector<Eigen::Vector3f> normals_;
     std::vector<ScalarField> fields_;
     std::vector<SensorPose> sensors_;
+    std::vector<AppliedTransform> history_;
 };
 
 //! Chooses an origin for global coordinates spanning `bounds`: zero when float32

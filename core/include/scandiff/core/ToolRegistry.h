@@ -8,8 +8,10 @@
 //! second copy of any default. Values are checked against their declaration
 //! before the tool runs, so a run function only sees valid parameters.
 
+#include <scandiff/core/Entity.h>
 #include <scandiff/core/PointCloud.h>
 #include <scandiff/core/Progress.h>
+#include <scandiff/core/Table.h>
 
 #include <cstdint>
 #include <functional>
@@ -42,6 +44,10 @@ struct ParameterSpec
     //! option is absent, the GUI's checkbox beside it is off); `defaultValue` is
     //! then only the value a dialog proposes when the user switches it on.
     bool optional = false;
+    //! Optional parameters sharing a group name are alternatives ("--radius R |
+    //! --knn K"): at most one may be given. The GUI lets one be switched on at a
+    //! time and proposes the group's first; the tool decides what none means.
+    std::string alternativeGroup;
 
     static ParameterSpec integer(std::string name, std::string label, std::string description, std::int64_t defaultValue,
                                  std::int64_t minimum, std::int64_t maximum, std::string unit = {});
@@ -53,6 +59,8 @@ struct ParameterSpec
     static ParameterSpec text(std::string name, std::string label, std::string description, std::string defaultValue = {});
     //! The same declaration, made optional (see `optional`).
     ParameterSpec asOptional() const;
+    //! The same declaration, optional and one of the alternatives of `group`.
+    ParameterSpec asAlternative(std::string group) const;
 
     //! Parses user text ("12", "0.5", "true", "plane") into a valid value.
     //! Throws Error(InvalidArgument) naming the parameter and its valid range.
@@ -81,10 +89,86 @@ private:
     std::map<std::string, ParameterValue> values_;
 };
 
+//! What a tool takes or gives. A Cloud input also accepts a mesh (its
+//! vertices); a Mesh input needs triangles.
+enum class DataKind { Cloud, Mesh, Table, Transform };
+
+//! One input of a tool: an entity, or several, playing a role.
+struct InputSpec
+{
+    //! "input" is the CLI's positional argument (IN, or IN... when repeated);
+    //! any other role is an option "--ROLE FILE". The GUI offers a list of the
+    //! open entities of the right kind for each role.
+    std::string role = "input";
+    std::string label = "Cloud";
+    std::string description;
+    DataKind kind = DataKind::Cloud;
+    bool repeated = false; //!< one or more entities (merge)
+    bool optional = false; //!< may be absent
+};
+
+//! One output of a tool.
+struct OutputSpec
+{
+    //! The first output is written to the CLI's "-o FILE"; each later one beside
+    //! it, as FILE's stem + "_" + role + FILE's extension (".csv" for a table,
+    //! ".txt" for a transform).
+    std::string role = "output";
+    std::string label;
+    DataKind kind = DataKind::Cloud;
+    //! The output is the first input changed in place (normals or fields added,
+    //! points moved): the workbench replaces that entity's data and keeps its
+    //! place and display instead of adding a new entity under it. A Cloud
+    //! output of the same size replaces a mesh's vertices and keeps its triangles.
+    bool updatesInput = false;
+};
+
+//! The entities a run gets, by role. It only refers to them: they belong to
+//! the caller (the CLI's files, the workbench's document) and must outlive the run.
+class ToolInputs
+{
+public:
+    ToolInputs& add(const std::string& role, const PointCloud& cloud);
+    ToolInputs& add(const std::string& role, const Mesh& mesh);
+    ToolInputs& add(const std::string& role, const Entity& entity);
+
+    std::size_t count(const std::string& role) const;
+    bool has(const std::string& role) const { return count(role) != 0; }
+    //! A cloud, or a mesh's vertices. Throws Error(InvalidArgument) naming the role when absent.
+    const PointCloud& cloud(const std::string& role = "input", std::size_t index = 0) const;
+    //! Throws Error(InvalidArgument) when absent or not a mesh.
+    const Mesh& mesh(const std::string& role = "input", std::size_t index = 0) const;
+    //! Null when the entity is a cloud.
+    const Mesh* meshOrNull(const std::string& role = "input", std::size_t index = 0) const;
+
+private:
+    using Ref = std::variant<const PointCloud*, const Mesh*>;
+    const Ref& at(const std::string& role, std::size_t index) const;
+    std::map<std::string, std::vector<Ref>> entities_;
+};
+
+using OutputData = std::variant<PointCloud, Mesh, Table, Eigen::Matrix4d>;
+
+struct ToolOutput
+{
+    std::string role;
+    OutputData data;
+};
+
 struct ToolResult
 {
-    PointCloud cloud;    //!< the tool's output cloud (input untouched)
-    std::string summary; //!< one line for the log: what was done, counts
+    std::vector<ToolOutput> outputs; //!< in the order of the tool's OutputSpecs; an output may be absent
+    std::string summary;             //!< one line for the log: what was done, counts
+
+    ToolResult& add(std::string role, OutputData data);
+    //! Null when the run produced no output of that role.
+    const ToolOutput* find(const std::string& role) const;
+    ToolOutput* find(const std::string& role);
+    //! The cloud of output `role`. Throws Error(Internal) when absent or not a cloud.
+    const PointCloud& cloud(const std::string& role = "output") const;
+    const Mesh& mesh(const std::string& role = "output") const;
+    const Table& table(const std::string& role = "output") const;
+    const Eigen::Matrix4d& transform(const std::string& role = "output") const;
 };
 
 struct ToolSpec
@@ -93,15 +177,24 @@ struct ToolSpec
     std::string title;       //!< menu text, e.g. "Statistical outlier filter"
     std::string description; //!< a paragraph of help, with the method's source
     std::string category;    //!< menu group, e.g. "Filters"
+    std::vector<InputSpec> inputs{InputSpec{}};
+    std::vector<OutputSpec> outputs{OutputSpec{}};
     std::vector<ParameterSpec> parameters;
-    std::function<ToolResult(const PointCloud&, const ParameterValues&, ProgressObserver*)> run;
+    std::function<ToolResult(const ToolInputs&, const ParameterValues&, ProgressObserver*)> run;
 
     const ParameterSpec* parameter(const std::string& name) const;
+    const InputSpec* input(const std::string& role) const;
+    const OutputSpec* output(const std::string& role) const;
     //! The declared defaults.
     ParameterValues defaults() const;
     //! Defaults overridden by user text, every value parsed and checked.
     //! Throws Error(InvalidArgument) for an unknown name or a bad value.
     ParameterValues resolve(const std::map<std::string, std::string>& userText) const;
+    //! Throws Error(InvalidArgument) when a required role is missing, a single
+    //! role has several entities, or a Mesh role holds a cloud.
+    void checkInputs(const ToolInputs& inputs) const;
+    //! checkInputs, then run: what every front end calls.
+    ToolResult execute(const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) const;
 };
 
 //! The declared defaults (optional parameters left unset), overridden by user

@@ -8,6 +8,7 @@
 //! PCL plugin). Every writer goes through AtomicFile: an existing output file is
 //! never left half-written.
 
+#include <scandiff/core/Entity.h>
 #include <scandiff/core/Mesh.h>
 #include <scandiff/core/PointCloud.h>
 #include <scandiff/core/Progress.h>
@@ -59,7 +60,7 @@ struct WriteOptions
     int asciiPrecision = 6;
 };
 
-using Entity = std::variant<PointCloud, Mesh>;
+using Entity = scandiff::Entity;
 
 struct FormatHandler
 {
