@@ -12,10 +12,12 @@ endmacro()
 
 scandiff_require(Eigen3 libeigen3-dev 3.3 NO_MODULE)
 scandiff_require(TBB libtbb-dev)
+scandiff_require(muparser libmuparser-dev)
 scandiff_require(assimp libassimp-dev)
 scandiff_require(CLI11 libcli11-dev)
 scandiff_require(nlohmann_json nlohmann-json3-dev)
 scandiff_require(PCL libpcl-dev 1.12 COMPONENTS common io)
+scandiff_require(CGAL libcgal-dev)
 
 if(SCANDIFF_BUILD_GUI)
   scandiff_require(Qt5 qtbase5-dev COMPONENTS Widgets Test)

@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build ccache pkg-config
-  libeigen3-dev libtbb-dev
+  libeigen3-dev libtbb-dev libmuparser-dev
   qtbase5-dev libqt5opengl5-dev
   libvtk9-dev libvtk9-qt-dev libopenmpi-dev
   libpcl-dev libflann-dev libcgal-dev libassimp-dev

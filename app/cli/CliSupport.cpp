@@ -85,8 +85,10 @@ std::string parameterHelp(const ParameterSpec& p)
         for (const auto& c : p.choices)
             s << ' ' << c;
     }
-    if (!p.optional && p.type != ParameterType::Boolean)
+    if (!p.optional && !p.required && p.type != ParameterType::Boolean)
         s << "; default " << ParameterSpec::format(p.defaultValue);
+    if (!p.alternativeGroup.empty())
+        s << "; one of the alternatives '" << p.alternativeGroup << "'";
     return s.str();
 }
 
@@ -115,6 +117,8 @@ std::map<std::string, CLI::Option*> addParameterOptions(CLI::App& command, const
         else
             option = command.add_option_function<std::string>("--" + name, [userText, name](const std::string& v) { (*userText)[name] = v; },
                                                               parameterHelp(p));
+        if (p.required)
+            option->required();
         options[name] = option;
     }
     return options;

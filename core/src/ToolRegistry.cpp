@@ -108,6 +108,13 @@ ParameterSpec ParameterSpec::asOptional() const
     return s;
 }
 
+ParameterSpec ParameterSpec::asRequired() const
+{
+    ParameterSpec s = *this;
+    s.required = true;
+    return s;
+}
+
 ParameterSpec ParameterSpec::asAlternative(std::string group) const
 {
     ParameterSpec s = asOptional();
@@ -367,7 +374,11 @@ const Eigen::Matrix4d& ToolResult::transform(const std::string& role) const
 
 ParameterValues ToolSpec::defaults() const
 {
-    return resolveParameters(parameters, {}, name);
+    ParameterValues values;
+    for (const auto& p : parameters)
+        if (!p.optional)
+            values.set(p.name, p.defaultValue);
+    return values;
 }
 
 ParameterValues ToolSpec::resolve(const std::map<std::string, std::string>& userText) const
@@ -388,6 +399,9 @@ ParameterValues resolveParameters(const std::vector<ParameterSpec>& parameters,
             throw Error(ErrorCode::InvalidArgument, owner + " has no parameter '" + key + "'");
         values.set(key, spec->parse(text));
     }
+    for (const auto& p : parameters)
+        if (p.required && !userText.count(p.name))
+            throw Error(ErrorCode::InvalidArgument, owner + " needs --" + p.name + " (" + p.description + ")");
     // Alternatives: at most one of a group may be given.
     std::map<std::string, std::string> givenInGroup;
     for (const auto& p : parameters) {

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include <scandiff/octree/Octree.h>
 
+#include "BatchQueries.h"
+
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -21,12 +23,14 @@
 
 namespace scandiff::octree {
 
+using detail::BatchScratch;
+using detail::KeyedIndex;
+using detail::kGuessFactor;
+using detail::kSlack;
+using detail::neighbourhoodOffsets;
+
 namespace {
 
-// Float distances are compared against double geometric bounds; this relative
-// slack makes the pruning and stopping tests conservative so that rounding can
-// never drop a point that brute force would return.
-constexpr double kSlack = 1e-5;
 
 //! Cells the constant-level search may visit (5 x 5 x 5: two rings around an
 //! inner cell) before switching to the descent.
@@ -52,15 +56,6 @@ void offer(std::vector<Neighbour>& heap, std::size_t k, const Neighbour& candida
     }
 }
 
-//! A code and its point index, packed to 12 bytes so the sort moves less memory.
-#pragma pack(push, 4)
-struct KeyedIndex
-{
-    MortonCode code;
-    std::uint32_t index;
-};
-#pragma pack(pop)
-static_assert(sizeof(KeyedIndex) == 12, "KeyedIndex must stay packed");
 
 //! Parallel LSD radix sort on the 63-bit codes, 8 bits per pass. Each pass is a
 //! per-block histogram, a prefix sum over (digit, block) and a stable parallel
@@ -536,306 +531,45 @@ std::vector<MortonCode> Octree::neighbourCells(MortonCode cellCode, int level, C
     return out;
 }
 
-namespace {
-
-//! Per-thread scratch of nearestBatch: the candidates of one query cell's
-//! neighbourhood, copied contiguously so the inner loops stream through memory.
-//! A neighbour cell is looked up and copied only when a query of the group
-//! first needs it (its box is nearer than the query's best distance so far):
-//! most groups never touch their corner cells.
-struct BatchScratch
+detail::QueryGroups Octree::groupQueriesByCell(const Eigen::Vector3f* queries, std::size_t count, int level) const
 {
-    enum : std::uint8_t { kUnknown, kEmpty, kGathered };
-
-    //! Candidate coordinates as three arrays (structure of arrays), so that the
-    //! distances of a cell's candidates are computed four at a time.
-    std::vector<float> x, y, z;
-    std::vector<std::uint32_t> indices;
-    std::vector<float> distances; //!< one cell's squared distances (k > 1)
-    std::vector<Neighbour> heap;
-    std::vector<Neighbour> top; //!< k > 1: the k best so far of one query
-    //! k > 1: the candidates within a guessed distance (selectWithin)
-    std::vector<float> survivorDistances;
-    std::vector<std::uint32_t> survivorIndices;
-    std::vector<Neighbour> ordered;
-    //! k > 1: the previous query's squared k-th distance (in this cell, or the worker's previous one)
-    float guess = std::numeric_limits<float>::infinity();
-    std::uint32_t used = 0; //!< candidates gathered for the current group
-    //! Per neighbour offset (neighbourhoodOffsets() order): state and the
-    //! candidates' range in the arrays once gathered.
-    std::array<std::uint8_t, 27> cellState{};
-    std::array<std::uint32_t, 27> cellBegin{}, cellEnd{};
-    QueryStatistics statistics;
-
-    void reserve(std::size_t size)
-    {
-        if (x.size() >= size)
-            return;
-        const std::size_t grown = std::max(size, 2 * x.size());
-        x.resize(grown);
-        y.resize(grown);
-        z.resize(grown);
-        indices.resize(grown);
-        distances.resize(grown);
-        survivorDistances.resize(grown);
-        survivorIndices.resize(grown);
-    }
-
-    //! The squared distance from q to candidate j, with the float operations
-    //! of Eigen's squaredNorm(), x^2 + (y^2 + z^2), so that the results are
-    //! bitwise those of nearest() and brute force; and the same for candidates
-    //! j .. j + 3 (q given per coordinate, broadcast).
-    float squaredDistance(const Eigen::Vector3f& q, std::uint32_t j) const
-    {
-        const float dx = x[j] - q.x(), dy = y[j] - q.y(), dz = z[j] - q.z();
-        return dx * dx + (dy * dy + dz * dz);
-    }
-#ifdef __SSE2__
-    __m128 squaredDistances4(__m128 qx, __m128 qy, __m128 qz, std::uint32_t j) const
-    {
-        const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x.data() + j), qx);
-        const __m128 dy = _mm_sub_ps(_mm_loadu_ps(y.data() + j), qy);
-        const __m128 dz = _mm_sub_ps(_mm_loadu_ps(z.data() + j), qz);
-        return _mm_add_ps(_mm_mul_ps(dx, dx), _mm_add_ps(_mm_mul_ps(dy, dy), _mm_mul_ps(dz, dz)));
-    }
-#endif
-
-    //! Appends the candidates of [begin, end) within squared distance `limit`
-    //! of q to the survivors, from position m; returns the new count. Most
-    //! candidates fall outside, so four are tested at once where SSE2 is
-    //! available and a group of four with none inside costs one branch.
-    std::size_t keepWithin(const Eigen::Vector3f& q, std::uint32_t begin, std::uint32_t end, float limit, std::size_t m)
-    {
-        float* survivorDistance = survivorDistances.data();
-        std::uint32_t* survivorIndex = survivorIndices.data();
-        std::uint32_t j = begin;
-#ifdef __SSE2__
-        const __m128 qx = _mm_set1_ps(q.x()), qy = _mm_set1_ps(q.y()), qz = _mm_set1_ps(q.z()), bound = _mm_set1_ps(limit);
-        for (; j + 4 <= end; j += 4) {
-            const __m128 d = squaredDistances4(qx, qy, qz, j);
-            int inside = _mm_movemask_ps(_mm_cmple_ps(d, bound));
-            if (inside == 0)
-                continue;
-            alignas(16) float lanes[4];
-            _mm_store_ps(lanes, d);
-            for (; inside != 0; inside &= inside - 1) {
-                const int lane = __builtin_ctz(static_cast<unsigned>(inside));
-                survivorDistance[m] = lanes[lane];
-                survivorIndex[m++] = indices[j + static_cast<std::uint32_t>(lane)];
+    // Morton order of the queries at this level; queries outside the cube get
+    // their own group each (their cell does not exist) and a full search. Their
+    // code is one past the level's last cell, so the sort needs 3 * level + 1 bits.
+    const double l = cellSize(level);
+    const std::int64_t n = std::int64_t(1) << level;
+    const MortonCode kOutside = MortonCode(1) << (3 * level);
+    detail::QueryGroups groups;
+    groups.outside = kOutside;
+    std::vector<KeyedIndex>& order = groups.order;
+    order.resize(count);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            std::int64_t c[3];
+            bool inside = queries[i].allFinite();
+            for (int a = 0; a < 3 && inside; ++a) {
+                const double cell = std::floor((queries[i][a] - box_.min[a]) / l);
+                inside = cell >= 0 && cell < static_cast<double>(n);
+                c[a] = inside ? static_cast<std::int64_t>(cell) : 0;
             }
+            order[i] = {inside ? encodeCell(static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]),
+                                            static_cast<std::uint32_t>(c[2]))
+                               : kOutside,
+                        static_cast<std::uint32_t>(i)};
         }
-#endif
-        for (; j < end; ++j) {
-            const float d = squaredDistance(q, j);
-            survivorDistance[m] = d;
-            survivorIndex[m] = indices[j];
-            m += d <= limit;
-        }
-        return m;
-    }
+    });
+    radixSort(order, 3 * level + 1);
 
-    //! The k nearest among the candidates within squared distance `limit` of q,
-    //! into heap (sorted), if there are at least k; false (heap untouched) if
-    //! not. Cells are skipped by their gap (gapTo) or their group (beyond);
-    //! gathered(c) brings a cell in. The survivors are ranked by counting
-    //! (branch-free, for the usual few dozen) or partially sorted.
-    template <typename Beyond, typename Gap, typename Gather>
-    bool selectWithin(const Eigen::Vector3f& q, float limit, std::size_t k, Beyond&& beyond, Gap&& gapTo, Gather&& gathered,
-                      std::size_t cells, std::size_t& scanned)
-    {
-        const double reach = static_cast<double>(limit) * (1 + kSlack);
-        std::size_t m = 0;
-        for (std::size_t c = 0; c < cells; ++c) {
-            if (beyond(c, reach))
-                break;
-            if (cellState[c] == kEmpty || gapTo(c) > reach || !gathered(c))
-                continue;
-            const std::uint32_t begin = cellBegin[c], end = cellEnd[c];
-            m = keepWithin(q, begin, end, limit, m);
-            scanned += end - begin;
-        }
-        if (m < k)
-            return false;
-        heap.resize(k);
-        const float* d = survivorDistances.data();
-        const std::uint32_t* id = survivorIndices.data();
-        if (m <= 64) {
-            // Rank of each survivor among them, (distance, index) order: the
-            // inner loop has no branch and vectorises.
-            for (std::size_t i = 0; i < m; ++i) {
-                const float di = d[i];
-                const std::uint32_t ii = id[i];
-                std::uint32_t rank = 0;
-                for (std::size_t j = 0; j < m; ++j)
-                    rank += static_cast<std::uint32_t>((d[j] < di) | ((d[j] == di) & (id[j] < ii)));
-                if (rank < k)
-                    heap[rank] = Neighbour{ii, di};
-            }
-        } else {
-            ordered.resize(m);
-            for (std::size_t i = 0; i < m; ++i)
-                ordered[i] = Neighbour{id[i], d[i]};
-            std::partial_sort(ordered.begin(), ordered.begin() + static_cast<std::ptrdiff_t>(k), ordered.end());
-            std::copy(ordered.begin(), ordered.begin() + static_cast<std::ptrdiff_t>(k), heap.begin());
-        }
-        return true;
-    }
+    // Groups of queries sharing a cell.
+    std::vector<std::size_t>& groupStart = groups.start;
+    groupStart.reserve(count / 2 + 1);
+    for (std::size_t i = 0; i < count; ++i)
+        if (i == 0 || order[i].code != order[i - 1].code || order[i].code == kOutside)
+            groupStart.push_back(i);
+    groupStart.push_back(count);
 
-    //! The k nearest of q into heap (sorted; fewer if the neighbourhood holds
-    //! fewer), when no guess settled it: the own cell first, then the other
-    //! cells by increasing gap to q, into a sorted list of the k best so far.
-    //! Once the list is full, a cell whose box lies farther than its last
-    //! entry cannot contribute, and neither can any later cell; cells already
-    //! beyond the own cell's k-th distance are not even sorted.
-    template <typename Gap, typename Gather>
-    void selectInGapOrder(const Eigen::Vector3f& q, std::size_t k, Gap&& gapTo, Gather&& gathered, std::size_t cells,
-                          std::size_t& scanned)
-    {
-        // The list in a plain array, its size and k-th distance in locals
-        // (registers), not in a vector's fields.
-        if (top.size() < k)
-            top.resize(k);
-        Neighbour* best = top.data();
-        std::size_t size = 0;
-        float worst = std::numeric_limits<float>::infinity(); // k-th distance once full
-        auto scan = [&](std::size_t c) {
-            const std::uint32_t begin = cellBegin[c];
-            const std::size_t count = cellEnd[c] - begin;
-            float* d2 = distances.data();
-            squaredDistances(q, begin, count, d2);
-            for (std::size_t j = 0; j < count; ++j) {
-                if (d2[j] > worst)
-                    continue;
-                const Neighbour candidate{indices[begin + j], d2[j]};
-                std::size_t at;
-                if (size == k) {
-                    if (!(candidate < best[k - 1]))
-                        continue; // a tie at the k-th distance with a larger index
-                    at = k - 1;
-                } else {
-                    at = size++;
-                }
-                // Insertion from the back: for a dozen entries, cheaper than a
-                // binary search's unpredictable branches.
-                for (; at > 0 && candidate < best[at - 1]; --at)
-                    best[at] = best[at - 1];
-                best[at] = candidate;
-                if (size == k)
-                    worst = best[k - 1].squaredDistance;
-            }
-            scanned += count;
-        };
-        if (cellState[0] != kEmpty && gathered(0))
-            scan(0);
-        const double bound = static_cast<double>(worst) * (1 + kSlack); // +inf until k are found
-        std::array<std::pair<double, std::size_t>, 26> byGap;
-        std::size_t candidates = 0;
-        for (std::size_t c = 1; c < cells; ++c) {
-            if (cellState[c] == kEmpty)
-                continue;
-            const double gap2 = gapTo(c);
-            if (gap2 > bound)
-                continue;
-            std::size_t j = candidates++;
-            for (; j > 0 && byGap[j - 1].first > gap2; --j)
-                byGap[j] = byGap[j - 1];
-            byGap[j] = {gap2, c};
-        }
-        for (std::size_t r = 0; r < candidates; ++r) {
-            const auto [gap2, c] = byGap[r];
-            if (gap2 > static_cast<double>(worst) * (1 + kSlack))
-                break;
-            if (gathered(c))
-                scan(c);
-        }
-        heap.assign(best, best + size);
-    }
-
-    //! Squared distances from q to candidates [begin, begin + count) into d2,
-    //! with the float operations of Eigen's squaredNorm(), x^2 + (y^2 + z^2),
-    //! so that the results are bitwise those of nearest() and brute force.
-    void squaredDistances(const Eigen::Vector3f& q, std::size_t begin, std::size_t count, float* d2) const
-    {
-        using Column = Eigen::Map<const Eigen::ArrayXf>;
-        const Eigen::Index n = static_cast<Eigen::Index>(count);
-        Eigen::Map<Eigen::ArrayXf>(d2, n) = (Column(x.data() + begin, n) - q.x()).square() +
-                                            ((Column(y.data() + begin, n) - q.y()).square() +
-                                             (Column(z.data() + begin, n) - q.z()).square());
-    }
-
-    //! Folds candidates [begin, end) into (bestDistance, bestIndex): the
-    //! smallest squared distance, ties to the smallest point index, exactly as
-    //! brute force decides. One pass, four candidates per step where SSE2 is
-    //! available (every x86-64).
-    void foldNearest(const Eigen::Vector3f& q, std::uint32_t begin, std::uint32_t end, float& bestDistance,
-                     std::uint32_t& bestIndex) const
-    {
-        std::uint32_t j = begin;
-        auto better = [](float d, std::uint32_t i, float bd, std::uint32_t bi) { return d < bd || (d == bd && i < bi); };
-#ifdef __SSE2__
-        if (end - begin >= 8) {
-            const __m128 qx = _mm_set1_ps(q.x()), qy = _mm_set1_ps(q.y()), qz = _mm_set1_ps(q.z());
-            // Indices compared as signed integers after flipping the sign bit,
-            // which orders them as unsigned (SSE2 has no unsigned compare).
-            const __m128i bias = _mm_set1_epi32(static_cast<int>(0x80000000u));
-            __m128 laneDistance = _mm_set1_ps(bestDistance);
-            __m128i laneIndex = _mm_xor_si128(_mm_set1_epi32(static_cast<int>(bestIndex)), bias);
-            for (; j + 4 <= end; j += 4) {
-                const __m128 d = squaredDistances4(qx, qy, qz, j);
-                const __m128i i = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(indices.data() + j)), bias);
-                const __m128 take = _mm_or_ps(_mm_cmplt_ps(d, laneDistance),
-                                              _mm_and_ps(_mm_cmpeq_ps(d, laneDistance), _mm_castsi128_ps(_mm_cmplt_epi32(i, laneIndex))));
-                laneDistance = _mm_or_ps(_mm_and_ps(take, d), _mm_andnot_ps(take, laneDistance));
-                const __m128i takeIndex = _mm_castps_si128(take);
-                laneIndex = _mm_or_si128(_mm_and_si128(takeIndex, i), _mm_andnot_si128(takeIndex, laneIndex));
-            }
-            alignas(16) float lanes[4];
-            alignas(16) std::uint32_t laneIndices[4];
-            _mm_store_ps(lanes, laneDistance);
-            _mm_store_si128(reinterpret_cast<__m128i*>(laneIndices), _mm_xor_si128(laneIndex, bias));
-            for (int lane = 0; lane < 4; ++lane)
-                if (better(lanes[lane], laneIndices[lane], bestDistance, bestIndex)) {
-                    bestDistance = lanes[lane];
-                    bestIndex = laneIndices[lane];
-                }
-        }
-#endif
-        for (; j < end; ++j) {
-            const float d = squaredDistance(q, j);
-            if (better(d, indices[j], bestDistance, bestIndex)) {
-                bestDistance = d;
-                bestIndex = indices[j];
-            }
-        }
-    }
-};
-
-//! k > 1: the squared radius a query first tries, relative to the previous
-//! query's squared k-th distance in the same cell (1.5: measured best of 1.2,
-//! 1.5, 2 and 3 on the benchmark's surface, no difference between 1.25, 1.5
-//! and 2 on the c2c data; a guess that holds fewer than k candidates costs
-//! one ordinary search more).
-constexpr float kGuessFactor = 1.5f;
-
-//! The 27 cell offsets, the own cell first, then faces, edges and corners, so
-//! that the closest candidates come first and the later cells are often pruned.
-const std::array<std::array<int, 3>, 27>& neighbourhoodOffsets()
-{
-    static const std::array<std::array<int, 3>, 27> offsets = [] {
-        std::array<std::array<int, 3>, 27> o{};
-        int i = 0;
-        for (int nonZero = 0; nonZero <= 3; ++nonZero)
-            for (int dx = -1; dx <= 1; ++dx)
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dz = -1; dz <= 1; ++dz)
-                        if ((dx != 0) + (dy != 0) + (dz != 0) == nonZero)
-                            o[static_cast<std::size_t>(i++)] = {dx, dy, dz};
-        return o;
-    }();
-    return offsets;
+    return groups;
 }
-
-} // namespace
 
 void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std::size_t k, int level,
                           std::vector<Neighbour>& out, QueryStatistics* statistics) const
@@ -856,54 +590,16 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
         std::fill(at + static_cast<std::ptrdiff_t>(found.size()), at + static_cast<std::ptrdiff_t>(k), missing);
     };
 
-    // Morton order of the queries at this level; queries outside the cube get
-    // their own group each (their cell does not exist) and a full search. Their
-    // code is one past the level's last cell, so the sort needs 3 * level + 1 bits.
-    const double l = cellSize(level);
     const std::int64_t n = std::int64_t(1) << level;
-    const MortonCode kOutside = MortonCode(1) << (3 * level);
-    std::vector<KeyedIndex> order(count);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            std::int64_t c[3];
-            bool inside = queries[i].allFinite();
-            for (int a = 0; a < 3 && inside; ++a) {
-                const double cell = std::floor((queries[i][a] - box_.min[a]) / l);
-                inside = cell >= 0 && cell < static_cast<double>(n);
-                c[a] = inside ? static_cast<std::int64_t>(cell) : 0;
-            }
-            order[i] = {inside ? encodeCell(static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]),
-                                            static_cast<std::uint32_t>(c[2]))
-                               : kOutside,
-                        static_cast<std::uint32_t>(i)};
-        }
-    });
-    radixSort(order, 3 * level + 1);
-
-    // Groups of queries sharing a cell.
-    std::vector<std::size_t> groupStart;
-    groupStart.reserve(count / 2 + 1);
-    for (std::size_t i = 0; i < count; ++i)
-        if (i == 0 || order[i].code != order[i - 1].code || order[i].code == kOutside)
-            groupStart.push_back(i);
-    groupStart.push_back(count);
+    const double l = cellSize(level);
+    const detail::QueryGroups groups = groupQueriesByCell(queries, count, level);
+    const std::vector<KeyedIndex>& order = groups.order;
+    const std::vector<std::size_t>& groupStart = groups.start;
+    const MortonCode kOutside = groups.outside;
 
     // The level's directory of non-empty cells: one binary search over the cells
     // (small enough to stay in cache) instead of two over every code.
     const CellDirectory& directory = cellDirectory(level);
-    // A cell is looked up within [from, to) of the directory: Morton codes grow
-    // with each coordinate, so the 27 cells around a query cell lie between the
-    // codes of its low and high corners, a short stretch of the directory that
-    // two searches per query cell find.
-    auto lookup = [&](MortonCode code, std::size_t from, std::size_t to) -> std::pair<std::size_t, std::size_t> {
-        const auto begin = directory.codes.begin();
-        const auto it = std::lower_bound(begin + static_cast<std::ptrdiff_t>(from), begin + static_cast<std::ptrdiff_t>(to), code);
-        if (it == begin + static_cast<std::ptrdiff_t>(to) || *it != code)
-            return {0, 0};
-        const auto d = static_cast<std::size_t>(it - begin);
-        return {directory.starts[d], directory.starts[d + 1]};
-    };
-
     tbb::enumerable_thread_specific<BatchScratch> scratch;
     const auto& offsets = neighbourhoodOffsets();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groupStart.size() - 1, 16), [&](const tbb::blocked_range<std::size_t>& range) {
@@ -934,14 +630,7 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
             // group's first query then tries it too instead of the slower
             // search in gap order (it falls back to that if the guess holds
             // fewer than k candidates).
-            auto clampedCode = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-                auto clamp = [&](std::int64_t v) { return static_cast<std::uint32_t>(std::clamp<std::int64_t>(v, 0, n - 1)); };
-                return encodeCell(clamp(x), clamp(y), clamp(z));
-            };
-            const auto codesBegin = directory.codes.begin();
-            const auto stretchBegin = std::lower_bound(codesBegin, directory.codes.end(), clampedCode(cx - 1, cy - 1, cz - 1));
-            const auto stretchEnd = std::upper_bound(stretchBegin, directory.codes.end(), clampedCode(cx + 1, cy + 1, cz + 1));
-            const auto from = static_cast<std::size_t>(stretchBegin - codesBegin), to = static_cast<std::size_t>(stretchEnd - codesBegin);
+            const detail::BlockLookup block(directory.codes, directory.starts, cx, cy, cz, n);
             for (std::size_t c = 0; c < offsets.size(); ++c) {
                 const std::int64_t x = cx + offsets[c][0], y = cy + offsets[c][1], z = cz + offsets[c][2];
                 const bool inCube = x >= 0 && y >= 0 && z >= 0 && x < n && y < n && z < n;
@@ -950,30 +639,14 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
             // Looks up and copies neighbour cell c on first use; false if it is empty.
             auto gathered = [&](std::size_t c) {
                 if (s.cellState[c] == BatchScratch::kUnknown) {
-                    const auto [b, e] = lookup(encodeCell(static_cast<std::uint32_t>(cx + offsets[c][0]),
-                                                          static_cast<std::uint32_t>(cy + offsets[c][1]),
-                                                          static_cast<std::uint32_t>(cz + offsets[c][2])),
-                                              from, to);
+                    const auto [b, e] = block.range(encodeCell(static_cast<std::uint32_t>(cx + offsets[c][0]),
+                                                               static_cast<std::uint32_t>(cy + offsets[c][1]),
+                                                               static_cast<std::uint32_t>(cz + offsets[c][2])));
                     ++s.statistics.cellLookups;
                     if (b == e) {
                         s.cellState[c] = BatchScratch::kEmpty;
                     } else {
-                        s.reserve(s.used + (e - b));
-                        float *px = s.x.data(), *py = s.y.data(), *pz = s.z.data();
-                        std::uint32_t* gatheredIndices = s.indices.data();
-                        std::uint32_t j = s.used;
-                        for (std::size_t i = b; i < e; ++i, ++j) {
-                            const std::uint32_t index = indices_[i];
-                            const Eigen::Vector3f& p = points_[index];
-                            gatheredIndices[j] = index;
-                            px[j] = p.x();
-                            py[j] = p.y();
-                            pz[j] = p.z();
-                        }
-                        s.cellBegin[c] = s.used;
-                        s.cellEnd[c] = j;
-                        s.used = j;
-                        s.cellState[c] = BatchScratch::kGathered;
+                        s.gather(c, b, e, indices_.data(), points_);
                     }
                 }
                 return s.cellState[c] == BatchScratch::kGathered;

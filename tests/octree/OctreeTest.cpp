@@ -436,3 +436,38 @@ TEST(Octree, ExtremeQueriesAndRadiiStayExact)
     faceTree.nearest({1.0f, 0.5f, 0.5f}, 1, 21, got);
     EXPECT_EQ(got[0].index, 1u);
 }
+
+TEST(Octree, BatchRadiusEqualsBruteForceForOwnAndOtherQueries)
+{
+    std::mt19937 rng(23);
+    for (const Shape& shape : kShapes) {
+        const Cloud cloud = shape.make(900, rng);
+        const Octree tree(cloud.data(), cloud.size());
+        Cloud others = randomCloud(60, rng);
+        others.push_back({1e6f, 0.0f, 0.0f});                         // far outside the cube
+        others.push_back({std::nanf(""), 0.0f, 0.0f});                // no neighbour
+        others.push_back(cloud.front() + Eigen::Vector3f(0, 0, 40.0f)); // outside, but the sphere may reach in
+        for (float r : {0.0f, 0.03f, 0.4f, 2.5f, 50.0f}) {
+            for (const Cloud* queries : std::initializer_list<const Cloud*>{&cloud, &others}) {
+                std::vector<std::vector<Neighbour>> got(queries->size());
+                std::vector<int> visits(queries->size(), 0);
+                tree.withinRadiusBatch(queries->data(), queries->size(), r,
+                                       [&](std::uint32_t q, const Neighbour* list, std::size_t count) {
+                                           got[q].assign(list, list + count);
+                                           ++visits[q];
+                                       });
+                for (std::size_t q = 0; q < queries->size(); ++q) {
+                    ASSERT_EQ(visits[q], 1) << shape.name << " query " << q;
+                    std::sort(got[q].begin(), got[q].end());
+                    const std::vector<Neighbour> expected =
+                        (*queries)[q].allFinite() ? bruteForceRadius(cloud, (*queries)[q], r) : std::vector<Neighbour>{};
+                    expectSame(got[q], expected, std::string(shape.name) + " radius " + std::to_string(r) + " query " + std::to_string(q));
+                }
+            }
+        }
+    }
+    const Cloud cloud = randomCloud(10, rng);
+    const Octree tree(cloud.data(), cloud.size());
+    EXPECT_THROW(tree.withinRadiusBatch(cloud.data(), cloud.size(), -1.0f, [](std::uint32_t, const Neighbour*, std::size_t) {}),
+                 std::invalid_argument);
+}

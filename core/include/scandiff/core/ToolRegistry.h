@@ -48,6 +48,10 @@ struct ParameterSpec
     //! --knn K"): at most one may be given. The GUI lets one be switched on at a
     //! time and proposes the group's first; the tool decides what none means.
     std::string alternativeGroup;
+    //! A required parameter has no default the user can rely on (a radius that
+    //! depends on the data): the CLI refuses to run without it, the GUI shows
+    //! `defaultValue` as a proposal the user confirms.
+    bool required = false;
 
     static ParameterSpec integer(std::string name, std::string label, std::string description, std::int64_t defaultValue,
                                  std::int64_t minimum, std::int64_t maximum, std::string unit = {});
@@ -61,6 +65,8 @@ struct ParameterSpec
     ParameterSpec asOptional() const;
     //! The same declaration, optional and one of the alternatives of `group`.
     ParameterSpec asAlternative(std::string group) const;
+    //! The same declaration, required (see `required`).
+    ParameterSpec asRequired() const;
 
     //! Parses user text ("12", "0.5", "true", "plane") into a valid value.
     //! Throws Error(InvalidArgument) naming the parameter and its valid range.
@@ -185,7 +191,7 @@ struct ToolSpec
     const ParameterSpec* parameter(const std::string& name) const;
     const InputSpec* input(const std::string& role) const;
     const OutputSpec* output(const std::string& role) const;
-    //! The declared defaults.
+    //! The declared defaults (a required parameter's proposal included).
     ParameterValues defaults() const;
     //! Defaults overridden by user text, every value parsed and checked.
     //! Throws Error(InvalidArgument) for an unknown name or a bad value.

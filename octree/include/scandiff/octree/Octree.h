@@ -16,12 +16,17 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <vector>
 
 namespace scandiff::octree {
+
+namespace detail {
+struct QueryGroups;
+}
 
 //! An axis-aligned cube: the root cell. Two octrees built on the same cube have
 //! equal codes for homologous cells (needed for cloud/cloud work).
@@ -129,6 +134,22 @@ public:
     void nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std::size_t k, int level,
                       std::vector<Neighbour>& out, QueryStatistics* statistics = nullptr) const;
 
+    //! Receives one query's neighbours in withinRadiusBatch(): the query's
+    //! index and every point within the radius, in no particular order (the
+    //! same order for the same inputs, whatever the number of threads).
+    using RadiusVisitor = std::function<void(std::uint32_t query, const Neighbour* neighbours, std::size_t count)>;
+
+    //! Every point within `radius` (distance <= radius, the set withinRadius()
+    //! returns) of each query, in parallel (TBB): queries are grouped by cell
+    //! at the deepest level whose cells are at least `radius` wide, so the 3 x 3
+    //! x 3 block around a cell holds every sphere centred in it; the block's
+    //! points are gathered once for all the cell's queries and each query keeps
+    //! those within reach. `visit` is called exactly once per query, from the
+    //! worker threads, concurrently; an exception it throws (a cancellation)
+    //! stops the batch and reaches the caller. A query that is not finite gets
+    //! no neighbour. Throws std::invalid_argument for a negative or non-finite radius.
+    void withinRadiusBatch(const Eigen::Vector3f* queries, std::size_t count, float radius, const RadiusVisitor& visit) const;
+
     //! The level of thesis 000 §4.5 (eq. 4.2) for k-nearest queries of the
     //! points of `queries`, an octree built on the same cube: the level that
     //! minimises the estimated cost of distances (candidates per query) plus
@@ -154,6 +175,9 @@ private:
     void descendNearest(const Eigen::Vector3f& q, std::size_t k, int leafLevel, std::vector<Neighbour>& heap) const;
     void scanCell(std::int64_t x, std::int64_t y, std::int64_t z, int level, const Eigen::Vector3f& q, std::size_t k,
                   std::vector<Neighbour>& heap) const;
+
+    //! The queries in Morton order at `level`, grouped by cell (BatchQueries.h).
+    detail::QueryGroups groupQueriesByCell(const Eigen::Vector3f* queries, std::size_t count, int level) const;
 
     //! The non-empty cells of one level with where their points start: batch
     //! queries search this (small, cache-resident) list instead of every code.

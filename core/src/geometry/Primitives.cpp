@@ -1,0 +1,402 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/core/geometry/Primitives.h>
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/TextLists.h>
+#include <scandiff/core/processing/Normals.h>
+
+#include <Eigen/Dense>
+#include <unsupported/Eigen/LevenbergMarquardt>
+#include <unsupported/Eigen/NumericalDiff>
+
+#include <charconv>
+#include <cmath>
+
+namespace scandiff {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr std::size_t kMaxFitPoints = 200000;
+
+//! A unit vector orthogonal to d, and a third completing a right-handed frame.
+void orthonormalFrame(const Eigen::Vector3d& d, Eigen::Vector3d& e1, Eigen::Vector3d& e2)
+{
+    const Eigen::Vector3d helper = std::abs(d.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+    e1 = (helper - helper.dot(d) * d).normalized();
+    e2 = d.cross(e1);
+}
+
+[[noreturn]] void cannotFit(PrimitiveKind kind, const std::string& why)
+{
+    throw Error(ErrorCode::InvalidData, std::string("fitting a ") + primitiveKindName(kind) + ": " + why);
+}
+
+//! The residual functions of the fits, over points relative to their centroid.
+//! Directions are refined as d0 + a e1 + b e2 (normalised), which keeps them
+//! unit length without a constraint.
+struct Residuals : Eigen::DenseFunctor<double>
+{
+    Residuals(const std::vector<Eigen::Vector3d>& points, int parameters, std::function<double(const Eigen::VectorXd&, const Eigen::Vector3d&)> f)
+        : Eigen::DenseFunctor<double>(parameters, static_cast<int>(points.size())), points_(points), f_(std::move(f))
+    {
+    }
+    int operator()(const Eigen::VectorXd& x, Eigen::VectorXd& residuals) const
+    {
+        for (std::size_t i = 0; i < points_.size(); ++i)
+            residuals[static_cast<Eigen::Index>(i)] = f_(x, points_[i]);
+        return 0;
+    }
+    const std::vector<Eigen::Vector3d>& points_;
+    std::function<double(const Eigen::VectorXd&, const Eigen::Vector3d&)> f_;
+};
+
+void refine(const std::vector<Eigen::Vector3d>& points, Eigen::VectorXd& x,
+            std::function<double(const Eigen::VectorXd&, const Eigen::Vector3d&)> residual, PrimitiveKind kind)
+{
+    if (points.size() < static_cast<std::size_t>(x.size()))
+        cannotFit(kind, "too few points");
+    Residuals functor(points, static_cast<int>(x.size()), std::move(residual));
+    Eigen::NumericalDiff<Residuals, Eigen::Central> numeric(functor);
+    Eigen::LevenbergMarquardt<Eigen::NumericalDiff<Residuals, Eigen::Central>> lm(numeric);
+    lm.setFtol(1e-15);
+    lm.setXtol(1e-15);
+    lm.setMaxfev(400 * static_cast<Eigen::Index>(x.size() + 1));
+    lm.minimize(x);
+    if (!x.allFinite())
+        cannotFit(kind, "the least-squares refinement diverged");
+}
+
+//! Kasa's algebraic circle through 2D points: centre and radius.
+bool fitCircle(const std::vector<Eigen::Vector2d>& p, Eigen::Vector2d& centre, double& radius)
+{
+    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    for (const auto& q : p) {
+        const Eigen::Vector3d row(2 * q.x(), 2 * q.y(), 1);
+        a.noalias() += row * row.transpose();
+        b += row * q.squaredNorm();
+    }
+    const Eigen::Vector3d s = a.ldlt().solve(b);
+    centre = s.head<2>();
+    radius = std::sqrt(s[2] + centre.squaredNorm());
+    return s.allFinite() && radius > 0;
+}
+
+//! The fitted points that have a normal, with it: the cloud's normals, or
+//! normals estimated on the whole cloud (plane, 12 neighbours).
+void withNormals(const PointCloud& cloud, const std::vector<std::size_t>& used, const std::vector<Eigen::Vector3d>& points,
+                 ProgressObserver* progress, std::vector<Eigen::Vector3d>& pairedPoints, std::vector<Eigen::Vector3d>& pairedNormals)
+{
+    std::vector<Eigen::Vector3f> estimated;
+    if (!cloud.hasNormals()) {
+        NormalParams params;
+        params.knn = 12;
+        params.orientation.kind = NormalOrientation::Kind::None;
+        estimated = computeNormals(cloud, params, progress).normals;
+    }
+    const std::vector<Eigen::Vector3f>& all = cloud.hasNormals() ? cloud.normals() : estimated;
+    for (std::size_t j = 0; j < used.size(); ++j)
+        if (all[used[j]] != Eigen::Vector3f::Zero()) {
+            pairedPoints.push_back(points[j]);
+            pairedNormals.push_back(all[used[j]].cast<double>().normalized());
+        }
+}
+
+Eigen::Vector3d smallestAxis(const Eigen::Matrix3d& m)
+{
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(m);
+    return solver.eigenvectors().col(0);
+}
+
+} // namespace
+
+double signedDistance(const Primitive& s, const Eigen::Vector3d& p)
+{
+    const Eigen::Vector3d v = p - s.point;
+    switch (s.kind) {
+    case PrimitiveKind::Plane: return v.dot(s.direction);
+    case PrimitiveKind::Sphere: return v.norm() - s.radius;
+    case PrimitiveKind::Cylinder: return (v - v.dot(s.direction) * s.direction).norm() - s.radius;
+    case PrimitiveKind::Cone: {
+        const double h = v.dot(s.direction), rho = (v - h * s.direction).norm();
+        return rho * std::cos(s.halfAngle) - h * std::sin(s.halfAngle);
+    }
+    }
+    return 0;
+}
+
+PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressObserver* progress)
+{
+    const std::size_t n = cloud.size();
+    if (n < 4)
+        cannotFit(kind, "cloud '" + cloud.name + "' has fewer than 4 points");
+    ProgressTicker ticker(progress, std::string("Fitting a ") + primitiveKindName(kind), 3);
+    // An even sample of large clouds, relative to its centroid (in double,
+    // from the global coordinates: the fit never sees a UTM magnitude).
+    const std::size_t stride = (n + kMaxFitPoints - 1) / kMaxFitPoints;
+    std::vector<std::size_t> used;
+    for (std::size_t i = 0; i < n; i += stride)
+        used.push_back(i);
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (std::size_t i : used)
+        centroid += cloud.positions()[i].cast<double>();
+    centroid /= static_cast<double>(used.size());
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(used.size());
+    for (std::size_t i : used)
+        points.push_back(cloud.positions()[i].cast<double>() - centroid);
+    const Eigen::Vector3d globalCentroid = cloud.origin() + centroid;
+
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (const auto& p : points)
+        covariance.noalias() += p * p.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca(covariance);
+    if (!(pca.eigenvalues()[1] > 1e-12 * pca.eigenvalues()[2]))
+        cannotFit(kind, "the points are (nearly) on a line");
+    ticker.step();
+
+    Primitive s;
+    s.kind = kind;
+    switch (kind) {
+    case PrimitiveKind::Plane: {
+        s.point = globalCentroid;
+        s.direction = pca.eigenvectors().col(0).normalized();
+        // A fixed side, so the same points always give the same plane: +Z
+        // first, then +Y, then +X.
+        const Eigen::Vector3d d = s.direction;
+        const double key = std::abs(d.z()) > 1e-9 ? d.z() : std::abs(d.y()) > 1e-9 ? d.y() : d.x();
+        if (key < 0)
+            s.direction = -s.direction;
+        break;
+    }
+    case PrimitiveKind::Sphere: {
+        Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
+        Eigen::Vector4d b = Eigen::Vector4d::Zero();
+        for (const auto& p : points) {
+            const Eigen::Vector4d row(2 * p.x(), 2 * p.y(), 2 * p.z(), 1);
+            a.noalias() += row * row.transpose();
+            b += row * p.squaredNorm();
+        }
+        const Eigen::Vector4d algebraic = a.ldlt().solve(b);
+        Eigen::VectorXd x(4);
+        x << algebraic.head<3>(), std::sqrt(algebraic[3] + algebraic.head<3>().squaredNorm());
+        if (!x.allFinite())
+            cannotFit(kind, "the points do not determine a sphere");
+        refine(points, x, [](const Eigen::VectorXd& x, const Eigen::Vector3d& p) { return (p - x.head<3>()).norm() - x[3]; }, kind);
+        s.point = globalCentroid + x.head<3>();
+        s.radius = std::abs(x[3]);
+        break;
+    }
+    case PrimitiveKind::Cylinder: {
+        // Every normal of a cylinder is orthogonal to its axis.
+        std::vector<Eigen::Vector3d> pairedPoints, normals;
+        withNormals(cloud, used, points, progress, pairedPoints, normals);
+        if (normals.size() < 5)
+            cannotFit(kind, "too few points with a normal");
+        Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+        for (const auto& nrm : normals)
+            m.noalias() += nrm * nrm.transpose();
+        const Eigen::Vector3d d0 = smallestAxis(m);
+        Eigen::Vector3d e1, e2;
+        orthonormalFrame(d0, e1, e2);
+        std::vector<Eigen::Vector2d> planar;
+        planar.reserve(points.size());
+        for (const auto& p : points)
+            planar.emplace_back(p.dot(e1), p.dot(e2));
+        Eigen::Vector2d centre;
+        double radius = 0;
+        if (!fitCircle(planar, centre, radius))
+            cannotFit(kind, "the points do not determine a circle across the axis");
+        Eigen::VectorXd x(5);
+        x << centre.x(), centre.y(), 0, 0, radius;
+        const auto axisOf = [d0, e1, e2](const Eigen::VectorXd& x) { return (d0 + x[2] * e1 + x[3] * e2).normalized(); };
+        refine(points, x, [&](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
+            const Eigen::Vector3d d = axisOf(x), v = p - (x[0] * e1 + x[1] * e2);
+            return (v - v.dot(d) * d).norm() - x[4];
+        }, kind);
+        const Eigen::Vector3d d = axisOf(x), onAxis = x[0] * e1 + x[1] * e2;
+        s.direction = d;
+        s.point = globalCentroid + onAxis - onAxis.dot(d) * d; // the foot of the centroid
+        s.radius = std::abs(x[4]);
+        break;
+    }
+    case PrimitiveKind::Cone: {
+        // A cone's normals make one angle with its axis (the axis is the
+        // direction along which they vary least), and each normal's plane
+        // through its point holds the apex.
+        std::vector<Eigen::Vector3d> pairedPoints, pairedNormals;
+        withNormals(cloud, used, points, progress, pairedPoints, pairedNormals);
+        if (pairedNormals.size() < 6)
+            cannotFit(kind, "too few points with a normal");
+        // Normals are unoriented: each turned to the side of the first before they are compared.
+        std::vector<Eigen::Vector3d> aligned = pairedNormals;
+        for (auto& nrm : aligned)
+            if (nrm.dot(aligned.front()) < 0)
+                nrm = -nrm;
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (const auto& nrm : aligned)
+            mean += nrm;
+        mean /= static_cast<double>(aligned.size());
+        Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+        for (const auto& nrm : aligned)
+            spread.noalias() += (nrm - mean) * (nrm - mean).transpose();
+        Eigen::Vector3d d0 = smallestAxis(spread);
+        Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+        Eigen::Vector3d b = Eigen::Vector3d::Zero();
+        for (std::size_t j = 0; j < pairedPoints.size(); ++j) {
+            a.noalias() += pairedNormals[j] * pairedNormals[j].transpose();
+            b += pairedNormals[j] * pairedNormals[j].dot(pairedPoints[j]);
+        }
+        const Eigen::Vector3d apex0 = a.ldlt().solve(b);
+        if (!apex0.allFinite())
+            cannotFit(kind, "the normals do not meet at an apex");
+        double along = 0;
+        for (const auto& p : points)
+            along += (p - apex0).dot(d0);
+        if (along < 0)
+            d0 = -d0;
+        double angle = 0;
+        for (const auto& p : points) {
+            const Eigen::Vector3d v = p - apex0;
+            const double h = v.dot(d0);
+            angle += std::atan2((v - h * d0).norm(), h);
+        }
+        angle /= static_cast<double>(points.size());
+        Eigen::Vector3d e1, e2;
+        orthonormalFrame(d0, e1, e2);
+        Eigen::VectorXd x(6);
+        x << apex0, 0, 0, angle;
+        const auto axisOf = [d0, e1, e2](const Eigen::VectorXd& x) { return (d0 + x[3] * e1 + x[4] * e2).normalized(); };
+        refine(points, x, [&](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
+            const Eigen::Vector3d d = axisOf(x), v = p - x.head<3>();
+            const double h = v.dot(d), rho = (v - h * d).norm();
+            return rho * std::cos(x[5]) - h * std::sin(x[5]);
+        }, kind);
+        s.point = globalCentroid + x.head<3>();
+        s.direction = axisOf(x);
+        s.halfAngle = x[5];
+        if (!(s.halfAngle > 0 && s.halfAngle < kPi / 2))
+            cannotFit(kind, "the fitted half-angle is not between 0 and 90 degrees");
+        break;
+    }
+    }
+    ticker.step();
+    PrimitiveFit fit;
+    fit.primitive = s;
+    fit.points = used.size();
+    double sum = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double d = signedDistance(s, cloud.globalPosition(i));
+        sum += d * d;
+    }
+    fit.rms = std::sqrt(sum / static_cast<double>(n));
+    ticker.step();
+    return fit;
+}
+
+PrimitiveKind parsePrimitiveKind(const std::string& name)
+{
+    if (name == "plane")
+        return PrimitiveKind::Plane;
+    if (name == "sphere")
+        return PrimitiveKind::Sphere;
+    if (name == "cylinder")
+        return PrimitiveKind::Cylinder;
+    if (name == "cone")
+        return PrimitiveKind::Cone;
+    throw Error(ErrorCode::InvalidArgument, "'" + name + "' is not plane, sphere, cylinder or cone");
+}
+
+const char* primitiveKindName(PrimitiveKind kind)
+{
+    switch (kind) {
+    case PrimitiveKind::Plane: return "plane";
+    case PrimitiveKind::Sphere: return "sphere";
+    case PrimitiveKind::Cylinder: return "cylinder";
+    case PrimitiveKind::Cone: return "cone";
+    }
+    return "";
+}
+
+Primitive parsePrimitive(const std::string& text)
+{
+    const auto colon = text.find(':');
+    if (colon == std::string::npos)
+        throw Error(ErrorCode::InvalidArgument, "primitive '" + text + "' is not KIND:NUMBERS (e.g. cylinder:PX,PY,PZ,DX,DY,DZ,R)");
+    Primitive s;
+    s.kind = parsePrimitiveKind(text.substr(0, colon));
+    const std::vector<double> v = parseNumberList(text.substr(colon + 1), "the primitive's numbers");
+    const std::size_t expected = s.kind == PrimitiveKind::Sphere ? 4 : s.kind == PrimitiveKind::Plane ? 6 : 7;
+    if (v.size() != expected)
+        throw Error(ErrorCode::InvalidArgument, std::string("a ") + primitiveKindName(s.kind) + " takes " + std::to_string(expected) +
+                                                    " numbers, not " + std::to_string(v.size()));
+    s.point = Eigen::Vector3d(v[0], v[1], v[2]);
+    if (s.kind == PrimitiveKind::Sphere) {
+        s.radius = v[3];
+    } else {
+        s.direction = Eigen::Vector3d(v[3], v[4], v[5]);
+        if (!(s.direction.norm() > 0))
+            throw Error(ErrorCode::InvalidArgument, "the primitive's direction must not be zero");
+        s.direction.normalize();
+        if (s.kind == PrimitiveKind::Cylinder)
+            s.radius = v[6];
+        if (s.kind == PrimitiveKind::Cone)
+            s.halfAngle = v[6] * kPi / 180.0;
+    }
+    if ((s.kind == PrimitiveKind::Sphere || s.kind == PrimitiveKind::Cylinder) && !(s.radius > 0))
+        throw Error(ErrorCode::InvalidArgument, "the primitive's radius must be > 0");
+    if (s.kind == PrimitiveKind::Cone && !(s.halfAngle > 0 && s.halfAngle < kPi / 2))
+        throw Error(ErrorCode::InvalidArgument, "the cone's half-angle must be between 0 and 90 degrees");
+    return s;
+}
+
+std::string primitiveText(const Primitive& s)
+{
+    std::string text = std::string(primitiveKindName(s.kind)) + ":";
+    const auto add = [&](double v, bool last = false) {
+        char buffer[32];
+        const auto r = std::to_chars(buffer, buffer + sizeof buffer, v);
+        text.append(buffer, r.ptr);
+        if (!last)
+            text += ',';
+    };
+    add(s.point.x());
+    add(s.point.y());
+    add(s.point.z());
+    if (s.kind == PrimitiveKind::Sphere) {
+        add(s.radius, true);
+        return text;
+    }
+    add(s.direction.x());
+    add(s.direction.y());
+    add(s.direction.z(), s.kind == PrimitiveKind::Plane);
+    if (s.kind == PrimitiveKind::Cylinder)
+        add(s.radius, true);
+    if (s.kind == PrimitiveKind::Cone)
+        add(s.halfAngle * 180.0 / kPi, true);
+    return text;
+}
+
+Table primitiveTable(const Primitive& s, std::optional<double> rms)
+{
+    Table t;
+    t.columns = {"parameter", "value"};
+    t.rows.push_back({std::string("kind"), std::string(primitiveKindName(s.kind))});
+    const char* pointName = s.kind == PrimitiveKind::Sphere ? "centre" : s.kind == PrimitiveKind::Cone ? "apex" : "point";
+    for (int a = 0; a < 3; ++a)
+        t.rows.push_back({std::string(pointName) + "_" + "xyz"[a], s.point[a]});
+    if (s.kind != PrimitiveKind::Sphere)
+        for (int a = 0; a < 3; ++a)
+            t.rows.push_back({std::string(s.kind == PrimitiveKind::Plane ? "normal_" : "axis_") + "xyz"[a], s.direction[a]});
+    if (s.kind == PrimitiveKind::Sphere || s.kind == PrimitiveKind::Cylinder)
+        t.rows.push_back({std::string("radius"), s.radius});
+    if (s.kind == PrimitiveKind::Cone)
+        t.rows.push_back({std::string("half_angle_deg"), s.halfAngle * 180.0 / kPi});
+    if (rms)
+        t.rows.push_back({std::string("rms"), *rms});
+    t.rows.push_back({std::string("text"), primitiveText(s)});
+    return t;
+}
+
+} // namespace scandiff

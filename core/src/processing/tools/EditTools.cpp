@@ -1,0 +1,295 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Tools: clone, merge, transform, crop.
+#include "processing/tools/ToolGroups.h"
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/TextLists.h>
+#include <scandiff/core/processing/CloudEditing.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace scandiff::detail {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+//! Numbers separated by commas, semicolons, spaces, tabs or line breaks.
+std::vector<double> numbersIn(const std::string& text, const std::string& what)
+{
+    std::string spaced = text;
+    for (char& c : spaced)
+        if (c == ',' || c == ';' || c == '\t' || c == '\n' || c == '\r')
+            c = ' ';
+    std::istringstream in(spaced);
+    std::vector<double> out;
+    std::string token;
+    while (in >> token) {
+        const std::vector<double> one = parseNumberList(token, what);
+        out.insert(out.end(), one.begin(), one.end());
+    }
+    return out;
+}
+
+Eigen::Vector3d vector3(const std::string& text, const std::string& what)
+{
+    const std::vector<double> v = parseNumberList(text, what);
+    if (v.size() != 3)
+        throw Error(ErrorCode::InvalidArgument, what + " is X,Y,Z");
+    return {v[0], v[1], v[2]};
+}
+
+//! 16 numbers typed or pasted (row by row), or the text file holding them
+//! (CloudCompare's layout: four lines of four numbers).
+Eigen::Matrix4d parseMatrix(const std::string& text)
+{
+    std::vector<double> v;
+    bool numeric = true;
+    try {
+        v = numbersIn(text, "the matrix");
+    } catch (const Error&) {
+        numeric = false;
+    }
+    if (!numeric || v.size() != 16) {
+        std::ifstream file(text);
+        if (!numeric && !file)
+            throw Error(ErrorCode::InvalidArgument, "transform: '" + text + "' is neither 16 numbers nor a readable matrix file");
+        if (file) {
+            std::stringstream content;
+            content << file.rdbuf();
+            v = numbersIn(content.str(), "the matrix file " + text);
+        }
+    }
+    if (v.size() != 16)
+        throw Error(ErrorCode::InvalidArgument, "transform: a matrix is 16 numbers (4 rows of 4), not " + std::to_string(v.size()));
+    Eigen::Matrix4d m;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+            m(r, c) = v[static_cast<std::size_t>(4 * r + c)];
+    return m;
+}
+
+Eigen::Vector3d centreOf(const PointCloud& cloud, const std::string& text)
+{
+    if (text == "centroid") {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (const auto& p : cloud.positions())
+            sum += p.cast<double>();
+        return cloud.origin() + sum / static_cast<double>(std::max<std::size_t>(1, cloud.size()));
+    }
+    if (text == "box-centre") {
+        const BoundingBox box = cloud.bounds();
+        return box.empty ? Eigen::Vector3d::Zero() : Eigen::Vector3d((box.min + box.max) / 2);
+    }
+    return vector3(text, "the centre");
+}
+
+void addCloneTool(ToolRegistry& registry)
+{
+    ToolSpec tool = oneCloudTool("clone", "Clone", "Edit", "A copy of the cloud, with every attribute.", newCloud("Copy"));
+    tool.run = [](const ToolInputs& inputs, const ParameterValues&, ProgressObserver*) {
+        PointCloud out = inputs.cloud().clone();
+        out.name = inputs.cloud().name + "_clone";
+        ToolResult result;
+        result.summary = describe("copied ", out.size(), " points");
+        result.add("output", std::move(out));
+        return result;
+    };
+    registry.add(std::move(tool));
+}
+
+void addMergeTool(ToolRegistry& registry)
+{
+    ToolSpec tool = oneCloudTool("merge", "Merge clouds", "Edit",
+                                 "One cloud holding every point of the inputs, in their order, with the field source_index "
+                                 "(0 for the first input). Global shifts are reconciled in double precision; fields are "
+                                 "matched by name (no value where a cloud lacks one).",
+                                 newCloud("Merged cloud"));
+    tool.inputs = {InputSpec{"input", "Clouds", "The clouds to merge, in order", DataKind::Cloud, true, false}};
+    tool.run = [](const ToolInputs& inputs, const ParameterValues&, ProgressObserver* progress) {
+        std::vector<const PointCloud*> clouds;
+        for (std::size_t i = 0; i < inputs.count("input"); ++i)
+            clouds.push_back(&inputs.cloud("input", i));
+        PointCloud out = mergeClouds(clouds, progress);
+        ToolResult result;
+        result.summary = describe("merged ", clouds.size(), " clouds into ", out.size(), " points");
+        result.add("output", std::move(out));
+        return result;
+    };
+    registry.add(std::move(tool));
+}
+
+void addTransformTool(ToolRegistry& registry)
+{
+    ToolSpec tool = oneCloudTool(
+        "transform", "Apply a transformation", "Edit",
+        "Moves the cloud (or a mesh's vertices) in global coordinates, in double precision: a 4x4 matrix (16 numbers "
+        "row by row, or a file of four lines of four numbers), a translation, a rotation about an axis through a "
+        "centre, or a uniform scale about it; --inverse applies the inverse. The matrix is kept in the cloud's history.",
+        updatedCloud("Moved cloud"));
+    tool.outputs.push_back(OutputSpec{"matrix", "Applied matrix", DataKind::Transform, false});
+    tool.parameters = {
+        ParameterSpec::text("matrix", "Matrix", "16 numbers row by row, or a matrix file").asAlternative("transformation"),
+        ParameterSpec::text("translate", "Translation", "X,Y,Z (m)").asAlternative("transformation"),
+        ParameterSpec::text("rotate", "Rotation", "AXIS,DEGREES with AXIS x, y, z or DX,DY,DZ (e.g. z,30 or 0,0,1,30)")
+            .asAlternative("transformation"),
+        ParameterSpec::real("scale", "Scale", "Uniform scale factor", 1.0, 1e-9, 1e9).asAlternative("transformation"),
+        ParameterSpec::text("centre", "Centre", "Centre of the rotation or the scale: X,Y,Z, centroid or box-centre", "0,0,0"),
+        ParameterSpec::boolean("inverse", "Inverse", "Apply the inverse of the transformation", false),
+    };
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        const PointCloud& input = inputs.cloud();
+        Eigen::Matrix4d m;
+        std::string description;
+        if (values.has("matrix")) {
+            m = parseMatrix(values.text("matrix"));
+            description = "matrix";
+        } else if (values.has("translate")) {
+            m = translation(vector3(values.text("translate"), "the translation"));
+            description = "translate " + values.text("translate");
+        } else if (values.has("rotate")) {
+            const std::string& text = values.text("rotate");
+            const auto comma = text.find(',');
+            Eigen::Vector3d axis;
+            double degrees = 0;
+            if (comma == 1 && text[0] >= 'x' && text[0] <= 'z') {
+                axis = Eigen::Vector3d::Unit(text[0] - 'x');
+                const std::vector<double> angle = parseNumberList(text.substr(2), "the rotation angle");
+                if (angle.size() != 1)
+                    throw Error(ErrorCode::InvalidArgument, "transform: --rotate is AXIS,DEGREES");
+                degrees = angle[0];
+            } else {
+                const std::vector<double> v = parseNumberList(text, "the rotation");
+                if (v.size() != 4)
+                    throw Error(ErrorCode::InvalidArgument, "transform: --rotate is AXIS,DEGREES or DX,DY,DZ,DEGREES");
+                axis = Eigen::Vector3d(v[0], v[1], v[2]);
+                degrees = v[3];
+            }
+            m = rotationAbout(axis, degrees, centreOf(input, values.text("centre")));
+            description = "rotate " + text + " about " + values.text("centre");
+        } else if (values.has("scale")) {
+            m = scaleAbout(values.real("scale"), centreOf(input, values.text("centre")));
+            description = describe("scale ", values.real("scale"), " about ", values.text("centre"));
+        } else {
+            throw Error(ErrorCode::InvalidArgument, "transform: give one of --matrix, --translate, --rotate, --scale");
+        }
+        if (values.boolean("inverse")) {
+            if (!m.allFinite() || !(std::abs(m.topLeftCorner<3, 3>().determinant()) > 1e-12))
+                throw Error(ErrorCode::InvalidArgument, "transform: the matrix has no inverse");
+            m = m.inverse().eval();
+            description = "inverse of " + description;
+        }
+        PointCloud out = transformCloud(input, m, description, progress);
+        ToolResult result;
+        result.summary = describe(description, " on ", out.size(), " points");
+        result.add("output", std::move(out));
+        result.add("matrix", m);
+        return result;
+    };
+    registry.add(std::move(tool));
+}
+
+CropBox parseOrientedBox(const std::string& text)
+{
+    const std::vector<double> v = parseNumberList(text, "the oriented box");
+    if (v.size() != 6 && v.size() != 7 && v.size() != 9)
+        throw Error(ErrorCode::InvalidArgument, "crop: --obox is CX,CY,CZ,SX,SY,SZ[,HEADING[,PITCH,ROLL]] (sizes in m, angles in degrees)");
+    CropBox box;
+    box.centre = Eigen::Vector3d(v[0], v[1], v[2]);
+    box.size = Eigen::Vector3d(v[3], v[4], v[5]);
+    const double heading = v.size() > 6 ? v[6] : 0, pitch = v.size() > 7 ? v[7] : 0, roll = v.size() > 8 ? v[8] : 0;
+    // Heading about Z, then pitch about Y, then roll about X, as sensor poses.
+    box.rotation = (Eigen::AngleAxisd(heading * kPi / 180, Eigen::Vector3d::UnitZ()) *
+                    Eigen::AngleAxisd(pitch * kPi / 180, Eigen::Vector3d::UnitY()) *
+                    Eigen::AngleAxisd(roll * kPi / 180, Eigen::Vector3d::UnitX()))
+                       .toRotationMatrix();
+    return box;
+}
+
+CropPolygon parsePolygon(const std::string& text, const std::string& axis)
+{
+    CropPolygon polygon;
+    polygon.axis = axis == "x" ? 0 : axis == "y" ? 1 : 2;
+    std::string separated = text;
+    std::replace(separated.begin(), separated.end(), ' ', ';');
+    for (const std::string& vertex : splitList(separated, ';')) {
+        if (vertex.empty())
+            continue;
+        const std::vector<double> v = parseNumberList(vertex, "a polygon vertex");
+        if (v.size() != 2)
+            throw Error(ErrorCode::InvalidArgument, "crop: a polygon vertex is A,B (two coordinates), not '" + vertex + "'");
+        polygon.vertices.emplace_back(v[0], v[1]);
+    }
+    return polygon;
+}
+
+void addCropTool(ToolRegistry& registry)
+{
+    ToolSpec tool = oneCloudTool(
+        "crop", "Crop", "Edit",
+        "Keeps the points inside an axis-aligned box, an oriented box, or a polygon seen along an axis (its vertices "
+        "are the two other coordinates: x y seen along z, y z along x, z x along y), or with --outside the others. "
+        "Coordinates are global.",
+        newCloud("Cropped cloud"));
+    tool.parameters = {
+        ParameterSpec::text("box", "Box", "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX").asAlternative("region"),
+        ParameterSpec::text("obox", "Oriented box", "CX,CY,CZ,SX,SY,SZ[,HEADING[,PITCH,ROLL]]: centre, sizes, degrees")
+            .asAlternative("region"),
+        ParameterSpec::text("polygon", "Polygon", "Vertices A1,B1;A2,B2;... (or separate A,B values)").asAlternative("region"),
+        ParameterSpec::choice("axis", "Polygon axis", "The axis the polygon is seen along", {"x", "y", "z"}, "z"),
+        ParameterSpec::boolean("outside", "Keep outside", "Keep the points outside instead", false),
+    };
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver*) {
+        const PointCloud& input = inputs.cloud();
+        std::vector<std::size_t> inside;
+        std::string region;
+        if (values.has("box")) {
+            const std::vector<double> v = parseNumberList(values.text("box"), "the box");
+            if (v.size() != 6)
+                throw Error(ErrorCode::InvalidArgument, "crop: --box is XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX");
+            CropBox box;
+            const Eigen::Vector3d low(v[0], v[1], v[2]), high(v[3], v[4], v[5]);
+            if ((high.array() < low.array()).any())
+                throw Error(ErrorCode::InvalidArgument, "crop: the box's maximum is below its minimum");
+            box.centre = (low + high) / 2;
+            box.size = high - low;
+            inside = pointsInBox(input, box);
+            region = "box";
+        } else if (values.has("obox")) {
+            inside = pointsInBox(input, parseOrientedBox(values.text("obox")));
+            region = "oriented box";
+        } else if (values.has("polygon")) {
+            const CropPolygon polygon = parsePolygon(values.text("polygon"), values.text("axis"));
+            inside = pointsInPolygon(input, polygon);
+            region = describe("polygon of ", polygon.vertices.size(), " vertices along ", values.text("axis"));
+        } else {
+            throw Error(ErrorCode::InvalidArgument, "crop: give one of --box, --obox, --polygon");
+        }
+        const bool outside = values.boolean("outside");
+        const std::vector<std::size_t> kept = outside ? complementOf(inside, input.size()) : inside;
+        PointCloud out = input.subset(kept);
+        out.name = input.name + "_cropped";
+        ToolResult result;
+        result.summary = describe("kept ", kept.size(), " of ", input.size(), " points (", outside ? "outside the " : "inside the ", region, ")");
+        result.add("output", std::move(out));
+        return result;
+    };
+    registry.add(std::move(tool));
+}
+
+} // namespace
+
+void registerEditTools(ToolRegistry& registry)
+{
+    addCloneTool(registry);
+    addMergeTool(registry);
+    addTransformTool(registry);
+    addCropTool(registry);
+}
+
+} // namespace scandiff::detail

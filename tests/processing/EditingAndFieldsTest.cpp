@@ -1,0 +1,222 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Merge, transform, crop and scalar-field operations.
+#include "SyntheticClouds.h"
+#include "TestSupport.h"
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/processing/CloudEditing.h>
+#include <scandiff/core/processing/FieldOperations.h>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include <gtest/gtest.h>
+
+using namespace scandiff;
+
+TEST(Transform, TransformAndInverseGiveThePointsBack)
+{
+    // A georeferenced cloud (UTM-like shift) with normals, a field and a sensor.
+    PointCloud cloud = test::randomPlaneCloud(2000, 50.0, 5);
+    cloud.setOrigin(Eigen::Vector3d(512000, 5403000, 120));
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        cloud.positions()[i].z() = static_cast<float>(0.1 * i / 2000.0);
+    cloud.enableNormals().assign(cloud.size(), Eigen::Vector3f::UnitZ());
+    SensorPose pose;
+    pose.position = Eigen::Vector3d(512010, 5403010, 125);
+    cloud.sensors().push_back(pose);
+    const Eigen::Vector3d centre(512025, 5403025, 120);
+    const Eigen::Matrix4d m = rotationAbout(Eigen::Vector3d(0.2, 0.3, 1), 37.5, centre) * scaleAbout(1.7, centre) *
+                              translation(Eigen::Vector3d(3, -2, 0.5));
+    const PointCloud moved = transformCloud(cloud, m, "test");
+    const PointCloud back = transformCloud(moved, m.inverse(), "inverse");
+    const double shift = cloud.origin().norm();
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        // The moved point is where the matrix says, to the float32 step of a
+        // local coordinate within a kilometre of its origin (0.06 mm).
+        const Eigen::Vector4d g(cloud.globalPosition(i).x(), cloud.globalPosition(i).y(), cloud.globalPosition(i).z(), 1);
+        EXPECT_LT((moved.globalPosition(i) - (m * g).head<3>()).norm(), 1.2e-4) << i;
+        EXPECT_LT((back.globalPosition(i) - cloud.globalPosition(i)).norm(), 1e-9 * shift) << i;
+        EXPECT_LT((back.normals()[i] - cloud.normals()[i]).norm(), 1e-6f) << i;
+    }
+    // Normals follow the rotation (the scale and the translation do not turn them).
+    const Eigen::Vector3d turned = (m.topLeftCorner<3, 3>().inverse().transpose() * Eigen::Vector3d::UnitZ()).normalized();
+    EXPECT_LT((moved.normals()[0].cast<double>() - turned).norm(), 1e-6);
+    EXPECT_LT((moved.sensors()[0].position - (m * Eigen::Vector4d(512010, 5403010, 125, 1)).head<3>()).norm(), 1e-6);
+    // The history keeps both steps.
+    ASSERT_EQ(back.transformHistory().size(), 2u);
+    EXPECT_EQ(back.transformHistory()[0].matrix, m);
+    EXPECT_EQ(back.transformHistory()[1].description, "inverse");
+
+    Eigen::Matrix4d projective = Eigen::Matrix4d::Identity();
+    projective(3, 0) = 0.1;
+    EXPECT_EQ(test::errorCodeOf([&] { transformCloud(cloud, projective, ""); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { transformCloud(cloud, scaleAbout(1, centre) * 0.0, ""); }), ErrorCode::InvalidArgument);
+}
+
+TEST(Merge, CloudsWithDifferentShiftsKeepTheirMillimetres)
+{
+    PointCloud a = test::randomPlaneCloud(1000, 20.0, 1), b = test::randomPlaneCloud(500, 20.0, 2);
+    a.setOrigin(Eigen::Vector3d(512000, 5403000, 0));
+    b.setOrigin(Eigen::Vector3d(513000, 5402000, 100)); // another shift, 1.4 km away
+    a.addField("intensity");
+    for (std::size_t i = 0; i < a.size(); ++i)
+        a.field("intensity")->setValue(i, static_cast<double>(i));
+    ScalarField& time = b.addField("gps_time");
+    time.setOffset(1.3e9);
+    for (std::size_t i = 0; i < b.size(); ++i)
+        time.setValue(i, 1.3e9 + 0.001 * static_cast<double>(i));
+    b.enableColors().assign(b.size(), Rgb8{10, 20, 30});
+    const PointCloud merged = mergeClouds({&a, &b});
+    ASSERT_EQ(merged.size(), 1500u);
+    for (std::size_t i = 0; i < a.size(); ++i)
+        EXPECT_LT((merged.globalPosition(i) - a.globalPosition(i)).norm(), 1e-3) << i;
+    for (std::size_t i = 0; i < b.size(); ++i)
+        EXPECT_LT((merged.globalPosition(a.size() + i) - b.globalPosition(i)).norm(), 1e-3) << i;
+    const ScalarField& source = *merged.field(fields::kSourceIndex);
+    EXPECT_EQ(source.value(0), 0.0);
+    EXPECT_EQ(source.value(1499), 1.0);
+    EXPECT_EQ(merged.field("intensity")->value(999), 999.0);
+    EXPECT_FALSE(merged.field("intensity")->hasValue(1000)); // b has no intensity
+    EXPECT_FALSE(merged.field("gps_time")->hasValue(0));
+    EXPECT_NEAR(merged.field("gps_time")->value(1000 + 400), 1.3e9 + 0.4, 1e-4);
+    EXPECT_EQ(merged.colors()[0], (Rgb8{255, 255, 255})); // a had none
+    EXPECT_EQ(merged.colors()[1000], (Rgb8{10, 20, 30}));
+    // Merging the merged cloud again numbers the inputs anew.
+    const PointCloud again = mergeClouds({&merged, &a});
+    EXPECT_EQ(again.field(fields::kSourceIndex)->value(1400), 0.0);
+    EXPECT_EQ(again.field(fields::kSourceIndex)->value(1500), 1.0);
+    EXPECT_EQ(test::errorCodeOf([&] { mergeClouds({}); }), ErrorCode::InvalidArgument);
+}
+
+TEST(Crop, BoxesAndPolygonsEqualBruteForce)
+{
+    PointCloud cloud = test::randomPlaneCloud(3000, 10.0, 9);
+    cloud.setOrigin(Eigen::Vector3d(600000, 4000000, 10));
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        cloud.positions()[i].z() = static_cast<float>(i % 7);
+    CropBox box;
+    box.centre = Eigen::Vector3d(600004, 4000005, 13);
+    box.size = Eigen::Vector3d(3, 4, 2);
+    box.rotation = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const std::vector<std::size_t> inBox = pointsInBox(cloud, box);
+    std::vector<std::size_t> expected;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Eigen::Vector3d local = box.rotation.transpose() * (cloud.globalPosition(i) - box.centre);
+        if ((local.array().abs() <= (box.size / 2).array()).all())
+            expected.push_back(i);
+    }
+    EXPECT_EQ(inBox, expected);
+    EXPECT_FALSE(inBox.empty());
+
+    // A concave L-shaped polygon seen along z.
+    CropPolygon polygon;
+    polygon.axis = 2;
+    for (const auto& [x, y] : std::vector<std::pair<double, double>>{{0, 0}, {6, 0}, {6, 2}, {2, 2}, {2, 6}, {0, 6}})
+        polygon.vertices.emplace_back(600000 + x, 4000000 + y);
+    const std::vector<std::size_t> inPolygon = pointsInPolygon(cloud, polygon);
+    expected.clear();
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const double x = cloud.globalPosition(i).x() - 600000, y = cloud.globalPosition(i).y() - 4000000;
+        if ((x > 0 && x < 6 && y > 0 && y < 2) || (x > 0 && x < 2 && y > 0 && y < 6))
+            expected.push_back(i);
+    }
+    EXPECT_EQ(inPolygon, expected);
+    const std::vector<std::size_t> outside = complementOf(inPolygon, cloud.size());
+    EXPECT_EQ(outside.size() + inPolygon.size(), cloud.size());
+    polygon.vertices.resize(2);
+    EXPECT_EQ(test::errorCodeOf([&] { pointsInPolygon(cloud, polygon); }), ErrorCode::InvalidArgument);
+}
+
+TEST(FieldOperations, ExpressionsOverFieldsCoordinatesAndColours)
+{
+    PointCloud cloud = test::randomPlaneCloud(5000, 1.0, 4);
+    cloud.setOrigin(Eigen::Vector3d(512000, 5403000, 0));
+    ScalarField& d = cloud.addField("C2C absolute distances");
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        d.setValue(i, i % 10 == 0 ? std::nan("") : 0.001 * static_cast<double>(i));
+    cloud.enableColors().assign(cloud.size(), Rgb8{100, 50, 0});
+    const auto [name, expression] = parseFieldAssignment("change = C2C_absolute_distances > 2 ? 1 : -x + x + r / 50");
+    EXPECT_EQ(name, "change");
+    const ScalarField result = evaluateFieldExpression(cloud, expression, name);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        if (i % 10 == 0) {
+            EXPECT_FALSE(result.hasValue(i)) << i; // no value in, no value out
+            continue;
+        }
+        EXPECT_NEAR(result.value(i), 0.001 * i > 2 ? 1.0 : 2.0, 1e-6) << i;
+    }
+    // Global coordinates in double: x - 512000 keeps the millimetres.
+    const ScalarField x = evaluateFieldExpression(cloud, "x - 512000", "dx");
+    for (std::size_t i = 0; i < cloud.size(); i += 101)
+        EXPECT_NEAR(x.value(i), cloud.positions()[i].x(), 1e-6);
+    // A large result keeps its precision through the offset.
+    const ScalarField big = evaluateFieldExpression(cloud, "y", "y");
+    EXPECT_NEAR(big.value(7), cloud.globalPosition(7).y(), 1e-3);
+    // Comparisons are not assignments.
+    EXPECT_EQ(parseFieldAssignment("a = b >= 2").second, "b >= 2");
+    EXPECT_EQ(test::errorCodeOf([&] { parseFieldAssignment("a == b"); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { evaluateFieldExpression(cloud, "unknown_field * 2", "z"); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { evaluateFieldExpression(cloud, "x +* 2", "z"); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(expressionName("3d dist."), "_3d_dist_");
+}
+
+TEST(FieldOperations, GaussianSmoothingKeepsAConstantAndReducesNoise)
+{
+    PointCloud cloud = test::randomPlaneCloud(20000, 5.0, 8);
+    ScalarField& constant = cloud.addField("constant");
+    ScalarField& noise = cloud.addField("noise");
+    std::mt19937 rng(1);
+    std::normal_distribution<double> g(0.0, 1.0);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        constant.setValue(i, 7.25);
+        noise.setValue(i, g(rng));
+    }
+    const ScalarField smoothConstant = gaussianSmoothing(cloud, "constant", 0.1, "s");
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        ASSERT_NEAR(smoothConstant.value(i), 7.25, 1e-5) << i;
+    const ScalarField smoothNoise = gaussianSmoothing(cloud, "noise", 0.1, "s");
+    double before = 0, after = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        before += noise.value(i) * noise.value(i);
+        after += smoothNoise.value(i) * smoothNoise.value(i);
+    }
+    EXPECT_LT(after, 0.2 * before);
+    EXPECT_EQ(test::errorCodeOf([&] { gaussianSmoothing(cloud, "missing", 0.1, "s"); }), ErrorCode::InvalidArgument);
+}
+
+TEST(FieldOperations, ColoursHistogramAndChannels)
+{
+    PointCloud cloud;
+    cloud.resize(11);
+    ScalarField& f = cloud.addField("v");
+    for (std::size_t i = 0; i < 10; ++i)
+        f.setValue(i, static_cast<double>(i));
+    const ColourScale grey = *ColourScale::preset("Grey");
+    const std::vector<Rgb8> colours = coloursFromField(f, grey, 0, 9);
+    const auto first = grey.colourAt(0.0), last = grey.colourAt(1.0);
+    EXPECT_EQ(colours[0], (Rgb8{first[0], first[1], first[2]}));
+    EXPECT_EQ(colours[10], (Rgb8{150, 150, 150})); // no value
+    EXPECT_EQ(colours[9], (Rgb8{last[0], last[1], last[2]}));
+
+    const Table histogram = fieldHistogram(f, 5);
+    ASSERT_EQ(histogram.rows.size(), 5u);
+    double total = 0;
+    for (const auto& row : histogram.rows)
+        total += std::get<double>(row[2]);
+    EXPECT_EQ(total, 10.0); // NaN is not counted
+    EXPECT_EQ(std::get<double>(histogram.rows.front()[0]), 0.0);
+    EXPECT_EQ(std::get<double>(histogram.rows.back()[1]), 9.0);
+    const Table ranged = fieldHistogram(f, 2, std::make_pair(0.0, 4.0));
+    EXPECT_EQ(std::get<double>(ranged.rows[0][2]), 2.0); // 0, 1
+    EXPECT_EQ(std::get<double>(ranged.rows[1][2]), 3.0); // 2, 3, 4
+    EXPECT_EQ(test::errorCodeOf([&] { fieldHistogram(f, 0); }), ErrorCode::InvalidArgument);
+
+    cloud.enableColors().assign(cloud.size(), Rgb8{200, 100, 50});
+    EXPECT_NEAR(fieldFromColours(cloud, ColourChannel::Luminance, "l").value(0), 0.2126 * 200 + 0.7152 * 100 + 0.0722 * 50, 1e-4);
+    EXPECT_EQ(fieldFromColours(cloud, ColourChannel::Green, "g").value(0), 100.0);
+    EXPECT_NEAR(fieldFromColours(cloud, ColourChannel::Mean, "m").value(0), 350.0 / 3, 1e-4);
+    PointCloud plain;
+    plain.resize(2);
+    EXPECT_EQ(test::errorCodeOf([&] { fieldFromColours(plain, ColourChannel::Red, "r"); }), ErrorCode::InvalidArgument);
+}
