@@ -5,6 +5,10 @@
 //! Usage: scandiff-make-scan POINTS OUTPUT [SEED]
 //!        scandiff-make-scan --mesh N OUTPUT   (the terrain as an N x N vertex grid:
 //!                                              2 (N-1)^2 triangles, 300 -> 178,802)
+//!        scandiff-make-scan --terrain POINTS SIZE OUTPUT [SEED]
+//!                                             (terrain only, SIZE x SIZE m: the
+//!                                              processing benchmarks' 1 M points
+//!                                              over 100 x 100 m)
 
 #include <scandiff/core/Error.h>
 #include <scandiff/io/FileIO.h>
@@ -45,10 +49,44 @@ int writeTerrainMesh(int n, const char* output)
     return 0;
 }
 
+//! A terrain scan without the wall: uniform over size x size metres, 3 mm of
+//! noise, colours and intensity.
+int writeTerrainScan(std::size_t n, float size, const char* output, unsigned seed)
+{
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, size);
+    std::normal_distribution<float> noise(0.0f, 0.003f);
+    scandiff::PointCloud cloud;
+    cloud.name = "terrain";
+    cloud.setOrigin({512000.0, 5423000.0, 100.0});
+    cloud.resize(n);
+    auto& colours = cloud.enableColors();
+    auto& intensity = cloud.addField("intensity");
+    for (std::size_t i = 0; i < n; ++i) {
+        const float x = u(rng), y = u(rng), z = terrainHeight(x, y) + noise(rng);
+        cloud.positions()[i] = {x, y, z};
+        colours[i] = {static_cast<std::uint8_t>(2.5f * x), static_cast<std::uint8_t>(2.5f * y), static_cast<std::uint8_t>(128 + 50 * z)};
+        intensity.values()[i] = static_cast<float>(i % 4096);
+    }
+    scandiff::io::FormatRegistry registry;
+    scandiff::io::registerBuiltinFormats(registry);
+    scandiff::io::writePointCloud(registry, cloud, output);
+    std::cout << "wrote " << output << " (" << n << " points)\n";
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
 {
+    if ((argc == 5 || argc == 6) && std::string(argv[1]) == "--terrain") {
+        try {
+            return writeTerrainScan(std::stoull(argv[2]), std::stof(argv[3]), argv[4], argc == 6 ? static_cast<unsigned>(std::stoul(argv[5])) : 1u);
+        } catch (const std::exception& e) {
+            std::cerr << "error: " << e.what() << '\n';
+            return 1;
+        }
+    }
     if (argc == 4 && std::string(argv[1]) == "--mesh") {
         try {
             return writeTerrainMesh(std::stoi(argv[2]), argv[3]);

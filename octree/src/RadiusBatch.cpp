@@ -9,6 +9,8 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -70,25 +72,33 @@ void Octree::withinRadiusBatch(const Eigen::Vector3f* queries, std::size_t count
                     s.gather(o, b, e, indices_.data(), points_);
             }
             const Eigen::Vector3d centre = box_.min + (Eigen::Vector3d(double(cx), double(cy), double(cz)).array() + 0.5).matrix() * l;
+            // The gathered cells once, for every query of the group.
+            std::array<std::uint8_t, 27> cells;
+            std::size_t cellCount = 0;
+            for (std::size_t o = 0; o < offsets.size(); ++o)
+                if (s.cellState[o] == detail::BatchScratch::kGathered)
+                    cells[cellCount++] = static_cast<std::uint8_t>(o);
+            s.reserve(s.used);
+            const double reach2 = static_cast<double>(r2) * (1 + detail::kSlack);
             for (std::size_t i = first; i < last; ++i) {
                 const std::uint32_t qi = groups.order[i].index;
                 const Eigen::Vector3f& q = queries[qi];
                 const Eigen::Vector3d local3 = q.cast<double>() - centre;
+                // Squared gap from q to the faces of the cells at offset -1 / 0 / +1 per axis.
+                double faceGap2[3][3];
+                for (int a = 0; a < 3; ++a) {
+                    const double below = 0.5 * l + local3[a], above = 0.5 * l - local3[a];
+                    faceGap2[a][0] = below * below;
+                    faceGap2[a][1] = 0.0;
+                    faceGap2[a][2] = above * above;
+                }
                 std::size_t m = 0;
-                for (std::size_t o = 0; o < offsets.size(); ++o) {
-                    if (s.cellState[o] != detail::BatchScratch::kGathered)
-                        continue;
+                for (std::size_t k = 0; k < cellCount; ++k) {
+                    const auto& o = offsets[cells[k]];
                     // A neighbour cell farther than the radius holds nothing within it.
-                    double gap2 = 0;
-                    for (int a = 0; a < 3; ++a) {
-                        const int d = offsets[o][static_cast<std::size_t>(a)];
-                        const double gap = d < 0 ? 0.5 * l + local3[a] : d > 0 ? 0.5 * l - local3[a] : 0.0;
-                        gap2 += gap * gap;
-                    }
-                    if (gap2 > static_cast<double>(r2) * (1 + detail::kSlack))
+                    if (faceGap2[0][o[0] + 1] + faceGap2[1][o[1] + 1] + faceGap2[2][o[2] + 1] > reach2)
                         continue;
-                    s.reserve(m + (s.cellEnd[o] - s.cellBegin[o]));
-                    m = s.keepWithin(q, s.cellBegin[o], s.cellEnd[o], r2, m);
+                    m = s.keepWithin(q, s.cellBegin[cells[k]], s.cellEnd[cells[k]], r2, m);
                 }
                 local.found.resize(m);
                 for (std::size_t j = 0; j < m; ++j)
@@ -97,6 +107,29 @@ void Octree::withinRadiusBatch(const Eigen::Vector3f* queries, std::size_t count
             }
         }
     });
+}
+
+void Octree::blockAround(MortonCode cellCode, int level, std::vector<CellSpan>& out) const
+{
+    if (level < 1 || level > kMaxLevel)
+        throw std::invalid_argument("octree level must be in 1.." + std::to_string(kMaxLevel));
+    out.clear();
+    const CellDirectory& directory = cellDirectory(level);
+    const std::int64_t n = std::int64_t(1) << level;
+    const CellCoordinates c = decodeCell(cellCode);
+    const detail::BlockLookup block(directory.codes, directory.starts, c.x, c.y, c.z, n);
+    for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dz = -1; dz <= 1; ++dz) {
+                const std::int64_t x = std::int64_t(c.x) + dx, y = std::int64_t(c.y) + dy, z = std::int64_t(c.z) + dz;
+                if (x < 0 || y < 0 || z < 0 || x >= n || y >= n || z >= n)
+                    continue;
+                const MortonCode code = encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(z));
+                const auto [first, last] = block.range(code);
+                if (first != last)
+                    out.push_back(CellSpan{code, first, last});
+            }
+    std::sort(out.begin(), out.end(), [](const CellSpan& a, const CellSpan& b) { return a.code < b.code; });
 }
 
 } // namespace scandiff::octree

@@ -117,8 +117,11 @@ TEST(LocalFeatures, RoughnessAndVerticality)
 
 TEST(Subsampling, SpatialKeepsNoTwoPointsWithinTheDistanceAndCoversEveryPoint)
 {
-    for (double d : {0.02, 0.05, 0.3}) {
+    // Local coordinates near 0 and near a kilometre (where a float's step is 60 um).
+    for (const auto& [d, offset] : std::vector<std::pair<double, float>>{{0.02, 0.0f}, {0.05, 0.0f}, {0.3, 0.0f}, {0.001, 900.0f}, {0.05, 900.0f}}) {
         PointCloud cloud = test::randomPlaneCloud(4000, 2.0, 7);
+        for (auto& p : cloud.positions())
+            p += Eigen::Vector3f(offset, offset, 0.0f);
         // Duplicates and a second layer make it harder.
         for (std::size_t i = 0; i < 200; ++i)
             cloud.positions()[3000 + i] = cloud.positions()[i];

@@ -115,11 +115,11 @@ NormalResult computeNormals(const PointCloud& cloud, const NormalParams& params,
     result.surfaceVariation = ScalarField(fields::kSurfaceVariation, n);
     std::vector<float>& variation = result.surfaceVariation.values();
 
-    tbb::enumerable_thread_specific<FitScratch> scratch;
     {
         ProgressTicker ticker(progress, "Fitting normals", n);
         detail::forEachPointNeighbourhood(tree, params.radius, params.knn, ticker, [&](std::size_t i, const octree::Neighbour* list, std::size_t count) {
-            FitScratch& s = scratch.local();
+            // Per worker thread: a thread_local costs less per point than TBB's lookup.
+            thread_local FitScratch s;
             const Eigen::Vector3f& p = positions[i];
             s.points.clear();
             s.points.emplace_back(Eigen::Vector3d::Zero());

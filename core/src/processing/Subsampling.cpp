@@ -49,46 +49,96 @@ std::vector<std::size_t> spatialSubsample(const PointCloud& cloud, double minDis
     const std::size_t n = cloud.size();
     const auto& order = tree.sortedIndices();
     const auto& positions = cloud.positions();
-    const auto radius = static_cast<float>(minDistance);
-    std::vector<char> removed(n, 0);
-    std::vector<std::size_t> kept;
+    const auto d2 = static_cast<float>(minDistance * minDistance);
+    // Cells at least minDistance wide, so a point's 27-cell block holds every
+    // point within reach, and of about 16 points, so a block's candidates are
+    // gathered once for a dozen points.
+    int level = 1;
+    while (level < octree::kMaxLevel && tree.cellSize(level + 1) >= minDistance)
+        ++level;
+    level = std::max(1, std::min(level, tree.levelNearestMeanPopulation(16.0)));
+
+    // The greedy rule in Morton order: a point is kept when no point kept
+    // before it lies within minDistance. The points kept before it are in the
+    // cells of its block already visited (earlier in Morton order) and earlier
+    // in its own cell. Sequential by nature, and the order is fixed, so the
+    // result never depends on the number of threads.
+    const double size = tree.cellSize(level);
+    const Eigen::Vector3d boxMin = tree.box().min;
+    // Cell boxes are widened before they are rounded to float, by more than
+    // the rounding of any coordinate of the cube, so that skipping a box the
+    // point is farther from than minDistance can never skip a point within it.
+    const double margin = 1e-4 * size + 8 * std::numeric_limits<float>::epsilon() *
+                                            (boxMin.cwiseAbs().maxCoeff() + tree.box().size);
+    std::vector<char> keptAt(n, 0); // by position in Morton order
+    std::vector<char> keptPoint(n, 0); // by point index
+    std::vector<float> x, y, z;
+    struct Segment
+    {
+        std::size_t begin, end;
+        Eigen::Vector3f low, high; //!< the cell's box (local coordinates)
+    };
+    std::vector<Segment> segments;
+    std::vector<octree::Octree::CellSpan> block;
     ProgressTicker ticker(progress, "Spatial subsampling", n);
-    // Chunks of the Morton order: the neighbourhoods of a chunk's points are
-    // found in parallel, then the chunk is decided in order (the greedy rule
-    // is sequential). A point already removed needs no neighbourhood.
-    constexpr std::size_t kChunk = 1 << 16;
-    std::vector<Eigen::Vector3f> queries;
-    std::vector<std::uint32_t> queryPoint;
-    std::vector<std::vector<std::uint32_t>> within;
-    for (std::size_t begin = 0; begin < n; begin += kChunk) {
-        const std::size_t end = std::min(n, begin + kChunk);
-        queries.clear();
-        queryPoint.clear();
-        for (std::size_t j = begin; j < end; ++j)
-            if (!removed[order[j]]) {
-                queries.push_back(positions[order[j]]);
-                queryPoint.push_back(order[j]);
-            }
-        within.resize(queries.size());
-        tree.withinRadiusBatch(queries.data(), queries.size(), radius, [&](std::uint32_t q, const octree::Neighbour* list, std::size_t count) {
-            std::vector<std::uint32_t>& w = within[q];
-            w.clear();
-            for (std::size_t j = 0; j < count; ++j)
-                w.push_back(list[j].index);
-        });
-        for (std::size_t q = 0; q < queries.size(); ++q) {
-            const std::uint32_t i = queryPoint[q];
-            if (removed[i])
+    tree.forEachCell(level, [&](octree::MortonCode code, std::size_t first, std::size_t last) {
+        x.clear();
+        y.clear();
+        z.clear();
+        segments.clear();
+        tree.blockAround(code, level, block);
+        for (const auto& cell : block) {
+            if (cell.code >= code)
+                break; // not visited yet: nothing kept there
+            Segment segment{x.size(), 0, {}, {}};
+            for (std::size_t j = cell.first; j < cell.last; ++j)
+                if (keptAt[j]) {
+                    const Eigen::Vector3f& p = positions[order[j]];
+                    x.push_back(p.x());
+                    y.push_back(p.y());
+                    z.push_back(p.z());
+                }
+            segment.end = x.size();
+            if (segment.end == segment.begin)
                 continue;
-            kept.push_back(i);
-            for (std::uint32_t j : within[q])
-                if (j != i)
-                    removed[j] = 1;
+            const octree::CellCoordinates c = octree::decodeCell(cell.code);
+            const Eigen::Vector3d low = boxMin + Eigen::Vector3d(c.x, c.y, c.z) * size;
+            segment.low = (low - Eigen::Vector3d::Constant(margin)).cast<float>();
+            segment.high = (low + Eigen::Vector3d::Constant(size + margin)).cast<float>();
+            segments.push_back(segment);
         }
-        ticker.step(end - begin);
-    }
-    std::sort(kept.begin(), kept.end());
-    return kept;
+        const std::size_t ownBegin = x.size();
+        for (std::size_t j = first; j < last; ++j) {
+            const Eigen::Vector3f& p = positions[order[j]];
+            bool free = true;
+            const auto scan = [&](std::size_t from, std::size_t to) {
+                // No early exit: the loop vectorises.
+                for (std::size_t k = from; k < to; ++k) {
+                    const float ex = x[k] - p.x(), ey = y[k] - p.y(), ez = z[k] - p.z();
+                    free &= ex * ex + (ey * ey + ez * ez) > d2;
+                }
+            };
+            for (const Segment& segment : segments) {
+                const Eigen::Vector3f gap = (segment.low - p).cwiseMax(p - segment.high).cwiseMax(0.0f);
+                if (gap.squaredNorm() <= d2) // else the point is farther than minDistance from the whole cell
+                    scan(segment.begin, segment.end);
+            }
+            scan(ownBegin, x.size());
+            if (free) {
+                keptAt[j] = 1;
+                keptPoint[order[j]] = 1;
+                x.push_back(p.x());
+                y.push_back(p.y());
+                z.push_back(p.z());
+            }
+        }
+        ticker.step(last - first);
+    });
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < n; ++i)
+        if (keptPoint[i])
+            out.push_back(i);
+    return out;
 }
 
 std::vector<std::size_t> octreeSubsample(const PointCloud& cloud, int level, ProgressObserver* progress)

@@ -16,11 +16,12 @@ namespace scandiff {
 //! cloud has no more). The same seed gives the same points.
 std::vector<std::size_t> randomSubsample(const PointCloud& cloud, std::size_t count, std::uint64_t seed = 0);
 
-//! Points at least `minDistance` apart: the points are visited in Morton order
-//! and each one not yet removed is kept and removes every point within
-//! `minDistance` of it. So no two kept points are within `minDistance` of each
-//! other (their distance is larger), and every removed point lies within
-//! `minDistance` of a kept one, exactly (the octree's radius queries).
+//! Points more than `minDistance` apart: the points are visited in Morton
+//! order and each one is kept unless a point kept before it lies within
+//! `minDistance`. So no two kept points are within `minDistance` of each other
+//! (their distance is larger), and every dropped point lies within
+//! `minDistance` of a kept one, exactly (distances as the octree's queries
+//! compute them, in float on the local coordinates).
 //! Throws Error(InvalidArgument) for a distance that is not > 0,
 //! Error(InvalidData) for non-finite coordinates, Error(Cancelled).
 std::vector<std::size_t> spatialSubsample(const PointCloud& cloud, double minDistance, ProgressObserver* progress = nullptr);
