@@ -85,6 +85,11 @@ std::string parameterHelp(const ParameterSpec& p)
         for (const auto& c : p.choices)
             s << ' ' << c;
     }
+    if (!p.suggestions.empty()) {
+        s << "; e.g.";
+        for (const auto& c : p.suggestions)
+            s << ' ' << c;
+    }
     if (!p.optional && !p.required && p.type != ParameterType::Boolean)
         s << "; default " << ParameterSpec::format(p.defaultValue);
     if (!p.alternativeGroup.empty())

@@ -115,6 +115,20 @@ ParameterSpec ParameterSpec::asRequired() const
     return s;
 }
 
+ParameterSpec ParameterSpec::withSuggestions(std::vector<std::string> values) const
+{
+    ParameterSpec s = *this;
+    s.suggestions = std::move(values);
+    return s;
+}
+
+ParameterSpec ParameterSpec::asFieldOf(std::string role) const
+{
+    ParameterSpec s = *this;
+    s.fieldOfInput = std::move(role);
+    return s;
+}
+
 ParameterSpec ParameterSpec::asAlternative(std::string group) const
 {
     ParameterSpec s = asOptional();

@@ -3,11 +3,15 @@
 // driven through their widgets as a user would.
 #include "document/Document.h"
 #include "controllers/ToolController.h"
+#include "tools/ParameterForm.h"
 #include "tools/ToolDialog.h"
 
 #include <scandiff/plugins/PluginRegistry.h>
 
+#include <QCheckBox>
+#include <QComboBox>
 #include <QDoubleSpinBox>
+#include <QListWidget>
 #include <QProgressDialog>
 #include <QPushButton>
 #include <QThread>
@@ -25,6 +29,12 @@ class ToolDialogTest : public QObject
     Q_OBJECT
 
 private slots:
+    void initTestCase()
+    {
+        qRegisterMetaType<gui::EntityId>("EntityId");
+        qRegisterMetaType<scandiff::Table>("scandiff::Table");
+    }
+
     void widgetsStartAtTheDeclaredDefaults()
     {
         const PluginRegistry registry = makePluginRegistry();
@@ -128,6 +138,133 @@ private slots:
         QCOMPARE(failed.count(), 1);
         QVERIFY(failed.at(0).at(0).toString().contains("cancelled"));
         QCOMPARE(document.size(), std::size_t(1));
+    }
+
+    void inputsAreProposedFromTheSelectionByRole()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::Document document;
+        PointCloud a, b, c;
+        a.resize(4);
+        b.resize(4);
+        c.resize(4);
+        const gui::EntityId idA = document.add("a", std::move(a));
+        const gui::EntityId idB = document.add("b", std::move(b));
+        document.add("c", std::move(c));
+        Mesh mesh;
+        mesh.vertices.resize(3);
+        mesh.triangles = {{0, 1, 2}};
+        const gui::EntityId idMesh = document.add("mesh", std::move(mesh));
+        // Merge takes every selected cloud; a mesh's vertices count as a cloud.
+        const gui::ToolInputChoice merge = gui::proposeInputs(document, *registry.tools.find("merge"), {idB, idA});
+        QCOMPARE(merge.at("input"), (std::vector<gui::EntityId>{idB, idA}));
+        // A single input takes the first selected; without a selection, the last added.
+        QCOMPARE(gui::proposeInputs(document, *registry.tools.find("normals"), {idA}).at("input"), (std::vector<gui::EntityId>{idA}));
+        QCOMPARE(gui::proposeInputs(document, *registry.tools.find("normals"), {}).at("input"), (std::vector<gui::EntityId>{idMesh}));
+        // A mesh input only accepts meshes, whatever is selected.
+        QCOMPARE(gui::proposeInputs(document, *registry.tools.find("sample-mesh"), {idA}).at("input"),
+                 (std::vector<gui::EntityId>{idMesh}));
+
+        // The dialog lists them: a checkable list for merge, a combo box for a single input.
+        gui::ToolDialog mergeDialog(*registry.tools.find("merge"), document, merge);
+        auto* list = mergeDialog.findChild<QListWidget*>("input-input");
+        QVERIFY(list);
+        QCOMPARE(list->count(), 4);
+        QCOMPARE(mergeDialog.inputs().at("input").size(), std::size_t(2));
+        list->item(2)->setCheckState(Qt::Checked);
+        QCOMPARE(mergeDialog.inputs().at("input").size(), std::size_t(3));
+        gui::ToolDialog sampleDialog(*registry.tools.find("sample-mesh"), document, {{"input", {idMesh}}});
+        auto* combo = sampleDialog.findChild<QComboBox*>("input-input");
+        QVERIFY(combo);
+        QCOMPARE(combo->count(), 1); // the clouds are not offered
+    }
+
+    void alternativesAndRequiredParametersInTheForm()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::Document document;
+        gui::ToolDialog dialog(*registry.tools.find("normals"), document, {});
+        QCheckBox* knn = dialog.form()->enabler("knn");
+        QCheckBox* radius = dialog.form()->enabler("radius");
+        QVERIFY(knn && radius);
+        QVERIFY(knn->isChecked()); // the group's first is proposed
+        QVERIFY(!radius->isChecked());
+        radius->setChecked(true);
+        QVERIFY(!knn->isChecked()); // switching one on switches the other off
+        QVERIFY(dialog.values().count("radius") && !dialog.values().count("knn"));
+        QVERIFY(registry.tools.find("normals")->resolve(dialog.values()).has("radius"));
+        // A field parameter lists the fields of the picked entity, its active one first.
+        PointCloud withFields;
+        withFields.resize(3);
+        withFields.addField("alpha");
+        withFields.addField("beta");
+        const gui::EntityId id = document.add("fields", std::move(withFields));
+        document.setActiveField(id, "beta");
+        gui::ToolDialog histogram(*registry.tools.find("field-histogram"), document, {{"input", {id}}});
+        auto* field = qobject_cast<QComboBox*>(histogram.editor("field"));
+        QVERIFY(field);
+        QCOMPARE(field->count(), 2);
+        QCOMPARE(field->currentText(), QString("beta"));
+        QCOMPARE(histogram.values().at("field"), std::string("beta"));
+        // An orientation is offered from a list and may be typed.
+        auto* orient = qobject_cast<QComboBox*>(dialog.editor("orient"));
+        QVERIFY(orient && orient->isEditable() && orient->findText("mst") >= 0);
+        orient->setCurrentText("0,1,1");
+        QCOMPARE(dialog.values().at("orient"), std::string("0,1,1"));
+        // A required parameter is sent with the proposed value.
+        gui::ToolDialog features(*registry.tools.find("features"), document, {});
+        QVERIFY(features.values().count("radius"));
+        QVERIFY(registry.tools.find("features")->resolve(features.values()).has("radius"));
+    }
+
+    void outputsGoWhereTheirDeclarationSays()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::Document document;
+        PointCloud plane;
+        plane.name = "plane";
+        plane.resize(400);
+        for (int i = 0; i < 20; ++i)
+            for (int j = 0; j < 20; ++j)
+                plane.positions()[static_cast<std::size_t>(i * 20 + j)] = Eigen::Vector3f(0.1f * i, 0.1f * j, 0.01f * ((i * j) % 3));
+        const gui::EntityId id = document.add("plane", std::move(plane));
+        QSignalSpy replaced(&document, &gui::Document::dataReplaced);
+
+        // Normals update the entity in place: same id, normals, the new field active.
+        gui::ToolController normals(*registry.tools.find("normals"), document, nullptr);
+        QVERIFY(normals.run(id, {{"knn", "8"}}));
+        QCOMPARE(document.size(), std::size_t(1));
+        QCOMPARE(replaced.count(), 1);
+        QVERIFY(document.item(id).cloud()->hasNormals());
+        QCOMPARE(document.item(id).display.activeField, std::string("surface_variation"));
+
+        // A mesh goes under its input; a table goes to its window.
+        gui::ToolController mesh(*registry.tools.find("mesh"), document, nullptr);
+        QVERIFY(mesh.run(id, {}));
+        QCOMPARE(document.size(), std::size_t(2));
+        const gui::EntityId meshId = document.ids().back();
+        QVERIFY(document.item(meshId).mesh());
+        QCOMPARE(document.item(meshId).parent, id);
+        gui::ToolController histogram(*registry.tools.find("field-histogram"), document, nullptr);
+        QSignalSpy tables(&histogram, &gui::ToolController::tableReady);
+        QVERIFY(histogram.run(id, {{"field", "surface_variation"}, {"bins", "7"}}));
+        QCOMPARE(tables.count(), 1);
+        QCOMPARE(tables.at(0).at(1).value<scandiff::Table>().rows.size(), std::size_t(7));
+        QCOMPARE(document.size(), std::size_t(2));
+
+        // A tool that updates a mesh's vertices keeps its triangles.
+        const std::size_t triangles = document.item(meshId).mesh()->triangles.size();
+        QVERIFY(normals.run(meshId, {{"knn", "8"}}));
+        QVERIFY(document.item(meshId).mesh());
+        QCOMPARE(document.item(meshId).mesh()->triangles.size(), triangles);
+        QVERIFY(document.item(meshId).mesh()->vertices.hasNormals());
+
+        // Two roles at once: merge the plane and the mesh's vertices.
+        gui::ToolController merge(*registry.tools.find("merge"), document, nullptr);
+        QSignalSpy finished(&merge, &gui::ToolController::finished);
+        QVERIFY(merge.run(gui::ToolInputChoice{{"input", {id, meshId}}}, {}));
+        QCOMPARE(document.item(document.ids().back()).points().size(), std::size_t(800));
+        QVERIFY(finished.at(0).at(0).toString().contains("scandiff-cli merge plane plane_mesh"));
     }
 
     void controllerReportsInvalidParameters()

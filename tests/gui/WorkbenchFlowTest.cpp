@@ -12,7 +12,9 @@
 #include "panels/EntityTree.h"
 #include "panels/PropertiesPanel.h"
 #include "panels/ScalarFieldPanel.h"
+#include "controllers/ToolController.h"
 #include "tools/ParameterForm.h"
+#include "tools/TableDialog.h"
 #include "view/CloudView.h"
 #include "widgets/RangeEditor.h"
 
@@ -29,6 +31,7 @@
 #include <QPushButton>
 #include <QSignalSpy>
 #include <QStandardPaths>
+#include <QTableWidget>
 #include <QTemporaryDir>
 #include <QtTest>
 
@@ -184,6 +187,64 @@ private slots:
             QCOMPARE(back.position[k], camera.position[k]);
             QCOMPARE(back.viewUp[k], camera.viewUp[k]);
         }
+    }
+
+    void processingToolsFromTheMenusDeclarations()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::MainWindow window(registry);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
+        const EntityId reference = window.document().ids()[0], compared = window.document().ids()[1];
+        const std::size_t points = window.document().item(reference).points().size();
+
+        // Every tool has its menu entry, under its category.
+        for (const ToolSpec& tool : registry.tools.tools())
+            QVERIFY2(window.toolController(tool.name), tool.name.c_str());
+
+        // Normals: the entity in the view is replaced by the same points with normals.
+        QVERIFY(window.toolController("normals")->run(reference, {{"radius", "3"}, {"orient", "+z"}}));
+        QVERIFY(window.document().item(reference).points().hasNormals());
+        QCOMPARE(window.document().item(reference).points().size(), points);
+        window.tree()->selectEntity(reference);
+        QCOMPARE(window.properties()->value("Normals"), QString("yes"));
+        window.view()->render();
+
+        // A translation is kept in the history, shown in the properties, and survives the session.
+        QVERIFY(window.toolController("transform")->run(reference, {{"translate", "1,2,3"}}));
+        window.tree()->selectEntity(reference);
+        QCOMPARE(window.properties()->value("Transformations"), QString("1"));
+        QTemporaryDir dir;
+        const QString session = dir.filePath("tools.scandiff");
+        QVERIFY(window.sessions()->save(session));
+        window.document().clear();
+        QVERIFY(window.sessions()->restore(session));
+        const EntityId restored = window.document().ids()[0];
+        const PointCloud& back = window.document().item(restored).points();
+        QCOMPARE(back.transformHistory().size(), std::size_t(1));
+        QCOMPARE(back.transformHistory()[0].matrix(1, 3), 2.0);
+        QVERIFY(back.hasNormals());
+
+        // The 2.5D mesh of the reference is a reference C2M can use.
+        QVERIFY(window.toolController("mesh")->run(restored, {{"max-edge", "10"}}));
+        const EntityId mesh = window.document().ids().back();
+        QVERIFY(window.document().item(mesh).mesh());
+        QVERIFY(window.distances()->runCloudToMesh(window.document().ids()[1], mesh, {}));
+        QVERIFY(window.document().item(window.document().ids()[1]).points().field("c2m_distance"));
+
+        // A table output opens a window that saves the CSV.
+        QVERIFY(window.toolController("field-histogram")->run(window.document().ids()[1], {{"field", "c2m_distance"}, {"bins", "16"}}));
+        gui::TableDialog* table = nullptr;
+        for (QWidget* w : QApplication::topLevelWidgets())
+            if (auto* t = qobject_cast<gui::TableDialog*>(w))
+                table = t;
+        QVERIFY(table);
+        QCOMPARE(table->view()->rowCount(), 16);
+        QVERIFY(table->saveAs(dir.filePath("histogram.csv")));
+        QVERIFY(QFileInfo(dir.filePath("histogram.csv")).size() > 0);
+        table->close();
+        (void)compared;
     }
 
     void pickingShowsEveryFieldOfThePoint()

@@ -38,6 +38,61 @@ json cameraJson(const CameraState& c)
             {"viewAngle", c.viewAngle}, {"parallel", c.parallel}, {"parallelScale", c.parallelScale}};
 }
 
+//! What a PLY file does not hold: the sensor poses and the transformation history.
+json provenanceJson(const PointCloud& points)
+{
+    json sensors = json::array();
+    for (const SensorPose& s : points.sensors())
+        sensors.push_back({{"position", {s.position.x(), s.position.y(), s.position.z()}},
+                           {"orientation", {s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z()}},
+                           {"steps", {s.yawStep, s.pitchStep}},
+                           {"fieldOfView", {s.yawMin, s.yawMax, s.pitchMin, s.pitchMax}},
+                           {"maxRange", bound(s.maxRange)}});
+    json transforms = json::array();
+    for (const AppliedTransform& t : points.transformHistory()) {
+        json matrix = json::array();
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c)
+                matrix.push_back(t.matrix(r, c));
+        transforms.push_back({{"description", t.description}, {"matrix", matrix}});
+    }
+    return {{"sensors", sensors}, {"transforms", transforms}};
+}
+
+void restoreProvenance(const json& e, PointCloud& points)
+{
+    for (const json& s : e.value("sensors", json::array())) {
+        SensorPose pose;
+        const auto p = s.at("position").get<std::vector<double>>();
+        const auto q = s.at("orientation").get<std::vector<double>>();
+        const auto steps = s.at("steps").get<std::vector<double>>();
+        const auto fov = s.at("fieldOfView").get<std::vector<double>>();
+        if (p.size() != 3 || q.size() != 4 || steps.size() != 2 || fov.size() != 4)
+            throw Error(ErrorCode::InvalidData, "a sensor pose of the session is malformed");
+        pose.position = Eigen::Vector3d(p[0], p[1], p[2]);
+        pose.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+        pose.yawStep = steps[0];
+        pose.pitchStep = steps[1];
+        pose.yawMin = fov[0];
+        pose.yawMax = fov[1];
+        pose.pitchMin = fov[2];
+        pose.pitchMax = fov[3];
+        pose.maxRange = bound(s.at("maxRange"), std::numeric_limits<double>::infinity());
+        points.sensors().push_back(pose);
+    }
+    for (const json& t : e.value("transforms", json::array())) {
+        const auto values = t.at("matrix").get<std::vector<double>>();
+        if (values.size() != 16)
+            throw Error(ErrorCode::InvalidData, "a transformation of the session is not 16 numbers");
+        AppliedTransform step;
+        step.description = t.value("description", std::string());
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c)
+                step.matrix(r, c) = values[static_cast<std::size_t>(4 * r + c)];
+        points.transformHistory().push_back(step);
+    }
+}
+
 CameraState cameraFrom(const json& j)
 {
     CameraState c;
@@ -83,7 +138,8 @@ bool SessionController::save(const QString& qpath)
                             {"visible", item.display.visible},
                             {"activeField", item.display.activeField},
                             {"outside", item.display.outside == FieldColouring::Outside::Grey ? "grey" : "hide"},
-                            {"fields", fields}});
+                            {"fields", fields},
+                            {"provenance", provenanceJson(item.points())}});
     }
     json scales = json::array();
     for (const ColourScale& s : scalarPanel_.customScales())
@@ -173,6 +229,11 @@ bool SessionController::restore(const QString& qpath)
                     entry.fields[name] = display;
                 }
                 entry.entity = io::readFile(registry_.formats, path.parent_path() / e.at("data").get<std::string>(), options);
+                if (e.contains("provenance")) {
+                    PointCloud& points = pointsOf(entry.entity);
+                    points.sensors().clear(); // the session's list is the whole list
+                    restoreProvenance(e.at("provenance"), points);
+                }
                 entries.push_back(std::move(entry));
             }
             const json scaleTexts = session.value("customScales", json::array());

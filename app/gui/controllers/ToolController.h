@@ -52,3 +52,6 @@ private:
 };
 
 } // namespace scandiff::gui
+
+// Tables travel in signals (the table window, tests' signal spies).
+Q_DECLARE_METATYPE(scandiff::Table)

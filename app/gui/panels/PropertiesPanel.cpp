@@ -109,6 +109,20 @@ void PropertiesPanel::rebuild()
             add(fields, QString::fromStdString(f.name()), range);
         }
         fields->setExpanded(true);
+        // The transformations applied, oldest first, each with its matrix
+        // (the rows as the text files and the console give them).
+        const auto& history = points.transformHistory();
+        if (!history.empty()) {
+            QTreeWidgetItem* steps = add(nullptr, tr("Transformations"), QString::number(history.size()));
+            for (std::size_t k = 0; k < history.size(); ++k) {
+                QTreeWidgetItem* step = add(steps, QString("%1").arg(k + 1), QString::fromStdString(history[k].description));
+                const Eigen::Matrix4d& m = history[k].matrix;
+                for (int r = 0; r < 4; ++r)
+                    add(step, tr("row %1").arg(r + 1),
+                        QString("%1 %2 %3 %4").arg(m(r, 0), 0, 'g', 12).arg(m(r, 1), 0, 'g', 12).arg(m(r, 2), 0, 'g', 12).arg(m(r, 3), 0, 'g', 12));
+            }
+            steps->setExpanded(true);
+        }
     }
     if (const Document::Item* picked = document_.find(pickedEntity_); picked && pickedIndex_ < picked->points().size()) {
         const PointCloud& points = picked->points();

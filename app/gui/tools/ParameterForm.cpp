@@ -64,6 +64,15 @@ QWidget* makeEditor(const ParameterSpec& p, QWidget* parent)
         return box;
     }
     case ParameterType::Text: {
+        if (!p.suggestions.empty() || !p.fieldOfInput.empty()) {
+            // An editable list: the usual values at hand, any other typed.
+            auto* box = new QComboBox(parent);
+            box->setEditable(true);
+            for (const auto& value : p.suggestions)
+                box->addItem(QString::fromStdString(value));
+            box->setCurrentText(QString::fromStdString(std::get<std::string>(p.defaultValue)));
+            return box;
+        }
         auto* line = new QLineEdit(QString::fromStdString(std::get<std::string>(p.defaultValue)), parent);
         line->setPlaceholderText(QString::fromStdString(p.description));
         return line;
@@ -84,6 +93,8 @@ std::string editorText(const ParameterSpec& p, QWidget* editor)
     case ParameterType::Choice:
         return static_cast<QComboBox*>(editor)->currentText().toStdString();
     case ParameterType::Text:
+        if (auto* box = qobject_cast<QComboBox*>(editor))
+            return box->currentText().toStdString();
         return static_cast<QLineEdit*>(editor)->text().toStdString();
     }
     return {};
@@ -162,7 +173,7 @@ bool ParameterForm::setValue(const std::string& parameterName, const QString& te
     else if (auto* check = qobject_cast<QCheckBox*>(editor))
         check->setChecked(text == "true" || text == "1");
     else if (auto* combo = qobject_cast<QComboBox*>(editor))
-        combo->setCurrentText(text);
+        combo->setCurrentText(text); // a choice's item, or an editable list's text
     else if (auto* line = qobject_cast<QLineEdit*>(editor))
         line->setText(text);
     if (QCheckBox* enabler = this->enabler(parameterName))

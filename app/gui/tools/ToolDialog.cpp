@@ -98,6 +98,33 @@ ToolDialog::ToolDialog(const ToolSpec& tool, const Document& document, const Too
 
     form_ = new ParameterForm(tool.parameters, this);
     addFormAndButtons(*this, *layout, form_);
+
+    // A parameter naming a field lists the fields of the entity picked for its
+    // role, and follows the picker.
+    for (const ParameterSpec& p : tool.parameters) {
+        if (p.fieldOfInput.empty())
+            continue;
+        auto* box = qobject_cast<QComboBox*>(form_->editor(p.name));
+        const auto picker = std::find_if(pickers_.begin(), pickers_.end(), [&](const Picker& k) { return k.role == p.fieldOfInput; });
+        if (!box || picker == pickers_.end() || !picker->single)
+            continue;
+        QComboBox* entities = picker->single;
+        const auto fill = [box, entities, &document] {
+            const QString typed = box->currentText();
+            box->clear();
+            if (const Document::Item* item = document.find(entities->currentData().toInt()))
+                for (const auto& f : item->points().fields())
+                    box->addItem(QString::fromStdString(f.name()));
+            // The entity's active field first: what the user is looking at.
+            if (const Document::Item* item = document.find(entities->currentData().toInt());
+                item && !item->display.activeField.empty())
+                box->setCurrentText(QString::fromStdString(item->display.activeField));
+            else if (!typed.isEmpty() && box->findText(typed) >= 0)
+                box->setCurrentText(typed);
+        };
+        fill();
+        connect(entities, QOverload<int>::of(&QComboBox::currentIndexChanged), box, fill);
+    }
 }
 
 std::map<std::string, std::string> ToolDialog::values() const { return form_->values(); }

@@ -52,6 +52,12 @@ struct ParameterSpec
     //! depends on the data): the CLI refuses to run without it, the GUI shows
     //! `defaultValue` as a proposal the user confirms.
     bool required = false;
+    //! Text only: values a user usually types, offered in a list the GUI lets
+    //! the user edit (an orientation "+z", "mst"...); any other text is still accepted.
+    std::vector<std::string> suggestions;
+    //! Text only: the value names a scalar field of the entity given as this
+    //! input role (the GUI lists that entity's fields; ';' joins several).
+    std::string fieldOfInput;
 
     static ParameterSpec integer(std::string name, std::string label, std::string description, std::int64_t defaultValue,
                                  std::int64_t minimum, std::int64_t maximum, std::string unit = {});
@@ -67,6 +73,10 @@ struct ParameterSpec
     ParameterSpec asAlternative(std::string group) const;
     //! The same declaration, required (see `required`).
     ParameterSpec asRequired() const;
+    //! The same declaration with suggestions (see `suggestions`).
+    ParameterSpec withSuggestions(std::vector<std::string> values) const;
+    //! The same declaration, naming a field of input `role` (see `fieldOfInput`).
+    ParameterSpec asFieldOf(std::string role = "input") const;
 
     //! Parses user text ("12", "0.5", "true", "plane") into a valid value.
     //! Throws Error(InvalidArgument) naming the parameter and its valid range.

@@ -139,7 +139,8 @@ void addTransformTool(ToolRegistry& registry)
         ParameterSpec::text("rotate", "Rotation", "AXIS,DEGREES with AXIS x, y, z or DX,DY,DZ (e.g. z,30 or 0,0,1,30)")
             .asAlternative("transformation"),
         ParameterSpec::real("scale", "Scale", "Uniform scale factor", 1.0, 1e-9, 1e9).asAlternative("transformation"),
-        ParameterSpec::text("centre", "Centre", "Centre of the rotation or the scale: X,Y,Z, centroid or box-centre", "0,0,0"),
+        ParameterSpec::text("centre", "Centre", "Centre of the rotation or the scale: X,Y,Z, centroid or box-centre", "0,0,0")
+            .withSuggestions({"0,0,0", "centroid", "box-centre"}),
         ParameterSpec::boolean("inverse", "Inverse", "Apply the inverse of the transformation", false),
     };
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {

@@ -28,7 +28,7 @@ const ScalarField& fieldOf(const PointCloud& cloud, const std::string& name, con
 
 ParameterSpec fieldParameter(const std::string& description)
 {
-    return ParameterSpec::text("field", "Field", description).asRequired();
+    return ParameterSpec::text("field", "Field", description).asRequired().asFieldOf("input");
 }
 
 //! The tool result of a cloud with one more (or a replaced) field.

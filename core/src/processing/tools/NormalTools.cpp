@@ -15,6 +15,8 @@ const char* kOrientHelp =
     "sensor:X,Y,Z, centroid (away from it), -centroid (towards it), mst (propagated over a minimum spanning tree, "
     "for closed or concave objects), none";
 
+const std::vector<std::string> kOrientations{"+z", "-z", "+x", "-x", "+y", "-y", "sensor", "centroid", "-centroid", "mst", "none"};
+
 const char* modelName(NormalModel model)
 {
     return model == NormalModel::Plane ? "plane" : model == NormalModel::Quadric ? "quadric" : "triangulation";
@@ -45,7 +47,7 @@ void addNormalsTool(ToolRegistry& registry)
             .asAlternative("neighbourhood"),
         ParameterSpec::choice("model", "Local model", "Surface fitted on each neighbourhood", {"plane", "quadric", "triangulation"},
                               "plane"),
-        ParameterSpec::text("orient", "Orientation", kOrientHelp, "+z"),
+        ParameterSpec::text("orient", "Orientation", kOrientHelp, "+z").withSuggestions(kOrientations),
         ParameterSpec::integer("mst-knn", "MST neighbours", "Neighbours per point in the graph of the mst orientation", 10, 1, 1000,
                                "points"),
         ParameterSpec::boolean("flip", "Flip", "Reverse every normal after orienting it", false),
@@ -85,7 +87,7 @@ void addOrientTool(ToolRegistry& registry)
                                  "graph (Hoppe et al. 1992). With --flip, reverses them.",
                                  updatedCloud("Cloud with oriented normals"));
     tool.parameters = {
-        ParameterSpec::text("orient", "Orientation", kOrientHelp, "mst"),
+        ParameterSpec::text("orient", "Orientation", kOrientHelp, "mst").withSuggestions(kOrientations),
         ParameterSpec::integer("mst-knn", "MST neighbours", "Neighbours per point in the graph of the mst orientation", 10, 1, 1000,
                                "points"),
         ParameterSpec::boolean("flip", "Flip", "Reverse every normal after orienting it", false),
