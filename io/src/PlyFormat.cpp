@@ -21,6 +21,9 @@
 #include <scandiff/core/Log.h>
 #include <scandiff/io/AtomicFile.h>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -601,6 +604,18 @@ struct RangeAccumulator
         }
     }
 
+    void merge(const RangeAccumulator& other)
+    {
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::min(lo[a], other.lo[a]);
+            hi[a] = std::max(hi[a], other.hi[a]);
+        }
+        for (std::size_t f = 0; f < fieldLo.size(); ++f) {
+            fieldLo[f] = std::min(fieldLo[f], other.fieldLo[f]);
+            fieldHi[f] = std::max(fieldHi[f], other.fieldHi[f]);
+        }
+    }
+
     BoundingBox box() const
     {
         BoundingBox b;
@@ -646,16 +661,23 @@ const char* visitBinaryVertices(const PlyElement& e, const VertexLayout& layout,
             ctx.truncated(e, available);
         const Slot* slotsBegin = layout.slots.data();
         const Slot* slotsEnd = slotsBegin + layout.slots.size();
-        for (std::uint64_t start = 0; start < n; start += kChunk) {
-            const std::uint64_t stop = std::min(n, start + kChunk);
-            const char* record = ptr + start * recordSize;
-            const char* chunkBegin = record;
-            for (std::uint64_t i = start; i < stop; ++i, record += recordSize)
-                for (const Slot* s = slotsBegin; s != slotsEnd; ++s)
-                    visit(i, *s, loadDouble<Swap>(record + s->offset, s->type));
-            MappedFile::releaseConsumed(chunkBegin, record);
-            ticker.step(stop - start);
-        }
+        // Records of a fixed size are decoded in chunks on both cores: the
+        // visitor is called for every value of a record, from one thread per
+        // chunk, so it must only write what belongs to record i (or to its
+        // chunk, i / kChunk).
+        const std::uint64_t chunks = (n + kChunk - 1) / kChunk;
+        tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, chunks, 1), [&](const tbb::blocked_range<std::uint64_t>& range) {
+            for (std::uint64_t chunk = range.begin(); chunk != range.end(); ++chunk) {
+                const std::uint64_t start = chunk * kChunk, stop = std::min(n, start + kChunk);
+                const char* record = ptr + start * recordSize;
+                const char* chunkBegin = record;
+                for (std::uint64_t i = start; i < stop; ++i, record += recordSize)
+                    for (const Slot* s = slotsBegin; s != slotsEnd; ++s)
+                        visit(i, *s, loadDouble<Swap>(record + s->offset, s->type));
+                MappedFile::releaseConsumed(chunkBegin, record);
+                ticker.step(stop - start);
+            }
+        });
         return ptr + n * recordSize;
     }
     for (std::uint64_t i = 0; i < n; ++i) {
@@ -1087,9 +1109,15 @@ private:
                       std::to_string(end - ptr) + " bytes of data remain");
         }
         RangeAccumulator ranges(layout_.fieldNames.size());
-        if (needsRanges)
-            visitBinaryVertices<Swap>(e, layout_, ptr, end, ctx_, ticker,
-                                      [&ranges](std::uint64_t, const Slot& s, double v) { ranges.add(s, v); });
+        if (needsRanges) {
+            // One accumulator per chunk (the decoding is parallel by chunk), merged after.
+            std::vector<RangeAccumulator> perChunk(static_cast<std::size_t>(e.count / kChunk + 1), ranges);
+            visitBinaryVertices<Swap>(e, layout_, ptr, end, ctx_, ticker, [&perChunk](std::uint64_t i, const Slot& s, double v) {
+                perChunk[static_cast<std::size_t>(i / kChunk)].add(s, v);
+            });
+            for (const RangeAccumulator& chunk : perChunk)
+                ranges.merge(chunk);
+        }
         VertexSink sink = prepareCloud(e.count);
         if (options_.origin)
             sink.origin = *options_.origin;

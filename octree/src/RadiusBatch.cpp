@@ -9,15 +9,107 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
 namespace scandiff::octree {
 
-void Octree::withinRadiusBatch(const Eigen::Vector3f* queries, std::size_t count, float radius, const RadiusVisitor& visit) const
+namespace {
+
+//! Queries per run: a few consecutive queries in Morton order lie close
+//! together, so the candidates within reach of their common box are picked
+//! once for all of them.
+constexpr std::size_t kRun = 8;
+
+//! The sums of the offsets p - q of the candidates [0, m) of `near` within
+//! squared distance r2 of q, and of their products, into `moments`. The
+//! distance is the one every query computes (float, x^2 + (y^2 + z^2)), so the
+//! points counted are exactly those withinRadiusBatch() lists; the sums are in
+//! double, four candidates at a time where SSE2 is available, those outside
+//! masked to zero rather than branched over.
+void accumulateMoments(const detail::BatchScratch& near, std::size_t m, const Eigen::Vector3f& q, float r2,
+                       NeighbourhoodMoments& moments)
+{
+    double sx = 0, sy = 0, sz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+    std::uint32_t count = 0;
+    std::size_t j = 0;
+#ifdef __SSE2__
+    const __m128 qx = _mm_set1_ps(q.x()), qy = _mm_set1_ps(q.y()), qz = _mm_set1_ps(q.z()), bound = _mm_set1_ps(r2);
+    __m128d sx2 = _mm_setzero_pd(), sy2 = sx2, sz2 = sx2, xx2 = sx2, xy2 = sx2, xz2 = sx2, yy2 = sx2, yz2 = sx2, zz2 = sx2;
+    for (; j + 4 <= m; j += 4) {
+        const __m128 dx = _mm_sub_ps(_mm_loadu_ps(near.x.data() + j), qx);
+        const __m128 dy = _mm_sub_ps(_mm_loadu_ps(near.y.data() + j), qy);
+        const __m128 dz = _mm_sub_ps(_mm_loadu_ps(near.z.data() + j), qz);
+        const __m128 d2 = _mm_add_ps(_mm_mul_ps(dx, dx), _mm_add_ps(_mm_mul_ps(dy, dy), _mm_mul_ps(dz, dz)));
+        const __m128 inside = _mm_cmple_ps(d2, bound);
+        const int mask = _mm_movemask_ps(inside);
+        if (mask == 0)
+            continue;
+        count += static_cast<std::uint32_t>(__builtin_popcount(static_cast<unsigned>(mask)));
+        const __m128 mx = _mm_and_ps(dx, inside), my = _mm_and_ps(dy, inside), mz = _mm_and_ps(dz, inside);
+        for (int half = 0; half < 2; ++half) {
+            const __m128d x = _mm_cvtps_pd(half ? _mm_movehl_ps(mx, mx) : mx);
+            const __m128d y = _mm_cvtps_pd(half ? _mm_movehl_ps(my, my) : my);
+            const __m128d z = _mm_cvtps_pd(half ? _mm_movehl_ps(mz, mz) : mz);
+            sx2 = _mm_add_pd(sx2, x);
+            sy2 = _mm_add_pd(sy2, y);
+            sz2 = _mm_add_pd(sz2, z);
+            xx2 = _mm_add_pd(xx2, _mm_mul_pd(x, x));
+            xy2 = _mm_add_pd(xy2, _mm_mul_pd(x, y));
+            xz2 = _mm_add_pd(xz2, _mm_mul_pd(x, z));
+            yy2 = _mm_add_pd(yy2, _mm_mul_pd(y, y));
+            yz2 = _mm_add_pd(yz2, _mm_mul_pd(y, z));
+            zz2 = _mm_add_pd(zz2, _mm_mul_pd(z, z));
+        }
+    }
+    const auto total = [](__m128d v) {
+        alignas(16) double lanes[2];
+        _mm_store_pd(lanes, v);
+        return lanes[0] + lanes[1];
+    };
+    sx = total(sx2);
+    sy = total(sy2);
+    sz = total(sz2);
+    xx = total(xx2);
+    xy = total(xy2);
+    xz = total(xz2);
+    yy = total(yy2);
+    yz = total(yz2);
+    zz = total(zz2);
+#endif
+    for (; j < m; ++j) {
+        const float fx = near.x[j] - q.x(), fy = near.y[j] - q.y(), fz = near.z[j] - q.z();
+        if (!(fx * fx + (fy * fy + fz * fz) <= r2))
+            continue;
+        const double x = fx, y = fy, z = fz;
+        ++count;
+        sx += x;
+        sy += y;
+        sz += z;
+        xx += x * x;
+        xy += x * y;
+        xz += x * z;
+        yy += y * y;
+        yz += y * z;
+        zz += z * z;
+    }
+    moments.count = count;
+    moments.sum = Eigen::Vector3d(sx, sy, sz);
+    moments.products = {xx, xy, xz, yy, yz, zz};
+}
+
+} // namespace
+
+template <typename PerQuery>
+void Octree::forEachRadiusRun(const Eigen::Vector3f* queries, std::size_t count, float radius, PerQuery&& perQuery) const
 {
     if (!(radius >= 0) || !std::isfinite(radius))
         throw std::invalid_argument("the search radius must be finite and >= 0");
@@ -29,31 +121,57 @@ void Octree::withinRadiusBatch(const Eigen::Vector3f* queries, std::size_t count
     while (level < kMaxLevel && cellSize(level + 1) >= static_cast<double>(radius))
         ++level;
     const std::int64_t n = std::int64_t(1) << level;
-    const double l = cellSize(level);
-    const float r2 = radius * radius;
-    const detail::QueryGroups groups = groupQueriesByCell(queries, count, level);
     const CellDirectory& directory = cellDirectory(level);
+    // The octree's own points need no sorting: they are in Morton order
+    // already, and the level's cells are their groups.
+    detail::QueryGroups groups;
+    if (queries == points_ && count == size()) {
+        groups.outside = MortonCode(1) << (3 * level); // no own point is outside
+        groups.order.resize(count);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i)
+                groups.order[i] = {cellCodeAtLevel(codes_[i], level), indices_[i]};
+        });
+        groups.start.assign(directory.starts.begin(), directory.starts.end());
+    } else {
+        groups = groupQueriesByCell(queries, count, level);
+    }
     const auto& offsets = detail::neighbourhoodOffsets();
-
+    // A run's box is widened by the radius plus more than the rounding of any
+    // float coordinate of the cube, so that the box test never drops a
+    // candidate the exact distance keeps.
+    const float reach = radius + static_cast<float>(8 * std::numeric_limits<float>::epsilon() *
+                                                    (box_.min.cwiseAbs().maxCoeff() + box_.size) + 1e-6 * radius);
     struct Scratch
     {
-        detail::BatchScratch block;
-        std::vector<Neighbour> found;
+        detail::BatchScratch block; //!< a group's 27-cell candidates
+        detail::BatchScratch near;  //!< those within reach of a run of queries
+        std::vector<Neighbour> outside; //!< a query outside the cube: its full search
     };
     tbb::enumerable_thread_specific<Scratch> scratch;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups.start.size() - 1, 16), [&](const tbb::blocked_range<std::size_t>& range) {
         Scratch& local = scratch.local();
         detail::BatchScratch& s = local.block;
+        detail::BatchScratch& near = local.near;
         for (std::size_t g = range.begin(); g != range.end(); ++g) {
             const std::size_t first = groups.start[g], last = groups.start[g + 1];
             const MortonCode cell = groups.order[first].code;
             if (cell == groups.outside) {
+                // Its candidates are the full search's points, the ones within the radius.
                 for (std::size_t i = first; i < last; ++i) {
                     const std::uint32_t qi = groups.order[i].index;
-                    local.found.clear();
+                    local.outside.clear();
                     if (queries[qi].allFinite())
-                        withinRadius(queries[qi], radius, level, local.found);
-                    visit(qi, local.found.data(), local.found.size());
+                        withinRadius(queries[qi], radius, level, local.outside);
+                    near.reserve(local.outside.size());
+                    for (std::size_t j = 0; j < local.outside.size(); ++j) {
+                        const Eigen::Vector3f& p = points_[local.outside[j].index];
+                        near.x[j] = p.x();
+                        near.y[j] = p.y();
+                        near.z[j] = p.z();
+                        near.indices[j] = local.outside[j].index;
+                    }
+                    perQuery(qi, near, local.outside.size());
                 }
                 continue;
             }
@@ -71,41 +189,56 @@ void Octree::withinRadiusBatch(const Eigen::Vector3f* queries, std::size_t count
                 if (b != e)
                     s.gather(o, b, e, indices_.data(), points_);
             }
-            const Eigen::Vector3d centre = box_.min + (Eigen::Vector3d(double(cx), double(cy), double(cz)).array() + 0.5).matrix() * l;
-            // The gathered cells once, for every query of the group.
-            std::array<std::uint8_t, 27> cells;
-            std::size_t cellCount = 0;
-            for (std::size_t o = 0; o < offsets.size(); ++o)
-                if (s.cellState[o] == detail::BatchScratch::kGathered)
-                    cells[cellCount++] = static_cast<std::uint8_t>(o);
-            s.reserve(s.used);
-            const double reach2 = static_cast<double>(r2) * (1 + detail::kSlack);
-            for (std::size_t i = first; i < last; ++i) {
-                const std::uint32_t qi = groups.order[i].index;
-                const Eigen::Vector3f& q = queries[qi];
-                const Eigen::Vector3d local3 = q.cast<double>() - centre;
-                // Squared gap from q to the faces of the cells at offset -1 / 0 / +1 per axis.
-                double faceGap2[3][3];
-                for (int a = 0; a < 3; ++a) {
-                    const double below = 0.5 * l + local3[a], above = 0.5 * l - local3[a];
-                    faceGap2[a][0] = below * below;
-                    faceGap2[a][1] = 0.0;
-                    faceGap2[a][2] = above * above;
+            near.reserve(s.used);
+            for (std::size_t run = first; run < last; run += kRun) {
+                const std::size_t runEnd = std::min(last, run + kRun);
+                Eigen::Array3f low = queries[groups.order[run].index].array(), high = low;
+                for (std::size_t i = run + 1; i < runEnd; ++i) {
+                    low = low.min(queries[groups.order[i].index].array());
+                    high = high.max(queries[groups.order[i].index].array());
                 }
-                std::size_t m = 0;
-                for (std::size_t k = 0; k < cellCount; ++k) {
-                    const auto& o = offsets[cells[k]];
-                    // A neighbour cell farther than the radius holds nothing within it.
-                    if (faceGap2[0][o[0] + 1] + faceGap2[1][o[1] + 1] + faceGap2[2][o[2] + 1] > reach2)
-                        continue;
-                    m = s.keepWithin(q, s.cellBegin[cells[k]], s.cellEnd[cells[k]], r2, m);
+                low -= reach;
+                high += reach;
+                // The block's candidates within the run's widened box, copied
+                // without a branch (a candidate outside is overwritten by the next).
+                std::uint32_t m = 0;
+                for (std::uint32_t j = 0; j < s.used; ++j) {
+                    const float x = s.x[j], y = s.y[j], z = s.z[j];
+                    const bool inside = x >= low.x() && x <= high.x() && y >= low.y() && y <= high.y() && z >= low.z() && z <= high.z();
+                    near.x[m] = x;
+                    near.y[m] = y;
+                    near.z[m] = z;
+                    near.indices[m] = s.indices[j];
+                    m += inside;
                 }
-                local.found.resize(m);
-                for (std::size_t j = 0; j < m; ++j)
-                    local.found[j] = Neighbour{s.survivorIndices[j], s.survivorDistances[j]};
-                visit(qi, local.found.data(), m);
+                for (std::size_t i = run; i < runEnd; ++i)
+                    perQuery(groups.order[i].index, near, m);
             }
         }
+    });
+}
+
+void Octree::withinRadiusBatch(const Eigen::Vector3f* queries, std::size_t count, float radius, const RadiusVisitor& visit) const
+{
+    const float r2 = radius * radius;
+    tbb::enumerable_thread_specific<std::vector<Neighbour>> lists;
+    forEachRadiusRun(queries, count, radius, [&](std::uint32_t qi, detail::BatchScratch& near, std::size_t m) {
+        const std::size_t kept = near.keepWithin(queries[qi], 0, static_cast<std::uint32_t>(m), r2, 0);
+        std::vector<Neighbour>& found = lists.local();
+        found.resize(kept);
+        for (std::size_t j = 0; j < kept; ++j)
+            found[j] = Neighbour{near.survivorIndices[j], near.survivorDistances[j]};
+        visit(qi, found.data(), kept);
+    });
+}
+
+void Octree::radiusMomentsBatch(const Eigen::Vector3f* queries, std::size_t count, float radius, const MomentsVisitor& visit) const
+{
+    const float r2 = radius * radius;
+    forEachRadiusRun(queries, count, radius, [&](std::uint32_t qi, detail::BatchScratch& near, std::size_t m) {
+        NeighbourhoodMoments moments;
+        accumulateMoments(near, m, queries[qi], r2, moments);
+        visit(qi, moments);
     });
 }
 

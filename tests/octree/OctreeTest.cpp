@@ -471,3 +471,36 @@ TEST(Octree, BatchRadiusEqualsBruteForceForOwnAndOtherQueries)
     EXPECT_THROW(tree.withinRadiusBatch(cloud.data(), cloud.size(), -1.0f, [](std::uint32_t, const Neighbour*, std::size_t) {}),
                  std::invalid_argument);
 }
+
+TEST(Octree, BatchMomentsEqualTheBruteForceNeighbourhoods)
+{
+    std::mt19937 rng(29);
+    for (const Shape& shape : kShapes) {
+        const Cloud cloud = shape.make(700, rng);
+        const Octree tree(cloud.data(), cloud.size());
+        Cloud others = randomCloud(40, rng);
+        others.push_back({1e6f, 0.0f, 0.0f});
+        for (float r : {0.0f, 0.05f, 0.6f, 3.0f}) {
+            for (const Cloud* queries : std::initializer_list<const Cloud*>{&cloud, &others}) {
+                std::vector<NeighbourhoodMoments> got(queries->size());
+                tree.radiusMomentsBatch(queries->data(), queries->size(), r,
+                                        [&](std::uint32_t q, const NeighbourhoodMoments& m) { got[q] = m; });
+                for (std::size_t q = 0; q < queries->size(); ++q) {
+                    const std::vector<Neighbour> list = bruteForceRadius(cloud, (*queries)[q], r);
+                    ASSERT_EQ(got[q].count, list.size()) << shape.name << " radius " << r << " query " << q;
+                    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+                    double xx = 0, yz = 0;
+                    for (const auto& n : list) {
+                        const Eigen::Vector3d d = (cloud[n.index] - (*queries)[q]).cast<double>();
+                        sum += d;
+                        xx += d.x() * d.x();
+                        yz += d.y() * d.z();
+                    }
+                    EXPECT_LT((got[q].sum - sum).norm(), 1e-9 * (1 + sum.norm())) << shape.name << " query " << q;
+                    EXPECT_NEAR(got[q].products[0], xx, 1e-9 * (1 + xx)) << shape.name << " query " << q;
+                    EXPECT_NEAR(got[q].products[4], yz, 1e-9 * (1 + std::abs(yz))) << shape.name << " query " << q;
+                }
+            }
+        }
+    }
+}

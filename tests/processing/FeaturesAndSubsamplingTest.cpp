@@ -107,10 +107,17 @@ TEST(LocalFeatures, RoughnessAndVerticality)
     const FeatureResult wallResult = computeLocalFeatures(wall, params);
     EXPECT_NEAR(fieldNamed(wallResult, fields::kVerticality).value(100), 1.0, 1e-6);
 
-    // No flag: every feature.
+    // No flag: every feature; with curvature the neighbourhoods are listed
+    // rather than summed, and the other features come out the same.
     FeatureParams all;
     all.radius = 0.16;
-    EXPECT_EQ(computeLocalFeatures(floor, all).fields.size(), 5u);
+    const FeatureResult everything = computeLocalFeatures(floor, all);
+    EXPECT_EQ(everything.fields.size(), 5u);
+    params.density = true;
+    const FeatureResult summed = computeLocalFeatures(floor, params);
+    for (const char* name : {fields::kSurfaceDensity, fields::kRoughness, fields::kVerticality})
+        for (std::size_t i = 0; i < floor.size(); ++i)
+            ASSERT_NEAR(fieldNamed(everything, name).value(i), fieldNamed(summed, name).value(i), 1e-7) << name << " " << i;
     FeatureParams bad;
     EXPECT_EQ(test::errorCodeOf([&] { computeLocalFeatures(floor, bad); }), ErrorCode::InvalidArgument);
 }

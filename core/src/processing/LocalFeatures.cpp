@@ -62,6 +62,20 @@ FeatureResult computeLocalFeatures(const PointCloud& cloud, const FeatureParams&
 
     tbb::enumerable_thread_specific<Scratch> scratch;
     ProgressTicker ticker(progress, "Local features", n);
+    if (!curvature) {
+        // Density, roughness and verticality need only the neighbourhood's moments.
+        detail::forEachPointMoments(tree, r, ticker, [&](std::size_t i, const octree::NeighbourhoodMoments& moments) {
+            if (densityValues)
+                (*densityValues)[i] = static_cast<float>(static_cast<double>(moments.count) * densityScale);
+            detail::LocalPlane plane;
+            // Roughness: the plane of the neighbours alone, and the point's distance to it.
+            if (roughnessValues && detail::fitLocalPlane(moments, true, plane))
+                (*roughnessValues)[i] = static_cast<float>(std::abs(plane.mean.dot(plane.normal)));
+            if (verticalityValues && detail::fitLocalPlane(moments, false, plane))
+                (*verticalityValues)[i] = static_cast<float>(1.0 - std::min(1.0, std::abs(plane.normal.z())));
+        });
+        return result;
+    }
     detail::forEachPointNeighbourhood(tree, r, 0, ticker, [&](std::size_t i, const octree::Neighbour* list, std::size_t count) {
         if (densityValues)
             (*densityValues)[i] = static_cast<float>(static_cast<double>(count) * densityScale);

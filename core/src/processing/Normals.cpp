@@ -29,16 +29,9 @@ struct FitScratch
     std::vector<std::array<int, 3>> triangles;
 };
 
-//! The least-squares plane's normal and surface variation (smallest variance
-//! over their sum) of a neighbourhood given as offsets from its point.
-bool planeNormal(const std::vector<Eigen::Vector3d>& offsets, Eigen::Vector3d& normal, double& variation)
+double surfaceVariationOf(const detail::LocalPlane& plane)
 {
-    detail::LocalPlane plane;
-    if (!detail::fitLocalPlane(offsets, 0, plane))
-        return false;
-    normal = plane.normal;
-    variation = std::max(0.0, plane.values[0]) / plane.values.sum();
-    return true;
+    return std::max(0.0, plane.values[0]) / plane.values.sum();
 }
 
 //! The normal of the fitted quadric above the neighbourhood's first point.
@@ -115,33 +108,43 @@ NormalResult computeNormals(const PointCloud& cloud, const NormalParams& params,
     result.surfaceVariation = ScalarField(fields::kSurfaceVariation, n);
     std::vector<float>& variation = result.surfaceVariation.values();
 
-    {
-        ProgressTicker ticker(progress, "Fitting normals", n);
-        detail::forEachPointNeighbourhood(tree, params.radius, params.knn, ticker, [&](std::size_t i, const octree::Neighbour* list, std::size_t count) {
-            // Per worker thread: a thread_local costs less per point than TBB's lookup.
-            thread_local FitScratch s;
-            const Eigen::Vector3f& p = positions[i];
-            s.points.clear();
-            s.points.emplace_back(Eigen::Vector3d::Zero());
-            for (std::size_t j = 0; j < count; ++j)
-                if (list[j].index != i)
-                    s.points.push_back((positions[list[j].index] - p).cast<double>());
-            Eigen::Vector3d normal;
-            double surfaceVariation = 0;
-            if (!planeNormal(s.points, normal, surfaceVariation))
+    ProgressTicker ticker(progress, "Fitting normals", n);
+    if (params.radius && params.model == NormalModel::Plane) {
+        // The plane needs only the neighbourhood's moments.
+        detail::forEachPointMoments(tree, *params.radius, ticker, [&](std::size_t i, const octree::NeighbourhoodMoments& moments) {
+            detail::LocalPlane plane;
+            if (!detail::fitLocalPlane(moments, false, plane))
                 return;
+            result.normals[i] = plane.normal.cast<float>();
+            variation[i] = static_cast<float>(surfaceVariationOf(plane));
+        });
+    } else {
+        detail::forEachPointNeighbourhood(tree, params.radius, params.knn, ticker, [&](std::size_t i, const octree::Neighbour* list, std::size_t count) {
+            const Eigen::Vector3f& p = positions[i];
+            detail::LocalPlane plane;
+            // The plane from the list itself (the point is in it, at offset 0).
+            if (!detail::fitLocalPlane(positions.data(), p, list, count, plane))
+                return;
+            Eigen::Vector3d normal = plane.normal;
             if (params.model != NormalModel::Plane) {
-                const LocalModel model =
-                    params.model == NormalModel::Quadric ? LocalModel::Quadric : LocalModel::Delaunay;
+                // Per worker thread: a thread_local costs less per point than TBB's lookup.
+                thread_local FitScratch s;
+                s.points.clear();
+                s.points.emplace_back(Eigen::Vector3d::Zero());
+                for (std::size_t j = 0; j < count; ++j)
+                    if (list[j].index != i)
+                        s.points.push_back((positions[list[j].index] - p).cast<double>());
+                const LocalModel model = params.model == NormalModel::Quadric ? LocalModel::Quadric : LocalModel::Delaunay;
                 detail::FittedModel fitted;
                 if (detail::fitModel(model, s.points, normal, fitted, s.model)) {
                     Eigen::Vector3d refined = normal;
                     const bool ok = model == LocalModel::Quadric ? (refined = quadricNormal(fitted, s.points.front())).allFinite()
-                                                                         : triangulationNormal(s.points, fitted.frame, s, refined);
+                                                                 : triangulationNormal(s.points, fitted.frame, s, refined);
                     if (ok)
                         normal = refined;
                 }
             }
+            const double surfaceVariation = surfaceVariationOf(plane);
             result.normals[i] = normal.cast<float>();
             variation[i] = static_cast<float>(surfaceVariation);
         });
