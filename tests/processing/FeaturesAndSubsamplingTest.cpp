@@ -9,6 +9,7 @@
 #include <scandiff/core/processing/Subsampling.h>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <map>
 #include <set>
@@ -152,6 +153,19 @@ TEST(Subsampling, SpatialKeepsNoTwoPointsWithinTheDistanceAndCoversEveryPoint)
             ASSERT_TRUE(covered) << "point " << i << " d " << d;
         }
     }
+}
+
+TEST(Subsampling, SpatialGivesTheSamePointsOnOneThreadOrSeveral)
+{
+    const PointCloud cloud = test::randomPlaneCloud(200000, 20.0, 12);
+    const std::vector<std::size_t> parallel = spatialSubsample(cloud, 0.04);
+    std::vector<std::size_t> serial;
+    {
+        const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        serial = spatialSubsample(cloud, 0.04);
+    }
+    EXPECT_EQ(parallel, serial);
+    EXPECT_LT(parallel.size(), cloud.size());
 }
 
 TEST(Subsampling, OctreeKeepsExactlyThePointNearestEachCellCentre)

@@ -5,9 +5,11 @@
 #include <scandiff/core/Error.h>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -58,11 +60,12 @@ std::vector<std::size_t> spatialSubsample(const PointCloud& cloud, double minDis
         ++level;
     level = std::max(1, std::min(level, tree.levelNearestMeanPopulation(16.0)));
 
-    // The greedy rule in Morton order: a point is kept when no point kept
-    // before it lies within minDistance. The points kept before it are in the
-    // cells of its block already visited (earlier in Morton order) and earlier
-    // in its own cell. Sequential by nature, and the order is fixed, so the
-    // result never depends on the number of threads.
+    // The greedy rule: a point is kept when no point kept before it lies
+    // within minDistance. "Before" is the order of the cells' eight parity
+    // classes (x, y and z of the cell even or odd), then Morton order within a
+    // cell. Two cells of one class are at least a cell apart, so at least
+    // minDistance: the cells of a class are decided independently, on both
+    // cores, and the result never depends on the number of threads.
     const double size = tree.cellSize(level);
     const Eigen::Vector3d boxMin = tree.box().min;
     // Cell boxes are widened before they are rounded to float, by more than
@@ -70,70 +73,89 @@ std::vector<std::size_t> spatialSubsample(const PointCloud& cloud, double minDis
     // point is farther from than minDistance can never skip a point within it.
     const double margin = 1e-4 * size + 8 * std::numeric_limits<float>::epsilon() *
                                             (boxMin.cwiseAbs().maxCoeff() + tree.box().size);
-    std::vector<char> keptAt(n, 0); // by position in Morton order
+    std::vector<char> keptAt(n, 0);    // by position in Morton order
     std::vector<char> keptPoint(n, 0); // by point index
-    std::vector<float> x, y, z;
+    std::array<std::vector<octree::Octree::CellSpan>, 8> classes;
+    tree.forEachCell(level, [&](octree::MortonCode code, std::size_t first, std::size_t last) {
+        const octree::CellCoordinates c = octree::decodeCell(code);
+        classes[(c.x & 1) << 2 | (c.y & 1) << 1 | (c.z & 1)].push_back({code, first, last});
+    });
     struct Segment
     {
         std::size_t begin, end;
         Eigen::Vector3f low, high; //!< the cell's box (local coordinates)
     };
-    std::vector<Segment> segments;
-    std::vector<octree::Octree::CellSpan> block;
-    ProgressTicker ticker(progress, "Spatial subsampling", n);
-    tree.forEachCell(level, [&](octree::MortonCode code, std::size_t first, std::size_t last) {
-        x.clear();
-        y.clear();
-        z.clear();
-        segments.clear();
-        tree.blockAround(code, level, block);
-        for (const auto& cell : block) {
-            if (cell.code >= code)
-                break; // not visited yet: nothing kept there
-            Segment segment{x.size(), 0, {}, {}};
-            for (std::size_t j = cell.first; j < cell.last; ++j)
+    struct Scratch
+    {
+        std::vector<float> x, y, z;
+        std::vector<Segment> segments;
+        std::vector<octree::Octree::CellSpan> block;
+    };
+    tbb::enumerable_thread_specific<Scratch> scratch;
+    const auto decide = [&](const octree::Octree::CellSpan& cell, Scratch& k) {
+        k.x.clear();
+        k.y.clear();
+        k.z.clear();
+        k.segments.clear();
+        // The points kept so far in the block: cells of earlier classes only.
+        tree.blockAround(cell.code, level, k.block);
+        for (const auto& other : k.block) {
+            if (other.code == cell.code)
+                continue;
+            Segment segment{k.x.size(), 0, {}, {}};
+            for (std::size_t j = other.first; j < other.last; ++j)
                 if (keptAt[j]) {
                     const Eigen::Vector3f& p = positions[order[j]];
-                    x.push_back(p.x());
-                    y.push_back(p.y());
-                    z.push_back(p.z());
+                    k.x.push_back(p.x());
+                    k.y.push_back(p.y());
+                    k.z.push_back(p.z());
                 }
-            segment.end = x.size();
+            segment.end = k.x.size();
             if (segment.end == segment.begin)
                 continue;
-            const octree::CellCoordinates c = octree::decodeCell(cell.code);
+            const octree::CellCoordinates c = octree::decodeCell(other.code);
             const Eigen::Vector3d low = boxMin + Eigen::Vector3d(c.x, c.y, c.z) * size;
             segment.low = (low - Eigen::Vector3d::Constant(margin)).cast<float>();
             segment.high = (low + Eigen::Vector3d::Constant(size + margin)).cast<float>();
-            segments.push_back(segment);
+            k.segments.push_back(segment);
         }
-        const std::size_t ownBegin = x.size();
-        for (std::size_t j = first; j < last; ++j) {
+        const std::size_t ownBegin = k.x.size();
+        for (std::size_t j = cell.first; j < cell.last; ++j) {
             const Eigen::Vector3f& p = positions[order[j]];
             bool free = true;
             const auto scan = [&](std::size_t from, std::size_t to) {
                 // No early exit: the loop vectorises.
-                for (std::size_t k = from; k < to; ++k) {
-                    const float ex = x[k] - p.x(), ey = y[k] - p.y(), ez = z[k] - p.z();
+                for (std::size_t q = from; q < to; ++q) {
+                    const float ex = k.x[q] - p.x(), ey = k.y[q] - p.y(), ez = k.z[q] - p.z();
                     free &= ex * ex + (ey * ey + ez * ez) > d2;
                 }
             };
-            for (const Segment& segment : segments) {
+            for (const Segment& segment : k.segments) {
                 const Eigen::Vector3f gap = (segment.low - p).cwiseMax(p - segment.high).cwiseMax(0.0f);
                 if (gap.squaredNorm() <= d2) // else the point is farther than minDistance from the whole cell
                     scan(segment.begin, segment.end);
             }
-            scan(ownBegin, x.size());
+            scan(ownBegin, k.x.size());
             if (free) {
                 keptAt[j] = 1;
                 keptPoint[order[j]] = 1;
-                x.push_back(p.x());
-                y.push_back(p.y());
-                z.push_back(p.z());
+                k.x.push_back(p.x());
+                k.y.push_back(p.y());
+                k.z.push_back(p.z());
             }
         }
-        ticker.step(last - first);
-    });
+    };
+    ProgressTicker ticker(progress, "Spatial subsampling", n);
+    for (const auto& cells : classes)
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+            Scratch& k = scratch.local();
+            std::size_t points = 0;
+            for (std::size_t c = r.begin(); c != r.end(); ++c) {
+                decide(cells[c], k);
+                points += cells[c].last - cells[c].first;
+            }
+            ticker.step(points);
+        });
     std::vector<std::size_t> out;
     for (std::size_t i = 0; i < n; ++i)
         if (keptPoint[i])
