@@ -7,11 +7,11 @@
 #include "controllers/SessionController.h"
 #include "controllers/SplitController.h"
 #include "controllers/ToolController.h"
-#include "tools/TableDialog.h"
 #include "panels/ConsolePanel.h"
 #include "panels/EntityTree.h"
 #include "panels/PropertiesPanel.h"
 #include "panels/ScalarFieldPanel.h"
+#include "tools/TableDialog.h"
 #include "view/CloudView.h"
 #include "view/EntityColouring.h"
 
@@ -28,6 +28,8 @@
 #include <QPushButton>
 #include <QStatusBar>
 #include <QToolBar>
+
+#include <set>
 
 namespace scandiff::gui {
 
@@ -210,7 +212,7 @@ void MainWindow::buildMenus()
     tools->addAction(tr("S&egment the changes..."), this, [this] { segmentation_->runInteractively(tree_->currentEntity()); });
     // The panel's own button: one place decides what a split takes.
     tools->addAction(tr("&Split at thresholds"), scalarPanel_->splitButton(), &QPushButton::click);
-    buildToolsMenu(tools);
+    buildToolsMenu(edit, tools);
 
     // The tree's own menu: what applies to the entity under the mouse.
     tree_->setContextMenuPolicy(Qt::ActionsContextMenu);
@@ -229,13 +231,23 @@ void MainWindow::buildMenus()
     tree_->addAction(remove);
 }
 
-void MainWindow::buildToolsMenu(QMenu* toolsMenu)
+void MainWindow::buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu)
 {
+    // Where a CloudCompare user looks for them: editing a cloud (its normals,
+    // its fields, copies, merges, moves, crops, subsampling) under Edit, the
+    // rest under Tools, one submenu per category. The "Edit" category's tools
+    // go straight into the Edit menu.
+    const std::set<std::string> underEdit{"Edit", "Normals", "Subsample", "Scalar fields"};
     std::map<std::string, QMenu*> categories;
+    editMenu->addSeparator();
     for (const ToolSpec& tool : registry_.tools.tools()) {
         QMenu*& menu = categories[tool.category];
-        if (!menu)
-            menu = tool.category.empty() ? toolsMenu : toolsMenu->addMenu(QString::fromStdString(tool.category));
+        if (!menu) {
+            QMenu* parent = underEdit.count(tool.category) ? editMenu : toolsMenu;
+            menu = tool.category.empty() ? toolsMenu
+                   : tool.category == "Edit" ? editMenu
+                                             : parent->addMenu(QString::fromStdString(tool.category));
+        }
         auto* controller = new ToolController(tool, document_, this);
         tools_[tool.name] = controller;
         QAction* action = menu->addAction(QString::fromStdString(tool.title) + "...", this,

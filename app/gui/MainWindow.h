@@ -61,7 +61,7 @@ protected:
 private:
     void buildDocks();
     void buildMenus();
-    void buildToolsMenu(QMenu* toolsMenu);
+    void buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu);
     //! The tree's current entity, then the other selected ones: what a tool proposes as its inputs.
     std::vector<EntityId> toolSelection() const;
     //! Console + status bar for a controller's finished/failed signals.
