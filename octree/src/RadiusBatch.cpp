@@ -38,12 +38,14 @@ constexpr std::size_t kRun = 8;
 void accumulateMoments(const detail::BatchScratch& near, std::size_t m, const Eigen::Vector3f& q, float r2,
                        NeighbourhoodMoments& moments)
 {
-    double sx = 0, sy = 0, sz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-    std::uint32_t count = 0;
+    moments = NeighbourhoodMoments{};
     std::size_t j = 0;
 #ifdef __SSE2__
     const __m128 qx = _mm_set1_ps(q.x()), qy = _mm_set1_ps(q.y()), qz = _mm_set1_ps(q.z()), bound = _mm_set1_ps(r2);
-    __m128d sx2 = _mm_setzero_pd(), sy2 = sx2, sz2 = sx2, xx2 = sx2, xy2 = sx2, xz2 = sx2, yy2 = sx2, yz2 = sx2, zz2 = sx2;
+    // Two lanes of double per sum: x, y, z, then xx xy xz yy yz zz.
+    __m128d sums[9];
+    for (__m128d& sum : sums)
+        sum = _mm_setzero_pd();
     for (; j + 4 <= m; j += 4) {
         const __m128 dx = _mm_sub_ps(_mm_loadu_ps(near.x.data() + j), qx);
         const __m128 dy = _mm_sub_ps(_mm_loadu_ps(near.y.data() + j), qy);
@@ -53,57 +55,33 @@ void accumulateMoments(const detail::BatchScratch& near, std::size_t m, const Ei
         const int mask = _mm_movemask_ps(inside);
         if (mask == 0)
             continue;
-        count += static_cast<std::uint32_t>(__builtin_popcount(static_cast<unsigned>(mask)));
+        moments.count += static_cast<std::uint32_t>(__builtin_popcount(static_cast<unsigned>(mask)));
         const __m128 mx = _mm_and_ps(dx, inside), my = _mm_and_ps(dy, inside), mz = _mm_and_ps(dz, inside);
         for (int half = 0; half < 2; ++half) {
             const __m128d x = _mm_cvtps_pd(half ? _mm_movehl_ps(mx, mx) : mx);
             const __m128d y = _mm_cvtps_pd(half ? _mm_movehl_ps(my, my) : my);
             const __m128d z = _mm_cvtps_pd(half ? _mm_movehl_ps(mz, mz) : mz);
-            sx2 = _mm_add_pd(sx2, x);
-            sy2 = _mm_add_pd(sy2, y);
-            sz2 = _mm_add_pd(sz2, z);
-            xx2 = _mm_add_pd(xx2, _mm_mul_pd(x, x));
-            xy2 = _mm_add_pd(xy2, _mm_mul_pd(x, y));
-            xz2 = _mm_add_pd(xz2, _mm_mul_pd(x, z));
-            yy2 = _mm_add_pd(yy2, _mm_mul_pd(y, y));
-            yz2 = _mm_add_pd(yz2, _mm_mul_pd(y, z));
-            zz2 = _mm_add_pd(zz2, _mm_mul_pd(z, z));
+            const __m128d terms[9] = {x, y, z, _mm_mul_pd(x, x), _mm_mul_pd(x, y), _mm_mul_pd(x, z),
+                                      _mm_mul_pd(y, y), _mm_mul_pd(y, z), _mm_mul_pd(z, z)};
+            for (std::size_t t = 0; t < 9; ++t)
+                sums[t] = _mm_add_pd(sums[t], terms[t]);
         }
     }
-    const auto total = [](__m128d v) {
-        alignas(16) double lanes[2];
-        _mm_store_pd(lanes, v);
-        return lanes[0] + lanes[1];
-    };
-    sx = total(sx2);
-    sy = total(sy2);
-    sz = total(sz2);
-    xx = total(xx2);
-    xy = total(xy2);
-    xz = total(xz2);
-    yy = total(yy2);
-    yz = total(yz2);
-    zz = total(zz2);
+    alignas(16) double lanes[2];
+    for (std::size_t t = 0; t < 9; ++t) {
+        _mm_store_pd(lanes, sums[t]);
+        const double total = lanes[0] + lanes[1];
+        if (t < 3)
+            moments.sum[static_cast<Eigen::Index>(t)] = total;
+        else
+            moments.products[t - 3] = total;
+    }
 #endif
     for (; j < m; ++j) {
         const float fx = near.x[j] - q.x(), fy = near.y[j] - q.y(), fz = near.z[j] - q.z();
-        if (!(fx * fx + (fy * fy + fz * fz) <= r2))
-            continue;
-        const double x = fx, y = fy, z = fz;
-        ++count;
-        sx += x;
-        sy += y;
-        sz += z;
-        xx += x * x;
-        xy += x * y;
-        xz += x * z;
-        yy += y * y;
-        yz += y * z;
-        zz += z * z;
+        if (fx * fx + (fy * fy + fz * fz) <= r2)
+            moments.add(Eigen::Vector3d(fx, fy, fz));
     }
-    moments.count = count;
-    moments.sum = Eigen::Vector3d(sx, sy, sz);
-    moments.products = {xx, xy, xz, yy, yz, zz};
 }
 
 } // namespace

@@ -26,20 +26,23 @@ struct LocalPlane
     Eigen::Vector3d values;  //!< principal variances (sums of squares), increasing
 };
 
-//! The plane through sums of offsets and of their products (xx xy xz yy yz zz)
-//! over n points; false when they fix none (fewer than 3, or a line).
-inline bool planeFromSums(double n, const Eigen::Vector3d& sum, const double (&products)[6], LocalPlane& plane)
+//! The plane of a neighbourhood given by its moments (offsets from its point);
+//! `excludeCentre` leaves the point itself out (its offset is zero: one fewer
+//! point). False when they fix none (fewer than 3 points, or a line).
+inline bool fitLocalPlane(const octree::NeighbourhoodMoments& m, bool excludeCentre, LocalPlane& plane)
 {
+    const double n = static_cast<double>(m.count) - (excludeCentre ? 1.0 : 0.0);
     if (n < 3)
         return false;
+    const Eigen::Vector3d& sum = m.sum;
     plane.mean = sum / n;
     Eigen::Matrix3d covariance;
-    covariance(0, 0) = products[0] - sum.x() * plane.mean.x();
-    covariance(1, 0) = covariance(0, 1) = products[1] - sum.x() * plane.mean.y();
-    covariance(2, 0) = covariance(0, 2) = products[2] - sum.x() * plane.mean.z();
-    covariance(1, 1) = products[3] - sum.y() * plane.mean.y();
-    covariance(2, 1) = covariance(1, 2) = products[4] - sum.y() * plane.mean.z();
-    covariance(2, 2) = products[5] - sum.z() * plane.mean.z();
+    covariance(0, 0) = m.products[0] - sum.x() * plane.mean.x();
+    covariance(1, 0) = covariance(0, 1) = m.products[1] - sum.x() * plane.mean.y();
+    covariance(2, 0) = covariance(0, 2) = m.products[2] - sum.x() * plane.mean.z();
+    covariance(1, 1) = m.products[3] - sum.y() * plane.mean.y();
+    covariance(2, 1) = covariance(1, 2) = m.products[4] - sum.y() * plane.mean.z();
+    covariance(2, 2) = m.products[5] - sum.z() * plane.mean.z();
     Eigen::Vector3d smallest, largest;
     principalAxes(covariance, plane.values, smallest, largest);
     if (!(plane.values[2] > 0) || !(plane.values[1] > kLineThreshold * plane.values[2]) || !smallest.allFinite())
@@ -52,28 +55,10 @@ inline bool planeFromSums(double n, const Eigen::Vector3d& sum, const double (&p
 //! magnitude out of the squares.
 inline bool fitLocalPlane(const std::vector<Eigen::Vector3d>& offsets, std::size_t first, LocalPlane& plane)
 {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    double products[6] = {0, 0, 0, 0, 0, 0};
-    for (std::size_t j = first; j < offsets.size(); ++j) {
-        const Eigen::Vector3d& d = offsets[j];
-        sum += d;
-        products[0] += d.x() * d.x();
-        products[1] += d.x() * d.y();
-        products[2] += d.x() * d.z();
-        products[3] += d.y() * d.y();
-        products[4] += d.y() * d.z();
-        products[5] += d.z() * d.z();
-    }
-    return planeFromSums(static_cast<double>(offsets.size() - std::min(first, offsets.size())), sum, products, plane);
-}
-
-//! The plane of a neighbourhood given by its moments (offsets from its point);
-//! `excludeCentre` leaves the point itself out (its offset is zero: one fewer point).
-inline bool fitLocalPlane(const octree::NeighbourhoodMoments& m, bool excludeCentre, LocalPlane& plane)
-{
-    const double products[6] = {m.products[0], m.products[1], m.products[2], m.products[3], m.products[4], m.products[5]};
-    const double n = static_cast<double>(m.count) - (excludeCentre ? 1.0 : 0.0);
-    return planeFromSums(n, m.sum, products, plane);
+    octree::NeighbourhoodMoments m;
+    for (std::size_t j = first; j < offsets.size(); ++j)
+        m.add(offsets[j]);
+    return fitLocalPlane(m, false, plane);
 }
 
 //! The plane of the listed points (the centre among them), from their offsets
@@ -81,19 +66,10 @@ inline bool fitLocalPlane(const octree::NeighbourhoodMoments& m, bool excludeCen
 inline bool fitLocalPlane(const Eigen::Vector3f* positions, const Eigen::Vector3f& centre, const octree::Neighbour* list,
                           std::size_t count, LocalPlane& plane)
 {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    double products[6] = {0, 0, 0, 0, 0, 0};
-    for (std::size_t j = 0; j < count; ++j) {
-        const Eigen::Vector3d d = (positions[list[j].index] - centre).cast<double>();
-        sum += d;
-        products[0] += d.x() * d.x();
-        products[1] += d.x() * d.y();
-        products[2] += d.x() * d.z();
-        products[3] += d.y() * d.y();
-        products[4] += d.y() * d.z();
-        products[5] += d.z() * d.z();
-    }
-    return planeFromSums(static_cast<double>(count), sum, products, plane);
+    octree::NeighbourhoodMoments m;
+    for (std::size_t j = 0; j < count; ++j)
+        m.add((positions[list[j].index] - centre).cast<double>());
+    return fitLocalPlane(m, false, plane);
 }
 
 } // namespace scandiff::detail

@@ -37,6 +37,19 @@ struct NeighbourhoodMoments
     std::uint32_t count = 0;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     std::array<double, 6> products{};
+
+    //! Counts one more point at offset d.
+    void add(const Eigen::Vector3d& d)
+    {
+        ++count;
+        sum += d;
+        products[0] += d.x() * d.x();
+        products[1] += d.x() * d.y();
+        products[2] += d.x() * d.z();
+        products[3] += d.y() * d.y();
+        products[4] += d.y() * d.z();
+        products[5] += d.z() * d.z();
+    }
 };
 
 //! An axis-aligned cube: the root cell. Two octrees built on the same cube have
