@@ -12,9 +12,18 @@
 // So the global allocation function is replaced (a replacement the C++
 // standard provides for): blocks of 4 MiB and more are aligned on 2 MiB and
 // marked; smaller ones go to malloc as before. Everything is released with
-// free(), which accepts both. Left out under AddressSanitizer, which
-// replaces these functions itself.
-#if !defined(__SANITIZE_ADDRESS__) && defined(__linux__)
+// free(), which accepts both. Left out under the sanitizers, which replace
+// these functions themselves.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#define SCANDIFF_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define SCANDIFF_SANITIZED 1
+#endif
+
+#if !defined(SCANDIFF_SANITIZED) && defined(__linux__)
 
 #include <cstdlib>
 #include <new>
@@ -33,32 +42,53 @@ void* allocate(std::size_t size) noexcept
     if (posix_memalign(&block, kHugePage, size) != 0)
         return nullptr;
     // Advice only: if the kernel has no huge page to give, 4 KiB pages serve.
-    madvise(block, (size + kHugePage - 1) & ~(kHugePage - 1), MADV_HUGEPAGE);
+    // Whole huge pages inside the block only: the memory after it is not ours.
+    madvise(block, size & ~(kHugePage - 1), MADV_HUGEPAGE);
     return block;
+}
+
+//! The standard's loop: while there is no memory, call the new-handler (which
+//! may free some) and try again; without one, bad_alloc.
+void* allocateOrThrow(std::size_t size)
+{
+    for (;;) {
+        if (void* block = allocate(size))
+            return block;
+        const std::new_handler handler = std::get_new_handler();
+        if (!handler)
+            throw std::bad_alloc();
+        handler();
+    }
 }
 
 } // namespace
 
 void* operator new(std::size_t size)
 {
-    if (void* block = allocate(size))
-        return block;
-    throw std::bad_alloc();
+    return allocateOrThrow(size);
 }
 
 void* operator new[](std::size_t size)
 {
-    return operator new(size);
+    return allocateOrThrow(size);
 }
 
 void* operator new(std::size_t size, const std::nothrow_t&) noexcept
 {
-    return allocate(size);
+    try {
+        return allocateOrThrow(size);
+    } catch (...) {
+        return nullptr;
+    }
 }
 
 void* operator new[](std::size_t size, const std::nothrow_t&) noexcept
 {
-    return allocate(size);
+    try {
+        return allocateOrThrow(size);
+    } catch (...) {
+        return nullptr;
+    }
 }
 
 void operator delete(void* block) noexcept

@@ -2,9 +2,9 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/TextLists.h>
 
+#include <charconv>
 #include <cmath>
 #include <sstream>
-#include <stdexcept>
 
 namespace scandiff {
 
@@ -22,14 +22,20 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
 {
     std::vector<double> values;
     for (const std::string& part : splitList(text, ',')) {
-        try {
-            std::size_t used = 0;
-            values.push_back(std::stod(part, &used));
-            if (used != part.size() || !std::isfinite(values.back()))
-                throw std::invalid_argument(part);
-        } catch (const std::exception&) {
-            throw Error(ErrorCode::InvalidArgument, what + ": '" + part + "' is not a finite number");
+        // from_chars, not stod: the decimal point must not depend on the
+        // process's locale (the workbench's Qt sets it from the environment).
+        std::size_t first = part.find_first_not_of(" \t"), last = part.find_last_not_of(" \t");
+        if (first != std::string::npos && part[first] == '+')
+            ++first;
+        double value = 0;
+        bool ok = first != std::string::npos && first <= last;
+        if (ok) {
+            const auto [end, ec] = std::from_chars(part.data() + first, part.data() + last + 1, value);
+            ok = ec == std::errc() && end == part.data() + last + 1 && std::isfinite(value);
         }
+        if (!ok)
+            throw Error(ErrorCode::InvalidArgument, what + ": '" + part + "' is not a finite number");
+        values.push_back(value);
     }
     return values;
 }

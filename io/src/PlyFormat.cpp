@@ -648,7 +648,9 @@ const char* skipBinaryList(const PlyElement& e, const PlyProperty& p, std::uint6
     return ptr + static_cast<std::size_t>(count) * itemSize;
 }
 
-//! Calls visit(index, slot, value) for every used vertex property, in file order.
+//! Calls visit(index, slot, value) for every used vertex property: in file
+//! order for records of variable size, by chunks on several threads for
+//! fixed-size records (see below).
 template <bool Swap, class Visit>
 const char* visitBinaryVertices(const PlyElement& e, const VertexLayout& layout, const char* ptr, const char* end,
                                 const Context& ctx, ProgressTicker& ticker, Visit&& visit)

@@ -95,8 +95,10 @@ void Octree::forEachRadiusRun(const Eigen::Vector3f* queries, std::size_t count,
         return;
     // The deepest level whose cells are at least as wide as the radius: the
     // 27 cells around a query's cell then hold its whole sphere.
+    // (With a relative margin: a cell exactly the radius wide could let float
+    // rounding accept a point two cells away, which the block does not hold.)
     int level = 1;
-    while (level < kMaxLevel && cellSize(level + 1) >= static_cast<double>(radius))
+    while (level < kMaxLevel && cellSize(level + 1) >= static_cast<double>(radius) * (1 + 1e-5))
         ++level;
     const std::int64_t n = std::int64_t(1) << level;
     const CellDirectory& directory = cellDirectory(level);

@@ -3,6 +3,7 @@
 #include <scandiff/core/FieldRange.h>
 #include <scandiff/core/Mesh.h>
 #include <scandiff/core/PointCloud.h>
+#include <scandiff/core/TextLists.h>
 
 #include "TestSupport.h"
 
@@ -169,4 +170,13 @@ TEST(FieldRange, SplitKeepsOrderAttributesAndSendsNaNOutside)
     EXPECT_EQ(countInRange(*cloud.field("d"), 100.0, 101.0), 3u);
     EXPECT_EQ(test::errorCodeOf([&] { splitByFieldRange(cloud, "none", 0, 1); }), ErrorCode::InvalidArgument);
     EXPECT_EQ(test::errorCodeOf([&] { splitByFieldRange(cloud, "d", 2, 1); }), ErrorCode::InvalidArgument);
+}
+
+TEST(TextLists, NumbersWithSpacesAndSignsInAnyLocale)
+{
+    EXPECT_EQ(parseNumberList(" 1.5, +2 ,-3e2", "test"), (std::vector<double>{1.5, 2, -300}));
+    EXPECT_THROW(parseNumberList("1,,2", "test"), Error);
+    EXPECT_THROW(parseNumberList("1,2x", "test"), Error);
+    EXPECT_THROW(parseNumberList("nan", "test"), Error);
+    EXPECT_THROW(parseNumberList("1;2", "test"), Error);
 }

@@ -504,3 +504,24 @@ TEST(Octree, BatchMomentsEqualTheBruteForceNeighbourhoods)
         }
     }
 }
+
+TEST(Octree, BatchRadiusExactlyACellWide)
+{
+    // A grid on the cube's own cell boundaries, queried with radius = a cell:
+    // every distance is a multiple of the spacing, many exactly the radius.
+    Cloud grid;
+    for (int i = 0; i <= 8; ++i)
+        for (int j = 0; j <= 8; ++j)
+            grid.push_back({0.125f * i, 0.125f * j, 0.0f});
+    const Octree tree(grid.data(), grid.size(), CubicBox{Eigen::Vector3d::Zero(), 1.0});
+    for (float r : {0.125f, 0.25f, 0.5f}) {
+        std::vector<std::vector<Neighbour>> got(grid.size());
+        tree.withinRadiusBatch(grid.data(), grid.size(), r, [&](std::uint32_t q, const Neighbour* list, std::size_t count) {
+            got[q].assign(list, list + count);
+        });
+        for (std::size_t q = 0; q < grid.size(); ++q) {
+            std::sort(got[q].begin(), got[q].end());
+            expectSame(got[q], bruteForceRadius(grid, grid[q], r), "radius " + std::to_string(r));
+        }
+    }
+}

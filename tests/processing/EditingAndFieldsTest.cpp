@@ -159,6 +159,15 @@ TEST(FieldOperations, ExpressionsOverFieldsCoordinatesAndColours)
     EXPECT_EQ(test::errorCodeOf([&] { evaluateFieldExpression(cloud, "unknown_field * 2", "z"); }), ErrorCode::InvalidArgument);
     EXPECT_EQ(test::errorCodeOf([&] { evaluateFieldExpression(cloud, "x +* 2", "z"); }), ErrorCode::InvalidArgument);
     EXPECT_EQ(expressionName("3d dist."), "_3d_dist_");
+    // Two fields with one expression name, or a field named like a coordinate:
+    // refused when the expression uses the name, harmless otherwise.
+    PointCloud clash = cloud.clone();
+    clash.addField("a b");
+    clash.addField("a_b");
+    clash.addField("x");
+    EXPECT_EQ(test::errorCodeOf([&] { evaluateFieldExpression(clash, "a_b * 2", "t"); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { evaluateFieldExpression(clash, "x + 1", "t"); }), ErrorCode::InvalidArgument);
+    EXPECT_NO_THROW(evaluateFieldExpression(clash, "y + 1", "t"));
 }
 
 TEST(FieldOperations, GaussianSmoothingKeepsAConstantAndReducesNoise)

@@ -151,6 +151,12 @@ TEST(Unrolling, ACylinderUnrollsToARectangleAndRollsBack)
     const PointCloud back = rollCloud(flat, surface, 0);
     for (std::size_t i = 0; i < cylinder.size(); ++i)
         ASSERT_LT((back.globalPosition(i) - cylinder.globalPosition(i)).norm(), 1e-4) << i;
+    // A point without finite coordinates stays so and moves nothing else.
+    PointCloud withNan = cylinder.clone();
+    withNan.positions()[0] = Eigen::Vector3f(std::nanf(""), 0, 0);
+    const PointCloud flatNan = unrollCloud(withNan, surface, 0);
+    EXPECT_FALSE(flatNan.positions()[0].allFinite());
+    EXPECT_LT((flatNan.globalPosition(5) - flat.globalPosition(5)).norm(), 1e-4);
     // Unrolling about a plane is refused.
     EXPECT_EQ(test::errorCodeOf([&] { unrollCloud(cylinder, parsePrimitive("plane:0,0,0,0,0,1")); }), ErrorCode::InvalidArgument);
 }
@@ -218,10 +224,23 @@ TEST(MeshSampling, PointsLieOnTheirTrianglesInProportionToArea)
     EXPECT_EQ(counts[2], 0u);
     EXPECT_LE(std::abs(static_cast<double>(counts[0]) - 10001 * area0 / (area0 + area1)), 1.0);
     EXPECT_LE(std::abs(static_cast<double>(counts[1]) - 10001 * area1 / (area0 + area1)), 1.0);
-    // The same seed, the same points; density mode.
+    // The same seed, the same points; other seeds, unrelated points (not the
+    // same draws shifted by one).
     EXPECT_EQ(sampleMesh(mesh, params).positions(), cloud.positions());
+    for (std::uint64_t other : {6u, 7u, 9u}) {
+        MeshSamplingParams reseeded = params;
+        reseeded.seed = other;
+        const PointCloud again = sampleMesh(mesh, reseeded);
+        std::size_t shared = 0;
+        for (const auto& p : again.positions())
+            shared += std::find(cloud.positions().begin(), cloud.positions().end(), p) != cloud.positions().end();
+        EXPECT_EQ(shared, 0u) << "seed " << other;
+    }
     MeshSamplingParams byDensity;
     byDensity.density = 100;
     EXPECT_EQ(sampleMesh(mesh, byDensity).size(), static_cast<std::size_t>(std::llround(100 * (area0 + area1))));
     EXPECT_EQ(test::errorCodeOf([&] { sampleMesh(mesh, MeshSamplingParams{}); }), ErrorCode::InvalidArgument);
+    MeshSamplingParams huge;
+    huge.count = std::size_t(100000000000); // refused before anything is allocated
+    EXPECT_EQ(test::errorCodeOf([&] { sampleMesh(mesh, huge); }), ErrorCode::InvalidArgument);
 }

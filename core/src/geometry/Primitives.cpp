@@ -137,7 +137,10 @@ PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressO
     const std::size_t stride = (n + kMaxFitPoints - 1) / kMaxFitPoints;
     std::vector<std::size_t> used;
     for (std::size_t i = 0; i < n; i += stride)
-        used.push_back(i);
+        if (cloud.positions()[i].allFinite())
+            used.push_back(i);
+    if (used.size() < 4)
+        cannotFit(kind, "cloud '" + cloud.name + "' has fewer than 4 points with finite coordinates");
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     for (std::size_t i : used)
         centroid += cloud.positions()[i].cast<double>();
@@ -286,11 +289,15 @@ PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressO
     fit.primitive = s;
     fit.points = used.size();
     double sum = 0;
+    std::size_t finite = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const double d = signedDistance(s, cloud.globalPosition(i));
-        sum += d * d;
+        if (std::isfinite(d)) {
+            sum += d * d;
+            ++finite;
+        }
     }
-    fit.rms = std::sqrt(sum / static_cast<double>(n));
+    fit.rms = std::sqrt(sum / static_cast<double>(finite));
     ticker.step();
     return fit;
 }

@@ -92,8 +92,16 @@ ScalarField evaluateFieldExpression(const PointCloud& cloud, const std::string& 
         if (cloud.hasColors())
             available[std::string(1, "rgb"[a])] = {VariableSource::Kind::Colour, nullptr, a};
     }
-    for (const auto& f : cloud.fields())
-        available[expressionName(f.name())] = {VariableSource::Kind::Field, &f, 0};
+    // A field whose expression name is taken (another field's, or x, r, nx...)
+    // is ambiguous: refused if the expression uses that name.
+    std::map<std::string, std::string> ambiguous;
+    for (const auto& f : cloud.fields()) {
+        const std::string name = expressionName(f.name());
+        const auto [it, fresh] = available.emplace(name, VariableSource{VariableSource::Kind::Field, &f, 0});
+        if (!fresh)
+            ambiguous[name] = f.name();
+        (void)it;
+    }
 
     constexpr int kBulk = 2048;
     struct Evaluator
@@ -116,6 +124,10 @@ ScalarField evaluateFieldExpression(const PointCloud& cloud, const std::string& 
             e.variables.reserve(used.size());
             for (const auto& [name, ignored] : used) {
                 (void)ignored;
+                if (const auto clash = ambiguous.find(name); clash != ambiguous.end())
+                    throw Error(ErrorCode::InvalidArgument,
+                                "field: '" + name + "' in '" + expression + "' is ambiguous: field '" + clash->second +
+                                    "' has the same name as another field or a coordinate (rename it first)");
                 const auto source = available.find(name);
                 if (source == available.end())
                     throw Error(ErrorCode::InvalidArgument,

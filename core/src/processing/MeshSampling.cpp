@@ -9,23 +9,31 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+
+#include <unistd.h>
 
 namespace scandiff {
 
 namespace {
 
-//! SplitMix64 (Steele, Lea and Flood 2014): a tiny generator seeded per
-//! triangle, so each triangle's points depend on the seed and its index only.
+//! SplitMix64's output function (Steele, Lea and Flood 2014): mixes the bits
+//! of a 64-bit value so that neighbouring inputs give unrelated outputs.
+std::uint64_t mix(std::uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+//! SplitMix64, a tiny generator started per triangle from the mixed seed and
+//! the mixed triangle index, so each triangle's points depend on both only
+//! (and seeds s and s + 1 are not one draw apart).
 struct SplitMix64
 {
     std::uint64_t state;
-    std::uint64_t next()
-    {
-        std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-        return z ^ (z >> 31);
-    }
+    SplitMix64(std::uint64_t seed, std::uint64_t triangle) : state(mix(mix(seed + 0x632be59bd9b4e019ULL) ^ mix(triangle))) {}
+    std::uint64_t next() { return mix(state += 0x9e3779b97f4a7c15ULL); }
     //! Uniform in [0, 1).
     double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
 };
@@ -51,8 +59,14 @@ PointCloud sampleMesh(const Mesh& mesh, const MeshSamplingParams& params, Progre
     if (!(total > 0))
         throw Error(ErrorCode::InvalidData, "mesh sampling: mesh '" + mesh.name + "' has no area");
     const double wanted = params.count ? static_cast<double>(*params.count) : std::round(params.density * total);
-    if (wanted > 2e9)
-        throw Error(ErrorCode::InvalidArgument, "mesh sampling: more than 2 billion points asked for");
+    // Refused before anything is allocated: what the points would take against
+    // the machine's memory (positions, normals, colours, every field).
+    const double bytesPerPoint = 12.0 + (params.normals ? 12.0 : 0.0) + (v.hasColors() ? 3.0 : 0.0) + 4.0 * (v.fields().size() + 1);
+    const double physical = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGESIZE));
+    if (wanted > 4e9 || (physical > 0 && wanted * bytesPerPoint > 0.8 * physical))
+        throw Error(ErrorCode::InvalidArgument, "mesh sampling: " + std::to_string(static_cast<std::uint64_t>(wanted)) +
+                                                    " points would need " + std::to_string(static_cast<int>(wanted * bytesPerPoint / 1e9)) +
+                                                    " GB, more than this machine's memory allows");
     // Triangle t gets round(wanted * C(t+1) / total) - round(wanted * C(t) / total) points.
     std::vector<std::size_t> first(triangles + 1, 0);
     for (std::size_t t = 0; t <= triangles; ++t)
@@ -64,13 +78,14 @@ PointCloud sampleMesh(const Mesh& mesh, const MeshSamplingParams& params, Progre
     out.name = (mesh.name.empty() ? mesh.vertices.name : mesh.name) + "_sampled";
     out.setOrigin(v.origin());
     out.resize(n);
-    if (params.normals)
-        out.enableNormals();
-    if (v.hasColors())
-        out.enableColors();
     for (const auto& f : v.fields())
         out.addField(f.name()).setOffset(f.offset());
-    ScalarField& triangleIndex = out.addField(fields::kTriangleIndex);
+    // A float holds every integer up to 2^24: beyond, the index would be
+    // rounded, so very large meshes get no index field.
+    const bool indexField = triangles <= (std::size_t(1) << 24);
+    ScalarField* triangleIndex = indexField ? &out.addField(fields::kTriangleIndex) : nullptr;
+    Eigen::Vector3f* normals = params.normals ? out.enableNormals().data() : nullptr;
+    Rgb8* colours = v.hasColors() ? out.enableColors().data() : nullptr;
     std::vector<ScalarField*> targets;
     for (const auto& f : v.fields())
         targets.push_back(out.field(f.name()));
@@ -83,27 +98,28 @@ PointCloud sampleMesh(const Mesh& mesh, const MeshSamplingParams& params, Progre
             const Eigen::Vector3d a = v.positions()[tri[0]].cast<double>(), b = v.positions()[tri[1]].cast<double>(),
                                   c = v.positions()[tri[2]].cast<double>();
             const Eigen::Vector3f normal = (b - a).cross(c - a).normalized().cast<float>();
-            SplitMix64 rng{params.seed * 0x9e3779b97f4a7c15ULL + t};
+            SplitMix64 rng(params.seed, t);
             for (std::size_t i = first[t]; i < first[t + 1]; ++i) {
                 // Uniform in the triangle: the square-root warp of two uniforms.
                 const double r1 = std::sqrt(rng.uniform()), r2 = rng.uniform();
                 const double wa = 1 - r1, wb = r1 * (1 - r2), wc = r1 * r2;
                 out.positions()[i] = (wa * a + wb * b + wc * c).cast<float>();
-                if (params.normals)
-                    out.enableNormals()[i] = normal;
+                if (normals)
+                    normals[i] = normal;
                 if (v.hasColors()) {
                     const Rgb8 &ca = v.colors()[tri[0]], &cb = v.colors()[tri[1]], &cc = v.colors()[tri[2]];
-                    const auto mix = [&](std::uint8_t x, std::uint8_t y, std::uint8_t z) {
+                    const auto blend = [&](std::uint8_t x, std::uint8_t y, std::uint8_t z) {
                         return static_cast<std::uint8_t>(std::clamp(std::lround(wa * x + wb * y + wc * z), 0L, 255L));
                     };
-                    out.enableColors()[i] = Rgb8{mix(ca.r, cb.r, cc.r), mix(ca.g, cb.g, cc.g), mix(ca.b, cb.b, cc.b)};
+                    colours[i] = Rgb8{blend(ca.r, cb.r, cc.r), blend(ca.g, cb.g, cc.g), blend(ca.b, cb.b, cc.b)};
                 }
                 for (std::size_t f = 0; f < v.fields().size(); ++f) {
                     const auto& values = v.fields()[f].values();
                     targets[f]->values()[i] =
                         static_cast<float>(wa * values[tri[0]] + wb * values[tri[1]] + wc * values[tri[2]]);
                 }
-                triangleIndex.values()[i] = static_cast<float>(t);
+                if (triangleIndex)
+                    triangleIndex->values()[i] = static_cast<float>(t);
             }
         }
         ticker.step(range.size());

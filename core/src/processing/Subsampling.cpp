@@ -55,8 +55,10 @@ std::vector<std::size_t> spatialSubsample(const PointCloud& cloud, double minDis
     // Cells at least minDistance wide, so a point's 27-cell block holds every
     // point within reach, and of about 16 points, so a block's candidates are
     // gathered once for a dozen points.
+    // (With a relative margin: a cell exactly minDistance wide could let float
+    // rounding find a point two cells away within it.)
     int level = 1;
-    while (level < octree::kMaxLevel && tree.cellSize(level + 1) >= minDistance)
+    while (level < octree::kMaxLevel && tree.cellSize(level + 1) >= minDistance * (1 + 1e-5))
         ++level;
     level = std::max(1, std::min(level, tree.levelNearestMeanPopulation(16.0)));
 

@@ -52,6 +52,8 @@ void storeGlobal(PointCloud& out, const std::vector<Eigen::Vector3d>& global)
 {
     BoundingBox box;
     for (const auto& g : global) {
+        if (!g.allFinite())
+            continue; // a point that was not finite stays so, and must not move the origin
         if (box.empty) {
             box.min = box.max = g;
             box.empty = false;

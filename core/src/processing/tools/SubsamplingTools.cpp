@@ -11,15 +11,15 @@ void registerSubsamplingTools(ToolRegistry& registry)
 {
     ToolSpec tool = oneCloudTool(
         "subsample", "Subsample", "Subsample",
-        "Keeps some of the points, with every field, colour and normal, in input order: a random count; the points "
-        "at least a distance apart (visited in octree order, each kept point removing every point within the distance, "
-        "exact); or one point per cell of an octree level (the nearest to the cell's centre).",
+        "Keeps some of the points, with every field, colour and normal, in input order: a random count; points more "
+        "than a distance apart (each point kept unless a point kept before it lies within the distance; exact, the "
+        "same on any number of threads); or one point per cell of an octree level (the nearest to the cell's centre).",
         newCloud("Subsampled cloud"));
     tool.parameters = {
         ParameterSpec::integer("random", "Random count", "Keep this many points, drawn at random", 100000, 1,
                                std::numeric_limits<std::int64_t>::max(), "points")
             .asAlternative("method"),
-        ParameterSpec::real("spatial", "Minimum distance", "Keep points at least this far apart", 0.05, 1e-9, 1e9, "m")
+        ParameterSpec::real("spatial", "Minimum distance", "Keep points more than this far apart", 0.05, 1e-9, 1e9, "m")
             .asAlternative("method"),
         ParameterSpec::integer("octree", "Octree level", "Keep one point per cell of this octree level", 8, 1, 21).asAlternative("method"),
         ParameterSpec::integer("seed", "Seed", "Random draw: the same seed gives the same points", 0, 0,
@@ -34,7 +34,7 @@ void registerSubsamplingTools(ToolRegistry& registry)
             how = describe("random, seed ", values.integer("seed"));
         } else if (values.has("spatial")) {
             kept = spatialSubsample(input, values.real("spatial"), progress);
-            how = describe("at least ", values.real("spatial"), " m apart");
+            how = describe("more than ", values.real("spatial"), " m apart");
         } else if (values.has("octree")) {
             kept = octreeSubsample(input, static_cast<int>(values.integer("octree")), progress);
             how = describe("one per cell of octree level ", values.integer("octree"));

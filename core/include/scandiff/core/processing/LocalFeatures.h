@@ -48,8 +48,9 @@ inline constexpr const char* kVerticality = "verticality";
 
 struct FeatureResult
 {
-    //! One field per feature, NaN where the neighbourhood is too small for it
-    //! (3 other points for roughness and verticality, 6 for curvature).
+    //! One field per feature, NaN where the neighbourhood does not fix it: a
+    //! plane through 3 points (the point itself counted for verticality, left
+    //! out for roughness) not on a line, a quadric through 6.
     std::vector<ScalarField> fields;
 };
 

@@ -22,7 +22,8 @@ struct MeshSamplingParams
 };
 
 namespace fields {
-//! The triangle a sampled point lies on (its index in the mesh).
+//! The triangle a sampled point lies on (its index in the mesh); left out for
+//! meshes of more than 2^24 triangles, whose indices a float cannot hold.
 inline constexpr const char* kTriangleIndex = "triangle_index";
 } // namespace fields
 
@@ -32,8 +33,8 @@ inline constexpr const char* kTriangleIndex = "triangle_index";
 //! random inside it. Colours and scalar fields of the vertices are
 //! interpolated at each point (barycentric), and fields::kTriangleIndex is
 //! added. Degenerate triangles get no point. Throws Error(InvalidArgument) for
-//! no count and a density that is not > 0, Error(InvalidData) for a mesh with
-//! no area.
+//! no count and a density that is not > 0, or a total the machine's memory
+//! could not hold; Error(InvalidData) for a mesh with no area.
 PointCloud sampleMesh(const Mesh& mesh, const MeshSamplingParams& params, ProgressObserver* progress = nullptr);
 
 } // namespace scandiff
