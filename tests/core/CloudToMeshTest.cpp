@@ -606,3 +606,39 @@ TEST(DistanceStatistics, NoValidValueGivesZeroCountAndNaN)
     EXPECT_TRUE(std::isnan(s.rms));
     EXPECT_EQ(computeStatistics(ScalarField()).count, 0u);
 }
+
+TEST(CloudToMesh, ClosestTrianglesGiveTheDistance)
+{
+    // A mesh of two triangles and points around it: each point's closest
+    // triangle, as reported, is at exactly the distance reported.
+    Mesh mesh;
+    mesh.vertices.resize(4);
+    mesh.vertices.positions() = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 1}};
+    mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+    PointCloud points;
+    points.resize(400);
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<float> u(-1.0f, 3.0f);
+    for (auto& p : points.positions())
+        p = {u(rng), u(rng), u(rng)};
+    CloudToMeshParams params;
+    params.closestTriangles = true;
+    params.maxDistance = 1.5;
+    const CloudToMeshResult result = cloudToMesh(points, mesh, params);
+    ASSERT_EQ(result.closestTriangle.size(), points.size());
+    std::size_t beyond = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        if (!result.distance.hasValue(i)) {
+            EXPECT_EQ(result.closestTriangle[i], kNoClosestTriangle);
+            ++beyond;
+            continue;
+        }
+        const auto& t = mesh.triangles[result.closestTriangle[i]];
+        const auto r = geometry::pointTriangleDistance(points.positions()[i].cast<double>(), mesh.vertices.positions()[t[0]].cast<double>(),
+                                                       mesh.vertices.positions()[t[1]].cast<double>(),
+                                                       mesh.vertices.positions()[t[2]].cast<double>());
+        EXPECT_NEAR(std::sqrt(r.squaredDistance), result.distance.value(i), 1e-6) << i;
+    }
+    EXPECT_GT(beyond, 0u);
+    EXPECT_TRUE(cloudToMesh(points, mesh, CloudToMeshParams{}).closestTriangle.empty());
+}

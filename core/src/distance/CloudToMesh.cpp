@@ -697,6 +697,8 @@ CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference,
     result.level = level;
     result.degenerateTriangles = totals.degenerate;
     std::vector<float>& values = result.distance.values();
+    if (params.closestTriangles)
+        result.closestTriangle.assign(pointCount, kNoClosestTriangle);
 
     SearchSettings settings;
     settings.signedDistances = params.signedDistances;
@@ -788,6 +790,8 @@ CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference,
                 const double d = std::sqrt(s.best2);
                 const bool outside = !(s.best2 < kInfinity) || (params.maxDistance && d > *params.maxDistance);
                 values[s.index] = static_cast<float>(outside ? beyond : s.side * d);
+                if (params.closestTriangles && !outside)
+                    result.closestTriangle[s.index] = s.triangle;
             }
             distanceTicker.step(last - first);
         }

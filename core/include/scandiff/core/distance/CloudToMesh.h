@@ -84,6 +84,9 @@ struct CloudToMeshParams
     //! cost 12 bytes each and a deep level on large triangles would need
     //! gigabytes. CloudToMeshResult::level tells the level used.
     int octreeLevel = 0;
+    //! Also give, per compared point, the index of the closest triangle (the
+    //! one whose distance was kept; registration needs it). Default false.
+    bool closestTriangles = false;
 };
 
 struct CloudToMeshResult
@@ -96,7 +99,13 @@ struct CloudToMeshResult
     DistanceStatistics statistics;
     int level = 0;                       //!< grid level used
     std::size_t degenerateTriangles = 0; //!< triangles used as a segment or a point (geometry::isDegenerateTriangle)
+    //! With closestTriangles: per compared point, its closest triangle, or
+    //! kNoClosestTriangle where the distance is NaN (no finite coordinate, or
+    //! beyond maxDistance).
+    std::vector<std::uint32_t> closestTriangle;
 };
+
+inline constexpr std::uint32_t kNoClosestTriangle = 0xffffffffu;
 
 //! Distances from every point of `compared` to the mesh `reference`.
 //! Throws Error(InvalidArgument) for parameters out of range, Error(InvalidData)

@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Fine registration: the iterative closest point method (Besl and McKay
+//! 1992; point-to-plane after Chen and Medioni 1992) with what a comparison
+//! of two epochs needs on top:
+//! - exact closest points (the octree's batch queries; a mesh reference
+//!   through the cloud-to-mesh search), in double in a frame centred on the
+//!   reference, so UTM coordinates lose nothing;
+//! - degrees of freedom constrained inside the solver (RigidMotion.h);
+//! - a maximum correspondence distance, a trimmed overlap ratio, a robust
+//!   kernel whose scale follows the residuals (1.4826 x their median absolute
+//!   value), switched on once the plain iterations have converged (a scale
+//!   taken while the clouds are still far apart would down-weight the far
+//!   points that hold the rotation);
+//! - the change-robust mode of thesis 000 §1.4: only the correspondences
+//!   below a distance that shrinks from one iteration to the next count (here
+//!   3 x the robust scale of the residuals, never below the median spacing of
+//!   the correspondences, never growing), so a moved wall or a new object does
+//!   not pull the result; what is finally left out is marked in the field
+//!   registration_excluded.
+
+#include <scandiff/core/Mesh.h>
+#include <scandiff/core/PointCloud.h>
+#include <scandiff/core/Progress.h>
+#include <scandiff/plugins/registration/RegistrationReport.h>
+#include <scandiff/plugins/registration/RigidMotion.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <optional>
+
+namespace scandiff::plugins {
+
+enum class IcpMethod { PointToPoint, PointToPlane };
+enum class RobustKernel { None, Huber, Cauchy, GemanMcClure };
+
+struct IcpParams
+{
+    IcpMethod method = IcpMethod::PointToPlane;
+    DofConstraint constraint;
+    //! Correspondences farther than this (m) are left out; absent: none.
+    std::optional<double> maxDistance;
+    //! The fraction of the correspondences kept, the closest (0 < f <= 1).
+    double overlap = 1.0;
+    RobustKernel kernel = RobustKernel::None;
+    bool changeRobust = false;
+    //! Moving points used: at most this many, drawn at random (all if 0).
+    std::size_t sampleCount = 50000;
+    std::uint64_t seed = 0;
+    std::size_t maxIterations = 100;
+    //! Converged when an iteration moves the points by less than this (m), or
+    //! the RMS changes by less than this fraction.
+    double moveTolerance = 1e-7;
+    double rmsTolerance = 1e-7;
+    //! Reference normals for point-to-plane (when the reference cloud has
+    //! none): a plane fit on this many neighbours.
+    std::size_t normalNeighbours = 12;
+    //! The moving cloud's starting motion (global coordinates), identity by default.
+    Eigen::Matrix4d initial = Eigen::Matrix4d::Identity();
+};
+
+namespace fields {
+//! The signed residual of each moving point after registration: along the
+//! reference normal for point-to-plane and a mesh, the distance for point-to-point.
+inline constexpr const char* kRegistrationResidual = "registration_residual";
+//! 1 for the points left out of the final correspondences (beyond the
+//! distance, trimmed, or treated as change), 0 for those used.
+inline constexpr const char* kRegistrationExcluded = "registration_excluded";
+} // namespace fields
+
+struct IcpResult
+{
+    RegistrationReport report;
+    ScalarField residual; //!< fields::kRegistrationResidual, one per moving point
+    ScalarField excluded; //!< fields::kRegistrationExcluded
+};
+
+//! Registers `moving` on a reference cloud or mesh (the other pointer null).
+//! Throws Error(InvalidArgument) for bad parameters, Error(InvalidData) for an
+//! empty cloud, too few correspondences, or a mesh without triangles;
+//! Error(Cancelled).
+IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud, const Mesh* referenceMesh,
+                      const IcpParams& params, ProgressObserver* progress = nullptr);
+
+IcpMethod parseIcpMethod(const std::string& text);
+RobustKernel parseRobustKernel(const std::string& text);
+
+} // namespace scandiff::plugins

@@ -1,0 +1,311 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/plugins/registration/Icp.h>
+
+#include "ReferenceSurface.h"
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/processing/Subsampling.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace scandiff::plugins {
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+//! The median of |values| (values copied: nth_element reorders).
+double medianAbsolute(std::vector<double> values)
+{
+    if (values.empty())
+        return 0.0;
+    for (double& v : values)
+        v = std::abs(v);
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+}
+
+double kernelWeight(RobustKernel kernel, double u)
+{
+    switch (kernel) {
+    case RobustKernel::None: return 1.0;
+    case RobustKernel::Huber: { // tuning constant 1.345: 95 % efficiency on Gaussian noise
+        const double a = std::abs(u);
+        return a <= 1.345 ? 1.0 : 1.345 / a;
+    }
+    case RobustKernel::Cauchy: { // 2.3849: 95 % efficiency
+        const double v = u / 2.3849;
+        return 1.0 / (1.0 + v * v);
+    }
+    case RobustKernel::GemanMcClure: {
+        const double d = 1.0 + u * u;
+        return 1.0 / (d * d);
+    }
+    }
+    return 1.0;
+}
+
+void checkParams(const IcpParams& params)
+{
+    if (params.maxDistance && !(*params.maxDistance > 0 && std::isfinite(*params.maxDistance)))
+        throw Error(ErrorCode::InvalidArgument, "registration: the maximum distance must be > 0");
+    if (!(params.overlap > 0 && params.overlap <= 1))
+        throw Error(ErrorCode::InvalidArgument, "registration: the overlap must be in (0, 1]");
+    if (params.maxIterations < 1)
+        throw Error(ErrorCode::InvalidArgument, "registration: at least one iteration");
+    if (!params.initial.allFinite() || params.initial.row(3) != Eigen::RowVector4d(0, 0, 0, 1))
+        throw Error(ErrorCode::InvalidArgument, "registration: the initial matrix must be finite with a last row 0 0 0 1");
+    if (!(params.constraint.axis.norm() > 0))
+        throw Error(ErrorCode::InvalidArgument, "registration: the rotation axis must not be zero");
+}
+
+//! One pass of correspondences: for the points x (frame), their closest
+//! points, residuals and the selection the rules keep.
+struct Correspondences
+{
+    detail::ClosestPoints closest;
+    std::vector<double> distance; //!< Euclidean, to the closest point
+    std::vector<double> residual; //!< signed (point-to-plane) or the distance
+    std::vector<char> used;
+    std::size_t usedCount = 0;
+    double cutoff = kInfinity; //!< the largest |residual| kept (trimming, threshold)
+};
+
+void correspond(const detail::ReferenceSurface& surface, const std::vector<Eigen::Vector3d>& x, const IcpParams& params,
+                double threshold, Correspondences& c)
+{
+    surface.closest(x, c.closest);
+    const std::size_t n = x.size();
+    c.distance.assign(n, kInfinity);
+    c.residual.assign(n, std::numeric_limits<double>::quiet_NaN());
+    c.used.assign(n, 0);
+    const bool plane = params.method == IcpMethod::PointToPlane;
+    std::vector<double> kept;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!c.closest.found[i])
+            continue;
+        const Eigen::Vector3d d = x[i] - c.closest.points[i];
+        c.distance[i] = d.norm();
+        if (plane && c.closest.normals[i] == Eigen::Vector3d::Zero())
+            continue; // no normal there: no point-to-plane residual
+        c.residual[i] = plane ? c.closest.normals[i].dot(d) : c.distance[i];
+        const bool near = !params.maxDistance || c.distance[i] <= *params.maxDistance;
+        if (near && std::abs(c.residual[i]) <= threshold) {
+            c.used[i] = 1;
+            kept.push_back(std::abs(c.residual[i]));
+        }
+    }
+    c.cutoff = threshold;
+    if (params.overlap < 1 && !kept.empty()) {
+        // Trimming: the closest fraction only.
+        const auto keep = static_cast<std::size_t>(std::ceil(params.overlap * static_cast<double>(kept.size())));
+        const auto at = kept.begin() + static_cast<std::ptrdiff_t>(std::max<std::size_t>(keep, 1) - 1);
+        std::nth_element(kept.begin(), at, kept.end());
+        c.cutoff = std::min(threshold, *at);
+        for (std::size_t i = 0; i < n; ++i)
+            if (c.used[i] && std::abs(c.residual[i]) > c.cutoff)
+                c.used[i] = 0;
+    }
+    c.usedCount = static_cast<std::size_t>(std::count(c.used.begin(), c.used.end(), 1));
+}
+
+double percentile(std::vector<double> values, double p)
+{
+    if (values.empty())
+        return std::numeric_limits<double>::quiet_NaN();
+    const auto at = values.begin() + static_cast<std::ptrdiff_t>(std::min(values.size() - 1, static_cast<std::size_t>(p * (values.size() - 1) + 0.5)));
+    std::nth_element(values.begin(), at, values.end());
+    return *at;
+}
+
+} // namespace
+
+IcpMethod parseIcpMethod(const std::string& text)
+{
+    if (text == "point-to-point")
+        return IcpMethod::PointToPoint;
+    if (text == "point-to-plane")
+        return IcpMethod::PointToPlane;
+    throw Error(ErrorCode::InvalidArgument, "registration: method '" + text + "' is not point-to-point or point-to-plane");
+}
+
+RobustKernel parseRobustKernel(const std::string& text)
+{
+    if (text == "none")
+        return RobustKernel::None;
+    if (text == "huber")
+        return RobustKernel::Huber;
+    if (text == "cauchy")
+        return RobustKernel::Cauchy;
+    if (text == "geman-mcclure")
+        return RobustKernel::GemanMcClure;
+    throw Error(ErrorCode::InvalidArgument, "registration: kernel '" + text + "' is not none, huber, cauchy or geman-mcclure");
+}
+
+IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud, const Mesh* referenceMesh,
+                      const IcpParams& params, ProgressObserver* progress)
+{
+    checkParams(params);
+    if (moving.empty())
+        throw Error(ErrorCode::InvalidData, "registration: the moving cloud '" + moving.name + "' is empty");
+    if (referenceCloud && referenceCloud->empty())
+        throw Error(ErrorCode::InvalidData, "registration: the reference cloud '" + referenceCloud->name + "' is empty");
+    const bool plane = params.method == IcpMethod::PointToPlane;
+    const std::unique_ptr<detail::ReferenceSurface> surface =
+        referenceMesh ? detail::meshSurface(*referenceMesh)
+                      : detail::cloudSurface(*referenceCloud, true, params.normalNeighbours, progress);
+    const Eigen::Vector3d origin = surface->frameOrigin();
+
+    // The moving points the iterations use, in the frame (double).
+    std::vector<std::size_t> sample = params.sampleCount > 0 ? randomSubsample(moving, params.sampleCount, params.seed)
+                                                             : randomSubsample(moving, moving.size(), 0);
+    std::vector<Eigen::Vector3d> x0;
+    x0.reserve(sample.size());
+    for (std::size_t i : sample)
+        if (moving.positions()[i].allFinite())
+            x0.push_back(moving.globalPosition(i) - origin);
+    if (x0.size() < 6)
+        throw Error(ErrorCode::InvalidData, "registration: the moving cloud has fewer than 6 points with finite coordinates");
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const auto& p : x0)
+        centroid += p;
+    centroid /= static_cast<double>(x0.size());
+    double spread = 0;
+    for (const auto& p : x0)
+        spread += (p - centroid).squaredNorm();
+    // The scale that turns a rotation into metres: the points' RMS distance to their centroid.
+    const double length = std::max(std::sqrt(spread / static_cast<double>(x0.size())), 1e-9);
+
+    Eigen::Isometry3d motion = toLocal(params.initial, origin);
+    IcpResult result;
+    RegistrationReport& report = result.report;
+    report.method = std::string(plane ? "ICP point-to-plane" : "ICP point-to-point") + ", " + dofName(params.constraint.dof) + " DOF" +
+                    (params.changeRobust ? ", change-robust" : "");
+    double threshold = kInfinity, previousRms = kInfinity;
+    bool kernelActive = false;
+    std::vector<Eigen::Vector3d> x(x0.size()), xs, ys, ns;
+    std::vector<double> w, usedResiduals;
+    Eigen::MatrixXd normalMatrix;
+    Correspondences c;
+    ProgressTicker ticker(progress, "Registration (ICP)", params.maxIterations);
+    for (std::size_t iteration = 1; iteration <= params.maxIterations; ++iteration) {
+        for (std::size_t i = 0; i < x0.size(); ++i)
+            x[i] = motion * x0[i];
+        correspond(*surface, x, params, threshold, c);
+        if (c.usedCount < static_cast<std::size_t>(dofCount(params.constraint.dof)) + 3)
+            throw Error(ErrorCode::InvalidData, "registration: only " + std::to_string(c.usedCount) +
+                                                    " correspondences left (iteration " + std::to_string(iteration) +
+                                                    "): the clouds do not overlap, or the maximum distance is too small");
+        xs.clear();
+        ys.clear();
+        ns.clear();
+        usedResiduals.clear();
+        std::vector<double> usedDistances;
+        for (std::size_t i = 0; i < x.size(); ++i)
+            if (c.used[i]) {
+                xs.push_back(x[i]);
+                ys.push_back(c.closest.points[i]);
+                ns.push_back(c.closest.normals[i]);
+                usedResiduals.push_back(c.residual[i]);
+                usedDistances.push_back(c.distance[i]);
+            }
+        // Robust weights on the residuals over their robust scale, once the
+        // plain iterations have converged: a scale taken from residuals that
+        // are still large with misalignment would down-weight the far points
+        // that hold the rotation, and the result could slide into a wrong basin.
+        const double scale = std::max(1.4826 * medianAbsolute(usedResiduals), 1e-12 * length);
+        w.resize(xs.size());
+        double sum2 = 0;
+        for (std::size_t i = 0; i < xs.size(); ++i) {
+            w[i] = kernelActive ? kernelWeight(params.kernel, usedResiduals[i] / scale) : 1.0;
+            sum2 += usedResiduals[i] * usedResiduals[i];
+        }
+        const double rms = std::sqrt(sum2 / static_cast<double>(xs.size()));
+        Eigen::Isometry3d step;
+        bool solved;
+        // The normal matrix of the point-to-plane problem is what tells whether
+        // the surfaces hold every direction, whichever method moves the points.
+        Eigen::Isometry3d planeStep;
+        const bool planeSolved = stepPointToPlane(xs, ys, ns, w, params.constraint, length, planeStep, normalMatrix);
+        if (plane) {
+            solved = planeSolved;
+            step = planeStep;
+        } else {
+            solved = fitPointToPoint(xs, ys, w, params.constraint, step);
+        }
+        if (!solved)
+            throw Error(ErrorCode::InvalidData, "registration: the correspondences do not determine a motion (degenerate geometry)");
+        motion = step * motion;
+        const double rotationStep = rotationDegrees(step.linear());
+        const double translationStep = step.translation().norm();
+        report.trace.push_back({iteration, rms, xs.size(), threshold, rotationStep, translationStep});
+        report.iterations = iteration;
+        if (params.changeRobust) {
+            // Thesis 000 §1.4: the threshold shrinks with the residuals (3 robust
+            // sigmas), never below the median spacing of the correspondences,
+            // never growing back.
+            const double floor = medianAbsolute(usedDistances);
+            threshold = std::min(threshold, std::max(3.0 * 1.4826 * medianAbsolute(usedResiduals), floor));
+        }
+        ticker.step();
+        // Converged when the step moves the points by less than the tolerance
+        // (the largest displacement it gives a point at twice the cloud's RMS
+        // radius), or the RMS no longer changes. With a kernel asked for, the
+        // first convergence switches it on and the iterations go on.
+        const double move = rotationStep * 3.14159265358979323846 / 180.0 * length * 2 + translationStep;
+        const bool still = move < params.moveTolerance || std::abs(previousRms - rms) <= params.rmsTolerance * std::max(rms, 1e-12);
+        previousRms = rms;
+        if (still && !kernelActive && params.kernel != RobustKernel::None) {
+            kernelActive = true;
+            previousRms = kInfinity;
+            continue;
+        }
+        if (still) {
+            report.converged = true;
+            break;
+        }
+    }
+    report.matrix = toGlobal(motion, origin);
+    report.degeneracy = degeneracyWarning(normalMatrix, dofCount(params.constraint.dof), params.constraint.axis, report.eigenvalues);
+
+    // Every moving point, moved: its residual, and whether the last
+    // iteration's rules keep it.
+    const std::size_t n = moving.size();
+    std::vector<Eigen::Vector3d> all(n);
+    for (std::size_t i = 0; i < n; ++i)
+        all[i] = moving.positions()[i].allFinite() ? Eigen::Vector3d(motion * (moving.globalPosition(i) - origin))
+                                                   : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    IcpParams final = params;
+    final.overlap = 1.0; // the trimming of the last iteration is applied as its cutoff
+    Correspondences last;
+    correspond(*surface, all, final, std::min(threshold, c.cutoff), last);
+    result.residual = ScalarField(fields::kRegistrationResidual, n);
+    result.excluded = ScalarField(fields::kRegistrationExcluded, n);
+    std::vector<double> magnitudes;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (std::isfinite(last.residual[i]))
+            result.residual.setValue(i, last.residual[i]);
+        result.excluded.setValue(i, last.used[i] ? 0.0 : 1.0);
+        if (last.used[i])
+            magnitudes.push_back(std::abs(last.residual[i]));
+    }
+    double sum2 = 0;
+    for (double m : magnitudes)
+        sum2 += m * m;
+    report.rms = magnitudes.empty() ? std::numeric_limits<double>::quiet_NaN() : std::sqrt(sum2 / static_cast<double>(magnitudes.size()));
+    report.median = percentile(magnitudes, 0.5);
+    report.p90 = percentile(magnitudes, 0.9);
+    report.p95 = percentile(magnitudes, 0.95);
+    report.p99 = percentile(magnitudes, 0.99);
+    report.overlap = static_cast<double>(magnitudes.size()) / static_cast<double>(n);
+    if (!report.converged)
+        report.notes.push_back("not converged after " + std::to_string(params.maxIterations) + " iterations");
+    return result;
+}
+
+} // namespace scandiff::plugins

@@ -1,0 +1,239 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Registration against known motions: ICP from a 25 degree start, the 4-DOF
+// constraint, changed scenes, meshes, UTM coordinates, degenerate geometry.
+#include "SyntheticSite.h"
+#include "TestSupport.h"
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/processing/CloudEditing.h>
+#include <scandiff/plugins/registration/Icp.h>
+
+#include <Eigen/Geometry>
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace scandiff;
+using namespace scandiff::plugins;
+
+namespace {
+
+//! The angle (degrees) and the largest point displacement over the site (m)
+//! between the found and the true motion.
+struct MotionError
+{
+    double degrees;
+    double metres;
+};
+
+MotionError errorOf(const Eigen::Matrix4d& found, const Eigen::Matrix4d& truth, const Eigen::Vector3d& centre)
+{
+    const Eigen::Matrix4d delta = found * truth.inverse();
+    MotionError e;
+    e.degrees = rotationDegrees(delta.topLeftCorner<3, 3>());
+    e.metres = 0;
+    // Corners of the site's box (60 x 60 x 12 m around its centre).
+    for (int k = 0; k < 8; ++k) {
+        const Eigen::Vector3d p = centre + Eigen::Vector3d((k & 1) ? 30 : -30, (k & 2) ? 30 : -30, (k & 4) ? 12 : 0);
+        e.metres = std::max(e.metres, ((delta * p.homogeneous()).head<3>() - p).norm());
+    }
+    return e;
+}
+
+struct Scene
+{
+    PointCloud reference, moving;
+    Eigen::Matrix4d truth; //!< moving -> reference
+};
+
+//! Two samplings of the site; the second (changed or not) moved by the inverse of `truth`.
+Scene makeScene(const Eigen::Matrix4d& truth, std::size_t points, bool changed, const Eigen::Vector3d& origin)
+{
+    test::SiteOptions a;
+    a.points = points;
+    a.seed = 1;
+    a.origin = origin;
+    test::SiteOptions b = a;
+    b.seed = 2;
+    b.changed = changed;
+    b.markChanges = true;
+    Scene s;
+    s.reference = test::syntheticSite(a);
+    s.moving = transformCloud(test::syntheticSite(b), truth.inverse(), "test");
+    s.moving.transformHistory().clear();
+    s.truth = truth;
+    return s;
+}
+
+} // namespace
+
+TEST(Icp, ConvergesFromA25DegreeStart)
+{
+    const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    const Eigen::Matrix4d truth = test::rigidMotionAbout(25, 3, -2, Eigen::Vector3d(1.5, -2.0, 0.4), origin);
+    const Scene scene = makeScene(truth, 60000, false, origin);
+    IcpParams params; // point-to-plane
+    params.kernel = RobustKernel::Cauchy;
+    const IcpResult result = icpRegister(scene.moving, &scene.reference, nullptr, params);
+    const MotionError e = errorOf(result.report.matrix, scene.truth, origin);
+    EXPECT_TRUE(result.report.converged);
+    EXPECT_LT(e.degrees, 0.002);
+    EXPECT_LT(e.metres, 0.002);
+    EXPECT_TRUE(result.report.degeneracy.empty()) << result.report.degeneracy;
+    // Point-to-point gets there too, more slowly and less closely (the two
+    // samplings' points never coincide).
+    params.method = IcpMethod::PointToPoint;
+    params.maxIterations = 300;
+    const MotionError p2p = errorOf(icpRegister(scene.moving, &scene.reference, nullptr, params).report.matrix, scene.truth, origin);
+    EXPECT_LT(p2p.degrees, 0.05);
+    EXPECT_LT(p2p.metres, 0.05);
+}
+
+TEST(Icp, FourDegreesOfFreedomLeaveTheTiltExactlyAsItWas)
+{
+    // A levelled scanner: the truth turns about Z only; the moving scan starts
+    // 60 degrees off. The 4-DOF solution's rotation is about Z to the last bit.
+    const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    const Eigen::Matrix4d truth = test::rigidMotionAbout(60, 0, 0, Eigen::Vector3d(2, 1, -0.3), origin);
+    const Scene scene = makeScene(truth, 60000, false, origin);
+    IcpParams params;
+    params.kernel = RobustKernel::Cauchy;
+    params.constraint.dof = Dof::Four;
+    const IcpResult result = icpRegister(scene.moving, &scene.reference, nullptr, params);
+    const Eigen::Matrix3d r = result.report.matrix.topLeftCorner<3, 3>();
+    EXPECT_EQ(r(2, 2), 1.0);
+    EXPECT_EQ(r(0, 2), 0.0);
+    EXPECT_EQ(r(1, 2), 0.0);
+    EXPECT_EQ(r(2, 0), 0.0);
+    EXPECT_EQ(r(2, 1), 0.0);
+    const MotionError e = errorOf(result.report.matrix, scene.truth, origin);
+    EXPECT_LT(e.degrees, 0.002);
+    EXPECT_LT(e.metres, 0.002);
+    // Translation only: a pure shift is found, the rotation stays the identity.
+    const Eigen::Matrix4d shift = test::rigidMotionAbout(0, 0, 0, Eigen::Vector3d(0.8, -0.5, 0.2), origin);
+    const Scene shifted = makeScene(shift, 40000, false, origin);
+    params.constraint.dof = Dof::Translation;
+    const IcpResult translated = icpRegister(shifted.moving, &shifted.reference, nullptr, params);
+    const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d rotation = translated.report.matrix.topLeftCorner<3, 3>();
+    EXPECT_TRUE(rotation == identity);
+    EXPECT_LT(errorOf(translated.report.matrix, shift, origin).metres, 0.002);
+}
+
+TEST(Icp, ChangeRobustModeIgnoresWhatChanged)
+{
+    // 30 % of the moving epoch is on changed surfaces (a building moved 0.3 m,
+    // a new block, a new wall). Plain ICP is pulled by them; the change-robust
+    // mode is not, and marks them.
+    const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    const Eigen::Matrix4d truth = test::rigidMotionAbout(8, 1, 0.5, Eigen::Vector3d(0.6, 0.4, 0.1), origin);
+    const Scene scene = makeScene(truth, 80000, true, origin);
+    const ScalarField& changed = *scene.moving.field("changed");
+    std::size_t changedCount = 0;
+    for (std::size_t i = 0; i < changed.size(); ++i)
+        changedCount += changed.value(i) > 0;
+    EXPECT_GT(changedCount, scene.moving.size() / 4);
+    IcpParams params;
+    params.kernel = RobustKernel::Cauchy;
+    params.changeRobust = true;
+    const IcpResult result = icpRegister(scene.moving, &scene.reference, nullptr, params);
+    const MotionError e = errorOf(result.report.matrix, scene.truth, origin);
+    EXPECT_LT(e.degrees, 0.01);
+    EXPECT_LT(e.metres, 0.001);
+    // The excluded points are, for the most part, the changed ones.
+    std::size_t excludedChanged = 0, excluded = 0;
+    for (std::size_t i = 0; i < changed.size(); ++i)
+        if (result.excluded.value(i) > 0) {
+            ++excluded;
+            excludedChanged += changed.value(i) > 0;
+        }
+    EXPECT_GT(excludedChanged, changedCount / 2);
+    EXPECT_GT(excludedChanged, excluded * 8 / 10);
+    // Without the mode, plain point-to-plane ICP is biased by the moved building.
+    IcpParams plain;
+    plain.maxIterations = 40;
+    const MotionError biased = errorOf(icpRegister(scene.moving, &scene.reference, nullptr, plain).report.matrix, scene.truth, origin);
+    EXPECT_GT(biased.metres, 10 * e.metres);
+}
+
+TEST(Icp, UtmCoordinatesGiveTheResultOfTheOrigin)
+{
+    const Eigen::Vector3d utm(500000, 5400000, 120);
+    const Eigen::Matrix4d truthNear = test::rigidMotionAbout(10, 0, 0, Eigen::Vector3d(0.5, 0.2, 0), Eigen::Vector3d::Zero());
+    const Eigen::Matrix4d truthUtm = test::rigidMotionAbout(10, 0, 0, Eigen::Vector3d(0.5, 0.2, 0), utm);
+    const Scene near = makeScene(truthNear, 40000, false, Eigen::Vector3d::Zero());
+    const Scene far = makeScene(truthUtm, 40000, false, utm);
+    IcpParams params;
+    params.kernel = RobustKernel::Cauchy;
+    const MotionError eNear = errorOf(icpRegister(near.moving, &near.reference, nullptr, params).report.matrix, truthNear, Eigen::Vector3d::Zero());
+    const MotionError eFar = errorOf(icpRegister(far.moving, &far.reference, nullptr, params).report.matrix, truthUtm, utm);
+    EXPECT_LT(eNear.metres, 0.002);
+    EXPECT_LT(eFar.metres, 0.002);
+    EXPECT_NEAR(eFar.degrees, eNear.degrees, 0.001);
+}
+
+TEST(Icp, OnAMeshAndOnASinglePlane)
+{
+    // The reference as a mesh: a terrain grid; the moving cloud sampled on it, moved.
+    Mesh mesh;
+    const int n = 101;
+    mesh.vertices.resize(static_cast<std::size_t>(n * n));
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const double x = -25 + 0.5 * i, y = -25 + 0.5 * j;
+            mesh.vertices.positions()[static_cast<std::size_t>(i * n + j)] =
+                Eigen::Vector3f(float(x), float(y), float(2 * std::sin(x / 6) * std::cos(y / 5) + 0.05 * x));
+        }
+    for (int i = 0; i + 1 < n; ++i)
+        for (int j = 0; j + 1 < n; ++j) {
+            const auto a = static_cast<std::uint32_t>(i * n + j), b = a + 1, c = a + static_cast<std::uint32_t>(n), d = c + 1;
+            mesh.triangles.push_back({a, b, d});
+            mesh.triangles.push_back({a, d, c});
+        }
+    PointCloud onMesh;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-20, 20);
+    onMesh.resize(20000);
+    for (auto& p : onMesh.positions()) {
+        const double x = u(rng), y = u(rng);
+        p = Eigen::Vector3f(float(x), float(y), float(2 * std::sin(x / 6) * std::cos(y / 5) + 0.05 * x));
+    }
+    const Eigen::Matrix4d truth = test::rigidMotionAbout(4, 0, 0, Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d::Zero());
+    const PointCloud moving = transformCloud(onMesh, truth.inverse(), "test");
+    IcpParams params;
+    const IcpResult result = icpRegister(moving, nullptr, &mesh, params);
+    // The mesh's triangles cut the surface's curvature: within a few mm.
+    EXPECT_LT(errorOf(result.report.matrix, truth, Eigen::Vector3d::Zero()).metres, 0.01);
+    EXPECT_LT(result.report.rms, 0.01);
+
+    // A single plane holds only three directions: the warning says so.
+    PointCloud plane, planeMoved;
+    plane.resize(5000);
+    planeMoved.resize(5000);
+    for (std::size_t i = 0; i < plane.size(); ++i) {
+        plane.positions()[i] = Eigen::Vector3f(float(u(rng)), float(u(rng)), 0.0f);
+        planeMoved.positions()[i] = Eigen::Vector3f(float(u(rng)), float(u(rng)), 0.1f);
+    }
+    const IcpResult flat = icpRegister(planeMoved, &plane, nullptr, IcpParams{});
+    EXPECT_NE(flat.report.degeneracy.find("degenerate"), std::string::npos);
+    EXPECT_NE(flat.report.degeneracy.find("translation along"), std::string::npos);
+    EXPECT_NEAR(flat.report.matrix(2, 3), -0.1, 1e-6); // what the plane holds is found
+}
+
+TEST(Icp, BadInput)
+{
+    PointCloud empty, some;
+    some.resize(10);
+    EXPECT_EQ(test::errorCodeOf([&] { icpRegister(empty, &some, nullptr, IcpParams{}); }), ErrorCode::InvalidData);
+    EXPECT_EQ(test::errorCodeOf([&] { icpRegister(some, &empty, nullptr, IcpParams{}); }), ErrorCode::InvalidData);
+    IcpParams bad;
+    bad.overlap = 0;
+    EXPECT_EQ(test::errorCodeOf([&] { icpRegister(some, &some, nullptr, bad); }), ErrorCode::InvalidArgument);
+    // Two clouds 100 m apart with a 1 m limit: no correspondence, a clear error.
+    PointCloud far = test::syntheticSite(test::SiteOptions{2000, 1, 0.002, false, Eigen::Vector3d(100, 0, 0), false});
+    PointCloud here = test::syntheticSite(test::SiteOptions{2000, 2, 0.002, false, Eigen::Vector3d::Zero(), false});
+    IcpParams limited;
+    limited.maxDistance = 1.0;
+    EXPECT_EQ(test::errorCodeOf([&] { icpRegister(far, &here, nullptr, limited); }), ErrorCode::InvalidData);
+}
