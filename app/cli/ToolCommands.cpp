@@ -3,9 +3,13 @@
 #include "Commands.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/io/AtomicFile.h>
 #include <scandiff/io/ResultFiles.h>
 
+#include <nlohmann/json.hpp>
+
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <map>
@@ -26,26 +30,87 @@ const char* kindName(DataKind kind)
     return "";
 }
 
-//! Where output `spec` goes: the first declared output to -o, each later one
-//! beside it (FILE's stem + "_" + role), tables as .csv and matrices as .txt.
-std::filesystem::path outputPath(const ToolSpec& tool, const OutputSpec& spec, const std::filesystem::path& primary)
+std::string extensionFor(const OutputSpec& spec, const OutputData& data, const std::string& cloudExtension)
 {
-    if (&spec == &tool.outputs.front())
+    if (const auto* table = std::get_if<Table>(&data))
+        return table->plainNumbers ? ".txt" : ".csv";
+    if (spec.kind == DataKind::Transform)
+        return ".txt";
+    return cloudExtension;
+}
+
+//! Where an output goes, by priority: its own --ROLE-out, else into --out-dir
+//! (DIR/ROLE.ext, a repeated output under its entity's name), else for the
+//! first declared output -o, for the others beside it (FILE's stem + "_" +
+//! role). Empty: printed (tables, matrices) or not written.
+struct OutputPlaces
+{
+    std::string primary, directory;
+    std::map<std::string, std::string> byRole;
+};
+
+std::filesystem::path outputPath(const ToolSpec& tool, const OutputSpec& spec, const ToolOutput& output, const OutputPlaces& places,
+                                 std::size_t repeat)
+{
+    const auto own = places.byRole.find(spec.role);
+    if (own != places.byRole.end() && !own->second.empty())
+        return own->second;
+    if (!places.directory.empty()) {
+        std::string name = spec.role;
+        if (spec.repeated) {
+            const PointCloud* cloud = std::get_if<PointCloud>(&output.data);
+            const Mesh* mesh = std::get_if<Mesh>(&output.data);
+            name = cloud && !cloud->name.empty() ? cloud->name : mesh && !mesh->name.empty() ? mesh->name : spec.role;
+            name += "_" + std::to_string(repeat);
+            for (char& c : name)
+                if (c == '/' || c == '\\')
+                    c = '_';
+        }
+        return std::filesystem::path(places.directory) / (name + extensionFor(spec, output.data, ".ply"));
+    }
+    if (places.primary.empty())
+        return {};
+    const std::filesystem::path primary(places.primary);
+    if (&spec == &tool.outputs.front() && !spec.repeated)
         return primary;
-    std::string extension = primary.extension().string();
-    if (spec.kind == DataKind::Table)
-        extension = ".csv";
-    else if (spec.kind == DataKind::Transform)
-        extension = ".txt";
-    return primary.parent_path() / (primary.stem().string() + "_" + spec.role + extension);
+    return primary.parent_path() / (primary.stem().string() + "_" + spec.role + (spec.repeated ? "_" + std::to_string(repeat) : "") +
+                                     extensionFor(spec, output.data, primary.extension().string()));
+}
+
+//! The run as JSON: what --report writes (tables and matrices by role).
+nlohmann::json reportJson(const ToolSpec& tool, const ToolResult& result, double seconds)
+{
+    nlohmann::json tables = nlohmann::json::object(), matrices = nlohmann::json::object();
+    for (const ToolOutput& output : result.outputs) {
+        if (const auto* table = std::get_if<Table>(&output.data)) {
+            nlohmann::json rows = nlohmann::json::array();
+            for (const auto& row : table->rows) {
+                nlohmann::json cells = nlohmann::json::array();
+                for (const auto& cell : row) {
+                    if (const auto* number = std::get_if<double>(&cell))
+                        cells.push_back(std::isfinite(*number) ? nlohmann::json(*number) : nlohmann::json(nullptr));
+                    else
+                        cells.push_back(std::get<std::string>(cell));
+                }
+                rows.push_back(cells);
+            }
+            tables[output.role] = {{"columns", table->columns}, {"rows", rows}};
+        } else if (const auto* matrix = std::get_if<Eigen::Matrix4d>(&output.data)) {
+            nlohmann::json m = nlohmann::json::array();
+            for (int r = 0; r < 4; ++r)
+                m.push_back({(*matrix)(r, 0), (*matrix)(r, 1), (*matrix)(r, 2), (*matrix)(r, 3)});
+            matrices[output.role] = m;
+        }
+    }
+    return {{"tool", tool.name}, {"summary", result.summary}, {"seconds", seconds}, {"tables", tables}, {"matrices", matrices}};
 }
 
 std::string outputHelp(const ToolSpec& tool)
 {
-    std::string help = "Output file (nothing is written without it, tables and matrices are then printed):";
+    std::string help = "Output file (nothing is written without it or --out-dir; tables and matrices are then printed):";
     for (const auto& o : tool.outputs)
-        help += " " + std::string(&o == &tool.outputs.front() ? "FILE" : "FILE_" + o.role) + " = " + o.label + " (" +
-                kindName(o.kind) + ")" + (&o == &tool.outputs.back() ? "" : ";");
+        help += " " + std::string(&o == &tool.outputs.front() && !o.repeated ? "FILE" : "FILE_" + o.role) + " = " + o.label + " (" +
+                kindName(o.kind) + (o.repeated ? ", one per entity" : "") + ")" + (&o == &tool.outputs.back() ? "" : ";");
     return help;
 }
 
@@ -83,7 +148,7 @@ void emitOutput(const OutputSpec& spec, ToolOutput& output, const std::filesyste
 {
     if (auto* table = std::get_if<Table>(&output.data)) {
         if (path.empty()) {
-            streams.out << table->toCsv();
+            streams.out << table->toText();
             return;
         }
         io::writeTable(*table, path);
@@ -116,7 +181,8 @@ void addOneTool(CLI::App& app, const ToolSpec& tool, const PluginRegistry& regis
     struct Args
     {
         std::map<std::string, std::vector<std::string>> inputs; // file names by role
-        std::string output;
+        std::string output, report;
+        OutputPlaces places;
         std::shared_ptr<std::map<std::string, std::string>> values = std::make_shared<std::map<std::string, std::string>>();
         int threads = 0;
         ReadFlags read;
@@ -134,8 +200,15 @@ void addOneTool(CLI::App& app, const ToolSpec& tool, const PluginRegistry& regis
         if (!input.optional)
             option->required();
     }
-    if (!tool.outputs.empty())
+    if (!tool.outputs.empty()) {
         command->add_option("-o,--output", args->output, outputHelp(tool));
+        command->add_option("--out-dir", args->places.directory,
+                            "Write every output into this existing folder: DIR/ROLE.ext, one file per entity of a repeated output");
+        for (const auto& o : tool.outputs)
+            if (&o != &tool.outputs.front() && !o.repeated)
+                command->add_option("--" + o.role + "-out", args->places.byRole[o.role], "Write the " + o.label + " to this file");
+        command->add_option("--report", args->report, "Write the run's summary, tables and matrices as JSON to this file");
+    }
     // Options come from the tool's own parameter declarations: one source of truth.
     addParameterOptions(*command, tool.parameters, args->values);
     ThreadLimit::addOption(*command, args->threads);
@@ -155,13 +228,26 @@ void addOneTool(CLI::App& app, const ToolSpec& tool, const PluginRegistry& regis
         streams.out << toolPtr->name << ": " << result.summary << " [" << std::fixed << std::setprecision(3) << seconds << " s]\n";
         streams.out.unsetf(std::ios::floatfield);
         const io::WriteOptions writeOptions = args->write.toOptions(&progress);
+        OutputPlaces places = args->places;
+        places.primary = args->output;
+        if (!places.directory.empty() && !std::filesystem::is_directory(places.directory))
+            throw Error(ErrorCode::Io, "--out-dir " + places.directory + " is not an existing folder");
+        if (!args->report.empty()) {
+            // Written first: the outputs below may move data out of the result.
+            io::AtomicFile file(args->report);
+            file.stream() << reportJson(*toolPtr, result, seconds).dump(2) << '\n';
+            file.commit();
+            streams.out << "wrote " << args->report << " (report)\n";
+        }
         for (const auto& spec : toolPtr->outputs) {
-            ToolOutput* output = result.find(spec.role);
-            if (!output)
-                continue;
-            const std::filesystem::path path =
-                args->output.empty() ? std::filesystem::path() : outputPath(*toolPtr, spec, args->output);
-            emitOutput(spec, *output, path, loaded, *toolPtr, registry, writeOptions, streams);
+            std::size_t repeat = 0;
+            for (ToolOutput* output : result.findAll(spec.role)) {
+                emitOutput(spec, *output, outputPath(*toolPtr, spec, *output, places, repeat), loaded, *toolPtr, registry, writeOptions,
+                           streams);
+                ++repeat;
+                if (!spec.repeated)
+                    break;
+            }
         }
     });
 }

@@ -255,8 +255,8 @@ void MainWindow::buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu)
         action->setStatusTip(QString::fromStdString(tool.description));
         report(controller);
         connect(controller, &ToolController::resultReady, tree_, &EntityTree::selectEntity);
-        connect(controller, &ToolController::tableReady, this, [this](const QString& title, const Table& table) {
-            auto* window = new TableDialog(title, table, this);
+        connect(controller, &ToolController::tablesReady, this, [this](const QString& title, const NamedTables& tables) {
+            auto* window = new TableDialog(title, tables, this);
             window->show();
         });
     }

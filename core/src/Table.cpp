@@ -56,4 +56,20 @@ std::string Table::toCsv() const
     return out;
 }
 
+std::string Table::toText() const
+{
+    if (!plainNumbers)
+        return toCsv();
+    std::string out;
+    for (const auto& row : rows) {
+        for (std::size_t c = 0; c < row.size(); ++c) {
+            if (c)
+                out += ' ';
+            appendCell(out, row[c]);
+        }
+        out += '\n';
+    }
+    return out;
+}
+
 } // namespace scandiff

@@ -356,6 +356,15 @@ const ToolOutput* ToolResult::find(const std::string& role) const
     return nullptr;
 }
 
+std::vector<ToolOutput*> ToolResult::findAll(const std::string& role)
+{
+    std::vector<ToolOutput*> all;
+    for (auto& o : outputs)
+        if (o.role == role)
+            all.push_back(&o);
+    return all;
+}
+
 ToolOutput* ToolResult::find(const std::string& role)
 {
     for (auto& o : outputs)

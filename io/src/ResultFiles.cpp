@@ -20,7 +20,7 @@ void writeText(const std::string& text, const std::filesystem::path& path)
 
 void writeTable(const Table& table, const std::filesystem::path& path)
 {
-    writeText(table.toCsv(), path);
+    writeText(table.toText(), path);
 }
 
 std::string matrixText(const Eigen::Matrix4d& matrix)

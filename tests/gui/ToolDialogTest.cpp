@@ -32,7 +32,7 @@ private slots:
     void initTestCase()
     {
         qRegisterMetaType<gui::EntityId>("EntityId");
-        qRegisterMetaType<scandiff::Table>("scandiff::Table");
+        qRegisterMetaType<gui::NamedTables>("scandiff::gui::NamedTables");
     }
 
     void widgetsStartAtTheDeclaredDefaults()
@@ -246,10 +246,10 @@ private slots:
         QVERIFY(document.item(meshId).mesh());
         QCOMPARE(document.item(meshId).parent, id);
         gui::ToolController histogram(*registry.tools.find("field-histogram"), document, nullptr);
-        QSignalSpy tables(&histogram, &gui::ToolController::tableReady);
+        QSignalSpy tables(&histogram, &gui::ToolController::tablesReady);
         QVERIFY(histogram.run(id, {{"field", "surface_variation"}, {"bins", "7"}}));
         QCOMPARE(tables.count(), 1);
-        QCOMPARE(tables.at(0).at(1).value<scandiff::Table>().rows.size(), std::size_t(7));
+        QCOMPARE(tables.at(0).at(1).value<gui::NamedTables>().front().second.rows.size(), std::size_t(7));
         QCOMPARE(document.size(), std::size_t(2));
 
         // A tool that updates a mesh's vertices keeps its triangles.

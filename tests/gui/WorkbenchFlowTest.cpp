@@ -240,7 +240,7 @@ private slots:
             if (auto* t = qobject_cast<gui::TableDialog*>(w))
                 table = t;
         QVERIFY(table);
-        QCOMPARE(table->view()->rowCount(), 16);
+        QCOMPARE(table->view(0)->rowCount(), 16);
         QVERIFY(table->saveAs(dir.filePath("histogram.csv")));
         QVERIFY(QFileInfo(dir.filePath("histogram.csv")).size() > 0);
         table->close();

@@ -7,6 +7,7 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/processing/CloudEditing.h>
 #include <scandiff/plugins/registration/Icp.h>
+#include <scandiff/plugins/registration/PointPairs.h>
 
 #include <Eigen/Geometry>
 
@@ -236,4 +237,101 @@ TEST(Icp, BadInput)
     IcpParams limited;
     limited.maxDistance = 1.0;
     EXPECT_EQ(test::errorCodeOf([&] { icpRegister(far, &here, nullptr, limited); }), ErrorCode::InvalidData);
+}
+
+TEST(PointPairs, ExactFromThreePairsAndClosedFormFromTenNoisyOnes)
+{
+    // Three picked targets at UTM magnitudes, moved by a known motion: the
+    // motion comes back to rounding, the residuals are zero.
+    const Eigen::Vector3d utm(500000, 5400000, 120);
+    const Eigen::Matrix4d truth = test::rigidMotionAbout(37, 5, -3, Eigen::Vector3d(4, -7, 1.5), utm);
+    const std::vector<Eigen::Vector3d> targets = {utm + Eigen::Vector3d(10, 0, 0), utm + Eigen::Vector3d(0, 25, 3),
+                                                  utm + Eigen::Vector3d(-12, -8, 9)};
+    std::vector<PointPair> pairs;
+    for (const auto& reference : targets)
+        pairs.push_back({(truth.inverse() * reference.homogeneous()).head<3>(), reference});
+    const RegistrationReport exact = fitPointPairs(pairs, DofConstraint{});
+    // (The matrix's translation is R x 5.4e6 m plus a shift: compared through
+    // what it does to the site, within a nanometre, not entry by entry.)
+    EXPECT_LT((exact.matrix.topLeftCorner<3, 3>() - truth.topLeftCorner<3, 3>()).cwiseAbs().maxCoeff(), 1e-10);
+    const auto displacement = [&](const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
+        double worst = 0;
+        for (const auto& p : targets)
+            worst = std::max(worst, ((a - b) * p.homogeneous()).norm());
+        return worst;
+    };
+    EXPECT_LT(displacement(exact.matrix, truth), 1e-8);
+    ASSERT_EQ(exact.pairResiduals.size(), 3u);
+    for (double r : exact.pairResiduals)
+        EXPECT_LT(r, 1e-7);
+    EXPECT_FALSE(exact.notes.empty()); // as many pairs as needed: nothing to check with
+
+    // Ten pairs with 5 mm noise: the result is the least-squares motion in
+    // closed form. Checked by its optimality: no small motion about it lowers
+    // the sum of squares (the gradient is zero to rounding).
+    std::mt19937 rng(11);
+    std::normal_distribution<double> noise(0, 0.005);
+    std::uniform_real_distribution<double> u(-30, 30);
+    std::vector<PointPair> noisy;
+    for (int i = 0; i < 10; ++i) {
+        const Eigen::Vector3d reference = utm + Eigen::Vector3d(u(rng), u(rng), 0.3 * u(rng));
+        noisy.push_back({(truth.inverse() * reference.homogeneous()).head<3>() + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)),
+                         reference});
+    }
+    const RegistrationReport fit = fitPointPairs(noisy, DofConstraint{});
+    const auto sumOfSquares = [&](const Eigen::Matrix4d& m) {
+        double s = 0;
+        for (const auto& p : noisy)
+            s += ((m * p.moving.homogeneous()).head<3>() - p.reference).squaredNorm();
+        return s;
+    };
+    const double best = sumOfSquares(fit.matrix);
+    for (int k = 0; k < 6; ++k)
+        for (double sign : {-1.0, 1.0}) {
+            Eigen::Vector3d rotation = Eigen::Vector3d::Zero(), translation = Eigen::Vector3d::Zero();
+            (k < 3 ? rotation[k] : translation[k - 3]) = sign * (k < 3 ? 1e-5 : 1e-4);
+            const Eigen::Matrix4d nudge = test::rigidMotionAbout(0, 0, 0, translation, Eigen::Vector3d::Zero()) *
+                                          [&] {
+                                              Eigen::Affine3d a = Eigen::Affine3d::Identity();
+                                              a.translate(utm);
+                                              a.rotate(Eigen::AngleAxisd(rotation.norm(), rotation.normalized()));
+                                              a.translate(-utm);
+                                              return a.matrix();
+                                          }();
+            EXPECT_GE(sumOfSquares(nudge * fit.matrix), best);
+        }
+    // The RMS equals the residuals' and the motion is within the noise.
+    double sum2 = 0;
+    for (double r : fit.pairResiduals)
+        sum2 += r * r;
+    EXPECT_NEAR(fit.rms, std::sqrt(sum2 / 10), 1e-12);
+    EXPECT_NEAR(fit.rms * fit.rms * 10, best, 1e-9);
+    EXPECT_LT(rotationDegrees((fit.matrix * truth.inverse()).topLeftCorner<3, 3>()), 0.05);
+
+    // Four degrees of freedom: two pairs fix a turn about Z; the tilt stays exact.
+    const Eigen::Matrix4d heading = test::rigidMotionAbout(-75, 0, 0, Eigen::Vector3d(3, 2, -1), utm);
+    std::vector<PointPair> two;
+    for (std::size_t i = 0; i < 2; ++i)
+        two.push_back({(heading.inverse() * targets[i].homogeneous()).head<3>(), targets[i]});
+    DofConstraint levelled;
+    levelled.dof = Dof::Four;
+    const RegistrationReport four = fitPointPairs(two, levelled);
+    EXPECT_EQ(four.matrix(2, 2), 1.0);
+    EXPECT_EQ(four.matrix(2, 0), 0.0);
+    EXPECT_LT(displacement(four.matrix, heading), 1e-8);
+}
+
+TEST(PointPairs, BadPairs)
+{
+    EXPECT_EQ(test::errorCodeOf([] { fitPointPairs({}, DofConstraint{}); }), ErrorCode::InvalidArgument);
+    // Collinear pairs do not fix the rotation about their line.
+    std::vector<PointPair> line;
+    for (int i = 0; i < 4; ++i)
+        line.push_back({Eigen::Vector3d(i, 0, 0), Eigen::Vector3d(i, 1, 0)});
+    EXPECT_EQ(test::errorCodeOf([&] { fitPointPairs(line, DofConstraint{}); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([] { parsePointPairs("1,2,3,4,5"); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([] { parsePointPairs("1,2,3,4,5,6;1,2,x,4,5,6"); }), ErrorCode::InvalidArgument);
+    const std::vector<PointPair> parsed = parsePointPairs("1 2 3 4 5 6\n7,8,9,10,11,12;");
+    ASSERT_EQ(parsed.size(), 2u);
+    EXPECT_EQ(parsed[1].reference, Eigen::Vector3d(10, 11, 12));
 }

@@ -95,30 +95,32 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
 
     QString notes;
     EntityId last = kNoEntity;
+    NamedTables tables;
     for (const OutputSpec& spec : tool_.outputs) {
-        ToolOutput* output = result->find(spec.role);
-        if (!output)
-            continue;
-        if (auto* table = std::get_if<Table>(&output->data)) {
-            emit tableReady(QString("%1: %2").arg(title, QString::fromStdString(spec.label)), *table);
-            continue;
+        for (ToolOutput* output : result->findAll(spec.role)) {
+            if (auto* table = std::get_if<Table>(&output->data)) {
+                tables.emplace_back(spec.label, std::move(*table));
+                continue;
+            }
+            if (auto* matrix = std::get_if<Eigen::Matrix4d>(&output->data)) {
+                notes += QString("\n%1:\n%2").arg(QString::fromStdString(spec.label), QString::fromStdString(io::matrixText(*matrix)).trimmed());
+                continue;
+            }
+            io::Entity entity = std::holds_alternative<PointCloud>(output->data) ? io::Entity(std::move(std::get<PointCloud>(output->data)))
+                                                                                 : io::Entity(std::move(std::get<Mesh>(output->data)));
+            if (spec.updatesInput && firstInput != kNoEntity) {
+                document_.replaceData(firstInput, std::move(entity));
+                last = firstInput;
+                continue;
+            }
+            const std::string& dataName = pointsOf(entity).name;
+            const auto* mesh = std::get_if<Mesh>(&entity);
+            const std::string name = mesh && !mesh->name.empty() ? mesh->name : dataName.empty() ? tool_.name : dataName;
+            last = document_.add(QString::fromStdString(name), std::move(entity), firstInput);
         }
-        if (auto* matrix = std::get_if<Eigen::Matrix4d>(&output->data)) {
-            notes += QString("\n%1:\n%2").arg(QString::fromStdString(spec.label), QString::fromStdString(io::matrixText(*matrix)).trimmed());
-            continue;
-        }
-        io::Entity entity = std::holds_alternative<PointCloud>(output->data) ? io::Entity(std::move(std::get<PointCloud>(output->data)))
-                                                                             : io::Entity(std::move(std::get<Mesh>(output->data)));
-        if (spec.updatesInput && firstInput != kNoEntity) {
-            document_.replaceData(firstInput, std::move(entity));
-            last = firstInput;
-            continue;
-        }
-        const std::string& dataName = pointsOf(entity).name;
-        const auto* mesh = std::get_if<Mesh>(&entity);
-        const std::string name = mesh && !mesh->name.empty() ? mesh->name : dataName.empty() ? tool_.name : dataName;
-        last = document_.add(QString::fromStdString(name), std::move(entity), firstInput);
     }
+    if (!tables.empty())
+        emit tablesReady(title, tables);
     emit finished(QString("%1 [%2]: %3; %4 s%5")
                       .arg(QString::fromStdString(tool_.name), commandLine(choice, parameters),
                            QString::fromStdString(result->summary))

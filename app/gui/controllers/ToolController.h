@@ -8,6 +8,7 @@
 //! No algorithm code lives here.
 
 #include "document/Document.h"
+#include "tools/TableDialog.h"
 #include "tools/ToolDialog.h"
 
 #include <scandiff/core/ToolRegistry.h>
@@ -39,8 +40,8 @@ signals:
     void failed(const QString& message);
     //! The entity the run created or changed last (the tree selects it).
     void resultReady(EntityId id);
-    //! A table output, for the window that shows it (and saves it as CSV).
-    void tableReady(const QString& title, const scandiff::Table& table);
+    //! The run's table outputs, for the window that shows them (and saves them as CSV).
+    void tablesReady(const QString& title, const scandiff::gui::NamedTables& tables);
 
 private:
     //! "scandiff-cli TOOL IN --role FILE ... --param value": what the console shows.
@@ -54,4 +55,4 @@ private:
 } // namespace scandiff::gui
 
 // Tables travel in signals (the table window, tests' signal spies).
-Q_DECLARE_METATYPE(scandiff::Table)
+Q_DECLARE_METATYPE(scandiff::gui::NamedTables)

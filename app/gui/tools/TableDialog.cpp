@@ -8,32 +8,49 @@
 #include <QHeaderView>
 #include <QMessageBox>
 #include <QPushButton>
+#include <QTabBar>
+#include <QTabWidget>
 #include <QTableWidget>
 #include <QVBoxLayout>
 
 namespace scandiff::gui {
 
-TableDialog::TableDialog(const QString& title, Table table, QWidget* parent) : QDialog(parent), table_(std::move(table))
+namespace {
+
+QTableWidget* makeView(const Table& table, QWidget* parent)
 {
-    setWindowTitle(title);
-    setAttribute(Qt::WA_DeleteOnClose);
-    auto* layout = new QVBoxLayout(this);
-    view_ = new QTableWidget(static_cast<int>(table_.rows.size()), static_cast<int>(table_.columns.size()), this);
+    auto* view = new QTableWidget(static_cast<int>(table.rows.size()), static_cast<int>(table.columns.size()), parent);
     QStringList headers;
-    for (const auto& c : table_.columns)
+    for (const auto& c : table.columns)
         headers << QString::fromStdString(c);
-    view_->setHorizontalHeaderLabels(headers);
-    for (std::size_t r = 0; r < table_.rows.size(); ++r)
-        for (std::size_t c = 0; c < table_.rows[r].size() && c < table_.columns.size(); ++c) {
-            const TableCell& cell = table_.rows[r][c];
+    view->setHorizontalHeaderLabels(headers);
+    for (std::size_t r = 0; r < table.rows.size(); ++r)
+        for (std::size_t c = 0; c < table.rows[r].size() && c < table.columns.size(); ++c) {
+            const TableCell& cell = table.rows[r][c];
             const QString text = std::holds_alternative<double>(cell) ? QString::number(std::get<double>(cell), 'g', 10)
                                                                        : QString::fromStdString(std::get<std::string>(cell));
             auto* item = new QTableWidgetItem(text);
             item->setFlags(item->flags() & ~Qt::ItemIsEditable);
-            view_->setItem(static_cast<int>(r), static_cast<int>(c), item);
+            view->setItem(static_cast<int>(r), static_cast<int>(c), item);
         }
-    view_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
-    layout->addWidget(view_);
+    view->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+    return view;
+}
+
+} // namespace
+
+TableDialog::TableDialog(const QString& title, NamedTables tables, QWidget* parent) : QDialog(parent), tables_(std::move(tables))
+{
+    setWindowTitle(title);
+    setAttribute(Qt::WA_DeleteOnClose);
+    auto* layout = new QVBoxLayout(this);
+    tabs_ = new QTabWidget(this);
+    for (const auto& [name, table] : tables_) {
+        views_.push_back(makeView(table, tabs_));
+        tabs_->addTab(views_.back(), QString::fromStdString(name));
+    }
+    tabs_->tabBar()->setVisible(tables_.size() > 1);
+    layout->addWidget(tabs_);
     auto* buttons = new QDialogButtonBox(QDialogButtonBox::Close, this);
     QPushButton* save = buttons->addButton(tr("Save as CSV..."), QDialogButtonBox::ActionRole);
     connect(save, &QPushButton::clicked, this, [this] {
@@ -43,13 +60,14 @@ TableDialog::TableDialog(const QString& title, Table table, QWidget* parent) : Q
     });
     connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
     layout->addWidget(buttons);
-    resize(560, 420);
+    resize(620, 460);
 }
 
-bool TableDialog::saveAs(const QString& path)
+bool TableDialog::saveAs(const QString& path, int index)
 {
+    const int which = index >= 0 ? index : tabs_->currentIndex();
     try {
-        io::writeTable(table_, path.toStdString());
+        io::writeTable(tables_.at(static_cast<std::size_t>(which)).second, path.toStdString());
         return true;
     } catch (const std::exception& e) {
         QMessageBox::warning(this, windowTitle(), QString::fromStdString(e.what()));

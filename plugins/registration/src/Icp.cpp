@@ -186,7 +186,7 @@ IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud
     RegistrationReport& report = result.report;
     report.method = std::string(plane ? "ICP point-to-plane" : "ICP point-to-point") + ", " + dofName(params.constraint.dof) + " DOF" +
                     (params.changeRobust ? ", change-robust" : "");
-    double threshold = kInfinity, previousRms = kInfinity;
+    double threshold = kInfinity, previousRms = kInfinity, rmsTwoBefore = kInfinity;
     bool kernelActive = false;
     std::vector<Eigen::Vector3d> x(x0.size()), xs, ys, ns;
     std::vector<double> w, usedResiduals;
@@ -257,12 +257,18 @@ IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud
         // (the largest displacement it gives a point at twice the cloud's RMS
         // radius), or the RMS no longer changes. With a kernel asked for, the
         // first convergence switches it on and the iterations go on.
+        // On a sparse reference, nearest neighbours can flip between two sets
+        // and the iterations between two states (a two-cycle): an RMS back to
+        // what it was two iterations ago counts as converged too.
         const double move = rotationStep * 3.14159265358979323846 / 180.0 * length * 2 + translationStep;
-        const bool still = move < params.moveTolerance || std::abs(previousRms - rms) <= params.rmsTolerance * std::max(rms, 1e-12);
+        const double rmsTolerance = params.rmsTolerance * std::max(rms, 1e-12);
+        const bool still = move < params.moveTolerance || std::abs(previousRms - rms) <= rmsTolerance ||
+                           std::abs(rmsTwoBefore - rms) <= rmsTolerance;
+        rmsTwoBefore = previousRms;
         previousRms = rms;
         if (still && !kernelActive && params.kernel != RobustKernel::None) {
             kernelActive = true;
-            previousRms = kInfinity;
+            previousRms = rmsTwoBefore = kInfinity;
             continue;
         }
         if (still) {
@@ -271,6 +277,7 @@ IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud
         }
     }
     report.matrix = toGlobal(motion, origin);
+    report.centre = centroid + origin;
     report.degeneracy = degeneracyWarning(normalMatrix, dofCount(params.constraint.dof), params.constraint.axis, report.eigenvalues);
 
     // Every moving point, moved: its residual, and whether the last

@@ -6,6 +6,7 @@
 #include <scandiff/core/processing/CloudEditing.h>
 #include <scandiff/plugins/PluginRegistry.h>
 #include <scandiff/plugins/registration/Icp.h>
+#include <scandiff/plugins/registration/PointPairs.h>
 
 #include <fstream>
 #include <sstream>
@@ -135,6 +136,44 @@ void addIcpTool(ToolRegistry& registry)
     registry.add(std::move(tool));
 }
 
+void addPointPairsTool(ToolRegistry& registry)
+{
+    ToolSpec tool;
+    tool.name = "register-pairs";
+    tool.title = "Point pairs";
+    tool.category = "Registration";
+    tool.description =
+        "Moves the moving cloud onto the reference from pairs of the same points picked in both (targets, corners): the "
+        "motion in closed form (Horn 1987, Umeyama 1991, without scale; 4 DOF: rotation about the axis only), each "
+        "pair's residual reported. At least 3 pairs not on a line (2 for 4 DOF, 1 for a translation).";
+    tool.inputs = movingAndReference();
+    tool.outputs = {OutputSpec{"output", "Moved cloud", DataKind::Cloud, true},
+                    OutputSpec{"matrix", "Matrix moving -> reference", DataKind::Transform, false},
+                    OutputSpec{"report", "Registration report", DataKind::Table, false}};
+    tool.parameters = {
+        ParameterSpec::text("pairs", "Point pairs",
+                            "MX,MY,MZ,RX,RY,RZ per pair (moving point, then the same point on the reference), pairs separated "
+                            "by ';', or a text/CSV file of such lines"),
+        ParameterSpec::choice("dof", "Degrees of freedom", "6; 4 (rotation about --axis and translation); translation",
+                              {"6", "4", "translation"}, "6"),
+        ParameterSpec::text("axis", "Rotation axis", "The axis of the 4-DOF rotation, X,Y,Z", "0,0,1").withSuggestions({"0,0,1"}),
+    };
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver*) {
+        const PointCloud& moving = inputs.cloud("moving");
+        DofConstraint constraint;
+        constraint.dof = parseDof(values.text("dof"));
+        constraint.axis = axisFrom(values.text("axis"));
+        const RegistrationReport report = fitPointPairs(parsePointPairs(values.text("pairs")), constraint);
+        ToolResult result;
+        result.summary = reportSummary(report);
+        result.add("output", transformCloud(moving, report.matrix, report.method));
+        result.add("matrix", report.matrix);
+        result.add("report", reportTable(report));
+        return result;
+    };
+    registry.add(std::move(tool));
+}
+
 } // namespace
 
 } // namespace scandiff::plugins
@@ -143,4 +182,5 @@ void scandiff_register_plugin_registration(scandiff::PluginRegistry& registry)
 {
     registry.plugins.push_back({"registration", "Fine, change-robust, constrained, global and multi-station registration", ""});
     scandiff::plugins::addIcpTool(registry.tools);
+    scandiff::plugins::addPointPairsTool(registry.tools);
 }

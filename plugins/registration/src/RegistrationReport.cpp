@@ -22,6 +22,11 @@ std::string vectorText(const Eigen::Vector3d& v)
     return s.str();
 }
 
+double centreShift(const RegistrationReport& r)
+{
+    return ((r.matrix * r.centre.homogeneous()).head<3>() - r.centre).norm();
+}
+
 } // namespace
 
 std::string degeneracyWarning(const Eigen::MatrixXd& normalMatrix, int dofCount, const Eigen::Vector3d& axis,
@@ -76,6 +81,7 @@ Table reportTable(const RegistrationReport& r)
             add("m" + std::to_string(row) + std::to_string(col), r.matrix(row, col));
     add("rotation_deg", rotationDegrees(r.matrix.topLeftCorner<3, 3>()));
     add("translation_m", r.matrix.topRightCorner<3, 1>().norm());
+    add("centre_shift_m", centreShift(r));
     add("rms_m", r.rms);
     add("median_m", r.median);
     add("p90_m", r.p90);
@@ -107,10 +113,18 @@ Table traceTable(const RegistrationReport& r)
 std::string reportSummary(const RegistrationReport& r)
 {
     std::ostringstream s;
-    s << r.method << ": rotation " << std::setprecision(6) << rotationDegrees(r.matrix.topLeftCorner<3, 3>()) << " deg, translation "
-      << r.matrix.topRightCorner<3, 1>().norm() << " m; RMS " << r.rms << " m (median " << r.median << ", p95 " << r.p95
-      << "); overlap " << std::setprecision(3) << 100 * r.overlap << " %; " << r.iterations << " iterations"
-      << (r.converged || r.iterations == 0 ? "" : " (not converged)");
+    s << r.method << ": rotation " << std::setprecision(6) << rotationDegrees(r.matrix.topLeftCorner<3, 3>()) << " deg, centre moved "
+      << centreShift(r) << " m; RMS " << r.rms << " m";
+    if (!r.pairResiduals.empty()) {
+        s << "; pair residuals (m):";
+        for (std::size_t i = 0; i < r.pairResiduals.size(); ++i)
+            s << (i ? ", " : " ") << r.pairResiduals[i];
+    } else {
+        s << " (median " << r.median << ", p95 " << r.p95 << "); overlap " << std::setprecision(3) << 100 * r.overlap << " %; "
+          << r.iterations << " iterations" << (r.converged || r.iterations == 0 ? "" : " (not converged)");
+    }
+    for (const auto& note : r.notes)
+        s << "; " << note;
     if (!r.degeneracy.empty())
         s << "; WARNING " << r.degeneracy;
     return s.str();

@@ -137,6 +137,9 @@ struct OutputSpec
     //! place and display instead of adding a new entity under it. A Cloud
     //! output of the same size replaces a mesh's vertices and keeps its triangles.
     bool updatesInput = false;
+    //! Any number of outputs of this role (one per station of a multi-station
+    //! registration): the CLI writes them with --out-dir, each under its name.
+    bool repeated = false;
 };
 
 //! The entities a run gets, by role. It only refers to them: they belong to
@@ -177,9 +180,11 @@ struct ToolResult
     std::string summary;             //!< one line for the log: what was done, counts
 
     ToolResult& add(std::string role, OutputData data);
-    //! Null when the run produced no output of that role.
+    //! Null when the run produced no output of that role (the first, for a repeated role).
     const ToolOutput* find(const std::string& role) const;
     ToolOutput* find(const std::string& role);
+    //! Every output of the role, in order.
+    std::vector<ToolOutput*> findAll(const std::string& role);
     //! The cloud of output `role`. Throws Error(Internal) when absent or not a cloud.
     const PointCloud& cloud(const std::string& role = "output") const;
     const Mesh& mesh(const std::string& role = "output") const;

@@ -14,7 +14,7 @@
 
 namespace scandiff::io {
 
-//! Table::toCsv() into `path`. Throws Error(Io).
+//! Table::toText() (CSV, or plain numbers) into `path`. Throws Error(Io).
 void writeTable(const Table& table, const std::filesystem::path& path);
 
 //! Four lines of four numbers, each the shortest text that reads back to the

@@ -27,6 +27,10 @@ struct RegistrationReport
     std::string method;
     //! Moving -> reference, in global (unshifted) coordinates.
     Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity();
+    //! The moving points' centroid (global): the motion's shift is reported
+    //! there, since the matrix's own translation, for georeferenced data, is
+    //! mostly the rotation of the coordinates' magnitude.
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     double rms = 0;                 //!< final residuals used
     double median = 0, p90 = 0, p95 = 0, p99 = 0; //!< of |residual| over the points used
     double overlap = 0;             //!< fraction of the moving points used at the end

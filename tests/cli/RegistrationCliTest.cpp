@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The registration tools from the command line: the moved cloud, the matrix
+// file (4 lines of 4 numbers, world coordinates), the JSON report.
+#include "Commands.h"
+#include "SyntheticSite.h"
+#include "TestSupport.h"
+
+#include <scandiff/core/processing/CloudEditing.h>
+
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <sstream>
+
+using namespace scandiff;
+
+namespace {
+
+struct CliRun
+{
+    int status = 0;
+    std::string out, err;
+};
+
+CliRun run(const PluginRegistry& registry, std::vector<std::string> args)
+{
+    args.insert(args.begin(), "scandiff-cli");
+    std::vector<const char*> argv;
+    for (const auto& a : args)
+        argv.push_back(a.c_str());
+    std::ostringstream out, err;
+    CliRun result;
+    result.status = cli::runCli(static_cast<int>(argv.size()), argv.data(), registry, {out, err});
+    result.out = out.str();
+    result.err = err.str();
+    return result;
+}
+
+Eigen::Matrix4d readMatrix(const std::filesystem::path& path)
+{
+    std::ifstream in(path);
+    Eigen::Matrix4d m;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+            in >> m(r, c);
+    EXPECT_TRUE(in) << path;
+    return m;
+}
+
+//! The largest displacement, over the site's corners, between two motions.
+double displacement(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, const Eigen::Vector3d& centre)
+{
+    double worst = 0;
+    for (int k = 0; k < 8; ++k) {
+        const Eigen::Vector3d p = centre + Eigen::Vector3d((k & 1) ? 30 : -30, (k & 2) ? 30 : -30, (k & 4) ? 12 : 0);
+        worst = std::max(worst, ((a - b) * p.homogeneous()).norm());
+    }
+    return worst;
+}
+
+} // namespace
+
+TEST(RegistrationCli, RegisterWritesTheMovedCloudTheMatrixAndTheReport)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    const Eigen::Vector3d utm(512000, 5423000, 100);
+    test::SiteOptions a{30000, 1, 0.002, false, utm, false};
+    test::SiteOptions b = a;
+    b.seed = 2;
+    const Eigen::Matrix4d truth = test::rigidMotionAbout(12, 2, -1, Eigen::Vector3d(0.7, -0.4, 0.2), utm);
+    PointCloud reference = test::syntheticSite(a);
+    PointCloud moving = transformCloud(test::syntheticSite(b), truth.inverse(), "test");
+    moving.transformHistory().clear();
+    io::writePointCloud(registry.formats, reference, dir / "ref.ply");
+    io::writePointCloud(registry.formats, moving, dir / "mov.ply");
+
+    CliRun r = run(registry, {"register", "--reference", (dir / "ref.ply").string(), "--moving", (dir / "mov.ply").string(), "-o",
+                              (dir / "out.ply").string(), "--matrix-out", (dir / "m.txt").string(), "--report",
+                              (dir / "r.json").string(), "--robust"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("RMS"), std::string::npos) << r.out;
+    EXPECT_LT(displacement(readMatrix(dir / "m.txt"), truth, utm), 0.003);
+    const PointCloud out = io::readPointCloud(registry.formats, dir / "out.ply");
+    ASSERT_EQ(out.size(), moving.size());
+    ASSERT_NE(out.field("registration_residual"), nullptr);
+    // The moved cloud lies on the reference: its first point where the truth puts it.
+    const Eigen::Vector3d expected = (truth * moving.globalPosition(0).homogeneous()).head<3>();
+    EXPECT_LT((out.globalPosition(0) - expected).norm(), 0.003);
+    // The JSON report: the matrix by role, the report table's rows.
+    std::ifstream json(dir / "r.json");
+    const nlohmann::json report = nlohmann::json::parse(json);
+    EXPECT_EQ(report["tool"], "register");
+    EXPECT_NEAR(report["matrices"]["matrix"][0][3].get<double>(), readMatrix(dir / "m.txt")(0, 3), 1e-9);
+    bool sawRms = false;
+    for (const auto& row : report["tables"]["report"]["rows"])
+        sawRms |= row[0] == "rms_m" && row[1].get<double>() < 0.05; // edges of a sparse reference
+    EXPECT_TRUE(sawRms);
+    EXPECT_FALSE(report["tables"]["trace"]["rows"].empty());
+
+    // Point pairs: three of the moving cloud's points and where the truth puts them.
+    std::ostringstream pairs;
+    pairs.precision(17);
+    for (std::size_t i : {0u, 1000u, 2000u}) {
+        const Eigen::Vector3d m = moving.globalPosition(i);
+        const Eigen::Vector3d f = (truth * m.homogeneous()).head<3>();
+        pairs << m.x() << ' ' << m.y() << ' ' << m.z() << ' ' << f.x() << ' ' << f.y() << ' ' << f.z() << '\n';
+    }
+    test::writeText(dir / "pairs.txt", pairs.str());
+    r = run(registry, {"register-pairs", "--reference", (dir / "ref.ply").string(), "--moving", (dir / "mov.ply").string(), "--pairs",
+                       (dir / "pairs.txt").string(), "--matrix-out", (dir / "p.txt").string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("pair residuals"), std::string::npos) << r.out;
+    EXPECT_LT(displacement(readMatrix(dir / "p.txt"), truth, utm), 1e-4); // pairs from float positions
+    r = run(registry, {"register-pairs", "--reference", (dir / "ref.ply").string(), "--moving", (dir / "mov.ply").string(), "--pairs",
+                       "1,2,3,4,5,6"});
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("at least 3"), std::string::npos) << r.err;
+}
