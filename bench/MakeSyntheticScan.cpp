@@ -9,9 +9,27 @@
 //!                                             (terrain only, SIZE x SIZE m: the
 //!                                              processing benchmarks' 1 M points
 //!                                              over 100 x 100 m)
+//!        scandiff-make-scan --site POINTS OUTPUT SEED [--changed]
+//!                           [--motion YAW,PITCH,ROLL,TX,TY,TZ] [--x-range LOW,HIGH]
+//!                                             (the registration tests' site of
+//!                                              tests/support/SyntheticSite.h at
+//!                                              UTM coordinates, 2 mm of noise;
+//!                                              --changed: the second epoch;
+//!                                              --motion: the scan moved by it
+//!                                              (degrees about Z, Y, X, then metres,
+//!                                              turning about the site's centre);
+//!                                              --x-range: only points in it, a
+//!                                              station's view. Writes the matrix
+//!                                              that registers it back, moving ->
+//!                                              site, to OUTPUT.truth.txt)
+
+#include "SyntheticSite.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/TextLists.h>
+#include <scandiff/core/processing/CloudEditing.h>
 #include <scandiff/io/FileIO.h>
+#include <scandiff/io/ResultFiles.h>
 
 #include <cmath>
 #include <iostream>
@@ -75,10 +93,65 @@ int writeTerrainScan(std::size_t n, float size, const char* output, unsigned see
     return 0;
 }
 
+int writeSite(int argc, char** argv)
+{
+    using namespace scandiff;
+    const Eigen::Vector3d utm(512000.0, 5423000.0, 100.0);
+    test::SiteOptions options;
+    options.points = std::stoull(argv[2]);
+    options.seed = static_cast<unsigned>(std::stoul(argv[4]));
+    options.origin = utm;
+    Eigen::Matrix4d motion = Eigen::Matrix4d::Identity();
+    double low = -1e9, high = 1e9;
+    for (int a = 5; a < argc; ++a) {
+        const std::string option = argv[a];
+        if (option == "--changed") {
+            options.changed = true;
+        } else if (option == "--motion" && a + 1 < argc) {
+            const std::vector<double> v = parseNumberList(argv[++a], "--motion");
+            if (v.size() != 6)
+                throw Error(ErrorCode::InvalidArgument, "--motion is YAW,PITCH,ROLL,TX,TY,TZ");
+            motion = test::rigidMotionAbout(v[0], v[1], v[2], Eigen::Vector3d(v[3], v[4], v[5]), utm);
+        } else if (option == "--x-range" && a + 1 < argc) {
+            const std::vector<double> v = parseNumberList(argv[++a], "--x-range");
+            if (v.size() != 2)
+                throw Error(ErrorCode::InvalidArgument, "--x-range is LOW,HIGH");
+            low = v[0];
+            high = v[1];
+        } else {
+            throw Error(ErrorCode::InvalidArgument, "unknown option " + option);
+        }
+    }
+    PointCloud site = test::syntheticSite(options);
+    std::vector<std::size_t> seen;
+    for (std::size_t i = 0; i < site.size(); ++i) {
+        const double x = site.positions()[i].x();
+        if (x >= low && x <= high)
+            seen.push_back(i);
+    }
+    PointCloud scan = transformCloud(site.subset(seen), motion, "synthetic motion");
+    scan.transformHistory().clear();
+    scan.name = std::filesystem::path(argv[3]).stem().string();
+    io::FormatRegistry registry;
+    io::registerBuiltinFormats(registry);
+    io::writePointCloud(registry, scan, argv[3]);
+    io::writeMatrix(motion.inverse(), std::string(argv[3]) + ".truth.txt");
+    std::cout << "wrote " << argv[3] << " (" << scan.size() << " points) and " << argv[3] << ".truth.txt\n";
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
 {
+    if (argc >= 5 && std::string(argv[1]) == "--site") {
+        try {
+            return writeSite(argc, argv);
+        } catch (const std::exception& e) {
+            std::cerr << "error: " << e.what() << '\n';
+            return 1;
+        }
+    }
     if ((argc == 5 || argc == 6) && std::string(argv[1]) == "--terrain") {
         try {
             return writeTerrainScan(std::stoull(argv[2]), std::stof(argv[3]), argv[4], argc == 6 ? static_cast<unsigned>(std::stoul(argv[5])) : 1u);

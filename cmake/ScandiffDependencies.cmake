@@ -16,7 +16,7 @@ scandiff_require(muparser libmuparser-dev)
 scandiff_require(assimp libassimp-dev)
 scandiff_require(CLI11 libcli11-dev)
 scandiff_require(nlohmann_json nlohmann-json3-dev)
-scandiff_require(PCL libpcl-dev 1.12 COMPONENTS common io)
+scandiff_require(PCL libpcl-dev 1.12 COMPONENTS common io features kdtree search)
 scandiff_require(CGAL libcgal-dev)
 
 if(SCANDIFF_BUILD_GUI)

@@ -106,9 +106,14 @@ std::map<std::string, CLI::Option*> addParameterOptions(CLI::App& command, const
     for (const auto& p : parameters) {
         const std::string name = p.name;
         CLI::Option* option = nullptr;
-        if (p.type == ParameterType::Boolean)
-            option = command.add_flag_function("--" + name, [userText, name](std::int64_t count) { (*userText)[name] = count > 0 ? "true" : "false"; },
-                                               parameterHelp(p));
+        if (p.type == ParameterType::Boolean) {
+            // A switch that is on by default is turned off by --no-NAME.
+            const bool onByDefault = std::get_if<bool>(&p.defaultValue) && std::get<bool>(p.defaultValue);
+            option = command.add_flag_function(
+                "--" + name + (onByDefault ? ",!--no-" + name : ""),
+                [userText, name](std::int64_t count) { (*userText)[name] = count > 0 ? "true" : "false"; },
+                parameterHelp(p) + (onByDefault ? " (on unless --no-" + name + ")" : ""));
+        }
         else if (p.type == ParameterType::Text)
             option = command.add_option_function<std::vector<std::string>>(
                 "--" + name,

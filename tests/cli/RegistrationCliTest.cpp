@@ -117,3 +117,63 @@ TEST(RegistrationCli, RegisterWritesTheMovedCloudTheMatrixAndTheReport)
     EXPECT_NE(r.status, 0);
     EXPECT_NE(r.err.find("at least 3"), std::string::npos) << r.err;
 }
+
+TEST(RegistrationCli, StationsWritePosesAndEveryStationMoved)
+{
+    // Three stations along the site (overlapping neighbours, one pair and a
+    // second, no loop), the last two moved by known errors.
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    const Eigen::Vector3d utm(512000, 5423000, 100);
+    const std::vector<Eigen::Matrix4d> errors = {Eigen::Matrix4d::Identity(),
+                                                 test::rigidMotionAbout(1.5, 0.3, 0, Eigen::Vector3d(0.2, -0.1, 0.05), utm),
+                                                 test::rigidMotionAbout(-1.0, 0, 0.4, Eigen::Vector3d(-0.15, 0.2, 0), utm)};
+    std::vector<std::string> args = {"register-stations"};
+    for (std::size_t k = 0; k < 3; ++k) {
+        test::SiteOptions o{40000, static_cast<unsigned>(20 + k), 0.002, false, utm, false};
+        const PointCloud site = test::syntheticSite(o);
+        std::vector<std::size_t> seen;
+        const double low = -30 + 15.0 * static_cast<double>(k);
+        for (std::size_t i = 0; i < site.size(); ++i) {
+            const double x = site.globalPosition(i).x() - utm.x();
+            if (x >= low && x <= low + 30)
+                seen.push_back(i);
+        }
+        PointCloud station = transformCloud(site.subset(seen), errors[k], "test");
+        station.name = "scan" + std::to_string(k);
+        const auto path = dir / (station.name + ".ply");
+        io::writePointCloud(registry.formats, station, path);
+        args.push_back(path.string());
+    }
+    std::filesystem::create_directories(dir / "out");
+    args.insert(args.end(), {"--out-dir", (dir / "out").string(), "--report", (dir / "out" / "run.json").string()});
+    CliRun r = run(registry, args);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("3 stations"), std::string::npos) << r.out;
+    // poses.txt: 3 lines of 16 numbers; the first the identity, the others undo the errors.
+    std::ifstream poses(dir / "out" / "poses.txt");
+    for (std::size_t k = 0; k < 3; ++k) {
+        Eigen::Matrix4d pose;
+        for (int i = 0; i < 16; ++i)
+            poses >> pose(i / 4, i % 4);
+        ASSERT_TRUE(poses) << "line " << k;
+        if (k == 0)
+            EXPECT_EQ(pose, Eigen::Matrix4d::Identity());
+        else
+            EXPECT_LT(displacement(pose, errors[k].inverse(), utm), 0.005) << "station " << k;
+    }
+    std::string extra;
+    EXPECT_FALSE(poses >> extra);
+    for (std::size_t k = 0; k < 3; ++k)
+        EXPECT_TRUE(std::filesystem::exists(dir / "out" / ("scan" + std::to_string(k) + "_" + std::to_string(k) + ".ply")));
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "pairs.csv"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "loops.csv"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "run.json"));
+
+    // Global alignment from the command line, without its ICP.
+    r = run(registry, {"register-global", "--reference", args[1], "--moving", args[2], "--no-refine", "--matrix-out",
+                       (dir / "g.txt").string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out.find("ICP"), std::string::npos) << r.out;
+    EXPECT_LT(displacement(readMatrix(dir / "g.txt"), errors[1].inverse(), utm), 1.5);
+}

@@ -6,8 +6,10 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/processing/CloudEditing.h>
+#include <scandiff/plugins/registration/GlobalAlignment.h>
 #include <scandiff/plugins/registration/Icp.h>
 #include <scandiff/plugins/registration/PointPairs.h>
+#include <scandiff/plugins/registration/Stations.h>
 
 #include <Eigen/Geometry>
 
@@ -334,4 +336,144 @@ TEST(PointPairs, BadPairs)
     const std::vector<PointPair> parsed = parsePointPairs("1 2 3 4 5 6\n7,8,9,10,11,12;");
     ASSERT_EQ(parsed.size(), 2u);
     EXPECT_EQ(parsed[1].reference, Eigen::Vector3d(10, 11, 12));
+}
+
+TEST(GlobalAlignment, Recovers140DegreesFromAnyStartThenIcpFinishes)
+{
+    // Turned 140 degrees about a tilted axis and shifted: far outside ICP's
+    // basin. The descriptors' consensus lands within the feature spacing;
+    // ICP from there lands on the truth.
+    const Eigen::Vector3d origin(500000, 5400000, 120);
+    const Eigen::Matrix4d truth = test::rigidMotionAbout(140, 25, -15, Eigen::Vector3d(6, -4, 1), origin);
+    const Scene scene = makeScene(truth, 80000, false, origin);
+    const GlobalAlignmentResult coarse = globalAlign(scene.moving, &scene.reference, nullptr, GlobalAlignmentParams{});
+    const MotionError e = errorOf(coarse.report.matrix, scene.truth, origin);
+    EXPECT_LT(e.degrees, 2.0) << coarse.report.notes.front();
+    EXPECT_LT(e.metres, 2 * coarse.spacing) << coarse.report.notes.front();
+    EXPECT_GT(coarse.inliers, 20u);
+    IcpParams params;
+    params.kernel = RobustKernel::Cauchy;
+    params.initial = coarse.report.matrix;
+    const MotionError fine = errorOf(icpRegister(scene.moving, &scene.reference, nullptr, params).report.matrix, scene.truth, origin);
+    EXPECT_LT(fine.degrees, 0.002);
+    EXPECT_LT(fine.metres, 0.002);
+}
+
+TEST(GlobalAlignment, FourDegreesOfFreedomSearchOnlyTheHeading)
+{
+    const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    const Eigen::Matrix4d truth = test::rigidMotionAbout(-140, 0, 0, Eigen::Vector3d(-5, 7, 0.5), origin);
+    const Scene scene = makeScene(truth, 80000, false, origin);
+    GlobalAlignmentParams params;
+    params.constraint.dof = Dof::Four;
+    const GlobalAlignmentResult coarse = globalAlign(scene.moving, &scene.reference, nullptr, params);
+    EXPECT_EQ(coarse.report.matrix(2, 2), 1.0);
+    EXPECT_EQ(coarse.report.matrix(2, 0), 0.0);
+    EXPECT_EQ(coarse.report.matrix(0, 2), 0.0);
+    const MotionError e = errorOf(coarse.report.matrix, scene.truth, origin);
+    EXPECT_LT(e.degrees, 2.0) << coarse.report.notes.front();
+    EXPECT_LT(e.metres, 2 * coarse.spacing);
+    // The same seed gives the same motion.
+    EXPECT_EQ(globalAlign(scene.moving, &scene.reference, nullptr, params).report.matrix, coarse.report.matrix);
+}
+
+namespace {
+
+//! Four stations around the site, each seeing a 40 x 40 m quarter (so each
+//! overlaps its two neighbours in a strip 20 m wide: a loop 0-1-2-3-0),
+//! each an independent sampling moved by its own small error.
+std::vector<PointCloud> fourStations(const std::vector<Eigen::Matrix4d>& errors, const Eigen::Vector3d& origin)
+{
+    const double lowX[4] = {-30, -10, -10, -30}, lowY[4] = {-30, -30, -10, -10};
+    std::vector<PointCloud> stations;
+    for (std::size_t k = 0; k < 4; ++k) {
+        test::SiteOptions o;
+        o.points = 60000;
+        o.seed = static_cast<unsigned>(10 + k);
+        o.origin = origin;
+        const PointCloud site = test::syntheticSite(o);
+        std::vector<std::size_t> seen;
+        for (std::size_t i = 0; i < site.size(); ++i) {
+            const Eigen::Vector3d p = site.globalPosition(i) - origin;
+            if (p.x() >= lowX[k] && p.x() <= lowX[k] + 40 && p.y() >= lowY[k] && p.y() <= lowY[k] + 40)
+                seen.push_back(i);
+        }
+        PointCloud station = transformCloud(site.subset(seen), errors[k], "test");
+        station.transformHistory().clear();
+        station.name = "station" + std::to_string(k);
+        stations.push_back(std::move(station));
+    }
+    return stations;
+}
+
+} // namespace
+
+TEST(Stations, FourStationsCloseTheirLoopAndFindEveryPose)
+{
+    const Eigen::Vector3d origin(500000, 5400000, 120);
+    const std::vector<Eigen::Matrix4d> errors = {Eigen::Matrix4d::Identity(),
+                                                 test::rigidMotionAbout(2.0, 0.5, -0.3, Eigen::Vector3d(0.3, -0.2, 0.05), origin),
+                                                 test::rigidMotionAbout(-1.5, -0.4, 0.6, Eigen::Vector3d(-0.25, 0.3, -0.1), origin),
+                                                 test::rigidMotionAbout(1.0, 0.3, 0.2, Eigen::Vector3d(0.2, 0.35, 0.08), origin)};
+    const std::vector<PointCloud> stations = fourStations(errors, origin);
+    std::vector<const PointCloud*> pointers;
+    for (const auto& s : stations)
+        pointers.push_back(&s);
+    const StationResult result = adjustStations(pointers, StationParams{});
+    ASSERT_EQ(result.poses.size(), 4u);
+    EXPECT_EQ(result.poses[0], Eigen::Matrix4d::Identity());
+    for (std::size_t k = 1; k < 4; ++k) {
+        // The pose undoes the station's error.
+        const MotionError e = errorOf(result.poses[k], errors[k].inverse(), origin);
+        EXPECT_LT(e.degrees, 0.005) << "station " << k;
+        EXPECT_LT(e.metres, 0.003) << "station " << k;
+    }
+    // The ring's four neighbour pairs (the diagonals share only the centre)
+    // and at least one loop, whose pairwise motions close within millimetres.
+    EXPECT_GE(result.pairs.size(), 4u);
+    ASSERT_GE(result.loops.size(), 1u);
+    for (const auto& loop : result.loops) {
+        EXPECT_EQ(loop.stations.front(), loop.stations.back());
+        EXPECT_LT(loop.translationMetres, 0.01);
+    }
+    EXPECT_TRUE(result.report.converged);
+    EXPECT_LT(result.report.median, 0.003);
+
+    // Levelled stations: errors about Z only, four unknowns a station; the
+    // poses keep the tilt exactly.
+    const std::vector<Eigen::Matrix4d> headings = {Eigen::Matrix4d::Identity(),
+                                                   test::rigidMotionAbout(3.0, 0, 0, Eigen::Vector3d(0.3, -0.2, 0.05), origin),
+                                                   test::rigidMotionAbout(-2.0, 0, 0, Eigen::Vector3d(-0.25, 0.3, -0.1), origin),
+                                                   test::rigidMotionAbout(1.5, 0, 0, Eigen::Vector3d(0.2, 0.35, 0.08), origin)};
+    const std::vector<PointCloud> levelled = fourStations(headings, origin);
+    std::vector<const PointCloud*> levelledPointers;
+    for (const auto& s : levelled)
+        levelledPointers.push_back(&s);
+    StationParams four;
+    four.constraint.dof = Dof::Four;
+    const StationResult fourResult = adjustStations(levelledPointers, four);
+    for (std::size_t k = 1; k < 4; ++k) {
+        EXPECT_EQ(fourResult.poses[k](2, 2), 1.0);
+        EXPECT_EQ(fourResult.poses[k](2, 0), 0.0);
+        EXPECT_EQ(fourResult.poses[k](0, 2), 0.0);
+        const MotionError e = errorOf(fourResult.poses[k], headings[k].inverse(), origin);
+        EXPECT_LT(e.metres, 0.003) << "station " << k;
+    }
+}
+
+TEST(Stations, BadInput)
+{
+    PointCloud one = test::syntheticSite(test::SiteOptions{2000, 1, 0.002, false, Eigen::Vector3d::Zero(), false});
+    PointCloud far = test::syntheticSite(test::SiteOptions{2000, 2, 0.002, false, Eigen::Vector3d(500, 0, 0), false});
+    PointCloud empty;
+    EXPECT_EQ(test::errorCodeOf([&] { adjustStations({&one}, StationParams{}); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(test::errorCodeOf([&] { adjustStations({&one, &empty}, StationParams{}); }), ErrorCode::InvalidData);
+    // A station that overlaps nothing: named, not silently left in place.
+    try {
+        adjustStations({&one, &far}, StationParams{});
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::InvalidData);
+        EXPECT_NE(std::string(e.what()).find("station 1"), std::string::npos) << e.what();
+    }
 }

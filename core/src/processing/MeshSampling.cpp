@@ -2,6 +2,7 @@
 #include <scandiff/core/processing/MeshSampling.h>
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/SplitMix.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -14,31 +15,6 @@
 #include <unistd.h>
 
 namespace scandiff {
-
-namespace {
-
-//! SplitMix64's output function (Steele, Lea and Flood 2014): mixes the bits
-//! of a 64-bit value so that neighbouring inputs give unrelated outputs.
-std::uint64_t mix(std::uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-
-//! SplitMix64, a tiny generator started per triangle from the mixed seed and
-//! the mixed triangle index, so each triangle's points depend on both only
-//! (and seeds s and s + 1 are not one draw apart).
-struct SplitMix64
-{
-    std::uint64_t state;
-    SplitMix64(std::uint64_t seed, std::uint64_t triangle) : state(mix(mix(seed + 0x632be59bd9b4e019ULL) ^ mix(triangle))) {}
-    std::uint64_t next() { return mix(state += 0x9e3779b97f4a7c15ULL); }
-    //! Uniform in [0, 1).
-    double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
-};
-
-} // namespace
 
 PointCloud sampleMesh(const Mesh& mesh, const MeshSamplingParams& params, ProgressObserver* progress)
 {

@@ -155,11 +155,21 @@ IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud
         throw Error(ErrorCode::InvalidData, "registration: the moving cloud '" + moving.name + "' is empty");
     if (referenceCloud && referenceCloud->empty())
         throw Error(ErrorCode::InvalidData, "registration: the reference cloud '" + referenceCloud->name + "' is empty");
-    const bool plane = params.method == IcpMethod::PointToPlane;
     const std::unique_ptr<detail::ReferenceSurface> surface =
         referenceMesh ? detail::meshSurface(*referenceMesh)
                       : detail::cloudSurface(*referenceCloud, true, params.normalNeighbours, progress);
-    const Eigen::Vector3d origin = surface->frameOrigin();
+    return detail::icpOnSurface(moving, *surface, params, progress);
+}
+
+namespace detail {
+
+IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface, const IcpParams& params, ProgressObserver* progress)
+{
+    checkParams(params);
+    if (moving.empty())
+        throw Error(ErrorCode::InvalidData, "registration: the moving cloud '" + moving.name + "' is empty");
+    const bool plane = params.method == IcpMethod::PointToPlane;
+    const Eigen::Vector3d origin = surface.frameOrigin();
 
     // The moving points the iterations use, in the frame (double).
     std::vector<std::size_t> sample = params.sampleCount > 0 ? randomSubsample(moving, params.sampleCount, params.seed)
@@ -196,7 +206,7 @@ IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud
     for (std::size_t iteration = 1; iteration <= params.maxIterations; ++iteration) {
         for (std::size_t i = 0; i < x0.size(); ++i)
             x[i] = motion * x0[i];
-        correspond(*surface, x, params, threshold, c);
+        correspond(surface, x, params, threshold, c);
         if (c.usedCount < static_cast<std::size_t>(dofCount(params.constraint.dof)) + 3)
             throw Error(ErrorCode::InvalidData, "registration: only " + std::to_string(c.usedCount) +
                                                     " correspondences left (iteration " + std::to_string(iteration) +
@@ -290,7 +300,7 @@ IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud
     IcpParams final = params;
     final.overlap = 1.0; // the trimming of the last iteration is applied as its cutoff
     Correspondences last;
-    correspond(*surface, all, final, std::min(threshold, c.cutoff), last);
+    correspond(surface, all, final, std::min(threshold, c.cutoff), last);
     result.residual = ScalarField(fields::kRegistrationResidual, n);
     result.excluded = ScalarField(fields::kRegistrationExcluded, n);
     std::vector<double> magnitudes;
@@ -314,5 +324,7 @@ IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud
         report.notes.push_back("not converged after " + std::to_string(params.maxIterations) + " iterations");
     return result;
 }
+
+} // namespace detail
 
 } // namespace scandiff::plugins

@@ -8,6 +8,7 @@
 #include <scandiff/core/Mesh.h>
 #include <scandiff/core/PointCloud.h>
 #include <scandiff/core/Progress.h>
+#include <scandiff/plugins/registration/Icp.h>
 #include <scandiff/octree/Octree.h>
 
 #include <Eigen/Core>
@@ -43,5 +44,8 @@ std::unique_ptr<ReferenceSurface> cloudSurface(const PointCloud& cloud, bool nee
                                                ProgressObserver* progress);
 //! A mesh (triangle normals by vertex order). The mesh must outlive the surface.
 std::unique_ptr<ReferenceSurface> meshSurface(const Mesh& mesh);
+
+//! icpRegister on a surface built once (several registrations on one reference).
+IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface, const IcpParams& params, ProgressObserver* progress);
 
 } // namespace scandiff::plugins::detail

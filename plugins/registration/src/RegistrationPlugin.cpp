@@ -5,8 +5,10 @@
 #include <scandiff/core/TextLists.h>
 #include <scandiff/core/processing/CloudEditing.h>
 #include <scandiff/plugins/PluginRegistry.h>
+#include <scandiff/plugins/registration/GlobalAlignment.h>
 #include <scandiff/plugins/registration/Icp.h>
 #include <scandiff/plugins/registration/PointPairs.h>
+#include <scandiff/plugins/registration/Stations.h>
 
 #include <fstream>
 #include <sstream>
@@ -74,26 +76,96 @@ std::vector<OutputSpec> registrationOutputs()
             OutputSpec{"trace", "Convergence trace", DataKind::Table, false}};
 }
 
-void addIcpTool(ToolRegistry& registry)
+std::vector<ParameterSpec> dofParameters()
+{
+    return {ParameterSpec::choice("dof", "Degrees of freedom",
+                                  "6; 4 (rotation about --axis and translation: levelled scanners); translation",
+                                  {"6", "4", "translation"}, "6"),
+            ParameterSpec::text("axis", "Rotation axis", "The axis of the 4-DOF rotation, X,Y,Z", "0,0,1").withSuggestions({"0,0,1"})};
+}
+
+DofConstraint dofFrom(const ParameterValues& values)
+{
+    DofConstraint constraint;
+    constraint.dof = parseDof(values.text("dof"));
+    constraint.axis = axisFrom(values.text("axis"));
+    return constraint;
+}
+
+std::vector<ParameterSpec> globalParameters()
+{
+    const GlobalAlignmentParams defaults;
+    return {ParameterSpec::real("spacing", "Feature spacing",
+                                "Both clouds thinned to this spacing for the descriptors (normals within 2, descriptors within 5 "
+                                "spacings); absent: the reference keeps about 10 000 points",
+                                0.5, 1e-6, 1e6, "m")
+                .asOptional(),
+            ParameterSpec::integer("hypotheses", "Hypotheses", "RANSAC hypotheses at most",
+                                   static_cast<std::int64_t>(defaults.maxIterations), 100, 100000000)};
+}
+
+GlobalAlignmentParams globalFrom(const ParameterValues& values)
+{
+    GlobalAlignmentParams params;
+    params.constraint = dofFrom(values);
+    if (values.has("spacing"))
+        params.spacing = values.real("spacing");
+    params.maxIterations = static_cast<std::size_t>(values.integer("hypotheses"));
+    params.seed = static_cast<std::uint64_t>(values.integer("seed"));
+    return params;
+}
+
+//! ICP after an optional global alignment: the result and the tool's outputs.
+ToolResult registerAndReport(const ToolInputs& inputs, IcpParams icp, const GlobalAlignmentParams* global, bool refine,
+                             ProgressObserver* progress)
+{
+    const PointCloud& moving = inputs.cloud("moving");
+    const Mesh* mesh = inputs.meshOrNull("reference");
+    const PointCloud* referenceCloud = mesh ? nullptr : &inputs.cloud("reference");
+    std::vector<std::string> globalNotes;
+    RegistrationReport coarseReport;
+    if (global) {
+        const GlobalAlignmentResult coarse = globalAlign(moving, referenceCloud, mesh, *global, progress);
+        icp.initial = coarse.report.matrix;
+        // From within about a spacing: correspondences much farther are not
+        // the same surface (partial overlap).
+        if (!icp.maxDistance)
+            icp.maxDistance = 3 * coarse.spacing;
+        coarseReport = coarse.report;
+        for (const auto& note : coarse.report.notes)
+            globalNotes.push_back("global alignment: " + note);
+    }
+    RegistrationReport report;
+    ScalarField residual, excluded;
+    if (refine) {
+        IcpResult fine = icpRegister(moving, referenceCloud, mesh, icp, progress);
+        report = std::move(fine.report);
+        residual = std::move(fine.residual);
+        excluded = std::move(fine.excluded);
+        if (global)
+            report.method = coarseReport.method + ", then " + report.method;
+        report.notes.insert(report.notes.begin(), globalNotes.begin(), globalNotes.end());
+    } else {
+        report = coarseReport;
+    }
+    ToolResult result;
+    result.summary = reportSummary(report);
+    if (refine)
+        result.add("output", movedCloud(moving, report.matrix, report.method, std::move(residual), std::move(excluded)));
+    else
+        result.add("output", transformCloud(moving, report.matrix, report.method));
+    result.add("matrix", report.matrix);
+    result.add("report", reportTable(report));
+    if (refine)
+        result.add("trace", traceTable(report));
+    return result;
+}
+
+std::vector<ParameterSpec> icpParameters()
 {
     const IcpParams defaults;
-    ToolSpec tool;
-    tool.name = "register";
-    tool.title = "Fine registration (ICP)";
-    tool.category = "Registration";
-    tool.description =
-        "Moves the moving cloud onto the reference (a cloud or a mesh) by iterative closest points: point-to-plane "
-        "(default) or point-to-point, on exact closest points, in double precision; degrees of freedom constrained in "
-        "the solver (4: rotation about an axis, levelled scanners); maximum distance, trimmed overlap, robust kernel; "
-        "--exclude-changes leaves out what changed between the epochs (thesis 000 §1.4) and marks it in "
-        "registration_excluded. Reports the matrix, residuals, convergence and a degeneracy warning.";
-    tool.inputs = movingAndReference();
-    tool.outputs = registrationOutputs();
-    tool.parameters = {
+    return {
         ParameterSpec::choice("method", "Method", "Residual minimised", {"point-to-plane", "point-to-point"}, "point-to-plane"),
-        ParameterSpec::choice("dof", "Degrees of freedom", "6; 4 (rotation about --axis and translation: levelled scanners); translation",
-                              {"6", "4", "translation"}, "6"),
-        ParameterSpec::text("axis", "Rotation axis", "The axis of the 4-DOF rotation, X,Y,Z", "0,0,1").withSuggestions({"0,0,1"}),
         ParameterSpec::real("max-dist", "Maximum distance", "Leave out correspondences farther than this", 1.0, 1e-9, 1e9, "m").asOptional(),
         ParameterSpec::real("overlap", "Overlap", "Keep this fraction of the correspondences, the closest", 1.0, 0.01, 1.0),
         ParameterSpec::boolean("robust", "Robust", "Weigh residuals with a robust kernel (scale from their median)", false),
@@ -104,34 +176,97 @@ void addIcpTool(ToolRegistry& registry)
                                static_cast<std::int64_t>(defaults.sampleCount), 0, 1000000000, "points"),
         ParameterSpec::integer("iterations", "Maximum iterations", "Iterations at most", static_cast<std::int64_t>(defaults.maxIterations),
                                1, 10000),
-        ParameterSpec::text("initial", "Initial matrix", "A starting motion: 16 numbers row by row, or a matrix file").asOptional(),
-        ParameterSpec::integer("seed", "Seed", "Random sampling seed", 0, 0, std::numeric_limits<std::int64_t>::max()),
     };
+}
+
+IcpParams icpFrom(const ParameterValues& values)
+{
+    IcpParams params;
+    params.method = parseIcpMethod(values.text("method"));
+    params.constraint = dofFrom(values);
+    if (values.has("max-dist"))
+        params.maxDistance = values.real("max-dist");
+    params.overlap = values.real("overlap");
+    params.kernel = values.boolean("robust") ? parseRobustKernel(values.text("kernel")) : RobustKernel::None;
+    params.changeRobust = values.boolean("exclude-changes");
+    params.sampleCount = static_cast<std::size_t>(values.integer("sample"));
+    params.maxIterations = static_cast<std::size_t>(values.integer("iterations"));
+    params.seed = static_cast<std::uint64_t>(values.integer("seed"));
+    return params;
+}
+
+ParameterSpec seedParameter()
+{
+    return ParameterSpec::integer("seed", "Seed", "Random sampling seed (the same seed, the same result)", 0, 0,
+                                  std::numeric_limits<std::int64_t>::max());
+}
+
+void addIcpTool(ToolRegistry& registry)
+{
+    ToolSpec tool;
+    tool.name = "register";
+    tool.title = "Fine registration (ICP)";
+    tool.category = "Registration";
+    tool.description =
+        "Moves the moving cloud onto the reference (a cloud or a mesh) by iterative closest points: point-to-plane "
+        "(default) or point-to-point, on exact closest points, in double precision; degrees of freedom constrained in "
+        "the solver (4: rotation about an axis, levelled scanners); maximum distance, trimmed overlap, robust kernel; "
+        "--exclude-changes leaves out what changed between the epochs (thesis 000 §1.4) and marks it in "
+        "registration_excluded; --global first finds the motion from any start. Reports the matrix, residuals, "
+        "convergence and a degeneracy warning.";
+    tool.inputs = movingAndReference();
+    tool.outputs = registrationOutputs();
+    tool.parameters = icpParameters();
+    const std::vector<ParameterSpec> dof = dofParameters();
+    tool.parameters.insert(tool.parameters.begin() + 1, dof.begin(), dof.end());
+    tool.parameters.push_back(
+        ParameterSpec::boolean("global", "Global alignment first", "Find the motion from any start first (FPFH descriptors, RANSAC)", false));
+    for (const auto& p : globalParameters())
+        tool.parameters.push_back(p);
+    tool.parameters.push_back(
+        ParameterSpec::text("initial", "Initial matrix", "A starting motion: 16 numbers row by row, or a matrix file").asOptional());
+    tool.parameters.push_back(seedParameter());
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
-        const PointCloud& moving = inputs.cloud("moving");
-        const Mesh* mesh = inputs.meshOrNull("reference");
-        IcpParams params;
-        params.method = parseIcpMethod(values.text("method"));
-        params.constraint.dof = parseDof(values.text("dof"));
-        params.constraint.axis = axisFrom(values.text("axis"));
-        if (values.has("max-dist"))
-            params.maxDistance = values.real("max-dist");
-        params.overlap = values.real("overlap");
-        params.kernel = values.boolean("robust") ? parseRobustKernel(values.text("kernel")) : RobustKernel::None;
-        params.changeRobust = values.boolean("exclude-changes");
-        params.sampleCount = static_cast<std::size_t>(values.integer("sample"));
-        params.maxIterations = static_cast<std::size_t>(values.integer("iterations"));
-        params.seed = static_cast<std::uint64_t>(values.integer("seed"));
+        IcpParams params = icpFrom(values);
+        const bool global = values.boolean("global");
+        if (global && values.has("initial"))
+            throw Error(ErrorCode::InvalidArgument, "registration: --global finds the start itself; give it or --initial, not both");
         if (values.has("initial"))
             params.initial = matrixFrom(values.text("initial"));
-        IcpResult icp = icpRegister(moving, mesh ? nullptr : &inputs.cloud("reference"), mesh, params, progress);
-        ToolResult result;
-        result.summary = reportSummary(icp.report);
-        result.add("output", movedCloud(moving, icp.report.matrix, icp.report.method, std::move(icp.residual), std::move(icp.excluded)));
-        result.add("matrix", icp.report.matrix);
-        result.add("report", reportTable(icp.report));
-        result.add("trace", traceTable(icp.report));
-        return result;
+        const GlobalAlignmentParams globalParams = globalFrom(values);
+        return registerAndReport(inputs, params, global ? &globalParams : nullptr, true, progress);
+    };
+    registry.add(std::move(tool));
+}
+
+void addGlobalTool(ToolRegistry& registry)
+{
+    ToolSpec tool;
+    tool.name = "register-global";
+    tool.title = "Global alignment";
+    tool.category = "Registration";
+    tool.description =
+        "Finds the motion of the moving cloud onto the reference from any start: both thinned to a feature spacing, a "
+        "shape descriptor per point (FPFH, Rusu et al. 2009), descriptors matched, and the motion most matches agree on "
+        "found by RANSAC (3 matches a hypothesis; 2 with 4 degrees of freedom, which searches only the heading). Then, "
+        "unless --refine is off, point-to-plane ICP with a robust kernel finishes it.";
+    tool.inputs = movingAndReference();
+    tool.outputs = registrationOutputs();
+    tool.parameters = dofParameters();
+    for (const auto& p : globalParameters())
+        tool.parameters.push_back(p);
+    tool.parameters.push_back(ParameterSpec::boolean("refine", "Refine with ICP", "Finish with point-to-plane ICP (robust kernel)", true));
+    tool.parameters.push_back(ParameterSpec::boolean(
+        "exclude-changes", "Exclude changes", "In the ICP, leave out what changed between the epochs (thesis 000 §1.4)", false));
+    tool.parameters.push_back(seedParameter());
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        IcpParams icp;
+        icp.constraint = dofFrom(values);
+        icp.kernel = RobustKernel::Cauchy;
+        icp.changeRobust = values.boolean("exclude-changes");
+        icp.seed = static_cast<std::uint64_t>(values.integer("seed"));
+        const GlobalAlignmentParams global = globalFrom(values);
+        return registerAndReport(inputs, icp, &global, values.boolean("refine"), progress);
     };
     registry.add(std::move(tool));
 }
@@ -154,21 +289,154 @@ void addPointPairsTool(ToolRegistry& registry)
         ParameterSpec::text("pairs", "Point pairs",
                             "MX,MY,MZ,RX,RY,RZ per pair (moving point, then the same point on the reference), pairs separated "
                             "by ';', or a text/CSV file of such lines"),
-        ParameterSpec::choice("dof", "Degrees of freedom", "6; 4 (rotation about --axis and translation); translation",
-                              {"6", "4", "translation"}, "6"),
-        ParameterSpec::text("axis", "Rotation axis", "The axis of the 4-DOF rotation, X,Y,Z", "0,0,1").withSuggestions({"0,0,1"}),
     };
+    for (const auto& p : dofParameters())
+        tool.parameters.push_back(p);
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver*) {
         const PointCloud& moving = inputs.cloud("moving");
-        DofConstraint constraint;
-        constraint.dof = parseDof(values.text("dof"));
-        constraint.axis = axisFrom(values.text("axis"));
-        const RegistrationReport report = fitPointPairs(parsePointPairs(values.text("pairs")), constraint);
+        const RegistrationReport report = fitPointPairs(parsePointPairs(values.text("pairs")), dofFrom(values));
         ToolResult result;
         result.summary = reportSummary(report);
         result.add("output", transformCloud(moving, report.matrix, report.method));
         result.add("matrix", report.matrix);
         result.add("report", reportTable(report));
+        return result;
+    };
+    registry.add(std::move(tool));
+}
+
+Table posesTable(const std::vector<Eigen::Matrix4d>& poses)
+{
+    Table t;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+            t.columns.push_back("m" + std::to_string(r) + std::to_string(c));
+    t.plainNumbers = true; // poses.txt: one line of 16 numbers per station, row by row
+    for (const auto& m : poses) {
+        std::vector<TableCell> row;
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c)
+                row.emplace_back(m(r, c));
+        t.rows.push_back(std::move(row));
+    }
+    return t;
+}
+
+Table stationsReportTable(const StationResult& s)
+{
+    Table t;
+    t.columns = {"metric", "value"};
+    const auto add = [&](const std::string& name, TableCell value) { t.rows.push_back({name, std::move(value)}); };
+    const RegistrationReport& r = s.report;
+    add("method", r.method);
+    add("stations", static_cast<double>(s.poses.size()));
+    add("pairs", static_cast<double>(s.pairs.size()));
+    add("loops", static_cast<double>(s.loops.size()));
+    add("rms_m", r.rms);
+    add("median_m", r.median);
+    add("p90_m", r.p90);
+    add("p95_m", r.p95);
+    add("p99_m", r.p99);
+    add("iterations", static_cast<double>(r.iterations));
+    add("converged", r.converged ? 1.0 : 0.0);
+    for (std::size_t k = 0; k < s.poses.size(); ++k) {
+        add("station_" + std::to_string(k) + "_rotation_deg", rotationDegrees(s.poses[k].topLeftCorner<3, 3>()));
+    }
+    add("warning", r.degeneracy);
+    for (const auto& note : r.notes)
+        add("note", note);
+    return t;
+}
+
+Table stationPairsTable(const StationResult& s)
+{
+    Table t;
+    t.columns = {"station_a", "station_b", "overlap", "pairwise_rms_m", "adjusted_rms_m", "disagreement_deg", "disagreement_m", "warning"};
+    for (const auto& p : s.pairs)
+        t.rows.push_back({static_cast<double>(p.a), static_cast<double>(p.b), p.overlap, p.pairwise.rms, p.adjustedRms,
+                          p.disagreementDegrees, p.disagreementMetres, p.pairwise.degeneracy});
+    return t;
+}
+
+Table stationLoopsTable(const StationResult& s)
+{
+    Table t;
+    t.columns = {"loop", "stations", "misclosure_deg", "misclosure_m"};
+    for (std::size_t i = 0; i < s.loops.size(); ++i) {
+        std::string path;
+        for (std::size_t k : s.loops[i].stations)
+            path += (path.empty() ? "" : "-") + std::to_string(k);
+        t.rows.push_back({static_cast<double>(i + 1), path, s.loops[i].rotationDegrees, s.loops[i].translationMetres});
+    }
+    return t;
+}
+
+void addStationsTool(ToolRegistry& registry)
+{
+    const StationParams defaults;
+    ToolSpec tool;
+    tool.name = "register-stations";
+    tool.title = "Multi-station adjustment";
+    tool.category = "Registration";
+    tool.description =
+        "Registers several scans of a site, roughly in a common frame, together: every overlapping pair by ICP alone "
+        "(the misclosure of every loop of pairs is reported), then every pose at once in one least-squares problem "
+        "over the point-to-plane residuals of all pairs, the first station fixed (6 unknowns per other station, 4 for "
+        "levelled scanners: thesis 004 §III-2.2.1). Writes each station moved and poses.txt (16 numbers a line, row by "
+        "row: station -> first station).";
+    tool.inputs = {InputSpec{"input", "Stations", "The stations' scans; the first one stays where it is", DataKind::Cloud, true, false}};
+    tool.outputs = {OutputSpec{"station", "Moved station", DataKind::Cloud, true, true},
+                    OutputSpec{"poses", "Poses (station -> first station)", DataKind::Table, false},
+                    OutputSpec{"report", "Adjustment report", DataKind::Table, false},
+                    OutputSpec{"pairs", "Pairs", DataKind::Table, false},
+                    OutputSpec{"loops", "Loop misclosures", DataKind::Table, false},
+                    OutputSpec{"trace", "Convergence trace", DataKind::Table, false}};
+    tool.parameters = dofParameters();
+    tool.parameters.push_back(ParameterSpec::real("max-dist", "Maximum distance",
+                                                  "Correspondences farther are left out; points this close overlap. The "
+                                                  "stations must start within it",
+                                                  defaults.maxDistance, 1e-9, 1e9, "m"));
+    tool.parameters.push_back(ParameterSpec::real("min-overlap", "Minimum overlap",
+                                                  "Pairs whose overlap (fraction of a station's points near the other) is "
+                                                  "smaller are not registered",
+                                                  defaults.minOverlap, 0.001, 1.0));
+    tool.parameters.push_back(ParameterSpec::integer("sample", "Sampled points", "Points of each station used, at random",
+                                                     static_cast<std::int64_t>(defaults.sampleCount), 10, 1000000000, "points"));
+    tool.parameters.push_back(ParameterSpec::integer("iterations", "Maximum iterations", "Joint iterations at most",
+                                                     static_cast<std::int64_t>(defaults.maxIterations), 1, 10000));
+    tool.parameters.push_back(seedParameter());
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        StationParams params;
+        params.constraint = dofFrom(values);
+        params.maxDistance = values.real("max-dist");
+        params.minOverlap = values.real("min-overlap");
+        params.sampleCount = static_cast<std::size_t>(values.integer("sample"));
+        params.maxIterations = static_cast<std::size_t>(values.integer("iterations"));
+        params.seed = static_cast<std::uint64_t>(values.integer("seed"));
+        std::vector<const PointCloud*> stations;
+        for (std::size_t k = 0; k < inputs.count("input"); ++k)
+            stations.push_back(&inputs.cloud("input", k));
+        const StationResult adjusted = adjustStations(stations, params, progress);
+        ToolResult result;
+        std::ostringstream summary;
+        double worstLoop = 0;
+        for (const auto& loop : adjusted.loops)
+            worstLoop = std::max(worstLoop, loop.translationMetres);
+        summary << adjusted.report.method << ": RMS " << adjusted.report.rms << " m (median " << adjusted.report.median << "); "
+                << adjusted.loops.size() << " loops";
+        if (!adjusted.loops.empty())
+            summary << ", worst misclosure " << worstLoop << " m";
+        summary << "; " << adjusted.report.iterations << " iterations" << (adjusted.report.converged ? "" : " (not converged)");
+        if (!adjusted.report.degeneracy.empty())
+            summary << "; WARNING " << adjusted.report.degeneracy;
+        result.summary = summary.str();
+        for (std::size_t k = 0; k < stations.size(); ++k)
+            result.add("station", transformCloud(*stations[k], adjusted.poses[k], adjusted.report.method));
+        result.add("poses", posesTable(adjusted.poses));
+        result.add("report", stationsReportTable(adjusted));
+        result.add("pairs", stationPairsTable(adjusted));
+        result.add("loops", stationLoopsTable(adjusted));
+        result.add("trace", traceTable(adjusted.report));
         return result;
     };
     registry.add(std::move(tool));
@@ -182,5 +450,7 @@ void scandiff_register_plugin_registration(scandiff::PluginRegistry& registry)
 {
     registry.plugins.push_back({"registration", "Fine, change-robust, constrained, global and multi-station registration", ""});
     scandiff::plugins::addIcpTool(registry.tools);
+    scandiff::plugins::addGlobalTool(registry.tools);
     scandiff::plugins::addPointPairsTool(registry.tools);
+    scandiff::plugins::addStationsTool(registry.tools);
 }

@@ -120,8 +120,12 @@ std::string reportSummary(const RegistrationReport& r)
         for (std::size_t i = 0; i < r.pairResiduals.size(); ++i)
             s << (i ? ", " : " ") << r.pairResiduals[i];
     } else {
-        s << " (median " << r.median << ", p95 " << r.p95 << "); overlap " << std::setprecision(3) << 100 * r.overlap << " %; "
-          << r.iterations << " iterations" << (r.converged || r.iterations == 0 ? "" : " (not converged)");
+        if (std::isfinite(r.median))
+            s << " (median " << r.median << ", p95 " << r.p95 << ")";
+        if (std::isfinite(r.overlap))
+            s << "; overlap " << std::setprecision(3) << 100 * r.overlap << " %";
+        if (!r.trace.empty())
+            s << "; " << r.iterations << " iterations" << (r.converged ? "" : " (not converged)");
     }
     for (const auto& note : r.notes)
         s << "; " << note;

@@ -33,7 +33,7 @@ struct RegistrationReport
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     double rms = 0;                 //!< final residuals used
     double median = 0, p90 = 0, p95 = 0, p99 = 0; //!< of |residual| over the points used
-    double overlap = 0;             //!< fraction of the moving points used at the end
+    double overlap = 0;             //!< fraction of the moving points used at the end (NaN: not a measure of the method)
     std::size_t iterations = 0;
     bool converged = false;
     std::vector<RegistrationIteration> trace;

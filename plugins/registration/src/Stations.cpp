@@ -1,0 +1,427 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/plugins/registration/Stations.h>
+
+#include "ReferenceSurface.h"
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/processing/Subsampling.h>
+#include <scandiff/plugins/registration/Icp.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <memory>
+
+namespace scandiff::plugins {
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+//! One station: its cloud, the surface others are matched on, and its
+//! sampled points in station coordinates relative to the world origin.
+struct Station
+{
+    const PointCloud* cloud = nullptr;
+    std::unique_ptr<detail::ReferenceSurface> surface;
+    std::vector<Eigen::Vector3d> sample;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero(); //!< of the sample, world-relative station coordinates
+};
+
+//! A pair's correspondences one way: points of `from` matched on `on`'s surface.
+struct Matched
+{
+    std::vector<Eigen::Vector3d> x, q, n; //!< world-relative, station 0's frame
+    std::vector<double> residual, distance;
+};
+
+//! The points of `from` (posed) matched on the surface of `on` (posed).
+void match(const Station& from, const Eigen::Isometry3d& fromPose, const Station& on, const Eigen::Isometry3d& onPose,
+           const Eigen::Vector3d& worldOrigin, std::size_t limit, Matched& m)
+{
+    const std::size_t count = std::min(limit, from.sample.size());
+    m.x.resize(count);
+    std::vector<Eigen::Vector3d> local(count);
+    const Eigen::Isometry3d toOn = onPose.inverse();
+    const Eigen::Vector3d toSurface = worldOrigin - on.surface->frameOrigin();
+    for (std::size_t i = 0; i < count; ++i) {
+        m.x[i] = fromPose * from.sample[i];
+        local[i] = toOn * m.x[i] + toSurface;
+    }
+    detail::ClosestPoints closest;
+    on.surface->closest(local, closest);
+    m.q.assign(count, Eigen::Vector3d::Zero());
+    m.n.assign(count, Eigen::Vector3d::Zero());
+    m.residual.assign(count, std::numeric_limits<double>::quiet_NaN());
+    m.distance.assign(count, kInfinity);
+    for (std::size_t i = 0; i < count; ++i) {
+        if (!closest.found[i] || closest.normals[i] == Eigen::Vector3d::Zero())
+            continue;
+        m.q[i] = onPose * (closest.points[i] - toSurface);
+        m.n[i] = onPose.linear() * closest.normals[i];
+        const Eigen::Vector3d d = m.x[i] - m.q[i];
+        m.distance[i] = d.norm();
+        m.residual[i] = m.n[i].dot(d);
+    }
+}
+
+double medianOf(std::vector<double> v)
+{
+    if (v.empty())
+        return 0;
+    const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
+}
+
+double percentileOf(std::vector<double> v, double p)
+{
+    if (v.empty())
+        return std::numeric_limits<double>::quiet_NaN();
+    const auto at = v.begin() + static_cast<std::ptrdiff_t>(std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5)));
+    std::nth_element(v.begin(), at, v.end());
+    return *at;
+}
+
+//! The displacement a motion gives a point, and its angle.
+void motionSize(const Eigen::Matrix4d& m, const Eigen::Vector3d& at, double& degrees, double& metres)
+{
+    degrees = rotationDegrees(m.topLeftCorner<3, 3>());
+    metres = ((m * at.homogeneous()).head<3>() - at).norm();
+}
+
+std::vector<Station> prepare(const std::vector<const PointCloud*>& clouds, const StationParams& params, Eigen::Vector3d& worldOrigin,
+                             ProgressObserver* progress)
+{
+    std::vector<Station> stations(clouds.size());
+    for (std::size_t k = 0; k < clouds.size(); ++k) {
+        if (!clouds[k] || clouds[k]->empty())
+            throw Error(ErrorCode::InvalidData, "stations: station " + std::to_string(k) + " is empty");
+        stations[k].cloud = clouds[k];
+        stations[k].surface = detail::cloudSurface(*clouds[k], true, 12, progress);
+    }
+    worldOrigin = stations[0].surface->frameOrigin();
+    for (std::size_t k = 0; k < clouds.size(); ++k) {
+        Station& s = stations[k];
+        for (std::size_t i : randomSubsample(*s.cloud, params.sampleCount, params.seed + k))
+            if (s.cloud->positions()[i].allFinite())
+                s.sample.push_back(s.cloud->globalPosition(i) - worldOrigin);
+        if (s.sample.empty())
+            throw Error(ErrorCode::InvalidData, "stations: station " + std::to_string(k) + " has no finite point");
+        for (const auto& p : s.sample)
+            s.centre += p / static_cast<double>(s.sample.size());
+    }
+    return stations;
+}
+
+//! The fraction of `from`'s first points within the distance of `on`, both as given.
+double overlapFraction(const Station& from, const Station& on, const Eigen::Vector3d& worldOrigin, double distance)
+{
+    Matched m;
+    match(from, Eigen::Isometry3d::Identity(), on, Eigen::Isometry3d::Identity(), worldOrigin, 4000, m);
+    std::size_t near = 0;
+    for (double d : m.distance)
+        near += d <= distance;
+    return static_cast<double>(near) / static_cast<double>(std::max<std::size_t>(m.x.size(), 1));
+}
+
+//! Poses along a breadth-first spanning tree from station 0, composed from the
+//! pairwise motions; `parentEdge[k]` is the pair that reached k (none for 0).
+std::vector<Eigen::Matrix4d> chainPoses(std::size_t count, const std::vector<StationPair>& pairs, std::vector<std::ptrdiff_t>& parentEdge,
+                                        std::vector<std::size_t>& parent)
+{
+    std::vector<Eigen::Matrix4d> pose(count, Eigen::Matrix4d::Identity());
+    std::vector<char> reached(count, 0);
+    parentEdge.assign(count, -1);
+    parent.assign(count, 0);
+    std::deque<std::size_t> queue{0};
+    reached[0] = 1;
+    while (!queue.empty()) {
+        const std::size_t s = queue.front();
+        queue.pop_front();
+        for (std::size_t e = 0; e < pairs.size(); ++e) {
+            const StationPair& p = pairs[e];
+            if (p.a != s && p.b != s)
+                continue;
+            const std::size_t other = p.a == s ? p.b : p.a;
+            if (reached[other])
+                continue;
+            // The pairwise matrix maps b's coordinates to a's.
+            pose[other] = p.a == s ? Eigen::Matrix4d(pose[s] * p.pairwise.matrix) : Eigen::Matrix4d(pose[s] * p.pairwise.matrix.inverse());
+            reached[other] = 1;
+            parentEdge[other] = static_cast<std::ptrdiff_t>(e);
+            parent[other] = s;
+            queue.push_back(other);
+        }
+    }
+    for (std::size_t k = 0; k < count; ++k)
+        if (!reached[k])
+            throw Error(ErrorCode::InvalidData, "stations: station " + std::to_string(k) +
+                                                    " overlaps no station linked to station 0 (within the maximum distance " +
+                                                    "and the minimum overlap): bring it closer first, or raise --max-dist");
+    return pose;
+}
+
+//! Every edge outside the tree closes a loop: the pairwise motions composed
+//! around it, compared with the identity.
+std::vector<StationLoop> loopMisclosures(const std::vector<Station>& stations, const std::vector<StationPair>& pairs,
+                                         const std::vector<Eigen::Matrix4d>& chain, const std::vector<std::ptrdiff_t>& parentEdge,
+                                         const std::vector<std::size_t>& parent, const Eigen::Vector3d& worldOrigin)
+{
+    std::vector<StationLoop> loops;
+    const auto pathToRoot = [&](std::size_t k) {
+        std::vector<std::size_t> path{k};
+        while (path.back() != 0)
+            path.push_back(parent[path.back()]);
+        return path;
+    };
+    for (std::size_t e = 0; e < pairs.size(); ++e) {
+        if (std::find(parentEdge.begin(), parentEdge.end(), static_cast<std::ptrdiff_t>(e)) != parentEdge.end())
+            continue;
+        const StationPair& p = pairs[e];
+        // a -> ... -> common ancestor -> ... -> b -> a.
+        std::vector<std::size_t> up = pathToRoot(p.a), down = pathToRoot(p.b);
+        while (up.size() > 1 && down.size() > 1 && up[up.size() - 2] == down[down.size() - 2]) {
+            up.pop_back();
+            down.pop_back();
+        }
+        StationLoop loop;
+        loop.stations = up;
+        for (auto it = down.rbegin() + 1; it != down.rend(); ++it)
+            loop.stations.push_back(*it);
+        loop.stations.push_back(p.a);
+        // The chain gives b's pose through the tree; the pair's own motion
+        // gives it through a: their difference is the loop's misclosure.
+        const Eigen::Matrix4d misclosure = chain[p.a] * p.pairwise.matrix * chain[p.b].inverse();
+        Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+        for (std::size_t i = 0; i + 1 < loop.stations.size(); ++i)
+            centre += (stations[loop.stations[i]].centre + worldOrigin) / static_cast<double>(loop.stations.size() - 1);
+        motionSize(misclosure, centre, loop.rotationDegrees, loop.translationMetres);
+        loops.push_back(std::move(loop));
+    }
+    return loops;
+}
+
+} // namespace
+
+StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const StationParams& params, ProgressObserver* progress)
+{
+    if (clouds.size() < 2)
+        throw Error(ErrorCode::InvalidArgument, "stations: at least 2 stations");
+    if (!(params.maxDistance > 0 && std::isfinite(params.maxDistance)) || !(params.minOverlap > 0 && params.minOverlap <= 1) ||
+        params.sampleCount < 10 || params.maxIterations < 1)
+        throw Error(ErrorCode::InvalidArgument,
+                    "stations: the maximum distance is > 0, the minimum overlap in (0, 1], at least 10 points and 1 iteration");
+    Eigen::Vector3d worldOrigin;
+    std::vector<Station> stations = prepare(clouds, params, worldOrigin, progress);
+    const std::size_t count = stations.size();
+    StationResult result;
+
+    // Overlapping pairs, each registered alone.
+    ProgressTicker pairTicker(progress, "Stations: pairwise registration", count * (count - 1) / 2);
+    for (std::size_t a = 0; a < count; ++a)
+        for (std::size_t b = a + 1; b < count; ++b) {
+            const double overlap = std::max(overlapFraction(stations[b], stations[a], worldOrigin, params.maxDistance),
+                                            overlapFraction(stations[a], stations[b], worldOrigin, params.maxDistance));
+            pairTicker.step();
+            if (overlap < params.minOverlap)
+                continue;
+            IcpParams icp;
+            icp.constraint = params.constraint;
+            icp.maxDistance = params.maxDistance;
+            icp.kernel = RobustKernel::Cauchy;
+            icp.changeRobust = true;
+            icp.sampleCount = params.sampleCount;
+            icp.seed = params.seed;
+            StationPair pair;
+            pair.a = a;
+            pair.b = b;
+            pair.overlap = overlap;
+            pair.pairwise = detail::icpOnSurface(*stations[b].cloud, *stations[a].surface, icp, nullptr).report;
+            result.pairs.push_back(std::move(pair));
+        }
+    std::vector<std::ptrdiff_t> parentEdge;
+    std::vector<std::size_t> parent;
+    const std::vector<Eigen::Matrix4d> chain = chainPoses(count, result.pairs, parentEdge, parent);
+    result.loops = loopMisclosures(stations, result.pairs, chain, parentEdge, parent, worldOrigin);
+
+    // The joint adjustment, from the chained poses.
+    std::vector<Eigen::Isometry3d> pose(count);
+    for (std::size_t k = 0; k < count; ++k)
+        pose[k] = toLocal(chain[k], worldOrigin);
+    double spread = 0;
+    std::size_t points = 0;
+    for (const Station& s : stations)
+        for (const auto& p : s.sample) {
+            spread += p.squaredNorm();
+            ++points;
+        }
+    const double length = std::max(std::sqrt(spread / static_cast<double>(points)), 1e-9);
+    const int u = dofCount(params.constraint.dof);
+    const Eigen::Vector3d axis = params.constraint.axis.normalized();
+    const Eigen::Index unknowns = static_cast<Eigen::Index>(u * (count - 1));
+    RegistrationReport& report = result.report;
+    report.method = "multi-station adjustment, " + std::to_string(count) + " stations, " + std::to_string(result.pairs.size()) +
+                    " pairs, " + dofName(params.constraint.dof) + " DOF";
+    double threshold = params.maxDistance, previousRms = kInfinity, rmsTwoBefore = kInfinity;
+    std::vector<double> finalResiduals;
+    std::vector<double> pairSquares(result.pairs.size()), pairCount(result.pairs.size());
+    // The unknowns of a station (none for station 0): its column block, and
+    // a full (rotation, translation) derivative reduced to them.
+    const auto block = [&](std::size_t station) -> Eigen::Index {
+        return station == 0 ? -1 : static_cast<Eigen::Index>(u * (station - 1));
+    };
+    const auto reduce = [&](const Eigen::Matrix<double, 6, 1>& full) -> Eigen::VectorXd {
+        Eigen::VectorXd v(u);
+        if (params.constraint.dof == Dof::Six)
+            v = full;
+        else if (params.constraint.dof == Dof::Four)
+            v << axis.dot(full.head<3>()), full.tail<3>();
+        else
+            v = full.tail<3>();
+        return v;
+    };
+    ProgressTicker ticker(progress, "Stations: joint adjustment", params.maxIterations);
+    Eigen::MatrixXd h;
+    for (std::size_t iteration = 1; iteration <= params.maxIterations; ++iteration) {
+        h = Eigen::MatrixXd::Zero(unknowns, unknowns);
+        Eigen::VectorXd g = Eigen::VectorXd::Zero(unknowns);
+        // Residuals of every pair, both ways, then their robust scale.
+        struct Row
+        {
+            std::size_t moving, on, pair;
+            Eigen::Vector3d x, q, n;
+            double r;
+        };
+        std::vector<Row> rows;
+        std::vector<double> distances;
+        for (std::size_t e = 0; e < result.pairs.size(); ++e)
+            for (int way = 0; way < 2; ++way) {
+                const std::size_t from = way ? result.pairs[e].a : result.pairs[e].b, on = way ? result.pairs[e].b : result.pairs[e].a;
+                Matched m;
+                match(stations[from], pose[from], stations[on], pose[on], worldOrigin, params.sampleCount, m);
+                for (std::size_t i = 0; i < m.x.size(); ++i)
+                    if (m.distance[i] <= params.maxDistance && std::abs(m.residual[i]) <= threshold) {
+                        rows.push_back({from, on, e, m.x[i], m.q[i], m.n[i], m.residual[i]});
+                        distances.push_back(m.distance[i]);
+                    }
+            }
+        if (rows.size() < static_cast<std::size_t>(unknowns) + 3)
+            throw Error(ErrorCode::InvalidData, "stations: only " + std::to_string(rows.size()) + " correspondences between the stations");
+        std::vector<double> magnitudes(rows.size());
+        for (std::size_t i = 0; i < rows.size(); ++i)
+            magnitudes[i] = std::abs(rows[i].r);
+        const double scale = std::max(1.4826 * medianOf(magnitudes), 1e-12 * length);
+        double sum2 = 0;
+        std::fill(pairSquares.begin(), pairSquares.end(), 0.0);
+        std::fill(pairCount.begin(), pairCount.end(), 0.0);
+        for (const Row& row : rows) {
+            // Cauchy weights (tuning 2.3849: 95 % efficiency on Gaussian noise).
+            const double v = row.r / scale / 2.3849, w = 1.0 / (1.0 + v * v);
+            sum2 += row.r * row.r;
+            pairSquares[row.pair] += row.r * row.r;
+            pairCount[row.pair] += 1;
+            // d r / d(station moved): rotation x × n, translation n; the
+            // surface's station: rotation n × (x - q) - q × n, translation -n.
+            const Eigen::Vector3d d = row.x - row.q;
+            Eigen::Matrix<double, 6, 1> jm, jo;
+            jm << row.x.cross(row.n) / length, row.n;
+            jo << (row.n.cross(d) - row.q.cross(row.n)) / length, -row.n;
+            // Only the two stations' blocks of the normal matrix change.
+            const Eigen::VectorXd a = reduce(jm), b = reduce(jo);
+            const Eigen::Index am = block(row.moving), ao = block(row.on);
+            if (am >= 0) {
+                h.block(am, am, u, u).noalias() += w * a * a.transpose();
+                g.segment(am, u).noalias() += w * row.r * a;
+            }
+            if (ao >= 0) {
+                h.block(ao, ao, u, u).noalias() += w * b * b.transpose();
+                g.segment(ao, u).noalias() += w * row.r * b;
+            }
+            if (am >= 0 && ao >= 0) {
+                h.block(am, ao, u, u).noalias() += w * a * b.transpose();
+                h.block(ao, am, u, u).noalias() += w * b * a.transpose();
+            }
+        }
+        const double rms = std::sqrt(sum2 / static_cast<double>(rows.size()));
+        const Eigen::LDLT<Eigen::MatrixXd> solver(h);
+        const Eigen::VectorXd delta = solver.solve(-g);
+        if (solver.info() != Eigen::Success || !delta.allFinite())
+            throw Error(ErrorCode::InvalidData, "stations: the overlaps do not determine every pose (degenerate geometry)");
+        double largestRotation = 0, largestTranslation = 0, largestMove = 0;
+        for (std::size_t k = 1; k < count; ++k) {
+            const Eigen::Index at = static_cast<Eigen::Index>(u * (k - 1));
+            Eigen::Vector3d omega = Eigen::Vector3d::Zero(), tau;
+            if (params.constraint.dof == Dof::Six) {
+                omega = delta.segment<3>(at) / length;
+                tau = delta.segment<3>(at + 3);
+            } else if (params.constraint.dof == Dof::Four) {
+                omega = axis * (delta[at] / length);
+                tau = delta.segment<3>(at + 1);
+            } else {
+                tau = delta.segment<3>(at);
+            }
+            Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+            if (omega.norm() > 0)
+                step.linear() = Eigen::AngleAxisd(omega.norm(), omega.normalized()).toRotationMatrix();
+            step.translation() = tau;
+            pose[k] = step * pose[k];
+            largestRotation = std::max(largestRotation, rotationDegrees(step.linear()));
+            largestTranslation = std::max(largestTranslation, tau.norm());
+            largestMove = std::max(largestMove, omega.norm() * 2 * length + tau.norm());
+        }
+        report.trace.push_back({iteration, rms, rows.size(), threshold, largestRotation, largestTranslation});
+        report.iterations = iteration;
+        finalResiduals = magnitudes;
+        // The threshold shrinks with the residuals, as in the change-robust
+        // ICP: 3 robust sigmas, never below the median match distance.
+        threshold = std::min(threshold, std::max(3 * scale, medianOf(distances)));
+        ticker.step();
+        const double tolerance = 1e-7 * std::max(rms, 1e-12);
+        if (largestMove < 1e-7 || std::abs(previousRms - rms) <= tolerance || std::abs(rmsTwoBefore - rms) <= tolerance) {
+            report.converged = true;
+            break;
+        }
+        rmsTwoBefore = previousRms;
+        previousRms = rms;
+    }
+
+    result.poses.resize(count);
+    for (std::size_t k = 0; k < count; ++k)
+        result.poses[k] = toGlobal(pose[k], worldOrigin);
+    result.poses[0] = Eigen::Matrix4d::Identity();
+    for (std::size_t e = 0; e < result.pairs.size(); ++e) {
+        StationPair& p = result.pairs[e];
+        p.adjustedRms = pairCount[e] > 0 ? std::sqrt(pairSquares[e] / pairCount[e]) : std::numeric_limits<double>::quiet_NaN();
+        const Eigen::Matrix4d adjusted = result.poses[p.a].inverse() * result.poses[p.b];
+        motionSize(p.pairwise.matrix.inverse() * adjusted, stations[p.b].centre + worldOrigin, p.disagreementDegrees,
+                   p.disagreementMetres);
+        if (!p.pairwise.degeneracy.empty())
+            report.notes.push_back("pair " + std::to_string(p.a) + "-" + std::to_string(p.b) + ": " + p.pairwise.degeneracy);
+    }
+    double sum2 = 0;
+    for (double r : finalResiduals)
+        sum2 += r * r;
+    report.rms = std::sqrt(sum2 / static_cast<double>(std::max<std::size_t>(finalResiduals.size(), 1)));
+    report.median = percentileOf(finalResiduals, 0.5);
+    report.p90 = percentileOf(finalResiduals, 0.9);
+    report.p95 = percentileOf(finalResiduals, 0.95);
+    report.p99 = percentileOf(finalResiduals, 0.99);
+    report.overlap = std::numeric_limits<double>::quiet_NaN();
+    // Each station's own block: the directions its overlaps do not hold, the
+    // other stations held fixed.
+    for (std::size_t k = 1; k < count; ++k) {
+        std::vector<double> eigenvalues;
+        const std::string weak = degeneracyWarning(h.block(block(k), block(k), u, u), u, axis, eigenvalues);
+        if (!weak.empty())
+            report.degeneracy += (report.degeneracy.empty() ? "" : "; ") + std::string("station ") + std::to_string(k) + ": " + weak;
+    }
+    if (!report.converged)
+        report.notes.push_back("not converged after " + std::to_string(params.maxIterations) + " iterations");
+    return result;
+}
+
+} // namespace scandiff::plugins
