@@ -337,17 +337,22 @@ void Octree::descend(const Eigen::Vector3f& q, int leafLevel, Visit&& visitRange
     }
 }
 
-void Octree::descendNearest(const Eigen::Vector3f& q, std::size_t k, int leafLevel, std::vector<Neighbour>& heap) const
+void Octree::descendNearest(const Eigen::Vector3f& q, std::size_t k, int leafLevel, std::vector<Neighbour>& heap, float maxSquared) const
 {
+    const double limit = static_cast<double>(maxSquared) * (1 + kSlack);
     descend(
         q, leafLevel,
         [&](std::size_t first, std::size_t last) {
             for (std::size_t i = first; i < last; ++i) {
                 const std::uint32_t index = indices_[i];
-                offer(heap, k, Neighbour{index, (points_[index] - q).squaredNorm()});
+                const float d2 = (points_[index] - q).squaredNorm();
+                if (d2 <= maxSquared)
+                    offer(heap, k, Neighbour{index, d2});
             }
         },
-        [&](double gap2) { return heapFull(heap, k) && gap2 > static_cast<double>(heap.front().squaredDistance) * (1 + kSlack); });
+        [&](double gap2) {
+            return gap2 > limit || (heapFull(heap, k) && gap2 > static_cast<double>(heap.front().squaredDistance) * (1 + kSlack));
+        });
 }
 
 void Octree::nearest(const Eigen::Vector3f& q, std::size_t k, int level, std::vector<Neighbour>& out) const
@@ -572,10 +577,20 @@ detail::QueryGroups Octree::groupQueriesByCell(const Eigen::Vector3f* queries, s
 }
 
 void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std::size_t k, int level,
-                          std::vector<Neighbour>& out, QueryStatistics* statistics) const
+                          std::vector<Neighbour>& out, QueryStatistics* statistics, float maxDistance) const
 {
     if (level < 1 || level > kMaxLevel)
         throw std::invalid_argument("octree level must be in 1.." + std::to_string(kMaxLevel));
+    if (std::isnan(maxDistance) || maxDistance < 0)
+        throw std::invalid_argument("the maximum distance must be >= 0");
+    const bool bounded = maxDistance < std::numeric_limits<float>::infinity();
+    const float maxSquared = bounded ? maxDistance * maxDistance : std::numeric_limits<float>::infinity();
+    // The bounded full search: best-first descent pruned at the distance.
+    auto boundedSearch = [&](const Eigen::Vector3f& q, std::vector<Neighbour>& heap) {
+        heap.clear();
+        descendNearest(q, k, level, heap, maxSquared);
+        std::sort_heap(heap.begin(), heap.end());
+    };
     const Neighbour missing{std::numeric_limits<std::uint32_t>::max(), std::numeric_limits<float>::infinity()};
     // Every slot is written by the worker that answers its query (padded with
     // `missing`), so a caller's buffer of the right size is reused as it is,
@@ -615,7 +630,10 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                         store(qi, s.heap); // no neighbour for a NaN query
                         continue;
                     }
-                    nearest(queries[qi], k, level, s.heap);
+                    if (bounded)
+                        boundedSearch(queries[qi], s.heap);
+                    else
+                        nearest(queries[qi], k, level, s.heap);
                     store(qi, s.heap);
                     ++s.statistics.fullSearches;
                 }
@@ -688,7 +706,9 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                     // one pass per cell, the own cell first, then faces, edges and
                     // corners; a cell whose box is already farther than the best
                     // distance is skipped (ties are still scanned).
-                    float bestDistance = std::numeric_limits<float>::infinity();
+                    // Bounded: a candidate at most at the bound is kept (the tie
+                    // rule prefers any index to the missing one).
+                    float bestDistance = maxSquared;
                     std::uint32_t bestIndex = std::numeric_limits<std::uint32_t>::max();
                     std::size_t scanned = 0;
                     for (std::size_t c = 0; c < offsets.size(); ++c) {
@@ -726,10 +746,18 @@ void Octree::nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std
                 const double inscribed = l + inner;
                 // k = 1 leaves its single entry in s.heap, k > 1 a sorted list: either
                 // way the k-th distance is the last entry.
-                const bool settled = heapFull(s.heap, k) &&
-                                     static_cast<double>(s.heap.back().squaredDistance) * (1 + kSlack) < inscribed * inscribed;
+                // Bounded: entries beyond the bound go, and when the 27 cells
+                // hold every point within it, what is left is the answer.
+                while (bounded && !s.heap.empty() && s.heap.back().squaredDistance > maxSquared)
+                    s.heap.pop_back();
+                const bool settled = (heapFull(s.heap, k) &&
+                                      static_cast<double>(s.heap.back().squaredDistance) * (1 + kSlack) < inscribed * inscribed) ||
+                                     (bounded && static_cast<double>(maxDistance) * (1 + kSlack) < inscribed);
                 if (!settled) {
-                    nearest(q, k, level, s.heap);
+                    if (bounded)
+                        boundedSearch(q, s.heap);
+                    else
+                        nearest(q, k, level, s.heap);
                     ++s.statistics.fullSearches;
                 }
                 store(qi, s.heap);

@@ -287,6 +287,43 @@ TEST(Octree, BatchNearestEqualsBruteForceAtEveryLevel)
     }
 }
 
+TEST(Octree, BoundedBatchNearestEqualsBruteForceWithinTheDistance)
+{
+    // Only neighbours within the distance, the k nearest of them, the rest
+    // missing: far queries and queries outside the cube included, at every level.
+    std::mt19937 rng(23);
+    for (const Shape& shape : kShapes) {
+        const Cloud cloud = shape.make(700, rng);
+        const Octree tree(cloud.data(), cloud.size());
+        Cloud queries = randomCloud(120, rng);
+        queries.insert(queries.end(), cloud.begin(), cloud.begin() + 60);
+        queries.push_back({1e3f, 0, 0});
+        queries.push_back({-30.0f, 0.5f, 0.5f});
+        for (int level = 1; level <= kMaxLevel; ++level)
+            for (std::size_t k : {1u, 6u})
+                for (float distance : {0.0f, 0.3f, 1.0f, 3.0f, 20.0f}) {
+                    std::vector<Neighbour> got;
+                    tree.nearestBatch(queries.data(), queries.size(), k, level, got, nullptr, distance);
+                    ASSERT_EQ(got.size(), queries.size() * k);
+                    for (std::size_t qi = 0; qi < queries.size(); ++qi) {
+                        std::vector<Neighbour> expected = bruteForceRadius(cloud, queries[qi], distance);
+                        expected.resize(std::min(k, expected.size()));
+                        std::vector<Neighbour> mine;
+                        for (std::size_t r = 0; r < k; ++r)
+                            if (got[qi * k + r].index != std::numeric_limits<std::uint32_t>::max())
+                                mine.push_back(got[qi * k + r]);
+                        expectSame(mine, expected, std::string(shape.name) + " level " + std::to_string(level) + " k " +
+                                                       std::to_string(k) + " distance " + std::to_string(distance) + " query " +
+                                                       std::to_string(qi));
+                    }
+                }
+    }
+    const Cloud one = {{0, 0, 0}};
+    const Octree small(one.data(), one.size());
+    std::vector<Neighbour> got;
+    EXPECT_THROW(small.nearestBatch(one.data(), 1, 1, 3, got, nullptr, -1.0f), std::invalid_argument);
+}
+
 TEST(Octree, BatchPadsMissingNeighboursAndSkipsNaNQueries)
 {
     const Cloud cloud = {{0, 0, 0}, {1, 0, 0}};

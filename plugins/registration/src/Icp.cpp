@@ -17,6 +17,8 @@ namespace scandiff::plugins {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+//! Moving points of the coarse iterations.
+constexpr std::size_t kCoarsePoints = 4000;
 
 //! The median of |values| (values copied: nth_element reorders).
 double medianAbsolute(std::vector<double> values)
@@ -76,10 +78,12 @@ struct Correspondences
     double cutoff = kInfinity; //!< the largest |residual| kept (trimming, threshold)
 };
 
+//! `searchBound`: closest points farther than this are not sought (the
+//! correspondence is left out).
 void correspond(const detail::ReferenceSurface& surface, const std::vector<Eigen::Vector3d>& x, const IcpParams& params,
-                double threshold, Correspondences& c)
+                double threshold, Correspondences& c, double searchBound = kInfinity)
 {
-    surface.closest(x, c.closest);
+    surface.closest(x, c.closest, searchBound);
     const std::size_t n = x.size();
     c.distance.assign(n, kInfinity);
     c.residual.assign(n, std::numeric_limits<double>::quiet_NaN());
@@ -181,6 +185,22 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
             x0.push_back(moving.globalPosition(i) - origin);
     if (x0.size() < 6)
         throw Error(ErrorCode::InvalidData, "registration: the moving cloud has fewer than 6 points with finite coordinates");
+    // Coarse to fine: the first iterations, while the clouds are still apart
+    // and each closest-point search goes far, use an even share of the
+    // sample (put first); once they have converged, the whole sample.
+    std::size_t active = x0.size();
+    if (x0.size() > 2 * kCoarsePoints) {
+        const std::size_t stride = x0.size() / kCoarsePoints;
+        std::vector<Eigen::Vector3d> ordered;
+        ordered.reserve(x0.size());
+        for (std::size_t i = 0; i < x0.size(); i += stride)
+            ordered.push_back(x0[i]);
+        active = ordered.size();
+        for (std::size_t i = 0; i < x0.size(); ++i)
+            if (i % stride != 0)
+                ordered.push_back(x0[i]);
+        x0 = std::move(ordered);
+    }
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     for (const auto& p : x0)
         centroid += p;
@@ -198,15 +218,25 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
                     (params.changeRobust ? ", change-robust" : "");
     double threshold = kInfinity, previousRms = kInfinity, rmsTwoBefore = kInfinity;
     bool kernelActive = false;
+    double kernelScale = kInfinity;
     std::vector<Eigen::Vector3d> x(x0.size()), xs, ys, ns;
     std::vector<double> w, usedResiduals;
     Eigen::MatrixXd normalMatrix;
     Correspondences c;
     ProgressTicker ticker(progress, "Registration (ICP)", params.maxIterations);
     for (std::size_t iteration = 1; iteration <= params.maxIterations; ++iteration) {
-        for (std::size_t i = 0; i < x0.size(); ++i)
+        x.resize(active);
+        for (std::size_t i = 0; i < active; ++i)
             x[i] = motion * x0[i];
-        correspond(surface, x, params, threshold, c);
+        // Beyond the maximum distance, or far beyond the change threshold
+        // (ten times: a closest point that far lies past the edge of the
+        // reference, not on the same surface), a closest point is not sought.
+        // With the kernel on, beyond 30 scales, where its weight is below 1 %,
+        // neither.
+        const double searchBound =
+            std::min({params.maxDistance.value_or(kInfinity), std::isfinite(threshold) ? 10 * threshold : kInfinity,
+                      kernelActive ? 30 * kernelScale : kInfinity});
+        correspond(surface, x, params, threshold, c, searchBound);
         if (c.usedCount < static_cast<std::size_t>(dofCount(params.constraint.dof)) + 3)
             throw Error(ErrorCode::InvalidData, "registration: only " + std::to_string(c.usedCount) +
                                                     " correspondences left (iteration " + std::to_string(iteration) +
@@ -229,6 +259,7 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
         // are still large with misalignment would down-weight the far points
         // that hold the rotation, and the result could slide into a wrong basin.
         const double scale = std::max(1.4826 * medianAbsolute(usedResiduals), 1e-12 * length);
+        kernelScale = scale;
         w.resize(xs.size());
         double sum2 = 0;
         for (std::size_t i = 0; i < xs.size(); ++i) {
@@ -276,6 +307,11 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
                            std::abs(rmsTwoBefore - rms) <= rmsTolerance;
         rmsTwoBefore = previousRms;
         previousRms = rms;
+        if (still && active < x0.size()) {
+            active = x0.size();
+            previousRms = rmsTwoBefore = kInfinity;
+            continue;
+        }
         if (still && !kernelActive && params.kernel != RobustKernel::None) {
             kernelActive = true;
             previousRms = rmsTwoBefore = kInfinity;
@@ -300,7 +336,7 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
     IcpParams final = params;
     final.overlap = 1.0; // the trimming of the last iteration is applied as its cutoff
     Correspondences last;
-    correspond(surface, all, final, std::min(threshold, c.cutoff), last);
+    correspond(surface, all, final, std::min(threshold, c.cutoff), last, params.maxDistance.value_or(kInfinity));
     result.residual = ScalarField(fields::kRegistrationResidual, n);
     result.excluded = ScalarField(fields::kRegistrationExcluded, n);
     std::vector<double> magnitudes;

@@ -10,6 +10,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <cmath>
 #include <limits>
 
 namespace scandiff::plugins::detail {
@@ -40,13 +41,16 @@ public:
         }
     }
 
-    void closest(const std::vector<Eigen::Vector3d>& queries, ClosestPoints& out) const override
+    void closest(const std::vector<Eigen::Vector3d>& queries, ClosestPoints& out, double maxDistance) const override
     {
         const std::size_t n = queries.size();
         queries_.resize(n);
         for (std::size_t i = 0; i < n; ++i)
             queries_[i] = (queries[i] + shift_).cast<float>();
-        tree_.nearestBatch(queries_.data(), n, 1, level_, neighbours_);
+        // Slightly wider in float, so a point at the bound in double is not lost to rounding.
+        const float bound = std::isfinite(maxDistance) ? static_cast<float>(maxDistance * (1 + 1e-6)) + 1e-6f
+                                                       : std::numeric_limits<float>::infinity();
+        tree_.nearestBatch(queries_.data(), n, 1, level_, neighbours_, nullptr, bound);
         out.points.resize(n);
         out.normals.resize(n);
         out.found.resize(n);
@@ -87,7 +91,7 @@ public:
         queries_.setOrigin(mesh.vertices.origin());
     }
 
-    void closest(const std::vector<Eigen::Vector3d>& queries, ClosestPoints& out) const override
+    void closest(const std::vector<Eigen::Vector3d>& queries, ClosestPoints& out, double maxDistance) const override
     {
         const std::size_t n = queries.size();
         queries_.resize(n);
@@ -95,6 +99,8 @@ public:
             queries_.positions()[i] = (queries[i] + shift_).cast<float>();
         CloudToMeshParams params;
         params.closestTriangles = true;
+        if (std::isfinite(maxDistance) && maxDistance > 0)
+            params.maxDistance = maxDistance * (1 + 1e-6) + 1e-6;
         const CloudToMeshResult result = cloudToMesh(queries_, mesh_, params);
         out.points.resize(n);
         out.normals.resize(n);

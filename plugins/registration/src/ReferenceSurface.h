@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -29,8 +30,11 @@ class ReferenceSurface
 {
 public:
     virtual ~ReferenceSurface() = default;
-    //! The closest point of the surface to each query (frame coordinates).
-    virtual void closest(const std::vector<Eigen::Vector3d>& queries, ClosestPoints& out) const = 0;
+    //! The closest point of the surface to each query (frame coordinates);
+    //! with a finite `maxDistance`, only within it (the others not found),
+    //! which makes queries far from the surface cheap.
+    virtual void closest(const std::vector<Eigen::Vector3d>& queries, ClosestPoints& out,
+                         double maxDistance = std::numeric_limits<double>::infinity()) const = 0;
     //! The frame's origin in global coordinates: the centre of the surface's box.
     const Eigen::Vector3d& frameOrigin() const { return origin_; }
 

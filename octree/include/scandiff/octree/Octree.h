@@ -167,8 +167,13 @@ public:
     //! 27-neighbourhood are gathered once for all its queries (thesis 000 §4.4,
     //! "same-cell optimisation"), and a query they do not settle by the
     //! inscribed-sphere rule gets a full search. Exact at every level.
+    //! With a finite `maxDistance`, only neighbours within it (squared distance,
+    //! in float, at most maxDistance²) are sought and reported, the others
+    //! missing: a query far from the cloud then costs a few cells instead of a
+    //! full search (what ICP needs with a maximum correspondence distance).
     void nearestBatch(const Eigen::Vector3f* queries, std::size_t count, std::size_t k, int level,
-                      std::vector<Neighbour>& out, QueryStatistics* statistics = nullptr) const;
+                      std::vector<Neighbour>& out, QueryStatistics* statistics = nullptr,
+                      float maxDistance = std::numeric_limits<float>::infinity()) const;
 
     //! Receives one query's neighbours in withinRadiusBatch(): the query's
     //! index and every point within the radius, in no particular order (the
@@ -215,7 +220,9 @@ private:
     //! sorted ranges, `prune(gap2)` ends the search once nothing closer remains.
     template <typename Visit, typename Prune>
     void descend(const Eigen::Vector3f& q, int leafLevel, Visit&& visitRange, Prune&& prune) const;
-    void descendNearest(const Eigen::Vector3f& q, std::size_t k, int leafLevel, std::vector<Neighbour>& heap) const;
+    //! The k nearest within sqrt(maxSquared) by best-first descent, as a max-heap.
+    void descendNearest(const Eigen::Vector3f& q, std::size_t k, int leafLevel, std::vector<Neighbour>& heap,
+                        float maxSquared = std::numeric_limits<float>::infinity()) const;
     void scanCell(std::int64_t x, std::int64_t y, std::int64_t z, int level, const Eigen::Vector3f& q, std::size_t k,
                   std::vector<Neighbour>& heap) const;
 
