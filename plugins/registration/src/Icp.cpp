@@ -218,7 +218,7 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
                     (params.changeRobust ? ", change-robust" : "");
     double threshold = kInfinity, previousRms = kInfinity, rmsTwoBefore = kInfinity;
     bool kernelActive = false;
-    double kernelScale = kInfinity;
+    double kernelScale = kInfinity, medianDistance = kInfinity;
     std::vector<Eigen::Vector3d> x(x0.size()), xs, ys, ns;
     std::vector<double> w, usedResiduals;
     Eigen::MatrixXd normalMatrix;
@@ -233,9 +233,11 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
         // reference, not on the same surface), a closest point is not sought.
         // With the kernel on, beyond 30 scales, where its weight is below 1 %,
         // neither.
+        // (Never below ten median correspondence distances: on a sparse
+        // reference the closest point is far while the plane is near.)
         const double searchBound =
             std::min({params.maxDistance.value_or(kInfinity), std::isfinite(threshold) ? 10 * threshold : kInfinity,
-                      kernelActive ? 30 * kernelScale : kInfinity});
+                      kernelActive ? std::max(30 * kernelScale, 10 * medianDistance) : kInfinity});
         correspond(surface, x, params, threshold, c, searchBound);
         if (c.usedCount < static_cast<std::size_t>(dofCount(params.constraint.dof)) + 3)
             throw Error(ErrorCode::InvalidData, "registration: only " + std::to_string(c.usedCount) +
@@ -286,12 +288,12 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
         const double translationStep = step.translation().norm();
         report.trace.push_back({iteration, rms, xs.size(), threshold, rotationStep, translationStep});
         report.iterations = iteration;
+        medianDistance = medianAbsolute(usedDistances);
         if (params.changeRobust) {
             // Thesis 000 §1.4: the threshold shrinks with the residuals (3 robust
             // sigmas), never below the median spacing of the correspondences,
             // never growing back.
-            const double floor = medianAbsolute(usedDistances);
-            threshold = std::min(threshold, std::max(3.0 * 1.4826 * medianAbsolute(usedResiduals), floor));
+            threshold = std::min(threshold, std::max(3.0 * 1.4826 * medianAbsolute(usedResiduals), medianDistance));
         }
         ticker.step();
         // Converged when the step moves the points by less than the tolerance
@@ -307,8 +309,13 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
                            std::abs(rmsTwoBefore - rms) <= rmsTolerance;
         rmsTwoBefore = previousRms;
         previousRms = rms;
-        if (still && active < x0.size()) {
+        // The coarse stage only has to bring the clouds together: it ends
+        // once a step moves the points by less than 1e-4 of their radius. The
+        // whole sample then starts with the kernel on, if asked for: the
+        // coarse convergence is what the kernel waits for.
+        if ((still || move < 1e-4 * length) && active < x0.size()) {
             active = x0.size();
+            kernelActive = params.kernel != RobustKernel::None;
             previousRms = rmsTwoBefore = kInfinity;
             continue;
         }

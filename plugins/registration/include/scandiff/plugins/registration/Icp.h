@@ -51,7 +51,7 @@ struct IcpParams
     std::size_t maxIterations = 100;
     //! Converged when an iteration moves the points by less than this (m), or
     //! the RMS changes by less than this fraction.
-    double moveTolerance = 1e-7;
+    double moveTolerance = 1e-6;
     double rmsTolerance = 1e-7;
     //! Reference normals for point-to-plane (when the reference cloud has
     //! none): a plane fit on this many neighbours.
