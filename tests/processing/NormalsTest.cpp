@@ -3,12 +3,15 @@
 #include "SyntheticClouds.h"
 #include "TestSupport.h"
 
+#include <scandiff/core/CloudOctree.h>
 #include <scandiff/core/Error.h>
 #include <scandiff/core/processing/Normals.h>
 
 #include <Eigen/Geometry>
 
 #include <gtest/gtest.h>
+
+#include <random>
 
 using namespace scandiff;
 using scandiff::test::kPi;
@@ -237,4 +240,34 @@ TEST(Normals, CancelStopsTheFit)
     NormalParams byRadius;
     byRadius.radius = 0.02;
     EXPECT_EQ(test::errorCodeOf([&] { computeNormals(sphere, byRadius, &cancel); }), ErrorCode::Cancelled);
+}
+
+TEST(Normals, SomePointsOnlyGiveTheNormalsOfTheWholeCloud)
+{
+    // planeNormalsOf (the registration's normals where closest points land)
+    // equals computeNormals with the same neighbours and +Z, bit for bit, in
+    // turns of a few points each.
+    std::mt19937 rng(8);
+    std::uniform_real_distribution<float> u(-5.0f, 5.0f);
+    PointCloud cloud;
+    cloud.resize(4000);
+    for (auto& p : cloud.positions()) {
+        const float x = u(rng), y = u(rng);
+        p = {x, y, 0.3f * std::sin(x) * std::cos(y) + 0.01f * u(rng)};
+    }
+    NormalParams params;
+    params.knn = 12;
+    const NormalResult all = computeNormals(cloud, params);
+    const octree::Octree tree = buildOctree(cloud);
+    std::vector<Eigen::Vector3f> some(cloud.size(), Eigen::Vector3f::Zero());
+    std::vector<std::uint32_t> first, second;
+    for (std::uint32_t i = 0; i < cloud.size(); ++i)
+        (i % 3 == 0 ? first : second).push_back(i);
+    planeNormalsOf(cloud, tree, first, 12, some);
+    for (std::uint32_t i : second)
+        EXPECT_EQ(some[i], Eigen::Vector3f::Zero()); // untouched until asked for
+    planeNormalsOf(cloud, tree, second, 12, some);
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        ASSERT_EQ(some[i], all.normals[i]) << i;
+    EXPECT_THROW(planeNormalsOf(cloud, tree, first, 2, some), Error);
 }

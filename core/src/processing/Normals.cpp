@@ -157,6 +157,36 @@ NormalResult computeNormals(const PointCloud& cloud, const NormalParams& params,
     return result;
 }
 
+void planeNormalsOf(const PointCloud& cloud, const octree::Octree& tree, const std::vector<std::uint32_t>& indices, std::size_t knn,
+                    std::vector<Eigen::Vector3f>& normals)
+{
+    if (knn < 3)
+        throw Error(ErrorCode::InvalidArgument, "normals: at least 3 neighbours");
+    if (normals.size() != cloud.size())
+        throw Error(ErrorCode::InvalidArgument, "normals: one slot per point of the cloud");
+    const auto& positions = cloud.positions();
+    std::vector<Eigen::Vector3f> queries(indices.size());
+    for (std::size_t q = 0; q < indices.size(); ++q)
+        queries[q] = positions[indices[q]];
+    const int level = tree.levelNearestMeanPopulation(std::max(8.0, 3.0 * static_cast<double>(knn)));
+    std::vector<octree::Neighbour> found;
+    tree.nearestBatch(queries.data(), queries.size(), knn, level, found);
+    tbb::parallel_for(std::size_t(0), indices.size(), [&](std::size_t q) {
+        const octree::Neighbour* list = found.data() + q * knn;
+        std::size_t count = 0;
+        while (count < knn && list[count].index != std::numeric_limits<std::uint32_t>::max())
+            ++count;
+        detail::LocalPlane plane;
+        Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+        if (detail::fitLocalPlane(positions.data(), queries[q], list, count, plane)) {
+            normal = plane.normal.cast<float>();
+            if (normal.z() < 0)
+                normal = -normal;
+        }
+        normals[indices[q]] = normal;
+    });
+}
+
 namespace {
 
 void orientTowards(const PointCloud& cloud, std::vector<Eigen::Vector3f>& normals,

@@ -161,7 +161,7 @@ IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud
         throw Error(ErrorCode::InvalidData, "registration: the reference cloud '" + referenceCloud->name + "' is empty");
     const std::unique_ptr<detail::ReferenceSurface> surface =
         referenceMesh ? detail::meshSurface(*referenceMesh)
-                      : detail::cloudSurface(*referenceCloud, true, params.normalNeighbours, progress);
+                      : detail::cloudSurface(*referenceCloud, true, params.normalNeighbours);
     return detail::icpOnSurface(moving, *surface, params, progress);
 }
 

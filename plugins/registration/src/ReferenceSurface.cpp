@@ -26,7 +26,7 @@ Eigen::Vector3d boxCentre(const PointCloud& cloud)
 class CloudSurface : public ReferenceSurface
 {
 public:
-    CloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours, ProgressObserver* progress)
+    CloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours)
         : cloud_(cloud), tree_(buildOctree(cloud))
     {
         origin_ = boxCentre(cloud);
@@ -34,10 +34,13 @@ public:
         // point O + q, that is (O - cloud origin) + q in the cloud's frame.
         shift_ = origin_ - cloud.origin();
         level_ = tree_.levelNearestMeanPopulation(30.0);
+        // Normals are fitted where closest points land, when they first do:
+        // a registration touches a part of the reference (a sample, its
+        // overlap), not all of it.
         if (needNormals && !cloud.hasNormals()) {
-            NormalParams params;
-            params.knn = normalNeighbours;
-            normals_ = computeNormals(cloud, params, progress).normals;
+            normals_.assign(cloud.size(), Eigen::Vector3f::Zero());
+            fitted_.assign(cloud.size(), 0);
+            normalNeighbours_ = normalNeighbours;
         }
     }
 
@@ -51,6 +54,15 @@ public:
         const float bound = std::isfinite(maxDistance) ? static_cast<float>(maxDistance * (1 + 1e-6)) + 1e-6f
                                                        : std::numeric_limits<float>::infinity();
         tree_.nearestBatch(queries_.data(), n, 1, level_, neighbours_, nullptr, bound);
+        if (!fitted_.empty()) {
+            std::vector<std::uint32_t> missing;
+            for (const auto& neighbour : neighbours_)
+                if (neighbour.index != std::numeric_limits<std::uint32_t>::max() && !fitted_[neighbour.index]) {
+                    fitted_[neighbour.index] = 1;
+                    missing.push_back(neighbour.index);
+                }
+            planeNormalsOf(cloud_, tree_, missing, normalNeighbours_, normals_);
+        }
         out.points.resize(n);
         out.normals.resize(n);
         out.found.resize(n);
@@ -72,7 +84,10 @@ private:
     octree::Octree tree_;
     int level_ = 1;
     Eigen::Vector3d shift_;
-    std::vector<Eigen::Vector3f> normals_;
+    // Normals fitted so far (zero where not yet, or where no plane fits).
+    mutable std::vector<Eigen::Vector3f> normals_;
+    mutable std::vector<char> fitted_;
+    std::size_t normalNeighbours_ = 12;
     // Buffers reused from one iteration to the next (a surface serves one run at a time).
     mutable std::vector<Eigen::Vector3f> queries_;
     mutable std::vector<octree::Neighbour> neighbours_;
@@ -132,10 +147,9 @@ private:
 
 } // namespace
 
-std::unique_ptr<ReferenceSurface> cloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours,
-                                               ProgressObserver* progress)
+std::unique_ptr<ReferenceSurface> cloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours)
 {
-    return std::make_unique<CloudSurface>(cloud, needNormals, normalNeighbours, progress);
+    return std::make_unique<CloudSurface>(cloud, needNormals, normalNeighbours);
 }
 
 std::unique_ptr<ReferenceSurface> meshSurface(const Mesh& mesh)

@@ -42,10 +42,10 @@ protected:
     Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
 };
 
-//! A cloud: `needNormals` computes them when the cloud has none (a plane on
-//! `normalNeighbours` points, turned towards +Z). The cloud must outlive the surface.
-std::unique_ptr<ReferenceSurface> cloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours,
-                                               ProgressObserver* progress);
+//! A cloud: `needNormals` fits them when the cloud has none (a plane on
+//! `normalNeighbours` points, turned towards +Z), each where a closest point
+//! first lands. The cloud must outlive the surface.
+std::unique_ptr<ReferenceSurface> cloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours);
 //! A mesh (triangle normals by vertex order). The mesh must outlive the surface.
 std::unique_ptr<ReferenceSurface> meshSurface(const Mesh& mesh);
 

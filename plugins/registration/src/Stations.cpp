@@ -101,7 +101,7 @@ std::vector<Station> prepare(const std::vector<const PointCloud*>& clouds, const
         if (!clouds[k] || clouds[k]->empty())
             throw Error(ErrorCode::InvalidData, "stations: station " + std::to_string(k) + " is empty");
         stations[k].cloud = clouds[k];
-        stations[k].surface = detail::cloudSurface(*clouds[k], true, 12, progress);
+        stations[k].surface = detail::cloudSurface(*clouds[k], true, 12);
     }
     worldOrigin = stations[0].surface->frameOrigin();
     for (std::size_t k = 0; k < clouds.size(); ++k) {

@@ -22,6 +22,7 @@
 
 #include <scandiff/core/PointCloud.h>
 #include <scandiff/core/Progress.h>
+#include <scandiff/octree/Octree.h>
 
 #include <Eigen/Core>
 
@@ -84,6 +85,15 @@ struct NormalResult
 //! a sensor orientation without any sensor, Error(InvalidData) for an empty
 //! cloud or non-finite coordinates, Error(Cancelled).
 NormalResult computeNormals(const PointCloud& cloud, const NormalParams& params, ProgressObserver* progress = nullptr);
+
+//! Plane normals (the least-squares plane of the `knn` >= 3 nearest points)
+//! of the points `indices` of `cloud` only, turned towards +Z, written to
+//! their slots of `normals` (one per point of the cloud; a zero vector where
+//! no plane fits): for a caller that needs some of them, in turns, and holds
+//! the cloud's octree (`tree`, built on its positions). The same normals as
+//! computeNormals with the same neighbours and orientation.
+void planeNormalsOf(const PointCloud& cloud, const octree::Octree& tree, const std::vector<std::uint32_t>& indices, std::size_t knn,
+                    std::vector<Eigen::Vector3f>& normals);
 
 //! Orients `normals` (one per point of `cloud`, zero vectors are left alone)
 //! in place; returns the number of connected parts for the MST orientation
