@@ -255,6 +255,9 @@ void MainWindow::buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu)
         action->setStatusTip(QString::fromStdString(tool.description));
         report(controller);
         connect(controller, &ToolController::resultReady, tree_, &EntityTree::selectEntity);
+        // A tool that picks points in the view (point pairs) gets the view's picks.
+        connect(view_, &CloudView::pointPicked, controller, &ToolController::pointPicked);
+        connect(controller, &ToolController::pickModeRequested, view_, &CloudView::setPickMode);
         connect(controller, &ToolController::tablesReady, this, [this](const QString& title, const NamedTables& tables) {
             auto* window = new TableDialog(title, tables, this);
             window->show();

@@ -122,6 +122,13 @@ ParameterSpec ParameterSpec::withSuggestions(std::vector<std::string> values) co
     return s;
 }
 
+ParameterSpec ParameterSpec::pickedAlternatelyOn(std::vector<std::string> roles) const
+{
+    ParameterSpec s = *this;
+    s.pickedOn = std::move(roles);
+    return s;
+}
+
 ParameterSpec ParameterSpec::asFieldOf(std::string role) const
 {
     ParameterSpec s = *this;

@@ -54,6 +54,26 @@ TEST(Transform, TransformAndInverseGiveThePointsBack)
     EXPECT_EQ(test::errorCodeOf([&] { transformCloud(cloud, scaleAbout(1, centre) * 0.0, ""); }), ErrorCode::InvalidArgument);
 }
 
+TEST(Transform, UndoMovesBackAndForgetsTheStep)
+{
+    PointCloud cloud = test::randomPlaneCloud(1000, 50.0, 7);
+    cloud.setOrigin(Eigen::Vector3d(512000, 5403000, 120));
+    const Eigen::Matrix4d first = translation(Eigen::Vector3d(1, 2, 3));
+    const Eigen::Matrix4d second = rotationAbout(Eigen::Vector3d::UnitZ(), 25, Eigen::Vector3d(512020, 5403020, 120));
+    const PointCloud once = transformCloud(cloud, first, "first");
+    const PointCloud twice = transformCloud(once, second, "registration");
+    const PointCloud undone = undoLastTransform(twice);
+    ASSERT_EQ(undone.transformHistory().size(), 1u);
+    EXPECT_EQ(undone.transformHistory()[0].description, "first");
+    // Back to the float steps of the local coordinates of both moves (each
+    // 0.06 mm within a kilometre of the origin).
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        ASSERT_LT((undone.globalPosition(i) - once.globalPosition(i)).norm(), 2.5e-4) << i;
+    const PointCloud original = undoLastTransform(undone);
+    EXPECT_TRUE(original.transformHistory().empty());
+    EXPECT_EQ(test::errorCodeOf([&] { undoLastTransform(original); }), ErrorCode::InvalidArgument);
+}
+
 TEST(Merge, CloudsWithDifferentShiftsKeepTheirMillimetres)
 {
     PointCloud a = test::randomPlaneCloud(1000, 20.0, 1), b = test::randomPlaneCloud(500, 20.0, 2);

@@ -9,7 +9,10 @@
 #include <scandiff/io/ResultFiles.h>
 
 #include <QElapsedTimer>
+
+#include <algorithm>
 #include <QMessageBox>
+#include <QTimer>
 
 #include <optional>
 
@@ -18,6 +21,12 @@ namespace scandiff::gui {
 ToolController::ToolController(const ToolSpec& tool, Document& document, QWidget* parentWindow)
     : QObject(parentWindow), tool_(tool), document_(document), parentWindow_(parentWindow)
 {
+}
+
+ToolController::~ToolController()
+{
+    // An open picking dialog refers to the tool and the document.
+    delete openDialog_.data();
 }
 
 void ToolController::runInteractively(const std::vector<EntityId>& selection)
@@ -29,9 +38,37 @@ void ToolController::runInteractively(const std::vector<EntityId>& selection)
                                      input.kind == DataKind::Mesh ? tr("Open a mesh first.") : tr("Open a point cloud first."));
             return;
         }
-    ToolDialog dialog(tool_, document_, proposed, parentWindow_);
-    if (dialog.exec() == QDialog::Accepted)
-        run(dialog.inputs(), dialog.values());
+    const bool picks = std::any_of(tool_.parameters.begin(), tool_.parameters.end(),
+                                   [](const ParameterSpec& p) { return !p.pickedOn.empty(); });
+    if (!picks) {
+        ToolDialog dialog(tool_, document_, proposed, parentWindow_);
+        if (dialog.exec() == QDialog::Accepted)
+            run(dialog.inputs(), dialog.values());
+        return;
+    }
+    // Points are picked in the view while the dialog is open: it must not block it.
+    if (openDialog_) {
+        openDialog_->raise();
+        openDialog_->activateWindow();
+        return;
+    }
+    auto* dialog = new ToolDialog(tool_, document_, proposed, parentWindow_);
+    dialog->setAttribute(Qt::WA_DeleteOnClose);
+    dialog->setModal(false);
+    openDialog_ = dialog;
+    connect(dialog, &ToolDialog::pickModeRequested, this, &ToolController::pickModeRequested);
+    // Run once the dialog has closed: the run's progress loop may delete it
+    // (WA_DeleteOnClose) and must not do so while it is still emitting.
+    connect(dialog, &QDialog::accepted, this, [this, dialog] {
+        QTimer::singleShot(0, this, [this, inputs = dialog->inputs(), values = dialog->values()] { run(inputs, values); });
+    });
+    dialog->show();
+}
+
+void ToolController::pointPicked(EntityId id, std::size_t index)
+{
+    if (openDialog_)
+        openDialog_->pointPicked(id, index);
 }
 
 bool ToolController::run(EntityId input, const std::map<std::string, std::string>& parameters)
@@ -64,7 +101,9 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
 {
     const QString title = QString::fromStdString(tool_.title);
     ToolInputs inputs;
-    EntityId firstInput = kNoEntity;
+    // The entities of the first role: an output that updates its input
+    // replaces the first of them, the k-th of a repeated output the k-th.
+    std::vector<EntityId> firstRole;
     for (const InputSpec& spec : tool_.inputs) {
         const auto it = choice.find(spec.role);
         if (it == choice.end())
@@ -76,10 +115,11 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
                 return false;
             }
             inputs.add(spec.role, item->entity);
-            if (firstInput == kNoEntity)
-                firstInput = id;
+            if (&spec == &tool_.inputs.front())
+                firstRole.push_back(id);
         }
     }
+    const EntityId firstInput = firstRole.empty() ? kNoEntity : firstRole.front();
     std::optional<ToolResult> result;
     QElapsedTimer clock;
     clock.start();
@@ -97,7 +137,9 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
     EntityId last = kNoEntity;
     NamedTables tables;
     for (const OutputSpec& spec : tool_.outputs) {
+        std::size_t repeat = 0;
         for (ToolOutput* output : result->findAll(spec.role)) {
+            const std::size_t k = repeat++;
             if (auto* table = std::get_if<Table>(&output->data)) {
                 tables.emplace_back(spec.label, std::move(*table));
                 continue;
@@ -108,9 +150,9 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
             }
             io::Entity entity = std::holds_alternative<PointCloud>(output->data) ? io::Entity(std::move(std::get<PointCloud>(output->data)))
                                                                                  : io::Entity(std::move(std::get<Mesh>(output->data)));
-            if (spec.updatesInput && firstInput != kNoEntity) {
-                document_.replaceData(firstInput, std::move(entity));
-                last = firstInput;
+            if (spec.updatesInput && k < firstRole.size()) {
+                document_.replaceData(firstRole[k], std::move(entity));
+                last = firstRole[k];
                 continue;
             }
             const std::string& dataName = pointsOf(entity).name;

@@ -14,6 +14,7 @@
 #include <scandiff/core/ToolRegistry.h>
 
 #include <QObject>
+#include <QPointer>
 
 class QWidget;
 
@@ -24,6 +25,7 @@ class ToolController : public QObject
     Q_OBJECT
 public:
     ToolController(const ToolSpec& tool, Document& document, QWidget* parentWindow);
+    ~ToolController() override;
 
     const ToolSpec& tool() const { return tool_; }
     //! Asks for the inputs (proposed from `selection`, the tree's selected
@@ -34,8 +36,17 @@ public:
     bool run(EntityId input, const std::map<std::string, std::string>& parameters);
     //! The same with entities for every role.
     bool run(const ToolInputChoice& inputs, const std::map<std::string, std::string>& parameters);
+    //! The dialog open for picking in the view (a tool with a picked
+    //! parameter opens it without blocking the view), or null.
+    ToolDialog* openDialog() const { return openDialog_; }
+
+public slots:
+    //! A point picked in the view: for the open dialog, if it picks.
+    void pointPicked(EntityId id, std::size_t index);
 
 signals:
+    //! The view's pick mode should be on (a dialog picks points) or off.
+    void pickModeRequested(bool on);
     void finished(const QString& summary);
     void failed(const QString& message);
     //! The entity the run created or changed last (the tree selects it).
@@ -50,6 +61,7 @@ private:
     const ToolSpec& tool_;
     Document& document_;
     QWidget* parentWindow_;
+    QPointer<ToolDialog> openDialog_;
 };
 
 } // namespace scandiff::gui

@@ -15,15 +15,15 @@
 
 namespace scandiff::gui {
 
-namespace {
-
-QTableWidget* makeView(const Table& table, QWidget* parent)
+void fillTableWidget(QTableWidget& view, const Table& table)
 {
-    auto* view = new QTableWidget(static_cast<int>(table.rows.size()), static_cast<int>(table.columns.size()), parent);
+    view.clear();
+    view.setRowCount(static_cast<int>(table.rows.size()));
+    view.setColumnCount(static_cast<int>(table.columns.size()));
     QStringList headers;
     for (const auto& c : table.columns)
         headers << QString::fromStdString(c);
-    view->setHorizontalHeaderLabels(headers);
+    view.setHorizontalHeaderLabels(headers);
     for (std::size_t r = 0; r < table.rows.size(); ++r)
         for (std::size_t c = 0; c < table.rows[r].size() && c < table.columns.size(); ++c) {
             const TableCell& cell = table.rows[r][c];
@@ -31,13 +31,10 @@ QTableWidget* makeView(const Table& table, QWidget* parent)
                                                                        : QString::fromStdString(std::get<std::string>(cell));
             auto* item = new QTableWidgetItem(text);
             item->setFlags(item->flags() & ~Qt::ItemIsEditable);
-            view->setItem(static_cast<int>(r), static_cast<int>(c), item);
+            view.setItem(static_cast<int>(r), static_cast<int>(c), item);
         }
-    view->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
-    return view;
+    view.horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
 }
-
-} // namespace
 
 TableDialog::TableDialog(const QString& title, NamedTables tables, QWidget* parent) : QDialog(parent), tables_(std::move(tables))
 {
@@ -46,7 +43,8 @@ TableDialog::TableDialog(const QString& title, NamedTables tables, QWidget* pare
     auto* layout = new QVBoxLayout(this);
     tabs_ = new QTabWidget(this);
     for (const auto& [name, table] : tables_) {
-        views_.push_back(makeView(table, tabs_));
+        views_.push_back(new QTableWidget(tabs_));
+        fillTableWidget(*views_.back(), table);
         tabs_->addTab(views_.back(), QString::fromStdString(name));
     }
     tabs_->tabBar()->setVisible(tables_.size() > 1);

@@ -20,6 +20,10 @@ namespace scandiff::gui {
 //! Tables by name, in the order a tool gave them.
 using NamedTables = std::vector<std::pair<std::string, Table>>;
 
+//! Shows `table` in `view` (its columns as headers, cells read-only, numbers
+//! to 10 significant digits), replacing what it showed.
+void fillTableWidget(QTableWidget& view, const Table& table);
+
 class TableDialog : public QDialog
 {
     Q_OBJECT

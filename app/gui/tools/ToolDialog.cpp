@@ -2,6 +2,9 @@
 #include "tools/ToolDialog.h"
 
 #include "tools/ParameterForm.h"
+#include "tools/PickedPointsPanel.h"
+
+#include <scandiff/core/Error.h>
 
 #include <QComboBox>
 #include <QFormLayout>
@@ -39,6 +42,15 @@ ToolInputChoice proposeInputs(const Document& document, const ToolSpec& tool, co
                 if (!input.repeated)
                     break;
             }
+        // A repeated role (merge, stations) with fewer than two chosen: every
+        // accepted entity left, in the document's order.
+        if (input.repeated && picked.size() < 2) {
+            for (EntityId id : accepted)
+                if (!isUsed(id) && std::find(picked.begin(), picked.end(), id) == picked.end()) {
+                    picked.push_back(id);
+                    used.push_back(id);
+                }
+        }
         if (picked.empty() && !input.optional)
             for (auto it = accepted.rbegin(); it != accepted.rend(); ++it)
                 if (!isUsed(*it)) {
@@ -51,7 +63,7 @@ ToolInputChoice proposeInputs(const Document& document, const ToolSpec& tool, co
 }
 
 ToolDialog::ToolDialog(const ToolSpec& tool, const Document& document, const ToolInputChoice& proposed, QWidget* parent)
-    : QDialog(parent)
+    : QDialog(parent), tool_(tool), document_(document)
 {
     setWindowTitle(QString::fromStdString(tool.title));
     auto* layout = new QVBoxLayout(this);
@@ -97,7 +109,29 @@ ToolDialog::ToolDialog(const ToolSpec& tool, const Document& document, const Too
     layout->addWidget(inputsBox);
 
     form_ = new ParameterForm(tool.parameters, this);
+    // A parameter picked in the view: the panel between the form and the buttons.
+    for (const ParameterSpec& p : tool.parameters)
+        if (!p.pickedOn.empty() && !picked_) {
+            picked_ = new PickedPointsPanel(p, tool.inputs, this);
+            pickedParameter_ = p.name;
+        }
     addFormAndButtons(*this, *layout, form_);
+    if (picked_) {
+        layout->insertWidget(layout->count() - 1, picked_);
+        connect(picked_, &PickedPointsPanel::pickModeRequested, this, &ToolDialog::pickModeRequested);
+        connect(picked_, &PickedPointsPanel::changed, this, [this] {
+            form_->setValue(pickedParameter_, picked_->text());
+            refreshPreview();
+        });
+        // Another degree-of-freedom setting changes the fit: the preview follows.
+        for (const ParameterSpec& p : tool.parameters)
+            if (QWidget* editor = form_->editor(p.name); editor && p.name != pickedParameter_) {
+                if (auto* box = qobject_cast<QComboBox*>(editor))
+                    connect(box, &QComboBox::currentTextChanged, this, &ToolDialog::refreshPreview);
+            }
+        connect(this, &QDialog::finished, this, [this] { emit pickModeRequested(false); });
+        refreshPreview();
+    }
 
     // A parameter naming a field lists the fields of the entity picked for its
     // role, and follows the picker.
@@ -128,6 +162,37 @@ ToolDialog::ToolDialog(const ToolSpec& tool, const Document& document, const Too
 }
 
 std::map<std::string, std::string> ToolDialog::values() const { return form_->values(); }
+
+EntityId ToolDialog::chosenEntity(const std::string& role) const
+{
+    const ToolInputChoice choice = inputs();
+    const auto it = choice.find(role);
+    return it == choice.end() || it->second.empty() ? kNoEntity : it->second.front();
+}
+
+void ToolDialog::pointPicked(EntityId id, std::size_t index)
+{
+    const Document::Item* item = document_.find(id);
+    if (!picked_ || !item || index >= item->points().size())
+        return;
+    picked_->addPoint(id, item->points().globalPosition(index), [this](const std::string& role) { return chosenEntity(role); });
+}
+
+void ToolDialog::refreshPreview()
+{
+    if (!picked_ || !tool_.preview)
+        return;
+    try {
+        ToolInputs inputs;
+        for (const auto& [role, ids] : this->inputs())
+            for (EntityId id : ids)
+                if (const Document::Item* item = document_.find(id))
+                    inputs.add(role, item->entity);
+        picked_->showPreview(tool_.preview(inputs, tool_.resolve(values())));
+    } catch (const std::exception& e) {
+        picked_->showPreviewError(QString::fromStdString(e.what()));
+    }
+}
 
 ToolInputChoice ToolDialog::inputs() const
 {

@@ -2,7 +2,8 @@
 #pragma once
 //! A tool's dialog: its description, one picker per declared input (a list of
 //! the open entities of the right kind, several ticked for a repeated input),
-//! and a ParameterForm generated from the tool's declarations (ToolSpec).
+//! a ParameterForm generated from the tool's declarations (ToolSpec), and for
+//! a parameter picked in the view a PickedPointsPanel with the tool's preview.
 
 #include "document/Document.h"
 
@@ -21,6 +22,7 @@ class QWidget;
 namespace scandiff::gui {
 
 class ParameterForm;
+class PickedPointsPanel;
 
 //! The entities chosen for each input role of a tool.
 using ToolInputChoice = std::map<std::string, std::vector<EntityId>>;
@@ -32,7 +34,8 @@ std::vector<EntityId> acceptedEntities(const Document& document, const InputSpec
 //! The inputs a tool proposes when started with `selection` (the tree's
 //! selected entities, current first): each role takes the first accepted
 //! selected entity not used by an earlier role, else the last accepted one
-//! added; a repeated role takes every accepted selected entity left.
+//! added; a repeated role takes every accepted selected entity left, or,
+//! with fewer than two selected, every accepted entity left.
 ToolInputChoice proposeInputs(const Document& document, const ToolSpec& tool, const std::vector<EntityId>& selection);
 
 class ToolDialog : public QDialog
@@ -48,16 +51,32 @@ public:
     //! The widget editing `parameterName` (tests drive it), null if unknown.
     QWidget* editor(const std::string& parameterName) const;
     ParameterForm* form() const { return form_; }
+    //! The panel of the parameter picked in the view, null if the tool has none.
+    PickedPointsPanel* pickedPoints() const { return picked_; }
+    //! A point picked in the view (point `index` of entity `id`), for the panel.
+    void pointPicked(EntityId id, std::size_t index);
+
+signals:
+    //! The view's pick mode should follow the panel's Pick button.
+    void pickModeRequested(bool on);
 
 private:
+    //! Runs the tool's preview on the current inputs and values, into the panel.
+    void refreshPreview();
+    EntityId chosenEntity(const std::string& role) const;
+
     struct Picker
     {
         std::string role;
         QComboBox* single = nullptr;
         QListWidget* several = nullptr;
     };
+    const ToolSpec& tool_;
+    const Document& document_;
     std::vector<Picker> pickers_;
     ParameterForm* form_;
+    PickedPointsPanel* picked_ = nullptr;
+    std::string pickedParameter_;
 };
 
 } // namespace scandiff::gui

@@ -111,6 +111,18 @@ PointCloud mergeClouds(const std::vector<const PointCloud*>& clouds, ProgressObs
     return merged;
 }
 
+PointCloud undoLastTransform(const PointCloud& cloud, ProgressObserver* progress)
+{
+    if (cloud.transformHistory().empty())
+        throw Error(ErrorCode::InvalidArgument, "undo: '" + cloud.name + "' has no transformation to undo");
+    const AppliedTransform last = cloud.transformHistory().back();
+    PointCloud out = transformCloud(cloud, last.matrix.inverse(), "undo", progress);
+    // Neither the undone step nor its undoing stays in the history.
+    out.transformHistory().pop_back();
+    out.transformHistory().pop_back();
+    return out;
+}
+
 Eigen::Matrix4d rotationAbout(const Eigen::Vector3d& axis, double degrees, const Eigen::Vector3d& centre)
 {
     if (!(axis.norm() > 0) || !axis.allFinite() || !std::isfinite(degrees))

@@ -291,7 +291,8 @@ void addPointPairsTool(ToolRegistry& registry)
     tool.parameters = {
         ParameterSpec::text("pairs", "Point pairs",
                             "MX,MY,MZ,RX,RY,RZ per pair (moving point, then the same point on the reference), pairs separated "
-                            "by ';', or a text/CSV file of such lines"),
+                            "by ';', or a text/CSV file of such lines")
+            .pickedAlternatelyOn({"moving", "reference"}),
     };
     for (const auto& p : dofParameters())
         tool.parameters.push_back(p);
@@ -304,6 +305,18 @@ void addPointPairsTool(ToolRegistry& registry)
         result.add("matrix", report.matrix);
         result.add("report", reportTable(report));
         return result;
+    };
+    // Each pair's residual as the pairs are picked: what tells a mistaken pick.
+    tool.preview = [](const ToolInputs&, const ParameterValues& values) {
+        const RegistrationReport report = fitPointPairs(parsePointPairs(values.text("pairs")), dofFrom(values));
+        Table t;
+        t.columns = {"pair", "residual_m"};
+        for (std::size_t i = 0; i < report.pairResiduals.size(); ++i)
+            t.rows.push_back({std::to_string(i + 1), report.pairResiduals[i]});
+        t.rows.push_back({std::string("RMS"), report.rms});
+        for (const auto& note : report.notes)
+            t.rows.push_back({note, std::string()});
+        return t;
     };
     registry.add(std::move(tool));
 }

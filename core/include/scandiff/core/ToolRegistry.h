@@ -58,6 +58,11 @@ struct ParameterSpec
     //! Text only: the value names a scalar field of the entity given as this
     //! input role (the GUI lists that entity's fields; ';' joins several).
     std::string fieldOfInput;
+    //! Text only: the value is points picked in the view, in turn on the
+    //! entity of each of these input roles ("moving", "reference": a pair of
+    //! points), their global coordinates as numbers, a group per line (';'
+    //! between groups on the command line). The workbench fills it by picking.
+    std::vector<std::string> pickedOn;
 
     static ParameterSpec integer(std::string name, std::string label, std::string description, std::int64_t defaultValue,
                                  std::int64_t minimum, std::int64_t maximum, std::string unit = {});
@@ -77,6 +82,8 @@ struct ParameterSpec
     ParameterSpec withSuggestions(std::vector<std::string> values) const;
     //! The same declaration, naming a field of input `role` (see `fieldOfInput`).
     ParameterSpec asFieldOf(std::string role = "input") const;
+    //! The same declaration, picked in the view on these roles (see `pickedOn`).
+    ParameterSpec pickedAlternatelyOn(std::vector<std::string> roles) const;
 
     //! Parses user text ("12", "0.5", "true", "plane") into a valid value.
     //! Throws Error(InvalidArgument) naming the parameter and its valid range.
@@ -202,6 +209,11 @@ struct ToolSpec
     std::vector<OutputSpec> outputs{OutputSpec{}};
     std::vector<ParameterSpec> parameters;
     std::function<ToolResult(const ToolInputs&, const ParameterValues&, ProgressObserver*)> run;
+    //! Optional: a quick table of what a run would give, for the workbench to
+    //! show and refresh while the dialog is open (point pairs: each pair's
+    //! residual as the pairs are picked). Fast, no progress; throws
+    //! Error(InvalidArgument) with the reason while the values cannot give one.
+    std::function<Table(const ToolInputs&, const ParameterValues&)> preview;
 
     const ParameterSpec* parameter(const std::string& name) const;
     const InputSpec* input(const std::string& role) const;

@@ -195,6 +195,26 @@ void addTransformTool(ToolRegistry& registry)
     registry.add(std::move(tool));
 }
 
+void addUndoTransformTool(ToolRegistry& registry)
+{
+    ToolSpec tool = oneCloudTool("undo-transform", "Undo the last transformation", "Edit",
+                                 "Moves the cloud (or a mesh's vertices) back by the inverse of the last transformation in its "
+                                 "history (a registration, a transform) and removes it from the history.",
+                                 updatedCloud("Moved cloud"));
+    tool.outputs.push_back(OutputSpec{"matrix", "Undone matrix", DataKind::Transform, false});
+    tool.run = [](const ToolInputs& inputs, const ParameterValues&, ProgressObserver* progress) {
+        const PointCloud& input = inputs.cloud();
+        const AppliedTransform undone = input.transformHistory().empty() ? AppliedTransform{} : input.transformHistory().back();
+        PointCloud out = undoLastTransform(input, progress);
+        ToolResult result;
+        result.summary = describe("undid ", undone.description, " on ", out.size(), " points");
+        result.add("output", std::move(out));
+        result.add("matrix", undone.matrix);
+        return result;
+    };
+    registry.add(std::move(tool));
+}
+
 CropBox parseOrientedBox(const std::string& text)
 {
     const std::vector<double> v = parseNumberList(text, "the oriented box");
@@ -290,6 +310,7 @@ void registerEditTools(ToolRegistry& registry)
     addCloneTool(registry);
     addMergeTool(registry);
     addTransformTool(registry);
+    addUndoTransformTool(registry);
     addCropTool(registry);
 }
 

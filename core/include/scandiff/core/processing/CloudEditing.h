@@ -38,6 +38,12 @@ PointCloud mergeClouds(const std::vector<const PointCloud*>& clouds, ProgressObs
 PointCloud transformCloud(const PointCloud& cloud, const Eigen::Matrix4d& matrix, const std::string& description,
                           ProgressObserver* progress = nullptr);
 
+//! The cloud moved back by the inverse of the last transformation of its
+//! history, which then no longer holds it: positions to the float step of the
+//! local coordinates (0.06 mm within a kilometre of the cloud's origin). Throws
+//! Error(InvalidArgument) when the history is empty.
+PointCloud undoLastTransform(const PointCloud& cloud, ProgressObserver* progress = nullptr);
+
 //! A rotation about an axis through `centre` (right hand, degrees), a uniform
 //! scale about `centre`, a translation: the matrices transformCloud applies.
 Eigen::Matrix4d rotationAbout(const Eigen::Vector3d& axis, double degrees, const Eigen::Vector3d& centre);
