@@ -39,13 +39,15 @@ PickedPointsPanel::PickedPointsPanel(const ParameterSpec& parameter, const std::
     buttons->addStretch();
     layout->addLayout(buttons);
     pointsView_ = new QTableWidget(this);
-    pointsView_->setMinimumHeight(120);
+    pointsView_->setMinimumHeight(90);
+    pointsView_->setMaximumHeight(170);
     layout->addWidget(pointsView_);
     previewStatus_ = new QLabel(this);
     previewStatus_->setWordWrap(true);
     layout->addWidget(previewStatus_);
     previewView_ = new QTableWidget(this);
-    previewView_->setMinimumHeight(100);
+    previewView_->setMinimumHeight(80);
+    previewView_->setMaximumHeight(150);
     layout->addWidget(previewView_);
     connect(pick_, &QPushButton::toggled, this, &PickedPointsPanel::pickModeRequested);
     connect(undo, &QPushButton::clicked, this, &PickedPointsPanel::undoLast);
@@ -62,7 +64,8 @@ bool PickedPointsPanel::addPoint(EntityId entity, const Eigen::Vector3d& global,
                                  const std::function<EntityId(const std::string&)>& entityOfRole)
 {
     if (entityOfRole(expectedRole()) != entity) {
-        status_->setText(tr("That point is not on the %1 entity: pick on it (or change the choice above).")
+        status_->setText(tr("That point is not on the %1 entity: pick on it (untick the other in the Entities tree to "
+                            "pick through it, or change the choice above).")
                              .arg(roleLabels_.at(points_.size() % roles_.size()).toLower()));
         return false;
     }

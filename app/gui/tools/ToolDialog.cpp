@@ -131,6 +131,11 @@ ToolDialog::ToolDialog(const ToolSpec& tool, const Document& document, const Too
             }
         connect(this, &QDialog::finished, this, [this] { emit pickModeRequested(false); });
         refreshPreview();
+        // Tall enough for the form and the picks, at the right of the window,
+        // so that the view stays in sight while picking.
+        resize(std::max(width(), 560), 800);
+        if (parent)
+            move(parent->geometry().right() - width() - 8, parent->geometry().top() + 40);
     }
 
     // A parameter naming a field lists the fields of the entity picked for its

@@ -48,8 +48,10 @@ RegistrationReport fitPointPairs(const std::vector<PointPair>& pairs, const DofC
     report.median = report.p90 = report.p95 = report.p99 = std::numeric_limits<double>::quiet_NaN();
     report.overlap = 1.0;
     report.converged = true;
-    if (pairs.size() == needed)
-        report.notes.push_back("as many pairs as unknowns need: the residuals say nothing of the error; add pairs to check");
+    // Three pairs for six unknowns (two for four) still check each other
+    // through their distances; one pair for a translation does not.
+    if (constraint.dof == Dof::Translation && pairs.size() == 1)
+        report.notes.push_back("one pair fixes a translation exactly: its residual says nothing of the error; add pairs to check");
     return report;
 }
 

@@ -310,12 +310,13 @@ void addPointPairsTool(ToolRegistry& registry)
     tool.preview = [](const ToolInputs&, const ParameterValues& values) {
         const RegistrationReport report = fitPointPairs(parsePointPairs(values.text("pairs")), dofFrom(values));
         Table t;
-        t.columns = {"pair", "residual_m"};
+        t.columns = {"pair", "residual_m", "note"};
         for (std::size_t i = 0; i < report.pairResiduals.size(); ++i)
-            t.rows.push_back({std::to_string(i + 1), report.pairResiduals[i]});
-        t.rows.push_back({std::string("RMS"), report.rms});
+            t.rows.push_back({std::to_string(i + 1), report.pairResiduals[i], std::string()});
+        std::string notes;
         for (const auto& note : report.notes)
-            t.rows.push_back({note, std::string()});
+            notes += (notes.empty() ? "" : "; ") + note;
+        t.rows.push_back({std::string("RMS"), report.rms, notes});
         return t;
     };
     registry.add(std::move(tool));
