@@ -6,6 +6,8 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/processing/CloudEditing.h>
+#include <scandiff/io/FileIO.h>
+#include <scandiff/plugins/PluginRegistry.h>
 #include <scandiff/plugins/registration/GlobalAlignment.h>
 #include <scandiff/plugins/registration/Icp.h>
 #include <scandiff/plugins/registration/PointPairs.h>
@@ -15,6 +17,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 using namespace scandiff;
@@ -480,5 +483,77 @@ TEST(Stations, BadInput)
     } catch (const Error& e) {
         EXPECT_EQ(e.code(), ErrorCode::InvalidData);
         EXPECT_NE(std::string(e.what()).find("station 1"), std::string::npos) << e.what();
+    }
+}
+
+namespace {
+
+//! Two independent samplings of a real scan: its points shared at random
+//! between two clouds, the second moved by the inverse of `truth`.
+std::pair<PointCloud, PointCloud> splitAndMove(const PointCloud& scan, const Eigen::Matrix4d& truth)
+{
+    std::vector<std::size_t> order(scan.size());
+    for (std::size_t i = 0; i < order.size(); ++i)
+        order[i] = i;
+    std::mt19937 rng(12);
+    std::shuffle(order.begin(), order.end(), rng);
+    std::vector<std::size_t> a(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(order.size() / 2)),
+        b(order.begin() + static_cast<std::ptrdiff_t>(order.size() / 2), order.end());
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    PointCloud moved = transformCloud(scan.subset(b), truth.inverse(), "test");
+    moved.transformHistory().clear();
+    return {scan.subset(a), std::move(moved)};
+}
+
+//! The largest displacement, over the corners of the scan's box, between two motions.
+double displacementOver(const PointCloud& scan, const Eigen::Matrix4d& a, const Eigen::Matrix4d& b)
+{
+    const BoundingBox box = scan.bounds();
+    double worst = 0;
+    for (int k = 0; k < 8; ++k) {
+        const Eigen::Vector3d p((k & 1) ? box.max.x() : box.min.x(), (k & 2) ? box.max.y() : box.min.y(),
+                                (k & 4) ? box.max.z() : box.min.z());
+        worst = std::max(worst, ((a - b) * p.homogeneous()).norm());
+    }
+    return worst;
+}
+
+} // namespace
+
+TEST(RealScans, TwoSamplingsOfARealScanRegisterBack)
+{
+    // Real scans of PCL's data repository (data/pcl-data): a terrestrial scan
+    // in millimetres, and an airborne LiDAR sample in UTM coordinates. Each
+    // split in two samplings, one moved by a known motion; registered back,
+    // fine from 20 degrees off, global from 120 degrees off.
+    const PluginRegistry registry = makePluginRegistry();
+    struct Case
+    {
+        const char* file;
+        //! At the corners of the scan's box, in its unit: a tenth of the
+        //! median spacing within a half or less (9 mm on the terrestrial scan, 1.1 m
+        //! on the airborne one, where the halves share no point).
+        double tolerance;
+    };
+    for (const Case& c : {Case{"region_growing_tutorial.pcd", 1.0}, Case{"samp11-utm.pcd", 0.1}}) {
+        const PointCloud scan = io::readPointCloud(registry.formats, std::filesystem::path(SCANDIFF_SAMPLE_DATA_DIR) / "pcl-data" / c.file);
+        const BoundingBox box = scan.bounds();
+        const Eigen::Vector3d centre = (box.min + box.max) / 2;
+        const double size = (box.max - box.min).norm();
+        const Eigen::Matrix4d fine = test::rigidMotionAbout(20, 2, -1, Eigen::Vector3d(0.01, -0.02, 0.005) * size, centre);
+        const auto [reference, moving] = splitAndMove(scan, fine);
+        IcpParams params;
+        params.kernel = RobustKernel::Cauchy;
+        const IcpResult icp = icpRegister(moving, &reference, nullptr, params);
+        EXPECT_LT(displacementOver(scan, icp.report.matrix, fine), c.tolerance) << c.file << " " << reportSummary(icp.report);
+
+        const Eigen::Matrix4d far = test::rigidMotionAbout(120, 0, 0, Eigen::Vector3d(0.05, 0.03, 0) * size, centre);
+        const auto [reference2, moving2] = splitAndMove(scan, far);
+        GlobalAlignmentParams global;
+        global.constraint.dof = Dof::Four;
+        params.initial = globalAlign(moving2, &reference2, nullptr, global).report.matrix;
+        const IcpResult icp2 = icpRegister(moving2, &reference2, nullptr, params);
+        EXPECT_LT(displacementOver(scan, icp2.report.matrix, far), c.tolerance) << c.file << " " << reportSummary(icp2.report);
     }
 }
