@@ -14,6 +14,7 @@
 //! per scalar field (double when the field has an offset, so GPS times survive).
 
 #include "internal/Formats.h"
+#include "internal/FieldOffset.h"
 #include "internal/MappedFile.h"
 #include "internal/TextUtil.h"
 
@@ -565,16 +566,6 @@ private:
     std::vector<Target> targets_;
 };
 
-//! Keeps float precision for large values (GPS time ~1e9 s, 32-bit ids): values
-//! are stored relative to their rounded-down minimum.
-double chooseFieldOffset(double lo, double hi)
-{
-    if (!(lo <= hi))
-        return 0.0;
-    if (std::max(std::abs(lo), std::abs(hi)) < 1e5)
-        return 0.0;
-    return std::floor(lo);
-}
 
 struct RangeAccumulator
 {

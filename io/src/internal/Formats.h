@@ -9,6 +9,7 @@ namespace scandiff::io::detail {
 FormatHandler plyFormat();        // PlyFormat.cpp
 FormatHandler asciiFormat();      // AsciiFormat.cpp
 FormatHandler lasFormat();        // LasFormat.cpp
+FormatHandler pcdFormat();        // PcdFormat.cpp
 FormatHandler assimpMeshFormat(); // AssimpMeshFormat.cpp
 FormatHandler dxfFormat();        // DxfWriter.cpp (export only)
 

@@ -97,11 +97,14 @@ std::vector<Station> prepare(const std::vector<const PointCloud*>& clouds, const
                              ProgressObserver* progress)
 {
     std::vector<Station> stations(clouds.size());
-    for (std::size_t k = 0; k < clouds.size(); ++k) {
+    for (std::size_t k = 0; k < clouds.size(); ++k)
         if (!clouds[k] || clouds[k]->empty())
             throw Error(ErrorCode::InvalidData, "stations: station " + std::to_string(k) + " is empty");
+    ProgressTicker ticker(progress, "Stations: octrees", clouds.size());
+    for (std::size_t k = 0; k < clouds.size(); ++k) {
         stations[k].cloud = clouds[k];
         stations[k].surface = detail::cloudSurface(*clouds[k], true, 12);
+        ticker.step(); // a station's octree takes a while: Cancel is heard between them
     }
     worldOrigin = stations[0].surface->frameOrigin();
     for (std::size_t k = 0; k < clouds.size(); ++k) {
