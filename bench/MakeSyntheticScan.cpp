@@ -22,7 +22,14 @@
 //!                                              station's view. Writes the matrix
 //!                                              that registers it back, moving ->
 //!                                              site, to OUTPUT.truth.txt)
+//!        scandiff-make-scan --primitives POINTS OUTPUT SEED
+//!                                             (the primitive tests' scene of
+//!                                              tests/support/PrimitiveScene.h:
+//!                                              15 known shapes, 5 mm of noise,
+//!                                              5 % clutter, no normals; the truth
+//!                                              to OUTPUT.truth.txt, a shape a line)
 
+#include "PrimitiveScene.h"
 #include "SyntheticSite.h"
 
 #include <scandiff/core/Error.h>
@@ -32,6 +39,7 @@
 #include <scandiff/io/ResultFiles.h>
 
 #include <cmath>
+#include <fstream>
 #include <iostream>
 #include <random>
 #include <string>
@@ -140,10 +148,32 @@ int writeSite(int argc, char** argv)
     return 0;
 }
 
+int writePrimitiveScene(std::size_t points, const std::string& output, unsigned seed)
+{
+    using namespace scandiff;
+    const test::PrimitiveScene scene = test::makePrimitiveScene(test::testSceneShapes(), points, 0.005, 0.05, seed, false);
+    io::FormatRegistry formats;
+    io::registerBuiltinFormats(formats);
+    io::writePointCloud(formats, scene.cloud, output);
+    std::string truth;
+    for (const auto& shape : scene.shapes)
+        truth += shape.label + " " + primitiveText(shape.truth) + "\n";
+    std::ofstream(output + ".truth.txt") << truth;
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
 {
+    if (argc == 5 && std::string(argv[1]) == "--primitives") {
+        try {
+            return writePrimitiveScene(std::stoull(argv[2]), argv[3], static_cast<unsigned>(std::stoul(argv[4])));
+        } catch (const std::exception& e) {
+            std::cerr << "error: " << e.what() << '\n';
+            return 1;
+        }
+    }
     if (argc >= 5 && std::string(argv[1]) == "--site") {
         try {
             return writeSite(argc, argv);

@@ -122,6 +122,10 @@ double signedDistance(const Primitive& s, const Eigen::Vector3d& p)
         const double h = v.dot(s.direction), rho = (v - h * s.direction).norm();
         return rho * std::cos(s.halfAngle) - h * std::sin(s.halfAngle);
     }
+    case PrimitiveKind::Torus: {
+        const double h = v.dot(s.direction), rho = (v - h * s.direction).norm();
+        return std::hypot(rho - s.radius, h) - s.minorRadius;
+    }
     }
     return 0;
 }
@@ -161,6 +165,8 @@ PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressO
 
     Primitive s;
     s.kind = kind;
+    if (kind == PrimitiveKind::Torus)
+        throw Error(ErrorCode::Unsupported, "a torus is fitted from a detected one (primitive extraction), not from scratch");
     switch (kind) {
     case PrimitiveKind::Plane: {
         s.point = globalCentroid;
@@ -283,6 +289,7 @@ PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressO
             cannotFit(kind, "the fitted half-angle is not between 0 and 90 degrees");
         break;
     }
+    case PrimitiveKind::Torus: break; // refused above
     }
     ticker.step();
     PrimitiveFit fit;
@@ -312,7 +319,9 @@ PrimitiveKind parsePrimitiveKind(const std::string& name)
         return PrimitiveKind::Cylinder;
     if (name == "cone")
         return PrimitiveKind::Cone;
-    throw Error(ErrorCode::InvalidArgument, "'" + name + "' is not plane, sphere, cylinder or cone");
+    if (name == "torus")
+        return PrimitiveKind::Torus;
+    throw Error(ErrorCode::InvalidArgument, "'" + name + "' is not plane, sphere, cylinder, cone or torus");
 }
 
 const char* primitiveKindName(PrimitiveKind kind)
@@ -322,6 +331,7 @@ const char* primitiveKindName(PrimitiveKind kind)
     case PrimitiveKind::Sphere: return "sphere";
     case PrimitiveKind::Cylinder: return "cylinder";
     case PrimitiveKind::Cone: return "cone";
+    case PrimitiveKind::Torus: return "torus";
     }
     return "";
 }
@@ -334,7 +344,7 @@ Primitive parsePrimitive(const std::string& text)
     Primitive s;
     s.kind = parsePrimitiveKind(text.substr(0, colon));
     const std::vector<double> v = parseNumberList(text.substr(colon + 1), "the primitive's numbers");
-    const std::size_t expected = s.kind == PrimitiveKind::Sphere ? 4 : s.kind == PrimitiveKind::Plane ? 6 : 7;
+    const std::size_t expected = s.kind == PrimitiveKind::Sphere ? 4 : s.kind == PrimitiveKind::Plane ? 6 : s.kind == PrimitiveKind::Torus ? 8 : 7;
     if (v.size() != expected)
         throw Error(ErrorCode::InvalidArgument, std::string("a ") + primitiveKindName(s.kind) + " takes " + std::to_string(expected) +
                                                     " numbers, not " + std::to_string(v.size()));
@@ -346,12 +356,16 @@ Primitive parsePrimitive(const std::string& text)
         if (!(s.direction.norm() > 0))
             throw Error(ErrorCode::InvalidArgument, "the primitive's direction must not be zero");
         s.direction.normalize();
-        if (s.kind == PrimitiveKind::Cylinder)
+        if (s.kind == PrimitiveKind::Cylinder || s.kind == PrimitiveKind::Torus)
             s.radius = v[6];
+        if (s.kind == PrimitiveKind::Torus)
+            s.minorRadius = v[7];
         if (s.kind == PrimitiveKind::Cone)
             s.halfAngle = v[6] * kPi / 180.0;
     }
-    if ((s.kind == PrimitiveKind::Sphere || s.kind == PrimitiveKind::Cylinder) && !(s.radius > 0))
+    if (s.kind == PrimitiveKind::Torus && !(s.minorRadius > 0))
+        throw Error(ErrorCode::InvalidArgument, "the torus's minor radius must be > 0");
+    if ((s.kind == PrimitiveKind::Sphere || s.kind == PrimitiveKind::Cylinder || s.kind == PrimitiveKind::Torus) && !(s.radius > 0))
         throw Error(ErrorCode::InvalidArgument, "the primitive's radius must be > 0");
     if (s.kind == PrimitiveKind::Cone && !(s.halfAngle > 0 && s.halfAngle < kPi / 2))
         throw Error(ErrorCode::InvalidArgument, "the cone's half-angle must be between 0 and 90 degrees");
@@ -382,6 +396,10 @@ std::string primitiveText(const Primitive& s)
         add(s.radius, true);
     if (s.kind == PrimitiveKind::Cone)
         add(s.halfAngle * 180.0 / kPi, true);
+    if (s.kind == PrimitiveKind::Torus) {
+        add(s.radius);
+        add(s.minorRadius, true);
+    }
     return text;
 }
 
@@ -390,7 +408,9 @@ Table primitiveTable(const Primitive& s, std::optional<double> rms)
     Table t;
     t.columns = {"parameter", "value"};
     t.rows.push_back({std::string("kind"), std::string(primitiveKindName(s.kind))});
-    const char* pointName = s.kind == PrimitiveKind::Sphere ? "centre" : s.kind == PrimitiveKind::Cone ? "apex" : "point";
+    const char* pointName = s.kind == PrimitiveKind::Sphere || s.kind == PrimitiveKind::Torus ? "centre"
+                            : s.kind == PrimitiveKind::Cone                                   ? "apex"
+                                                                                              : "point";
     for (int a = 0; a < 3; ++a)
         t.rows.push_back({std::string(pointName) + "_" + "xyz"[a], s.point[a]});
     if (s.kind != PrimitiveKind::Sphere)
@@ -398,12 +418,156 @@ Table primitiveTable(const Primitive& s, std::optional<double> rms)
             t.rows.push_back({std::string(s.kind == PrimitiveKind::Plane ? "normal_" : "axis_") + "xyz"[a], s.direction[a]});
     if (s.kind == PrimitiveKind::Sphere || s.kind == PrimitiveKind::Cylinder)
         t.rows.push_back({std::string("radius"), s.radius});
+    if (s.kind == PrimitiveKind::Torus) {
+        t.rows.push_back({std::string("major_radius"), s.radius});
+        t.rows.push_back({std::string("minor_radius"), s.minorRadius});
+    }
     if (s.kind == PrimitiveKind::Cone)
         t.rows.push_back({std::string("half_angle_deg"), s.halfAngle * 180.0 / kPi});
     if (rms)
         t.rows.push_back({std::string("rms"), *rms});
     t.rows.push_back({std::string("text"), primitiveText(s)});
     return t;
+}
+
+} // namespace scandiff
+
+namespace scandiff {
+
+namespace {
+
+//! Levenberg-Marquardt from x, then the parameters' covariance
+//! sigma^2 (J^T J)^-1 at the solution (sigma^2 from the residuals).
+Eigen::MatrixXd refineWithCovariance(const std::vector<Eigen::Vector3d>& points, Eigen::VectorXd& x,
+                                     std::function<double(const Eigen::VectorXd&, const Eigen::Vector3d&)> residual,
+                                     PrimitiveKind kind)
+{
+    if (points.size() <= static_cast<std::size_t>(x.size()))
+        cannotFit(kind, "too few points");
+    Residuals functor(points, static_cast<int>(x.size()), residual);
+    Eigen::NumericalDiff<Residuals, Eigen::Central> numeric(functor);
+    Eigen::LevenbergMarquardt<Eigen::NumericalDiff<Residuals, Eigen::Central>> lm(numeric);
+    lm.setFtol(1e-15);
+    lm.setXtol(1e-15);
+    lm.setMaxfev(400 * static_cast<Eigen::Index>(x.size() + 1));
+    lm.minimize(x);
+    if (!x.allFinite())
+        cannotFit(kind, "the least-squares refinement diverged");
+    Eigen::VectorXd r(static_cast<Eigen::Index>(points.size()));
+    functor(x, r);
+    Eigen::MatrixXd jacobian(static_cast<Eigen::Index>(points.size()), x.size());
+    numeric.df(x, jacobian);
+    const double variance = r.squaredNorm() / static_cast<double>(points.size() - static_cast<std::size_t>(x.size()));
+    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
+    return variance * normal.completeOrthogonalDecomposition().pseudoInverse();
+}
+
+} // namespace
+
+PrimitiveRefinement refinePrimitive(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre,
+                                    const Primitive& initial)
+{
+    const PrimitiveKind kind = initial.kind;
+    // At most this many points, evenly spread, enter the solver; the
+    // uncertainties are scaled to the whole set (independent residuals).
+    constexpr std::size_t kMaxRefinePoints = 20000;
+    std::vector<Eigen::Vector3d> used;
+    const std::size_t stride = (points.size() + kMaxRefinePoints - 1) / std::max<std::size_t>(kMaxRefinePoints, 1);
+    for (std::size_t i = 0; i < points.size(); i += std::max<std::size_t>(stride, 1))
+        used.push_back(points[i]);
+    const double scale = std::sqrt(static_cast<double>(used.size()) / static_cast<double>(std::max<std::size_t>(points.size(), 1)));
+    const Eigen::Vector3d d0 = initial.direction.normalized();
+    Eigen::Vector3d e1, e2;
+    orthonormalFrame(d0, e1, e2);
+    const Eigen::Vector3d p0 = initial.point - centre;
+    const auto directionOf = [&](double a, double b) { return Eigen::Vector3d(d0 + a * e1 + b * e2).normalized(); };
+    const auto sigma = [&](const Eigen::MatrixXd& cov, std::initializer_list<Eigen::Index> indices) {
+        double sum = 0;
+        for (Eigen::Index i : indices)
+            sum += std::max(cov(i, i), 0.0);
+        return std::sqrt(sum) * scale;
+    };
+    constexpr double kDegrees = 180.0 / kPi;
+    PrimitiveRefinement out;
+    Primitive& s = out.primitive;
+    s = initial;
+    switch (kind) {
+    case PrimitiveKind::Plane: {
+        Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
+        const Eigen::MatrixXd cov = refineWithCovariance(used, x, [&](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
+            return (p - p0).dot(directionOf(x[0], x[1])) - x[2];
+        }, kind);
+        s.direction = directionOf(x[0], x[1]);
+        s.point = centre + p0 + x[2] * s.direction;
+        out.uncertainty = {{"direction_deg", sigma(cov, {0, 1}) * kDegrees}, {"offset", sigma(cov, {2})}};
+        break;
+    }
+    case PrimitiveKind::Sphere: {
+        Eigen::VectorXd x(4);
+        x << p0, initial.radius;
+        const Eigen::MatrixXd cov = refineWithCovariance(used, x, [](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
+            return (p - x.head<3>()).norm() - x[3];
+        }, kind);
+        s.point = centre + x.head<3>();
+        s.radius = std::abs(x[3]);
+        out.uncertainty = {{"centre", sigma(cov, {0, 1, 2})}, {"radius", sigma(cov, {3})}};
+        break;
+    }
+    case PrimitiveKind::Cylinder: {
+        Eigen::VectorXd x(5);
+        x << 0, 0, 0, 0, initial.radius;
+        const Eigen::MatrixXd cov = refineWithCovariance(used, x, [&](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
+            const Eigen::Vector3d d = directionOf(x[2], x[3]), v = p - (p0 + x[0] * e1 + x[1] * e2);
+            return (v - v.dot(d) * d).norm() - x[4];
+        }, kind);
+        s.direction = directionOf(x[2], x[3]);
+        const Eigen::Vector3d onAxis = p0 + x[0] * e1 + x[1] * e2;
+        s.point = centre + onAxis - onAxis.dot(s.direction) * s.direction; // the foot of the centre
+        s.radius = std::abs(x[4]);
+        out.uncertainty = {{"direction_deg", sigma(cov, {2, 3}) * kDegrees}, {"axis_position", sigma(cov, {0, 1})}, {"radius", sigma(cov, {4})}};
+        break;
+    }
+    case PrimitiveKind::Cone: {
+        Eigen::VectorXd x(6);
+        x << p0, 0, 0, initial.halfAngle;
+        const Eigen::MatrixXd cov = refineWithCovariance(used, x, [&](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
+            const Eigen::Vector3d d = directionOf(x[3], x[4]), v = p - x.head<3>();
+            const double h = v.dot(d), rho = (v - h * d).norm();
+            return rho * std::cos(x[5]) - h * std::sin(x[5]);
+        }, kind);
+        s.point = centre + x.head<3>();
+        s.direction = directionOf(x[3], x[4]);
+        s.halfAngle = x[5];
+        if (!(s.halfAngle > 0 && s.halfAngle < kPi / 2))
+            cannotFit(kind, "the fitted half-angle is not between 0 and 90 degrees");
+        out.uncertainty = {{"apex", sigma(cov, {0, 1, 2})}, {"direction_deg", sigma(cov, {3, 4}) * kDegrees},
+                           {"half_angle_deg", sigma(cov, {5}) * kDegrees}};
+        break;
+    }
+    case PrimitiveKind::Torus: {
+        Eigen::VectorXd x(7);
+        x << p0, 0, 0, initial.radius, initial.minorRadius;
+        const Eigen::MatrixXd cov = refineWithCovariance(used, x, [&](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
+            const Eigen::Vector3d d = directionOf(x[3], x[4]), v = p - x.head<3>();
+            const double h = v.dot(d), rho = (v - h * d).norm();
+            return std::hypot(rho - x[5], h) - x[6];
+        }, kind);
+        s.point = centre + x.head<3>();
+        s.direction = directionOf(x[3], x[4]);
+        s.radius = std::abs(x[5]);
+        s.minorRadius = std::abs(x[6]);
+        out.uncertainty = {{"centre", sigma(cov, {0, 1, 2})}, {"direction_deg", sigma(cov, {3, 4}) * kDegrees},
+                           {"radius", sigma(cov, {5})}, {"minor_radius", sigma(cov, {6})}};
+        break;
+    }
+    }
+    double sum = 0;
+    for (const Eigen::Vector3d& p : points) {
+        const double d = signedDistance(s, centre + p);
+        sum += d * d;
+    }
+    out.rms = points.empty() ? 0 : std::sqrt(sum / static_cast<double>(points.size()));
+    return out;
 }
 
 } // namespace scandiff

@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Primitive extraction: planes, spheres, cylinders, cones and tori found in a
+//! cloud by efficient RANSAC (Schnabel, Wahl and Klein 2007, through CGAL's
+//! Shape_detection), then made what a user can trust:
+//! - each shape's inliers one connected part (cluster epsilon): disjoint
+//!   coplanar plates are separate shapes;
+//! - the right type: the simplest type that fits the shape's points about as
+//!   well as the best (a complexity penalty), with a radius within bounds
+//!   tied to the extent of its points; a shape no type holds within epsilon
+//!   leaves its points unassigned;
+//! - every shape refitted by least squares on its inliers (geometric
+//!   distances), with the standard uncertainty of its parameters;
+//! - repeatable: the same seed gives the same shapes, whatever the threads.
+
+#include <scandiff/core/PointCloud.h>
+#include <scandiff/core/Progress.h>
+#include <scandiff/core/geometry/Primitives.h>
+
+#include <cstdint>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace scandiff::plugins {
+
+struct PrimitiveDetectionParams
+{
+    std::set<PrimitiveKind> kinds = {PrimitiveKind::Plane, PrimitiveKind::Sphere, PrimitiveKind::Cylinder, PrimitiveKind::Cone,
+                                     PrimitiveKind::Torus};
+    //! Largest distance of an inlier to its shape (m); absent: 3 x the noise
+    //! estimated from the points' local plane fits.
+    std::optional<double> epsilon;
+    //! Largest gap inside one connected part (m); absent: 3 x the median spacing.
+    std::optional<double> clusterEpsilon;
+    double normalDeviationDegrees = 25; //!< largest angle between a point's normal and its shape's
+    std::size_t minPoints = 200;        //!< smallest support of a shape (points)
+    double probability = 0.01;          //!< RANSAC's chance of missing the largest shape in a round
+    //! A shape's type is the simplest (plane, sphere, cylinder, cone, torus)
+    //! whose least-squares RMS is within this fraction of the best type's.
+    double typeTolerance = 0.2;
+    std::uint64_t seed = 0;
+};
+
+struct DetectedPrimitive
+{
+    int id = 0;
+    Primitive primitive;              //!< global coordinates
+    std::vector<std::uint32_t> inliers; //!< indices into the input cloud, increasing
+    double rms = 0;                   //!< of the inliers' distances
+    double area = 0;                  //!< of the inliers' footprint on the surface (m², cells of the cluster epsilon)
+    double length = 0;                //!< cylinder, cone: the inliers' extent along the axis (m)
+    std::vector<std::pair<std::string, double>> uncertainty; //!< see refinePrimitive()
+};
+
+struct PrimitiveDetectionResult
+{
+    std::vector<DetectedPrimitive> primitives;
+    std::vector<int> primitiveId;       //!< per input point, -1 when on no shape
+    std::vector<float> distance;        //!< per input point, signed distance to its shape (NaN off every shape)
+    double epsilon = 0, clusterEpsilon = 0; //!< the values used
+    bool normalsComputed = false;       //!< the cloud had none: fitted within max(2.5 spacings, 10 x the noise)
+    std::vector<std::string> notes;
+};
+
+//! Throws Error(InvalidArgument) for bad parameters, Error(InvalidData) for an
+//! empty cloud or one with fewer points than the minimum support,
+//! Error(Cancelled).
+PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const PrimitiveDetectionParams& params,
+                                          ProgressObserver* progress = nullptr);
+
+} // namespace scandiff::plugins

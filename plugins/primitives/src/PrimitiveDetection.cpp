@@ -1,0 +1,427 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/plugins/primitives/PrimitiveDetection.h>
+
+#include "EfficientRansac.h"
+
+#include <scandiff/core/CloudOctree.h>
+#include <scandiff/core/Error.h>
+#include <scandiff/core/processing/Normals.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_set>
+
+namespace scandiff::plugins {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+//! The scan's point spacing and noise, from a sample of its neighbourhoods:
+//! the median distance to the nearest other point, and the median standard
+//! deviation across the least-squares plane of 16 neighbours.
+struct ScanScale
+{
+    double spacing = 0;
+    double noise = 0;
+};
+
+ScanScale estimateScale(const PointCloud& cloud, const octree::Octree& tree)
+{
+    constexpr std::size_t kSample = 2000, kNeighbours = 16;
+    const std::size_t stride = std::max<std::size_t>(1, cloud.size() / kSample);
+    std::vector<Eigen::Vector3f> queries;
+    for (std::size_t i = 0; i < cloud.size(); i += stride)
+        queries.push_back(cloud.positions()[i]);
+    const int level = tree.levelNearestMeanPopulation(3.0 * kNeighbours);
+    std::vector<octree::Neighbour> found;
+    tree.nearestBatch(queries.data(), queries.size(), kNeighbours, level, found);
+    std::vector<double> spacing, noise;
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+        const octree::Neighbour* list = found.data() + q * kNeighbours;
+        std::size_t count = 0;
+        while (count < kNeighbours && list[count].index != std::numeric_limits<std::uint32_t>::max())
+            ++count;
+        if (count < 4)
+            continue;
+        spacing.push_back(std::sqrt(static_cast<double>(list[1].squaredDistance)));
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (std::size_t k = 0; k < count; ++k)
+            mean += cloud.positions()[list[k].index].cast<double>();
+        mean /= static_cast<double>(count);
+        Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+        for (std::size_t k = 0; k < count; ++k) {
+            const Eigen::Vector3d d = cloud.positions()[list[k].index].cast<double>() - mean;
+            covariance.noalias() += d * d.transpose();
+        }
+        covariance /= static_cast<double>(count);
+        noise.push_back(std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues()[0])));
+    }
+    ScanScale scale;
+    auto median = [](std::vector<double>& v) {
+        if (v.empty())
+            return 0.0;
+        std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+        return v[v.size() / 2];
+    };
+    scale.spacing = median(spacing);
+    scale.noise = median(noise);
+    return scale;
+}
+
+double extentOf(const std::vector<Eigen::Vector3d>& points)
+{
+    Eigen::Vector3d lo = points.front(), hi = points.front();
+    for (const auto& p : points) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+    }
+    return (hi - lo).norm();
+}
+
+//! The largest radius a curved shape may have for the extent of its points:
+//! beyond it, the arc is so flat that the points do not say it is curved.
+bool radiusPlausible(const Primitive& p, double extent)
+{
+    switch (p.kind) {
+    case PrimitiveKind::Sphere:
+    case PrimitiveKind::Cylinder: return p.radius > 0 && p.radius < 2.0 * extent;
+    case PrimitiveKind::Torus: return p.minorRadius > 0 && p.radius > p.minorRadius && p.radius < 2.0 * extent;
+    case PrimitiveKind::Cone: return p.halfAngle > 1e-3 && p.halfAngle < kPi / 2 - 1e-3;
+    case PrimitiveKind::Plane: return true;
+    }
+    return false;
+}
+
+//! The occupied area of points on their surface: cells of `cell` (m) they
+//! fall in, counted in 3D, times the cell's area.
+double footprint(const std::vector<Eigen::Vector3d>& points, double cell)
+{
+    std::unordered_set<std::uint64_t> cells;
+    for (const auto& p : points) {
+        const auto key = [&](double v) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / cell)) & 0x1fffff); };
+        cells.insert(key(p.x()) | key(p.y()) << 21 | key(p.z()) << 42);
+    }
+    return static_cast<double>(cells.size()) * cell * cell;
+}
+
+//! A cylinder's or cone's extent along its axis.
+double lengthAlong(const Primitive& p, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre)
+{
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto& q : points) {
+        const double t = (centre + q - p.point).dot(p.direction);
+        lo = std::min(lo, t);
+        hi = std::max(hi, t);
+    }
+    return hi - lo;
+}
+
+//! The sphere through points by the algebraic fit (centre, radius), in their frame.
+std::optional<Primitive> algebraicSphere(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre)
+{
+    Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d b = Eigen::Vector4d::Zero();
+    for (const auto& p : points) {
+        const Eigen::Vector4d row(2 * p.x(), 2 * p.y(), 2 * p.z(), 1);
+        a.noalias() += row * row.transpose();
+        b += row * p.squaredNorm();
+    }
+    const Eigen::Vector4d s = a.ldlt().solve(b);
+    const double r2 = s[3] + s.head<3>().squaredNorm();
+    if (!s.allFinite() || !(r2 > 0))
+        return std::nullopt;
+    Primitive sphere;
+    sphere.kind = PrimitiveKind::Sphere;
+    sphere.point = centre + s.head<3>();
+    sphere.radius = std::sqrt(r2);
+    return sphere;
+}
+
+//! The least-squares plane of points (their frame), as a primitive (global).
+Primitive pcaPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre)
+{
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& p : points)
+        mean += p;
+    mean /= static_cast<double>(points.size());
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (const auto& p : points)
+        covariance.noalias() += (p - mean) * (p - mean).transpose();
+    Primitive plane;
+    plane.kind = PrimitiveKind::Plane;
+    plane.point = centre + mean;
+    plane.direction = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvectors().col(0);
+    return plane;
+}
+
+//! The shape's type, chosen among the types asked for: each candidate (the
+//! type RANSAC found, a plane, a sphere, a cylinder for a cone) refitted by
+//! least squares, and the
+//! simplest one kept whose RMS is within params.typeTolerance (20 %) of the best plausible fit's
+//! (fewer parameters: plane 3, sphere 4, cylinder 5, cone 6, torus 7). So a
+//! box side is a plane even when a huge cylinder fits it as well, and a
+//! sphere stays a sphere when a spindle torus fits it too. Empty when no
+//! candidate holds the points within epsilon.
+std::optional<PrimitiveRefinement> chooseType(const std::vector<Eigen::Vector3d>& members, const Eigen::Vector3d& centre,
+                                              const Primitive& found, const PrimitiveDetectionParams& params, double epsilon,
+                                              std::vector<std::string>& notes)
+{
+    std::vector<Primitive> candidates{found};
+    if (params.kinds.count(PrimitiveKind::Plane) && found.kind != PrimitiveKind::Plane)
+        candidates.push_back(pcaPlane(members, centre));
+    if (params.kinds.count(PrimitiveKind::Sphere) && found.kind != PrimitiveKind::Sphere && found.kind != PrimitiveKind::Plane)
+        if (const auto sphere = algebraicSphere(members, centre))
+            candidates.push_back(*sphere);
+    if (params.kinds.count(PrimitiveKind::Cylinder) && found.kind == PrimitiveKind::Cone) {
+        // A cone of a small angle may be a cylinder: the same axis, the mean radius.
+        Primitive cylinder = found;
+        cylinder.kind = PrimitiveKind::Cylinder;
+        double radius = 0;
+        for (const auto& p : members) {
+            const Eigen::Vector3d v = centre + p - found.point;
+            radius += (v - v.dot(found.direction) * found.direction).norm();
+        }
+        cylinder.radius = radius / static_cast<double>(members.size());
+        candidates.push_back(cylinder);
+    }
+    const double extent = extentOf(members);
+    std::vector<PrimitiveRefinement> fits;
+    for (const Primitive& candidate : candidates) {
+        try {
+            PrimitiveRefinement fit = refinePrimitive(members, centre, candidate);
+            if (radiusPlausible(fit.primitive, extent) && fit.rms < epsilon)
+                fits.push_back(std::move(fit));
+        } catch (const Error&) {
+            // This type does not fit these points: the others are tried.
+        }
+    }
+    if (fits.empty()) {
+        notes.push_back(std::string("a ") + primitiveKindName(found.kind) + " of " + std::to_string(members.size()) +
+                        " points was left out: no shape type holds them within epsilon");
+        return std::nullopt;
+    }
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& fit : fits)
+        best = std::min(best, fit.rms);
+    const PrimitiveRefinement* chosen = nullptr;
+    for (const auto& fit : fits)
+        if (fit.rms <= (1 + params.typeTolerance) * best && (!chosen || fit.primitive.kind < chosen->primitive.kind))
+            chosen = &fit;
+    if (chosen->primitive.kind != found.kind)
+        notes.push_back(std::string("a ") + primitiveKindName(found.kind) + " of " + std::to_string(members.size()) + " points is a " +
+                        primitiveKindName(chosen->primitive.kind) + " (it fits them as well, with fewer parameters)");
+    return *chosen;
+}
+
+//! Whether two point sets come within about one cell of each other: the
+//! cells (of side `cell`) of one, and the 27-cell blocks around the other's.
+bool touching(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b, double cell)
+{
+    auto key = [cell](const Eigen::Vector3d& p, int dx, int dy, int dz) {
+        const auto c = [&](double v, int d) { return static_cast<std::uint64_t>((static_cast<std::int64_t>(std::floor(v / cell)) + d) & 0x1fffff); };
+        return c(p.x(), dx) | c(p.y(), dy) << 21 | c(p.z(), dz) << 42;
+    };
+    std::unordered_set<std::uint64_t> cells;
+    for (const auto& p : a)
+        cells.insert(key(p, 0, 0, 0));
+    for (const auto& p : b)
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dz = -1; dz <= 1; ++dz)
+                    if (cells.count(key(p, dx, dy, dz)))
+                        return true;
+    return false;
+}
+
+void checkParameters(const PrimitiveDetectionParams& params)
+{
+    auto bad = [](const std::string& why) { throw Error(ErrorCode::InvalidArgument, "primitives: " + why); };
+    if (params.kinds.empty())
+        bad("no shape type asked for");
+    if (params.epsilon && !(*params.epsilon > 0))
+        bad("epsilon must be > 0");
+    if (params.clusterEpsilon && !(*params.clusterEpsilon > 0))
+        bad("the cluster epsilon must be > 0");
+    if (!(params.normalDeviationDegrees > 0 && params.normalDeviationDegrees < 90))
+        bad("the normal deviation must be between 0 and 90 degrees");
+    if (params.minPoints < 10)
+        bad("the minimum support is at least 10 points");
+    if (!(params.probability > 0 && params.probability < 1))
+        bad("the probability must be in (0, 1)");
+    if (!(params.typeTolerance >= 0 && params.typeTolerance <= 1))
+        bad("the type tolerance must be in [0, 1]");
+}
+
+} // namespace
+
+PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const PrimitiveDetectionParams& params, ProgressObserver* progress)
+{
+    checkParameters(params);
+    if (cloud.empty())
+        throw Error(ErrorCode::InvalidData, "primitives: cloud '" + cloud.name + "' is empty");
+    if (cloud.size() < params.minPoints)
+        throw Error(ErrorCode::InvalidData, "primitives: cloud '" + cloud.name + "' has " + std::to_string(cloud.size()) +
+                                                " points, fewer than the minimum support (" + std::to_string(params.minPoints) + ")");
+    ProgressTicker ticker(progress, "Primitives", 100);
+    PrimitiveDetectionResult result;
+    const octree::Octree tree = buildOctree(cloud);
+    const ScanScale scale = estimateScale(cloud, tree);
+    result.epsilon = params.epsilon ? *params.epsilon : std::max(3.0 * scale.noise, 1e-6);
+    result.clusterEpsilon = params.clusterEpsilon ? *params.clusterEpsilon : std::max(3.0 * scale.spacing, result.epsilon);
+    if (!params.epsilon)
+        result.notes.push_back("epsilon " + std::to_string(result.epsilon) + " m: 3 x the noise estimated from the points");
+    if (!params.clusterEpsilon)
+        result.notes.push_back("cluster epsilon " + std::to_string(result.clusterEpsilon) + " m: 3 x the median spacing");
+
+    std::vector<Eigen::Vector3f> normalsStore;
+    const std::vector<Eigen::Vector3f>* normals = &cloud.normals();
+    if (!cloud.hasNormals()) {
+        // A neighbourhood wide enough for the noise to tilt a normal by no
+        // more than about 5 degrees (radius >= 10 sigma), and holding a few
+        // spacings: 12 neighbours of a dense, noisy scan give normals too
+        // scattered for the shapes' normal test, which then breaks them up.
+        NormalParams normalParams;
+        normalParams.radius = std::max(2.5 * scale.spacing, 10.0 * scale.noise);
+        normalParams.orientation.kind = NormalOrientation::Kind::None;
+        normalsStore = computeNormals(cloud, normalParams, progress).normals;
+        normals = &normalsStore;
+        result.normalsComputed = true;
+        result.notes.push_back("the cloud has no normals: fitted within " + std::to_string(*normalParams.radius) + " m");
+    }
+    ticker.step(10);
+
+    // Local coordinates in double, centred on the cloud: CGAL and the fits
+    // never see a UTM magnitude.
+    const BoundingBox box = cloud.bounds();
+    const Eigen::Vector3d localCentre = (box.min + box.max) / 2 - cloud.origin();
+    const Eigen::Vector3d centre = cloud.origin() + localCentre;
+    std::vector<Eigen::Vector3d> points(cloud.size()), unitNormals(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        points[i] = cloud.positions()[i].cast<double>() - localCentre;
+        const Eigen::Vector3d n = (*normals)[i].cast<double>();
+        unitNormals[i] = n.norm() > 0 ? n.normalized() : Eigen::Vector3d::UnitZ();
+    }
+
+    detail::RansacSettings settings;
+    settings.kinds = params.kinds;
+    settings.epsilon = result.epsilon;
+    settings.clusterEpsilon = result.clusterEpsilon;
+    settings.normalCosine = std::cos(params.normalDeviationDegrees * kPi / 180.0);
+    settings.minPoints = params.minPoints;
+    settings.probability = params.probability;
+    settings.seed = params.seed;
+    bool cancelled = false;
+    const std::vector<detail::RansacShape> found = detail::efficientRansac(points, unitNormals, settings, [&](double fraction) {
+        (void)fraction;
+        if (progress && progress->cancelRequested()) {
+            cancelled = true;
+            return false;
+        }
+        return true;
+    });
+    if (cancelled)
+        ticker.checkCancel();
+    ticker.step(60);
+
+    // Each shape refitted, its type checked; a curved shape that does not fit
+    // clearly better than a plane becomes a plane when a plane holds its
+    // points within epsilon, and is dropped otherwise.
+    for (const detail::RansacShape& shape : found) {
+        std::vector<Eigen::Vector3d> members;
+        members.reserve(shape.members.size());
+        for (std::uint32_t i : shape.members)
+            members.push_back(points[i]);
+        if (members.size() < params.minPoints)
+            continue;
+        Primitive initial = shape.primitive;
+        initial.point += centre; // CGAL's frame -> global
+        std::optional<PrimitiveRefinement> chosen = chooseType(members, centre, initial, params, result.epsilon, result.notes);
+        if (!chosen)
+            continue;
+        const PrimitiveRefinement& refined = *chosen;
+        DetectedPrimitive detected;
+        detected.primitive = refined.primitive;
+        detected.inliers.assign(shape.members.begin(), shape.members.end());
+        std::sort(detected.inliers.begin(), detected.inliers.end());
+        detected.rms = refined.rms;
+        detected.uncertainty = refined.uncertainty;
+        detected.area = footprint(members, std::max(2.0 * scale.spacing, 1e-6));
+        if (detected.primitive.kind == PrimitiveKind::Cylinder || detected.primitive.kind == PrimitiveKind::Cone)
+            detected.length = lengthAlong(detected.primitive, members, centre);
+        result.primitives.push_back(std::move(detected));
+        ticker.checkCancel();
+    }
+    ticker.step(20);
+
+    // RANSAC may take one surface in two parts (a sphere's cap found apart
+    // from the rest): touching shapes of one type whose union fits as well as
+    // each part are merged. Disjoint coplanar plates do not touch: they stay apart.
+    for (bool merged = true; merged;) {
+        merged = false;
+        for (std::size_t a = 0; a < result.primitives.size() && !merged; ++a)
+            for (std::size_t b = a + 1; b < result.primitives.size() && !merged; ++b) {
+                DetectedPrimitive& first = result.primitives[a];
+                DetectedPrimitive& second = result.primitives[b];
+                if (first.primitive.kind != second.primitive.kind)
+                    continue;
+                // A cheap look first: a sample of the second part on the first's surface?
+                std::size_t near = 0, tried = 0;
+                const std::size_t step = std::max<std::size_t>(1, second.inliers.size() / 100);
+                for (std::size_t k = 0; k < second.inliers.size(); k += step, ++tried)
+                    near += std::abs(signedDistance(first.primitive, centre + points[second.inliers[k]])) <= result.epsilon;
+                if (2 * near < tried)
+                    continue;
+                std::vector<Eigen::Vector3d> pa, pb;
+                for (std::uint32_t i : first.inliers)
+                    pa.push_back(points[i]);
+                for (std::uint32_t i : second.inliers)
+                    pb.push_back(points[i]);
+                if (!touching(pa, pb, result.clusterEpsilon))
+                    continue;
+                std::vector<Eigen::Vector3d> both = pa;
+                both.insert(both.end(), pb.begin(), pb.end());
+                PrimitiveRefinement joint;
+                try {
+                    joint = refinePrimitive(both, centre, first.inliers.size() >= second.inliers.size() ? first.primitive : second.primitive);
+                } catch (const Error&) {
+                    continue;
+                }
+                if (!(joint.rms <= (1 + params.typeTolerance) * std::max(first.rms, second.rms)))
+                    continue;
+                first.inliers.insert(first.inliers.end(), second.inliers.begin(), second.inliers.end());
+                std::sort(first.inliers.begin(), first.inliers.end());
+                first.primitive = joint.primitive;
+                first.rms = joint.rms;
+                first.uncertainty = joint.uncertainty;
+                first.area += second.area;
+                if (first.primitive.kind == PrimitiveKind::Cylinder || first.primitive.kind == PrimitiveKind::Cone)
+                    first.length = lengthAlong(first.primitive, both, centre);
+                result.notes.push_back(std::string("two touching parts of one ") + primitiveKindName(first.primitive.kind) + " merged");
+                result.primitives.erase(result.primitives.begin() + static_cast<std::ptrdiff_t>(b));
+                merged = true;
+            }
+    }
+
+    // Largest first; ties by first inlier, so the order never depends on threads.
+    std::sort(result.primitives.begin(), result.primitives.end(), [](const DetectedPrimitive& a, const DetectedPrimitive& b) {
+        return a.inliers.size() != b.inliers.size() ? a.inliers.size() > b.inliers.size() : a.inliers.front() < b.inliers.front();
+    });
+    result.primitiveId.assign(cloud.size(), -1);
+    result.distance.assign(cloud.size(), std::numeric_limits<float>::quiet_NaN());
+    for (std::size_t k = 0; k < result.primitives.size(); ++k) {
+        DetectedPrimitive& shape = result.primitives[k];
+        shape.id = static_cast<int>(k);
+        for (std::uint32_t i : shape.inliers) {
+            result.primitiveId[i] = shape.id;
+            result.distance[i] = static_cast<float>(signedDistance(shape.primitive, centre + points[i]));
+        }
+    }
+    ticker.step(10);
+    return result;
+}
+
+} // namespace scandiff::plugins

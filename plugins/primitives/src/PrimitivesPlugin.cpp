@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Registers primitive extraction as the tool "primitives".
+#include <scandiff/core/Error.h>
+#include <scandiff/core/TextLists.h>
+#include <scandiff/plugins/PluginRegistry.h>
+#include <scandiff/plugins/primitives/PrimitiveDetection.h>
+
+#include <sstream>
+
+namespace scandiff::plugins {
+
+namespace {
+
+constexpr double kDegrees = 180.0 / 3.14159265358979323846;
+
+std::set<PrimitiveKind> kindsFrom(const std::string& text)
+{
+    std::set<PrimitiveKind> kinds;
+    for (const std::string& name : splitList(text, ','))
+        if (!name.empty())
+            kinds.insert(parsePrimitiveKind(name));
+    if (kinds.empty())
+        throw Error(ErrorCode::InvalidArgument, "primitives: --shapes names at least one of plane, sphere, cylinder, cone, torus");
+    return kinds;
+}
+
+//! One row per shape: its parameters in world coordinates (plane: n.x + d = 0),
+//! support, RMS, area and the standard uncertainties.
+Table primitivesTable(const PrimitiveDetectionResult& result)
+{
+    Table t;
+    t.columns = {"id", "type", "inliers", "rms", "area", "x", "y", "z", "dx", "dy", "dz", "d", "radius", "minor_radius",
+                 "half_angle_deg", "length", "sigma_direction_deg", "sigma_position", "sigma_radius", "text"};
+    for (const DetectedPrimitive& s : result.primitives) {
+        const Primitive& p = s.primitive;
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        auto sigma = [&](const std::string& name) {
+            for (const auto& [key, value] : s.uncertainty)
+                if (key == name)
+                    return value;
+            return nan;
+        };
+        const bool plane = p.kind == PrimitiveKind::Plane, sphere = p.kind == PrimitiveKind::Sphere;
+        const double position = plane ? sigma("offset") : sphere || p.kind == PrimitiveKind::Torus ? sigma("centre")
+                                                      : p.kind == PrimitiveKind::Cone              ? sigma("apex")
+                                                                                                   : sigma("axis_position");
+        const double radiusSigma = p.kind == PrimitiveKind::Cone ? sigma("half_angle_deg") : sigma("radius");
+        t.rows.push_back({static_cast<double>(s.id), std::string(primitiveKindName(p.kind)), static_cast<double>(s.inliers.size()), s.rms,
+                          s.area, p.point.x(), p.point.y(), p.point.z(), sphere ? nan : p.direction.x(), sphere ? nan : p.direction.y(),
+                          sphere ? nan : p.direction.z(), plane ? -p.direction.dot(p.point) : nan,
+                          plane || p.kind == PrimitiveKind::Cone ? nan : p.radius, p.kind == PrimitiveKind::Torus ? p.minorRadius : nan,
+                          p.kind == PrimitiveKind::Cone ? p.halfAngle * kDegrees : nan, s.length > 0 ? s.length : nan,
+                          sphere ? nan : sigma("direction_deg"), position, radiusSigma, primitiveText(p)});
+    }
+    return t;
+}
+
+} // namespace
+
+} // namespace scandiff::plugins
+
+void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
+{
+    using namespace scandiff;
+    using namespace scandiff::plugins;
+    const PrimitiveDetectionParams defaults;
+    registry.plugins.push_back({"primitives", "Planes, spheres, cylinders, cones and tori by efficient RANSAC", "CGAL"});
+
+    ToolSpec tool;
+    tool.name = "primitives";
+    tool.title = "Primitives (efficient RANSAC)";
+    tool.category = "Primitives";
+    tool.description =
+        "Finds planes, spheres, cylinders, cones and tori (efficient RANSAC, Schnabel et al. 2007, through CGAL), splits each "
+        "shape into connected parts, keeps a curved shape only where it fits its points clearly better than a plane, and "
+        "refits every shape by least squares with the uncertainty of its parameters. Adds primitive_id (-1: none), "
+        "primitive_type (0 plane, 1 sphere, 2 cylinder, 3 cone, 4 torus) and primitive_distance to the cloud; gives one cloud "
+        "per shape and a table of their parameters. Normals are fitted when the cloud has none (within 10 x the noise).";
+    tool.parameters = {
+        ParameterSpec::text("shapes", "Shape types", "Comma-separated: plane, sphere, cylinder, cone, torus",
+                            "plane,sphere,cylinder,cone,torus")
+            .withSuggestions({"plane,sphere,cylinder,cone,torus", "plane", "plane,cylinder", "plane,sphere,cylinder"}),
+        ParameterSpec::real("epsilon", "Distance threshold",
+                            "Largest distance of a point to its shape; absent: 3 x the noise estimated from the points", 0.01, 1e-9,
+                            1e9, "m")
+            .asOptional(),
+        ParameterSpec::real("cluster-epsilon", "Connectivity",
+                            "Largest gap inside one shape's points: farther parts are separate shapes; absent: 3 x the median "
+                            "point spacing",
+                            0.1, 1e-9, 1e9, "m")
+            .asOptional(),
+        ParameterSpec::real("normal-deviation", "Normal deviation", "Largest angle between a point's normal and its shape's",
+                            defaults.normalDeviationDegrees, 0.1, 89.9, "deg"),
+        ParameterSpec::integer("min-points", "Minimum support", "Smallest number of points of a shape",
+                               static_cast<std::int64_t>(defaults.minPoints), 10, 1000000000, "points"),
+        ParameterSpec::real("probability", "Miss probability", "RANSAC's chance of overlooking the largest remaining shape",
+                            defaults.probability, 1e-6, 0.5),
+        ParameterSpec::integer("seed", "Seed", "Random sampling seed (the same seed, the same shapes)", 0, 0, 4294967295LL),
+    };
+    tool.outputs = {OutputSpec{"primitives", "Cloud with primitive fields", DataKind::Cloud, true},
+                    OutputSpec{"shape", "Shape", DataKind::Cloud, false, true},
+                    OutputSpec{"table", "Primitives", DataKind::Table, false}};
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        const PointCloud& input = inputs.cloud();
+        PrimitiveDetectionParams params;
+        params.kinds = kindsFrom(values.text("shapes"));
+        if (values.has("epsilon"))
+            params.epsilon = values.real("epsilon");
+        if (values.has("cluster-epsilon"))
+            params.clusterEpsilon = values.real("cluster-epsilon");
+        params.normalDeviationDegrees = values.real("normal-deviation");
+        params.minPoints = static_cast<std::size_t>(values.integer("min-points"));
+        params.probability = values.real("probability");
+        params.seed = static_cast<std::uint64_t>(values.integer("seed"));
+        const PrimitiveDetectionResult detected = detectPrimitives(input, params, progress);
+
+        ToolResult result;
+        PointCloud labelled = input.clone();
+        ScalarField& id = labelled.addField("primitive_id");
+        ScalarField& type = labelled.addField("primitive_type");
+        ScalarField& distance = labelled.addField("primitive_distance");
+        for (std::size_t i = 0; i < input.size(); ++i) {
+            id.values()[i] = static_cast<float>(detected.primitiveId[i]);
+            type.values()[i] = detected.primitiveId[i] < 0
+                                   ? -1.0f
+                                   : static_cast<float>(detected.primitives[static_cast<std::size_t>(detected.primitiveId[i])].primitive.kind);
+            distance.values()[i] = detected.distance[i];
+        }
+        result.add("primitives", std::move(labelled));
+        for (const DetectedPrimitive& shape : detected.primitives) {
+            std::vector<std::size_t> indices(shape.inliers.begin(), shape.inliers.end());
+            PointCloud part = input.subset(indices);
+            part.name = primitiveKindName(shape.primitive.kind); // the CLI adds the shape's id: plane_0.ply
+            result.add("shape", std::move(part));
+        }
+        result.add("table", primitivesTable(detected));
+        std::ostringstream summary;
+        std::map<std::string, int> counts;
+        std::size_t assigned = 0;
+        for (const DetectedPrimitive& shape : detected.primitives) {
+            ++counts[primitiveKindName(shape.primitive.kind)];
+            assigned += shape.inliers.size();
+        }
+        summary << detected.primitives.size() << " shapes (";
+        bool first = true;
+        for (const auto& [name, count] : counts) {
+            summary << (first ? "" : ", ") << count << " " << (count > 1 ? (name == "torus" ? "tori" : name + "s") : name);
+            first = false;
+        }
+        summary << "), " << assigned << " of " << input.size() << " points assigned; epsilon " << detected.epsilon
+                << " m, cluster epsilon " << detected.clusterEpsilon << " m";
+        for (const std::string& note : detected.notes)
+            summary << "; " << note;
+        result.summary = summary.str();
+        return result;
+    };
+    registry.tools.add(std::move(tool));
+}

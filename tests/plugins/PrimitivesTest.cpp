@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/core/Error.h>
+#include <scandiff/plugins/primitives/PrimitiveDetection.h>
+
+#include "PrimitiveScene.h"
+#include "TestSupport.h"
+
+#include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
+
+#include <cmath>
+
+using namespace scandiff;
+using namespace scandiff::plugins;
+
+namespace {
+
+constexpr double kDegrees = 180.0 / 3.14159265358979323846;
+
+double angleBetweenLines(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+    return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * kDegrees;
+}
+
+//! The detected shape holding most of the true shape's points, and how many it holds.
+const DetectedPrimitive* bestMatch(const PrimitiveDetectionResult& result, const test::PrimitiveScene& scene, int shape, std::size_t& shared)
+{
+    std::map<int, std::size_t> votes;
+    for (std::size_t i = 0; i < scene.truth.size(); ++i)
+        if (scene.truth[i] == shape && result.primitiveId[i] >= 0)
+            ++votes[result.primitiveId[i]];
+    shared = 0;
+    const DetectedPrimitive* best = nullptr;
+    for (const auto& [id, count] : votes)
+        if (count > shared) {
+            shared = count;
+            best = &result.primitives[static_cast<std::size_t>(id)];
+        }
+    return best;
+}
+
+double uncertainty(const DetectedPrimitive& shape, const std::string& name)
+{
+    for (const auto& [key, value] : shape.uncertainty)
+        if (key == name)
+            return value;
+    ADD_FAILURE() << "no uncertainty " << name;
+    return 0;
+}
+
+const test::PrimitiveScene& scene()
+{
+    // 5 mm of noise, 5 % clutter, exact normals (computed ones: NormalsAreComputedWhenAbsent).
+    static const test::PrimitiveScene s = test::makePrimitiveScene(test::testSceneShapes(), 120000, 0.005, 0.05, 3, true);
+    return s;
+}
+
+const PrimitiveDetectionResult& detected()
+{
+    static const PrimitiveDetectionResult r = [] {
+        PrimitiveDetectionParams params;
+        params.seed = 5;
+        return detectPrimitives(scene().cloud, params);
+    }();
+    return r;
+}
+
+} // namespace
+
+TEST(Primitives, EveryShapeOfTheAnalyticSceneIsFoundOnceWithItsType)
+{
+    const PrimitiveDetectionResult& result = detected();
+    const test::PrimitiveScene& s = scene();
+    std::set<int> used;
+    for (std::size_t k = 0; k < s.shapes.size(); ++k) {
+        std::size_t shared = 0, total = 0;
+        for (int t : s.truth)
+            total += t == static_cast<int>(k);
+        const DetectedPrimitive* match = bestMatch(result, s, static_cast<int>(k), shared);
+        ASSERT_NE(match, nullptr) << s.shapes[k].label << " not found";
+        EXPECT_EQ(match->primitive.kind, s.shapes[k].truth.kind) << s.shapes[k].label;
+        EXPECT_GT(static_cast<double>(shared), 0.8 * static_cast<double>(total)) << s.shapes[k].label;
+        EXPECT_TRUE(used.insert(match->id).second) << s.shapes[k].label << " shares its shape with another";
+        const Primitive& got = match->primitive;
+        const Primitive& truth = s.shapes[k].truth;
+        switch (truth.kind) {
+        case PrimitiveKind::Plane:
+            // 0.05 degrees and 1 mm, or three standard uncertainties on the
+            // small planes whose points cannot hold that (a box side of
+            // 800 points: 0.04 degrees).
+            EXPECT_LT(angleBetweenLines(got.direction, truth.direction), std::max(0.05, 3 * uncertainty(*match, "direction_deg")))
+                << s.shapes[k].label;
+            EXPECT_LT(std::abs((got.point - truth.point).dot(truth.direction)), std::max(0.001, 3 * uncertainty(*match, "offset")))
+                << s.shapes[k].label;
+            break;
+        case PrimitiveKind::Sphere:
+            EXPECT_LT((got.point - truth.point).norm(), 0.002);
+            EXPECT_LT(std::abs(got.radius - truth.radius), 0.002);
+            break;
+        case PrimitiveKind::Cylinder:
+            EXPECT_LT(angleBetweenLines(got.direction, truth.direction), 0.1) << s.shapes[k].label;
+            EXPECT_LT(std::abs(got.radius - truth.radius), 0.002) << s.shapes[k].label;
+            break;
+        case PrimitiveKind::Cone:
+            EXPECT_LT(angleBetweenLines(got.direction, truth.direction), 0.1);
+            EXPECT_LT(std::abs(got.halfAngle - truth.halfAngle) * kDegrees, 0.1);
+            EXPECT_LT((got.point - truth.point).norm(), 0.005);
+            break;
+        case PrimitiveKind::Torus:
+            EXPECT_LT((got.point - truth.point).norm(), 0.002);
+            EXPECT_LT(std::abs(got.radius - truth.radius), 0.002);
+            EXPECT_LT(std::abs(got.minorRadius - truth.minorRadius), 0.002);
+            break;
+        }
+    }
+    EXPECT_EQ(result.primitives.size(), s.shapes.size());
+}
+
+TEST(Primitives, RepeatableWithOneOrTwoThreads)
+{
+    PrimitiveDetectionParams params;
+    params.seed = 5;
+    PrimitiveDetectionResult one;
+    {
+        tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+        one = detectPrimitives(scene().cloud, params);
+    }
+    const PrimitiveDetectionResult& two = detected();
+    ASSERT_EQ(one.primitives.size(), two.primitives.size());
+    EXPECT_EQ(one.primitiveId, two.primitiveId);
+    for (std::size_t k = 0; k < one.primitives.size(); ++k)
+        EXPECT_EQ(primitiveText(one.primitives[k].primitive), primitiveText(two.primitives[k].primitive));
+}
+
+TEST(Primitives, BadInputIsAClearError)
+{
+    PointCloud empty;
+    EXPECT_EQ(test::errorCodeOf([&] { detectPrimitives(empty, {}); }), ErrorCode::InvalidData);
+    PointCloud few;
+    few.resize(50);
+    EXPECT_EQ(test::errorCodeOf([&] { detectPrimitives(few, {}); }), ErrorCode::InvalidData);
+    PrimitiveDetectionParams bad;
+    bad.kinds.clear();
+    EXPECT_EQ(test::errorCodeOf([&] { detectPrimitives(scene().cloud, bad); }), ErrorCode::InvalidArgument);
+}
+
+TEST(Primitives, NormalsAreComputedWhenAbsent)
+{
+    const test::PrimitiveScene s = test::makePrimitiveScene(test::testSceneShapes(), 120000, 0.005, 0.05, 3, false);
+    PrimitiveDetectionParams params;
+    params.seed = 5;
+    const PrimitiveDetectionResult result = detectPrimitives(s.cloud, params);
+    EXPECT_TRUE(result.normalsComputed);
+    std::map<PrimitiveKind, int> expected, found;
+    for (const auto& shape : s.shapes)
+        ++expected[shape.truth.kind];
+    for (const auto& shape : result.primitives)
+        ++found[shape.primitive.kind];
+    EXPECT_EQ(found, expected);
+}
+
+TEST(Primitives, PlanesOnlyStillFindEveryPlane)
+{
+    // Asked for planes only, every true plane is found once, as a plane
+    // (the curved shapes may give facets: they are not asked about).
+    PrimitiveDetectionParams params;
+    params.seed = 5;
+    params.kinds = {PrimitiveKind::Plane};
+    const PrimitiveDetectionResult result = detectPrimitives(scene().cloud, params);
+    std::set<int> used;
+    for (std::size_t k = 0; k < scene().shapes.size(); ++k) {
+        if (scene().shapes[k].truth.kind != PrimitiveKind::Plane)
+            continue;
+        std::size_t shared = 0;
+        const DetectedPrimitive* match = bestMatch(result, scene(), static_cast<int>(k), shared);
+        ASSERT_NE(match, nullptr) << scene().shapes[k].label;
+        EXPECT_EQ(match->primitive.kind, PrimitiveKind::Plane);
+        EXPECT_LT(angleBetweenLines(match->primitive.direction, scene().shapes[k].truth.direction), 0.1) << scene().shapes[k].label;
+        EXPECT_TRUE(used.insert(match->id).second) << scene().shapes[k].label;
+    }
+}
+
+TEST(Primitives, UtmCoordinatesGiveTheSameShapes)
+{
+    // The scene moved to UTM coordinates (its points unchanged relative to
+    // the cloud's origin): the same shapes, moved by the origin.
+    const Eigen::Vector3d origin(512000, 5423000, 100);
+    test::PrimitiveScene moved = test::makePrimitiveScene(test::testSceneShapes(), 120000, 0.005, 0.05, 3, true);
+    moved.cloud.setOrigin(origin);
+    PrimitiveDetectionParams params;
+    params.seed = 5;
+    const PrimitiveDetectionResult result = detectPrimitives(moved.cloud, params);
+    const PrimitiveDetectionResult& local = detected();
+    ASSERT_EQ(result.primitives.size(), local.primitives.size());
+    EXPECT_EQ(result.primitiveId, local.primitiveId);
+    for (std::size_t k = 0; k < local.primitives.size(); ++k) {
+        const Primitive& a = result.primitives[k].primitive;
+        const Primitive& b = local.primitives[k].primitive;
+        ASSERT_EQ(a.kind, b.kind);
+        EXPECT_LT((a.point - origin - b.point).norm(), 1e-6) << k;
+        EXPECT_LT((a.direction - b.direction).norm(), 1e-6) << k;
+        EXPECT_NEAR(a.radius, b.radius, 1e-6) << k;
+    }
+}
