@@ -51,12 +51,15 @@ struct Residuals : Eigen::DenseFunctor<double>
     std::function<double(const Eigen::VectorXd&, const Eigen::Vector3d&)> f_;
 };
 
-void refine(const std::vector<Eigen::Vector3d>& points, Eigen::VectorXd& x,
-            std::function<double(const Eigen::VectorXd&, const Eigen::Vector3d&)> residual, PrimitiveKind kind)
+//! Levenberg-Marquardt from x, then the parameters' covariance
+//! sigma^2 (J^T J)^-1 at the solution (sigma^2 from the residuals).
+Eigen::MatrixXd refineWithCovariance(const std::vector<Eigen::Vector3d>& points, Eigen::VectorXd& x,
+                                     std::function<double(const Eigen::VectorXd&, const Eigen::Vector3d&)> residual,
+                                     PrimitiveKind kind)
 {
     if (points.size() < static_cast<std::size_t>(x.size()))
         cannotFit(kind, "too few points");
-    Residuals functor(points, static_cast<int>(x.size()), std::move(residual));
+    Residuals functor(points, static_cast<int>(x.size()), residual);
     Eigen::NumericalDiff<Residuals, Eigen::Central> numeric(functor);
     Eigen::LevenbergMarquardt<Eigen::NumericalDiff<Residuals, Eigen::Central>> lm(numeric);
     lm.setFtol(1e-15);
@@ -65,6 +68,20 @@ void refine(const std::vector<Eigen::Vector3d>& points, Eigen::VectorXd& x,
     lm.minimize(x);
     if (!x.allFinite())
         cannotFit(kind, "the least-squares refinement diverged");
+    Eigen::VectorXd r(static_cast<Eigen::Index>(points.size()));
+    functor(x, r);
+    Eigen::MatrixXd jacobian(static_cast<Eigen::Index>(points.size()), x.size());
+    numeric.df(x, jacobian);
+    // With as many points as parameters the residuals say nothing of the noise (0 here).
+    const double variance = r.squaredNorm() / static_cast<double>(std::max<std::size_t>(1, points.size() - static_cast<std::size_t>(x.size())));
+    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
+    return variance * normal.completeOrthogonalDecomposition().pseudoInverse();
+}
+
+void refine(const std::vector<Eigen::Vector3d>& points, Eigen::VectorXd& x,
+            std::function<double(const Eigen::VectorXd&, const Eigen::Vector3d&)> residual, PrimitiveKind kind)
+{
+    refineWithCovariance(points, x, std::move(residual), kind);
 }
 
 //! Kasa's algebraic circle through 2D points: centre and radius.
@@ -433,36 +450,6 @@ Table primitiveTable(const Primitive& s, std::optional<double> rms)
 } // namespace scandiff
 
 namespace scandiff {
-
-namespace {
-
-//! Levenberg-Marquardt from x, then the parameters' covariance
-//! sigma^2 (J^T J)^-1 at the solution (sigma^2 from the residuals).
-Eigen::MatrixXd refineWithCovariance(const std::vector<Eigen::Vector3d>& points, Eigen::VectorXd& x,
-                                     std::function<double(const Eigen::VectorXd&, const Eigen::Vector3d&)> residual,
-                                     PrimitiveKind kind)
-{
-    if (points.size() <= static_cast<std::size_t>(x.size()))
-        cannotFit(kind, "too few points");
-    Residuals functor(points, static_cast<int>(x.size()), residual);
-    Eigen::NumericalDiff<Residuals, Eigen::Central> numeric(functor);
-    Eigen::LevenbergMarquardt<Eigen::NumericalDiff<Residuals, Eigen::Central>> lm(numeric);
-    lm.setFtol(1e-15);
-    lm.setXtol(1e-15);
-    lm.setMaxfev(400 * static_cast<Eigen::Index>(x.size() + 1));
-    lm.minimize(x);
-    if (!x.allFinite())
-        cannotFit(kind, "the least-squares refinement diverged");
-    Eigen::VectorXd r(static_cast<Eigen::Index>(points.size()));
-    functor(x, r);
-    Eigen::MatrixXd jacobian(static_cast<Eigen::Index>(points.size()), x.size());
-    numeric.df(x, jacobian);
-    const double variance = r.squaredNorm() / static_cast<double>(points.size() - static_cast<std::size_t>(x.size()));
-    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
-    return variance * normal.completeOrthogonalDecomposition().pseudoInverse();
-}
-
-} // namespace
 
 PrimitiveRefinement refinePrimitive(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre,
                                     const Primitive& initial)
