@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "Commands.h"
+#include "CliRunner.h"
 
 #include <scandiff/core/Error.h>
 
@@ -13,26 +13,6 @@
 using namespace scandiff;
 
 namespace {
-
-struct CliRun
-{
-    int status = 0;
-    std::string out, err;
-};
-
-CliRun runCli(const PluginRegistry& registry, std::vector<std::string> args)
-{
-    args.insert(args.begin(), "scandiff-cli");
-    std::vector<const char*> argv;
-    for (const auto& a : args)
-        argv.push_back(a.c_str());
-    std::ostringstream out, err;
-    CliRun run;
-    run.status = cli::runCli(static_cast<int>(argv.size()), argv.data(), registry, {out, err});
-    run.out = out.str();
-    run.err = err.str();
-    return run;
-}
 
 std::filesystem::path sampleCloud(const PluginRegistry& registry, const std::filesystem::path& dir)
 {
@@ -53,7 +33,7 @@ TEST(Cli, InfoJsonDescribesTheFile)
 {
     const PluginRegistry registry = makePluginRegistry();
     const auto file = sampleCloud(registry, test::tempDir());
-    const CliRun run = runCli(registry, {"info", file.string(), "--json"});
+    const test::CliRun run = test::runCliInProcess(registry, {"info", file.string(), "--json"});
     ASSERT_EQ(run.status, 0) << run.err;
     const auto j = nlohmann::json::parse(run.out);
     EXPECT_EQ(j["points"], 4);
@@ -73,13 +53,13 @@ TEST(Cli, InfoTextAndConvertRoundTrip)
     const PluginRegistry registry = makePluginRegistry();
     const auto dir = test::tempDir();
     const auto file = sampleCloud(registry, dir);
-    CliRun run = runCli(registry, {"info", file.string()});
+    test::CliRun run = test::runCliInProcess(registry, {"info", file.string()});
     ASSERT_EQ(run.status, 0) << run.err;
     EXPECT_NE(run.out.find("points:        4"), std::string::npos) << run.out;
     EXPECT_NE(run.out.find("intensity"), std::string::npos);
     for (const char* ext : {"las", "xyz", "pcd", "ply"}) {
         const auto out = dir / (std::string("converted.") + ext);
-        run = runCli(registry, {"convert", file.string(), out.string()});
+        run = test::runCliInProcess(registry, {"convert", file.string(), out.string()});
         ASSERT_EQ(run.status, 0) << ext << ": " << run.err;
         const PointCloud back = io::readPointCloud(registry.formats, out);
         ASSERT_EQ(back.size(), 4u) << ext;
@@ -92,16 +72,16 @@ TEST(Cli, ErrorsExitNonZeroWithAMessage)
 {
     const PluginRegistry registry = makePluginRegistry();
     const auto dir = test::tempDir();
-    CliRun run = runCli(registry, {"info", (dir / "missing.ply").string()});
+    test::CliRun run = test::runCliInProcess(registry, {"info", (dir / "missing.ply").string()});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::Io));
     EXPECT_NE(run.err.find("error: "), std::string::npos);
     EXPECT_NE(run.err.find("missing.ply"), std::string::npos);
     test::writeText(dir / "bad.ply", "ply\nformat nonsense 1.0\nend_header\n");
-    run = runCli(registry, {"info", (dir / "bad.ply").string()});
+    run = test::runCliInProcess(registry, {"info", (dir / "bad.ply").string()});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidData));
-    run = runCli(registry, {"convert", (dir / "bad.ply").string()});
+    run = test::runCliInProcess(registry, {"convert", (dir / "bad.ply").string()});
     EXPECT_NE(run.status, 0);
-    run = runCli(registry, {"frobnicate"});
+    run = test::runCliInProcess(registry, {"frobnicate"});
     EXPECT_NE(run.status, 0);
 }
 
@@ -112,7 +92,7 @@ TEST(Cli, ConvertNeverLeavesAHalfWrittenFile)
     const auto file = sampleCloud(registry, dir);
     test::writeText(dir / "target.obj", "precious");
     // A cloud cannot become an OBJ mesh: the error must leave the old file as it was.
-    const CliRun run = runCli(registry, {"convert", file.string(), (dir / "target.obj").string()});
+    const test::CliRun run = test::runCliInProcess(registry, {"convert", file.string(), (dir / "target.obj").string()});
     EXPECT_NE(run.status, 0);
     EXPECT_EQ(test::readBytes(dir / "target.obj"), "precious");
 }
@@ -122,19 +102,19 @@ TEST(Cli, ToolsBecomeSubcommandsWithTheirDeclaredOptions)
     const PluginRegistry registry = makePluginRegistry();
     const auto dir = test::tempDir();
     const auto file = sampleCloud(registry, dir);
-    CliRun run = runCli(registry, {"sor-filter", "--help"});
+    test::CliRun run = test::runCliInProcess(registry, {"sor-filter", "--help"});
     EXPECT_EQ(run.status, 0);
     EXPECT_NE(run.out.find("--n-sigma"), std::string::npos) << run.out;
     EXPECT_NE(run.out.find("default 6"), std::string::npos) << run.out;
-    run = runCli(registry, {"sor-filter", file.string(), "--k", "2", "-o", (dir / "filtered.ply").string()});
+    run = test::runCliInProcess(registry, {"sor-filter", file.string(), "--k", "2", "-o", (dir / "filtered.ply").string()});
     ASSERT_EQ(run.status, 0) << run.err;
     EXPECT_TRUE(std::filesystem::exists(dir / "filtered.ply"));
-    run = runCli(registry, {"sor-filter", file.string(), "--k", "0"});
+    run = test::runCliInProcess(registry, {"sor-filter", file.string(), "--k", "0"});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
     EXPECT_NE(run.err.find("[1, 1000]"), std::string::npos) << run.err;
-    run = runCli(registry, {"tools"});
+    run = test::runCliInProcess(registry, {"tools"});
     EXPECT_NE(run.out.find("sor-filter"), std::string::npos);
-    run = runCli(registry, {"formats"});
+    run = test::runCliInProcess(registry, {"formats"});
     EXPECT_NE(run.out.find(".pcd"), std::string::npos);
     EXPECT_NE(run.out.find(".las"), std::string::npos);
 }
@@ -179,7 +159,7 @@ TEST(Cli, CloudToCloudAndCloudToMeshWriteTheirFields)
     compared.positions() = {{0.55f, 0.55f, 0.2f}, {1.0f, 1.0f, -0.1f}, {1.23f, 0.47f, 0.05f}};
     io::writePointCloud(registry.formats, compared, dir / "compared.ply");
 
-    CliRun run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared",
+    test::CliRun run = test::runCliInProcess(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared",
                                    (dir / "compared.ply").string(), "--model", "plane", "--split-xyz", "-o",
                                    (dir / "c2c.ply").string(), "--both-ways", "--closest-points"});
     ASSERT_EQ(run.status, 0) << run.err;
@@ -195,7 +175,7 @@ TEST(Cli, CloudToCloudAndCloudToMeshWriteTheirFields)
     const PointCloud closest = io::readPointCloud(registry.formats, dir / "c2c_closest.ply");
     EXPECT_EQ(closest.size(), 3u);
 
-    run = runCli(registry, {"c2m", "--reference", (dir / "mesh.ply").string(), "--compared", (dir / "compared.ply").string(),
+    run = test::runCliInProcess(registry, {"c2m", "--reference", (dir / "mesh.ply").string(), "--compared", (dir / "compared.ply").string(),
                             "--signed", "-o", (dir / "c2m.ply").string()});
     ASSERT_EQ(run.status, 0) << run.err;
     out = io::readPointCloud(registry.formats, dir / "c2m.ply");
@@ -204,23 +184,23 @@ TEST(Cli, CloudToCloudAndCloudToMeshWriteTheirFields)
     EXPECT_NEAR(out.field("c2m_distance")->values()[1], -0.1, 1e-6);
 
     // Without -o nothing is written; bad options are refused with a message.
-    run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string()});
+    run = test::runCliInProcess(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string()});
     EXPECT_EQ(run.status, 0);
-    run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
+    run = test::runCliInProcess(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
                             "--signed"});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
     EXPECT_NE(run.err.find("normals"), std::string::npos) << run.err;
-    run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
+    run = test::runCliInProcess(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
                             "--clamp"});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
-    run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
+    run = test::runCliInProcess(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
                             "--knn", "8", "--radius", "0.5"});
     EXPECT_NE(run.status, 0);
-    run = runCli(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
+    run = test::runCliInProcess(registry, {"c2c", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string(),
                             "--visibility"});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
     EXPECT_NE(run.err.find("sensor"), std::string::npos) << run.err;
-    run = runCli(registry, {"c2m", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string()});
+    run = test::runCliInProcess(registry, {"c2m", "--reference", (dir / "reference.ply").string(), "--compared", (dir / "compared.ply").string()});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidData)) << run.err;
 }
 
@@ -239,7 +219,7 @@ TEST(Cli, CloudToCloudVisibilityFromTheCommandLine)
     compared.resize(2);
     compared.positions() = {{10.0f, 0.3f, 0.2f}, {12.0f, 0.5f, -0.4f}};
     io::writePointCloud(registry.formats, compared, dir / "compared.ply");
-    const CliRun run = runCli(registry, {"c2c", "--reference", (dir / "wall.ply").string(), "--compared",
+    const test::CliRun run = test::runCliInProcess(registry, {"c2c", "--reference", (dir / "wall.ply").string(), "--compared",
                                          (dir / "compared.ply").string(), "--sensor", "0,0,0", "-o", (dir / "out.ply").string()});
     ASSERT_EQ(run.status, 0) << run.err;
     const PointCloud out = io::readPointCloud(registry.formats, dir / "out.ply");

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The processing tools from the command line: one subcommand each, inputs by
 // role, outputs written beside -o, tables and matrices printed or saved.
-#include "Commands.h"
+#include "CliRunner.h"
 
 #include <scandiff/core/Error.h>
 
@@ -15,26 +15,6 @@
 using namespace scandiff;
 
 namespace {
-
-struct CliRun
-{
-    int status = 0;
-    std::string out, err;
-};
-
-CliRun run(const PluginRegistry& registry, std::vector<std::string> args)
-{
-    args.insert(args.begin(), "scandiff-cli");
-    std::vector<const char*> argv;
-    for (const auto& a : args)
-        argv.push_back(a.c_str());
-    std::ostringstream out, err;
-    CliRun result;
-    result.status = cli::runCli(static_cast<int>(argv.size()), argv.data(), registry, {out, err});
-    result.out = out.str();
-    result.err = err.str();
-    return result;
-}
 
 //! A georeferenced wavy terrain with a field, written as PLY.
 std::filesystem::path terrain(const PluginRegistry& registry, const std::filesystem::path& path, std::uint32_t seed, double shift)
@@ -63,7 +43,7 @@ TEST(ProcessingCli, NormalsSubsampleAndFieldsWriteTheirOutputs)
     const auto dir = test::tempDir();
     const auto input = terrain(registry, dir / "t.ply", 1, 0).string();
 
-    CliRun r = run(registry, {"normals", input, "--radius", "0.5", "--orient", "+z", "-o", (dir / "n.ply").string()});
+    test::CliRun r = test::runCliInProcess(registry, {"normals", input, "--radius", "0.5", "--orient", "+z", "-o", (dir / "n.ply").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     const PointCloud withNormals = io::readPointCloud(registry.formats, dir / "n.ply");
     ASSERT_TRUE(withNormals.hasNormals());
@@ -72,32 +52,32 @@ TEST(ProcessingCli, NormalsSubsampleAndFieldsWriteTheirOutputs)
     for (const auto& n : withNormals.normals())
         ASSERT_GT(n.z(), 0.9f);
 
-    r = run(registry, {"subsample", input, "--spatial", "0.3", "-o", (dir / "s.ply").string()});
+    r = test::runCliInProcess(registry, {"subsample", input, "--spatial", "0.3", "-o", (dir / "s.ply").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("kept"), std::string::npos);
     const PointCloud sparse = io::readPointCloud(registry.formats, dir / "s.ply");
     EXPECT_LT(sparse.size(), 3000u);
     EXPECT_NE(sparse.field("intensity"), nullptr);
 
-    r = run(registry, {"field", input, "--expr", "high = intensity >= 50", "-o", (dir / "f.ply").string()});
+    r = test::runCliInProcess(registry, {"field", input, "--expr", "high = intensity >= 50", "-o", (dir / "f.ply").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(io::readPointCloud(registry.formats, dir / "f.ply").field("high")->value(75), 1.0);
 
     // A table: printed as CSV without -o, written with it.
-    r = run(registry, {"field-histogram", input, "--field", "intensity", "--bins", "4"});
+    r = test::runCliInProcess(registry, {"field-histogram", input, "--field", "intensity", "--bins", "4"});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("bin_min,bin_max,count\n0,24.75,750\n"), std::string::npos) << r.out;
-    r = run(registry, {"field-histogram", input, "--field", "intensity", "--bins", "4", "-o", (dir / "h.csv").string()});
+    r = test::runCliInProcess(registry, {"field-histogram", input, "--field", "intensity", "--bins", "4", "-o", (dir / "h.csv").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(test::readBytes(dir / "h.csv").substr(0, 22), "bin_min,bin_max,count\n");
 
     // Alternatives, required parameters and unknown fields are clear errors.
-    r = run(registry, {"subsample", input, "--spatial", "0.3", "--random", "5"});
+    r = test::runCliInProcess(registry, {"subsample", input, "--spatial", "0.3", "--random", "5"});
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("only one of"), std::string::npos) << r.err;
-    r = run(registry, {"features", input});
+    r = test::runCliInProcess(registry, {"features", input});
     EXPECT_NE(r.status, 0);
-    r = run(registry, {"field-smooth", input, "--field", "missing", "--sigma", "1"});
+    r = test::runCliInProcess(registry, {"field-smooth", input, "--field", "missing", "--sigma", "1"});
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("intensity"), std::string::npos) << r.err; // names the fields it has
 }
@@ -108,7 +88,7 @@ TEST(ProcessingCli, MergeTransformAndCropKeepGlobalCoordinates)
     const auto dir = test::tempDir();
     const auto a = terrain(registry, dir / "a.ply", 1, 0).string();
     const auto b = terrain(registry, dir / "b.ply", 2, 3000).string(); // another shift, 3 km east
-    CliRun r = run(registry, {"merge", a, b, "-o", (dir / "m.ply").string()});
+    test::CliRun r = test::runCliInProcess(registry, {"merge", a, b, "-o", (dir / "m.ply").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     const PointCloud merged = io::readPointCloud(registry.formats, dir / "m.ply");
     const PointCloud cloudB = io::readPointCloud(registry.formats, b);
@@ -117,12 +97,12 @@ TEST(ProcessingCli, MergeTransformAndCropKeepGlobalCoordinates)
     EXPECT_EQ(merged.field("source_index")->value(5999), 1.0);
 
     // The transformation: the cloud moved, the matrix written beside it.
-    r = run(registry, {"transform", a, "--rotate", "z,90", "--centre", "512005,5423005,100", "-o", (dir / "r.ply").string()});
+    r = test::runCliInProcess(registry, {"transform", a, "--rotate", "z,90", "--centre", "512005,5423005,100", "-o", (dir / "r.ply").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_TRUE(std::filesystem::exists(dir / "r_matrix.txt"));
     EXPECT_NE(r.out.find("Applied matrix"), std::string::npos);
     // Inverting the written matrix file brings the points back.
-    r = run(registry, {"transform", (dir / "r.ply").string(), "--matrix", (dir / "r_matrix.txt").string(), "--inverse", "-o",
+    r = test::runCliInProcess(registry, {"transform", (dir / "r.ply").string(), "--matrix", (dir / "r_matrix.txt").string(), "--inverse", "-o",
                        (dir / "back.ply").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     const PointCloud original = io::readPointCloud(registry.formats, a), back = io::readPointCloud(registry.formats, dir / "back.ply");
@@ -130,7 +110,7 @@ TEST(ProcessingCli, MergeTransformAndCropKeepGlobalCoordinates)
         ASSERT_LT((back.globalPosition(i) - original.globalPosition(i)).norm(), 1e-4) << i;
 
     // Crop by a polygon given as repeated values.
-    r = run(registry, {"crop", a, "--polygon", "512000,5423000", "512005,5423000", "512005,5423005", "512000,5423005", "-o",
+    r = test::runCliInProcess(registry, {"crop", a, "--polygon", "512000,5423000", "512005,5423000", "512005,5423005", "512000,5423005", "-o",
                        (dir / "c.ply").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     const PointCloud cropped = io::readPointCloud(registry.formats, dir / "c.ply");
@@ -146,23 +126,23 @@ TEST(ProcessingCli, MeshThenSampleThenCompare)
     const PluginRegistry registry = makePluginRegistry();
     const auto dir = test::tempDir();
     const auto input = terrain(registry, dir / "t.ply", 3, 0).string();
-    CliRun r = run(registry, {"mesh", input, "--max-edge", "1", "-o", (dir / "mesh.ply").string()});
+    test::CliRun r = test::runCliInProcess(registry, {"mesh", input, "--max-edge", "1", "-o", (dir / "mesh.ply").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     const Mesh mesh = io::readMesh(registry.formats, dir / "mesh.ply");
     EXPECT_GT(mesh.triangles.size(), 5000u);
     // Normals on a mesh's vertices keep its triangles.
-    r = run(registry, {"normals", (dir / "mesh.ply").string(), "-o", (dir / "mesh_n.ply").string()});
+    r = test::runCliInProcess(registry, {"normals", (dir / "mesh.ply").string(), "-o", (dir / "mesh_n.ply").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(io::readMesh(registry.formats, dir / "mesh_n.ply").triangles.size(), mesh.triangles.size());
     // Points sampled on the mesh lie on it: C2M gives zero, to the float rounding of their coordinates.
-    r = run(registry, {"sample-mesh", (dir / "mesh.ply").string(), "--count", "2000", "-o", (dir / "samples.ply").string()});
+    r = test::runCliInProcess(registry, {"sample-mesh", (dir / "mesh.ply").string(), "--count", "2000", "-o", (dir / "samples.ply").string()});
     ASSERT_EQ(r.status, 0) << r.err;
-    r = run(registry, {"c2m", "--reference", (dir / "mesh.ply").string(), "--compared", (dir / "samples.ply").string()});
+    r = test::runCliInProcess(registry, {"c2m", "--reference", (dir / "mesh.ply").string(), "--compared", (dir / "samples.ply").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     const auto at = r.out.find("max ");
     ASSERT_NE(at, std::string::npos) << r.out;
     EXPECT_LT(std::stod(r.out.substr(at + 4)), 1e-5) << r.out;
     // sample-mesh refuses a point cloud.
-    r = run(registry, {"sample-mesh", input, "--count", "10"});
+    r = test::runCliInProcess(registry, {"sample-mesh", input, "--count", "10"});
     EXPECT_EQ(r.status, 2);
 }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The registration tools from the command line: the moved cloud, the matrix
 // file (4 lines of 4 numbers, world coordinates), the JSON report.
-#include "Commands.h"
+#include "CliRunner.h"
 #include "SyntheticSite.h"
 #include "TestSupport.h"
 
@@ -15,26 +15,6 @@
 using namespace scandiff;
 
 namespace {
-
-struct CliRun
-{
-    int status = 0;
-    std::string out, err;
-};
-
-CliRun run(const PluginRegistry& registry, std::vector<std::string> args)
-{
-    args.insert(args.begin(), "scandiff-cli");
-    std::vector<const char*> argv;
-    for (const auto& a : args)
-        argv.push_back(a.c_str());
-    std::ostringstream out, err;
-    CliRun result;
-    result.status = cli::runCli(static_cast<int>(argv.size()), argv.data(), registry, {out, err});
-    result.out = out.str();
-    result.err = err.str();
-    return result;
-}
 
 Eigen::Matrix4d readMatrix(const std::filesystem::path& path)
 {
@@ -75,7 +55,7 @@ TEST(RegistrationCli, RegisterWritesTheMovedCloudTheMatrixAndTheReport)
     io::writePointCloud(registry.formats, reference, dir / "ref.ply");
     io::writePointCloud(registry.formats, moving, dir / "mov.ply");
 
-    CliRun r = run(registry, {"register", "--reference", (dir / "ref.ply").string(), "--moving", (dir / "mov.ply").string(), "-o",
+    test::CliRun r = test::runCliInProcess(registry, {"register", "--reference", (dir / "ref.ply").string(), "--moving", (dir / "mov.ply").string(), "-o",
                               (dir / "out.ply").string(), "--matrix-out", (dir / "m.txt").string(), "--report",
                               (dir / "r.json").string(), "--robust"});
     ASSERT_EQ(r.status, 0) << r.err;
@@ -107,12 +87,12 @@ TEST(RegistrationCli, RegisterWritesTheMovedCloudTheMatrixAndTheReport)
         pairs << m.x() << ' ' << m.y() << ' ' << m.z() << ' ' << f.x() << ' ' << f.y() << ' ' << f.z() << '\n';
     }
     test::writeText(dir / "pairs.txt", pairs.str());
-    r = run(registry, {"register-pairs", "--reference", (dir / "ref.ply").string(), "--moving", (dir / "mov.ply").string(), "--pairs",
+    r = test::runCliInProcess(registry, {"register-pairs", "--reference", (dir / "ref.ply").string(), "--moving", (dir / "mov.ply").string(), "--pairs",
                        (dir / "pairs.txt").string(), "--matrix-out", (dir / "p.txt").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("pair residuals"), std::string::npos) << r.out;
     EXPECT_LT(displacement(readMatrix(dir / "p.txt"), truth, utm), 1e-4); // pairs from float positions
-    r = run(registry, {"register-pairs", "--reference", (dir / "ref.ply").string(), "--moving", (dir / "mov.ply").string(), "--pairs",
+    r = test::runCliInProcess(registry, {"register-pairs", "--reference", (dir / "ref.ply").string(), "--moving", (dir / "mov.ply").string(), "--pairs",
                        "1,2,3,4,5,6"});
     EXPECT_NE(r.status, 0);
     EXPECT_NE(r.err.find("at least 3"), std::string::npos) << r.err;
@@ -147,7 +127,7 @@ TEST(RegistrationCli, StationsWritePosesAndEveryStationMoved)
     }
     std::filesystem::create_directories(dir / "out");
     args.insert(args.end(), {"--out-dir", (dir / "out").string(), "--report", (dir / "out" / "run.json").string()});
-    CliRun r = run(registry, args);
+    test::CliRun r = test::runCliInProcess(registry, args);
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("3 stations"), std::string::npos) << r.out;
     // poses.txt: 3 lines of 16 numbers; the first the identity, the others undo the errors.
@@ -171,7 +151,7 @@ TEST(RegistrationCli, StationsWritePosesAndEveryStationMoved)
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "run.json"));
 
     // Global alignment from the command line, without its ICP.
-    r = run(registry, {"register-global", "--reference", args[1], "--moving", args[2], "--no-refine", "--matrix-out",
+    r = test::runCliInProcess(registry, {"register-global", "--reference", args[1], "--moving", args[2], "--no-refine", "--matrix-out",
                        (dir / "g.txt").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(r.out.find("ICP"), std::string::npos) << r.out;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `segment` and `compare` on the synthetic pair with three known changes.
-#include "Commands.h"
+#include "CliRunner.h"
 
 #include <scandiff/core/Error.h>
 
@@ -15,26 +15,6 @@
 using namespace scandiff;
 
 namespace {
-
-struct CliResult
-{
-    int status = 0;
-    std::string out, err;
-};
-
-CliResult runCommand(const PluginRegistry& registry, std::vector<std::string> args)
-{
-    args.insert(args.begin(), "scandiff-cli");
-    std::vector<const char*> argv;
-    for (const auto& a : args)
-        argv.push_back(a.c_str());
-    std::ostringstream out, err;
-    CliResult run;
-    run.status = cli::runCli(static_cast<int>(argv.size()), argv.data(), registry, {out, err});
-    run.out = out.str();
-    run.err = err.str();
-    return run;
-}
 
 std::size_t lineCount(const std::filesystem::path& file)
 {
@@ -71,7 +51,7 @@ TEST(SegmentCli, CompareRunsTheWholeChainAndFindsTheThreeChanges)
     const auto dir = test::tempDir();
     const auto [reference, compared] = writeEpochs(registry, dir);
     const auto out = dir / "out";
-    const CliResult run = runCommand(registry, {"compare", "--reference", reference, "--compared", compared, "--model", "plane", "--above", "0.1",
+    const test::CliRun run = test::runCliInProcess(registry, {"compare", "--reference", reference, "--compared", compared, "--model", "plane", "--above", "0.1",
                                    "--components", "--min-points", "50", "--out-dir", out.string()});
     ASSERT_EQ(run.status, 0) << run.err;
     EXPECT_NE(run.out.find("3 regions"), std::string::npos) << run.out;
@@ -99,7 +79,7 @@ TEST(SegmentCli, SegmentWithEachMethodOnTheDistances)
     const PluginRegistry registry = makePluginRegistry();
     const auto dir = test::tempDir();
     const auto [reference, compared] = writeEpochs(registry, dir);
-    ASSERT_EQ(runCommand(registry, {"c2c", "--reference", reference, "--compared", compared, "--model", "plane", "-o",
+    ASSERT_EQ(test::runCliInProcess(registry, {"c2c", "--reference", reference, "--compared", compared, "--model", "plane", "-o",
                              (dir / "distances.ply").string()})
                   .status,
               0);
@@ -113,14 +93,14 @@ TEST(SegmentCli, SegmentWithEachMethodOnTheDistances)
         std::vector<std::string> args{"segment", input, "--field", "c2c_distance", "--min-points", "50", "--reference", reference,
                                       "--dxf-points", "--out-dir", (dir / method[0].substr(2)).string()};
         args.insert(args.end(), method.begin(), method.end());
-        const CliResult run = runCommand(registry, args);
+        const test::CliRun run = test::runCliInProcess(registry, args);
         ASSERT_EQ(run.status, 0) << method[0] << ": " << run.err;
         EXPECT_NE(run.out.find("3 regions"), std::string::npos) << method[0] << ": " << run.out;
         EXPECT_EQ(lineCount(dir / method[0].substr(2) / "regions.csv"), 4u) << method[0];
         EXPECT_EQ(dxfAudit(dir / method[0].substr(2) / "regions.dxf"), 0) << method[0];
     }
     // Without --components the changed points form one region.
-    const CliResult one = runCommand(registry, {"segment", input, "--kmeans", "2", "--out-dir", (dir / "kmeans").string()});
+    const test::CliRun one = test::runCliInProcess(registry, {"segment", input, "--kmeans", "2", "--out-dir", (dir / "kmeans").string()});
     ASSERT_EQ(one.status, 0) << one.err;
     EXPECT_NE(one.out.find("one region"), std::string::npos) << one.out;
 }
@@ -138,19 +118,19 @@ TEST(SegmentCli, BadInputGivesAnErrorAndAStatus)
         d.values()[i] = i % 3 == 0 ? std::nanf("") : static_cast<float>(i) * 0.1f; // NaN values are not an error
     io::writePointCloud(registry.formats, cloud, dir / "in.ply");
     const std::string in = (dir / "in.ply").string(), out = (dir / "out").string();
-    EXPECT_EQ(runCommand(registry, {"segment", in, "--field", "d", "--above", "1", "--components", "--out-dir", out}).status, 0);
-    CliResult run = runCommand(registry, {"segment", in, "--field", "d", "--out-dir", out});
+    EXPECT_EQ(test::runCliInProcess(registry, {"segment", in, "--field", "d", "--above", "1", "--components", "--out-dir", out}).status, 0);
+    test::CliRun run = test::runCliInProcess(registry, {"segment", in, "--field", "d", "--out-dir", out});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
     EXPECT_NE(run.err.find("choose a method"), std::string::npos) << run.err;
-    run = runCommand(registry, {"segment", in, "--field", "missing", "--above", "1", "--out-dir", out});
+    run = test::runCliInProcess(registry, {"segment", in, "--field", "missing", "--above", "1", "--out-dir", out});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
     EXPECT_NE(run.err.find("missing"), std::string::npos) << run.err;
-    EXPECT_NE(runCommand(registry, {"segment", in, "--field", "d", "--above", "1", "--kmeans", "2", "--out-dir", out}).status, 0);
-    run = runCommand(registry, {"segment", in, "--field", "d", "--propagate", "--out-dir", out});
+    EXPECT_NE(test::runCliInProcess(registry, {"segment", in, "--field", "d", "--above", "1", "--kmeans", "2", "--out-dir", out}).status, 0);
+    run = test::runCliInProcess(registry, {"segment", in, "--field", "d", "--propagate", "--out-dir", out});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
     EXPECT_NE(run.err.find("min-seed"), std::string::npos) << run.err;
-    run = runCommand(registry, {"segment", in, "--field", "d", "--stat-test", "weibull", "--fit-box", "1,2,3", "--out-dir", out});
+    run = test::runCliInProcess(registry, {"segment", in, "--field", "d", "--stat-test", "weibull", "--fit-box", "1,2,3", "--out-dir", out});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::InvalidArgument));
-    run = runCommand(registry, {"segment", (dir / "none.ply").string(), "--field", "d", "--above", "1", "--out-dir", out});
+    run = test::runCliInProcess(registry, {"segment", (dir / "none.ply").string(), "--field", "d", "--above", "1", "--out-dir", out});
     EXPECT_EQ(run.status, static_cast<int>(ErrorCode::Io));
 }
