@@ -197,18 +197,11 @@ PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressO
         break;
     }
     case PrimitiveKind::Sphere: {
-        Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
-        Eigen::Vector4d b = Eigen::Vector4d::Zero();
-        for (const auto& p : points) {
-            const Eigen::Vector4d row(2 * p.x(), 2 * p.y(), 2 * p.z(), 1);
-            a.noalias() += row * row.transpose();
-            b += row * p.squaredNorm();
-        }
-        const Eigen::Vector4d algebraic = a.ldlt().solve(b);
-        Eigen::VectorXd x(4);
-        x << algebraic.head<3>(), std::sqrt(algebraic[3] + algebraic.head<3>().squaredNorm());
-        if (!x.allFinite())
+        const std::optional<Primitive> algebraic = algebraicSphere(points, globalCentroid);
+        if (!algebraic)
             cannotFit(kind, "the points do not determine a sphere");
+        Eigen::VectorXd x(4);
+        x << algebraic->point - globalCentroid, algebraic->radius;
         refine(points, x, [](const Eigen::VectorXd& x, const Eigen::Vector3d& p) { return (p - x.head<3>()).norm() - x[3]; }, kind);
         s.point = globalCentroid + x.head<3>();
         s.radius = std::abs(x[3]);
@@ -450,6 +443,26 @@ Table primitiveTable(const Primitive& s, std::optional<double> rms)
 } // namespace scandiff
 
 namespace scandiff {
+
+std::optional<Primitive> algebraicSphere(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre)
+{
+    Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d b = Eigen::Vector4d::Zero();
+    for (const auto& p : points) {
+        const Eigen::Vector4d row(2 * p.x(), 2 * p.y(), 2 * p.z(), 1);
+        a.noalias() += row * row.transpose();
+        b += row * p.squaredNorm();
+    }
+    const Eigen::Vector4d s = a.ldlt().solve(b);
+    const double r2 = s[3] + s.head<3>().squaredNorm();
+    if (!s.allFinite() || !(r2 > 0))
+        return std::nullopt;
+    Primitive sphere;
+    sphere.kind = PrimitiveKind::Sphere;
+    sphere.point = centre + s.head<3>();
+    sphere.radius = std::sqrt(r2);
+    return sphere;
+}
 
 PrimitiveRefinement refinePrimitive(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre,
                                     const Primitive& initial)

@@ -96,15 +96,22 @@ bool radiusPlausible(const Primitive& p, double extent)
     return false;
 }
 
+//! The key of the cube of side `cell` holding p, moved by (dx, dy, dz) cells.
+std::uint64_t cellKey(const Eigen::Vector3d& p, double cell, int dx = 0, int dy = 0, int dz = 0)
+{
+    const auto c = [cell](double v, int d) {
+        return static_cast<std::uint64_t>((static_cast<std::int64_t>(std::floor(v / cell)) + d) & 0x1fffff);
+    };
+    return c(p.x(), dx) | c(p.y(), dy) << 21 | c(p.z(), dz) << 42;
+}
+
 //! The occupied area of points on their surface: cells of `cell` (m) they
 //! fall in, counted in 3D, times the cell's area.
 double footprint(const std::vector<Eigen::Vector3d>& points, double cell)
 {
     std::unordered_set<std::uint64_t> cells;
-    for (const auto& p : points) {
-        const auto key = [&](double v) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / cell)) & 0x1fffff); };
-        cells.insert(key(p.x()) | key(p.y()) << 21 | key(p.z()) << 42);
-    }
+    for (const auto& p : points)
+        cells.insert(cellKey(p, cell));
     return static_cast<double>(cells.size()) * cell * cell;
 }
 
@@ -118,27 +125,6 @@ double lengthAlong(const Primitive& p, const std::vector<Eigen::Vector3d>& point
         hi = std::max(hi, t);
     }
     return hi - lo;
-}
-
-//! The sphere through points by the algebraic fit (centre, radius), in their frame.
-std::optional<Primitive> algebraicSphere(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre)
-{
-    Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
-    Eigen::Vector4d b = Eigen::Vector4d::Zero();
-    for (const auto& p : points) {
-        const Eigen::Vector4d row(2 * p.x(), 2 * p.y(), 2 * p.z(), 1);
-        a.noalias() += row * row.transpose();
-        b += row * p.squaredNorm();
-    }
-    const Eigen::Vector4d s = a.ldlt().solve(b);
-    const double r2 = s[3] + s.head<3>().squaredNorm();
-    if (!s.allFinite() || !(r2 > 0))
-        return std::nullopt;
-    Primitive sphere;
-    sphere.kind = PrimitiveKind::Sphere;
-    sphere.point = centre + s.head<3>();
-    sphere.radius = std::sqrt(r2);
-    return sphere;
 }
 
 //! The least-squares plane of points (their frame), as a primitive (global).
@@ -221,18 +207,14 @@ std::optional<PrimitiveRefinement> chooseType(const std::vector<Eigen::Vector3d>
 //! cells (of side `cell`) of one, and the 27-cell blocks around the other's.
 bool touching(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b, double cell)
 {
-    auto key = [cell](const Eigen::Vector3d& p, int dx, int dy, int dz) {
-        const auto c = [&](double v, int d) { return static_cast<std::uint64_t>((static_cast<std::int64_t>(std::floor(v / cell)) + d) & 0x1fffff); };
-        return c(p.x(), dx) | c(p.y(), dy) << 21 | c(p.z(), dz) << 42;
-    };
     std::unordered_set<std::uint64_t> cells;
     for (const auto& p : a)
-        cells.insert(key(p, 0, 0, 0));
+        cells.insert(cellKey(p, cell));
     for (const auto& p : b)
         for (int dx = -1; dx <= 1; ++dx)
             for (int dy = -1; dy <= 1; ++dy)
                 for (int dz = -1; dz <= 1; ++dz)
-                    if (cells.count(key(p, dx, dy, dz)))
+                    if (cells.count(cellKey(p, cell, dx, dy, dz)))
                         return true;
     return false;
 }

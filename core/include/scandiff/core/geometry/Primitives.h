@@ -13,6 +13,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace scandiff {
 
@@ -53,6 +54,10 @@ struct PrimitiveFit
 //! Error(InvalidData) when the points do not determine the primitive (too
 //! few, collinear, a fit that does not converge).
 PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressObserver* progress = nullptr);
+
+//! The sphere of the algebraic fit (Kasa) through `points`, given relative to
+//! `centre`; empty when they determine none. A start for refinePrimitive().
+std::optional<Primitive> algebraicSphere(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre);
 
 //! A refined primitive and the standard uncertainty of its parameters.
 struct PrimitiveRefinement
