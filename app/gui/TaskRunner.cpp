@@ -6,8 +6,10 @@
 #include <QApplication>
 #include <QEvent>
 #include <QEventLoop>
+#include <QKeyEvent>
 #include <QProgressDialog>
 #include <QThread>
+#include <QWindow>
 
 namespace scandiff::gui {
 
@@ -27,40 +29,69 @@ namespace {
 //! the work reads entities of the document, which must not change or vanish
 //! under it. The dialog appears only after a moment (short tasks do not
 //! flash), so until then, and after Cancel, input is swallowed here.
+//! Qt delivers a mouse click or a key first to the native window (a QWindow,
+//! not a widget), then to the widget under it: both must be let through for
+//! the dialog. Escape cancels wherever the keyboard focus is: before the
+//! dialog shows, it is still in the main window.
 class InputBlocker : public QObject
 {
 public:
-    explicit InputBlocker(const QWidget* allowed) : allowed_(allowed) { qApp->installEventFilter(this); }
+    InputBlocker(QWidget* allowed, std::function<void()> onEscape) : allowed_(allowed), onEscape_(std::move(onEscape))
+    {
+        qApp->installEventFilter(this);
+    }
     ~InputBlocker() override { qApp->removeEventFilter(this); }
 
 protected:
     bool eventFilter(QObject* target, QEvent* event) override
     {
         switch (event->type()) {
+        case QEvent::Show:
+            // The keyboard goes to the dialog when it shows: a modal dialog
+            // blocks the keys of the window under it before any filter sees
+            // them, so Escape would be lost if the focus stayed there.
+            if (target == allowed_)
+                allowed_->activateWindow();
+            return false;
+        case QEvent::KeyPress:
+            if (static_cast<QKeyEvent*>(event)->key() == Qt::Key_Escape) {
+                if (!static_cast<QKeyEvent*>(event)->isAutoRepeat())
+                    onEscape_();
+                return true;
+            }
+            return !inDialog(target);
         case QEvent::MouseButtonPress:
         case QEvent::MouseButtonRelease:
         case QEvent::MouseButtonDblClick:
         case QEvent::MouseMove:
         case QEvent::Wheel:
-        case QEvent::KeyPress:
         case QEvent::KeyRelease:
         case QEvent::Shortcut:
         case QEvent::ShortcutOverride:
         case QEvent::DragEnter:
         case QEvent::DragMove:
         case QEvent::Drop:
-        case QEvent::Close: {
-            const auto* widget = qobject_cast<const QWidget*>(target);
-            const bool inDialog = widget && (widget == allowed_ || allowed_->isAncestorOf(widget));
-            return !inDialog;
-        }
+        case QEvent::Close:
+            return !inDialog(target);
         default:
             return false;
         }
     }
 
 private:
-    const QWidget* allowed_;
+    bool inDialog(const QObject* target) const
+    {
+        if (const auto* window = qobject_cast<const QWindow*>(target))
+            return window == allowed_->windowHandle();
+        // Widgets, and the dialog's Escape shortcut (a QObject child of it).
+        for (const QObject* object = target; object; object = object->parent())
+            if (object == allowed_)
+                return true;
+        return false;
+    }
+
+    QWidget* allowed_;
+    std::function<void()> onEscape_;
 };
 
 } // namespace
@@ -74,15 +105,24 @@ TaskResult runTask(QWidget* parent, const QString& title, const std::function<vo
     dialog.setMinimumDuration(400);
     dialog.setAutoClose(false);
     dialog.setAutoReset(false);
-    QObject::connect(&bridge, &ProgressBridge::stageChanged, &dialog, &QProgressDialog::setLabelText, Qt::QueuedConnection);
+    QObject::connect(
+        &bridge, &ProgressBridge::stageChanged, &dialog,
+        [&bridge, &dialog](const QString& stage) {
+            if (!bridge.cancelRequested())
+                dialog.setLabelText(stage);
+        },
+        Qt::QueuedConnection);
     QObject::connect(&bridge, &ProgressBridge::progressed, &dialog, &QProgressDialog::setValue, Qt::QueuedConnection);
     // Cancel asks the work to stop; the dialog stays until it has (Qt would hide it at once).
     QObject::disconnect(&dialog, &QProgressDialog::canceled, &dialog, &QProgressDialog::cancel);
-    QObject::connect(&dialog, &QProgressDialog::canceled, &dialog, [&bridge, &dialog] {
+    // Once cancelled, the label says so and stays: a stage starting meanwhile
+    // (the work hears Cancel at its next check) must not overwrite it.
+    const auto cancel = [&bridge, &dialog] {
         bridge.requestCancel();
         dialog.setLabelText(QObject::tr("Cancelling..."));
-    });
-    const InputBlocker blocker(&dialog);
+    };
+    QObject::connect(&dialog, &QProgressDialog::canceled, &dialog, cancel);
+    const InputBlocker blocker(&dialog, cancel);
 
     TaskResult result;
     QThread* worker = QThread::create([&] {

@@ -152,12 +152,15 @@ CloudToCloudRun runCloudToCloud(const PointCloud& compared, const PointCloud& re
 {
     CloudToCloudRun run;
     run.params = cloudToCloudSettings(values, reference);
-    run.forward = cloudToCloud(compared, reference, run.params, progress);
-    if (cloudToCloudBothWays(values)) {
+    const bool bothWays = cloudToCloudBothWays(values);
+    PrefixedProgress forwardProgress(progress, bothWays ? "Compared -> reference: " : "");
+    run.forward = cloudToCloud(compared, reference, run.params, forwardProgress.get());
+    if (bothWays) {
         CloudToCloudParams reverseParams = run.params;
         reverseParams.viewpoints = compared.sensors();
         reverseParams.closestPoints = false;
-        run.reverse = cloudToCloud(reference, compared, reverseParams, progress);
+        PrefixedProgress reverseProgress(progress, "Reference -> compared: ");
+        run.reverse = cloudToCloud(reference, compared, reverseParams, reverseProgress.get());
     }
     return run;
 }

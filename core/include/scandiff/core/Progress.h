@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <utility>
 
 namespace scandiff {
 
@@ -53,6 +54,24 @@ private:
     std::uint64_t stride_;
     std::atomic<std::uint64_t> done_{0};
     std::atomic<std::uint64_t> nextReport_{0};
+};
+
+//! Forwards to another observer with every stage title prefixed, so a run that
+//! repeats a computation (C2C both ways, a per-station loop) says which pass the
+//! bar shows.
+class PrefixedProgress : public ProgressObserver
+{
+public:
+    PrefixedProgress(ProgressObserver* target, std::string prefix) : target_(target), prefix_(std::move(prefix)) {}
+    void beginStage(const std::string& title) override { target_->beginStage(prefix_ + title); }
+    void report(double fraction) override { target_->report(fraction); }
+    bool cancelRequested() const override { return target_->cancelRequested(); }
+    //! Null when `target` is null, so the result can be passed on as is.
+    ProgressObserver* get() { return target_ ? this : nullptr; }
+
+private:
+    ProgressObserver* target_;
+    std::string prefix_;
 };
 
 } // namespace scandiff
