@@ -53,9 +53,16 @@ std::string regionLabel(const RegionStatistics& r)
     if (r.distanceCount > 0)
         s << ", mean " << shortNumber(r.meanDistance) << " m, max " << shortNumber(r.maxDistance) << " m, RMS "
           << shortNumber(r.rmsDistance) << " m";
-    s << ", area " << shortNumber(r.footprintArea) << " m2";
-    if (r.volume)
+    s << ", footprint " << shortNumber(r.footprintArea) << " m2";
+    if (std::abs(r.outlineArea - r.footprintArea) > 0.05 * r.outlineArea)
+        s << " (" << shortNumber(r.outlineArea) << " m2 in its plane)"; // a wall, a slope
+    if (r.volume) {
         s << ", volume " << shortNumber(*r.volume) << " m3";
+        if (r.volumeAdded > 0 && r.volumeRemoved > 0)
+            s << " (+" << shortNumber(r.volumeAdded) << " -" << shortNumber(r.volumeRemoved) << ")";
+        if (r.volumeCoverage < 0.999)
+            s << " over " << shortNumber(100.0 * r.volumeCoverage) << " % of it";
+    }
     return s.str();
 }
 
@@ -99,7 +106,8 @@ void writeRegionsCsv(const std::vector<RegionStatistics>& regions, const std::fi
     AtomicFile file(path);
     std::ofstream& out = file.stream();
     out << "id,points,min_x,min_y,min_z,max_x,max_y,max_z,centroid_x,centroid_y,centroid_z,normal_x,normal_y,normal_z,"
-           "footprint_area,distance_count,mean_distance,max_distance,rms_distance,volume,volume_coverage\n";
+           "footprint_area,outline_area,distance_count,mean_distance,max_distance,rms_distance,volume,volume_added,volume_removed,"
+           "volume_coverage\n";
     for (const RegionStatistics& r : regions) {
         out << r.id << ',' << r.pointCount;
         for (const Eigen::Vector3d* v : {&r.bounds.min, &r.bounds.max, &r.centroid})
@@ -107,10 +115,11 @@ void writeRegionsCsv(const std::vector<RegionStatistics>& regions, const std::fi
                 out << ',' << coordinate((*v)[a]);
         for (int a = 0; a < 3; ++a)
             out << ',' << csvNumber(r.planeNormal[a]);
-        out << ',' << csvNumber(r.footprintArea) << ',' << r.distanceCount << ',' << csvNumber(r.meanDistance) << ','
-            << csvNumber(r.maxDistance) << ',' << csvNumber(r.rmsDistance) << ','
-            << (r.volume ? csvNumber(*r.volume) : std::string()) << ','
-            << (r.volume ? csvNumber(r.volumeCoverage) : std::string()) << '\n';
+        out << ',' << csvNumber(r.footprintArea) << ',' << csvNumber(r.outlineArea) << ',' << r.distanceCount << ','
+            << csvNumber(r.meanDistance) << ',' << csvNumber(r.maxDistance) << ',' << csvNumber(r.rmsDistance);
+        for (double value : {r.volume.value_or(0.0), r.volumeAdded, r.volumeRemoved, r.volumeCoverage})
+            out << ',' << (r.volume ? csvNumber(value) : std::string());
+        out << '\n';
     }
     file.commit();
 }

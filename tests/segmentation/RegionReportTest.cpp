@@ -39,7 +39,9 @@ TEST(Outline, SquareAndConcaveLShape)
     // A 1 m square sampled every 2 cm, outlined on 3 cm cells.
     const Outline2d square = concaveOutline(gridPoints(0, 0, 1, 1, 0.02), 0.03);
     ASSERT_EQ(square.rings.size(), 1u);
-    EXPECT_NEAR(square.area, 1.0, 4 * 1.0 * 0.03); // within a cell along the perimeter
+    // The outline runs through the outermost points (0.01 and 0.99), not up
+    // to a cell beyond them: the area is that of the sampled square, exactly.
+    EXPECT_NEAR(square.area, 0.98 * 0.98, 1e-9);
     EXPECT_EQ(square.rings[0].size(), 4u);         // straight sides collapse to 4 corners
     EXPECT_GT(ringArea(square.rings[0]), 0.0);     // counter-clockwise
 
@@ -117,12 +119,13 @@ TEST(RegionReport, MeasuresEachRegion)
     EXPECT_NEAR(slab.bounds.min.x(), 1000.01, 1e-4);
     EXPECT_NEAR(slab.bounds.max.y(), 2000.99, 1e-4);
     EXPECT_NEAR(std::abs(slab.planeNormal.z()), 1.0, 1e-9);
-    EXPECT_NEAR(slab.footprintArea, 1.0, 0.15);
+    EXPECT_NEAR(slab.footprintArea, 0.98 * 0.98, 1e-6); // the square through the outermost points
+    EXPECT_NEAR(slab.outlineArea, 0.98 * 0.98, 1e-6);
     EXPECT_NEAR(slab.meanDistance, 0.5, 1e-6);
     EXPECT_NEAR(slab.maxDistance, 0.5, 1e-6);
     EXPECT_NEAR(slab.rmsDistance, 0.5, 1e-6);
     ASSERT_TRUE(slab.volume.has_value());
-    EXPECT_NEAR(*slab.volume, 0.5, 0.01); // 1 m^2 at 0.5 m; the 10 cm columns tile the square
+    EXPECT_NEAR(*slab.volume, 0.5 * 0.98 * 0.98, 1e-6); // 0.5 m over the footprint
     EXPECT_NEAR(slab.volumeCoverage, 1.0, 1e-12);
     ASSERT_EQ(slab.outlines.size(), 1u);
     for (const auto& v : slab.outlines[0])
@@ -131,13 +134,110 @@ TEST(RegionReport, MeasuresEachRegion)
     const RegionStatistics& tilted = report[1];
     EXPECT_EQ(tilted.id, 2);
     EXPECT_NEAR(std::abs(tilted.planeNormal.dot(tiltU.cross(tiltV).normalized())), 1.0, 1e-6);
-    EXPECT_NEAR(tilted.footprintArea, 0.25, 0.06);
+    // 0.48 x 0.48 in its plane; seen from above, its width along x shrinks by cos = 0.6.
+    EXPECT_NEAR(tilted.outlineArea, 0.48 * 0.48, 1e-4);
+    EXPECT_NEAR(tilted.footprintArea, 0.48 * 0.6 * 0.48, 1e-4);
     ASSERT_FALSE(tilted.outlines.empty());
     const Eigen::Vector3d origin(1000, 2000, 0);
     for (const auto& v : tilted.outlines[0]) // the outline lies in the tilted plane
         EXPECT_NEAR((v - origin - Eigen::Vector3d(5, 5, 0)).dot(tiltU.cross(tiltV)), 0.0, 1e-4);
     EXPECT_LT(tilted.maxDistance, 0.0); // the sign of the largest value is kept
     EXPECT_FALSE(tilted.volumeCoverage > 0.0); // the reference does not reach it
+}
+
+namespace {
+
+//! A horizontal square grid of points at height z, corners included.
+void addGrid(PointCloud& cloud, double x0, double y0, double x1, double y1, double z, double step)
+{
+    for (double x = x0; x <= x1 + 1e-9; x += step)
+        for (double y = y0; y <= y1 + 1e-9; y += step)
+            cloud.positions().emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+}
+
+//! The four vertical walls of the box [x0, x1] x [y0, y1] x [0, height].
+void addWalls(PointCloud& cloud, double x0, double y0, double x1, double y1, double height, double step)
+{
+    for (double z = 0; z < height - 1e-9; z += step) {
+        for (double x = x0; x <= x1 + 1e-9; x += step) {
+            cloud.positions().emplace_back(static_cast<float>(x), static_cast<float>(y0), static_cast<float>(z));
+            cloud.positions().emplace_back(static_cast<float>(x), static_cast<float>(y1), static_cast<float>(z));
+        }
+        for (double y = y0 + step; y < y1 - 1e-9; y += step) {
+            cloud.positions().emplace_back(static_cast<float>(x0), static_cast<float>(y), static_cast<float>(z));
+            cloud.positions().emplace_back(static_cast<float>(x1), static_cast<float>(y), static_cast<float>(z));
+        }
+    }
+}
+
+void markRegion(PointCloud& cloud, std::size_t from, float id)
+{
+    ScalarField* field = cloud.field("region_id");
+    if (!field)
+        field = &cloud.addField("region_id");
+    field->values().resize(cloud.size(), std::nanf(""));
+    for (std::size_t i = from; i < cloud.size(); ++i)
+        field->values()[i] = id;
+}
+
+} // namespace
+
+// The trial's scene in closed form: between two epochs of flat ground, an
+// 8 x 8 x 4 m box appeared (roof and walls scanned) and a 20 x 20 x 2 m block
+// went. The trial's report gave the box -10.2 m^3 and 80.1 m^2.
+TEST(RegionReport, AppearedBoxAndRemovedBlockInClosedForm)
+{
+    constexpr double step = 0.25;
+    PointCloud earlier, later;
+    for (PointCloud* epoch : {&earlier, &later})
+        epoch->setOrigin({512000, 5403000, 380});
+    // Earlier: ground (not under the block) and the block, roof and walls.
+    addGrid(earlier, -10, -10, 12, 30, 0, step);
+    addGrid(earlier, 12.25, -10, 40, -0.25, 0, step);
+    addGrid(earlier, 12.25, 20.25, 40, 30, 0, step);
+    addGrid(earlier, 35.25, 0, 40, 20, 0, step);
+    const std::size_t blockStart = earlier.size();
+    addGrid(earlier, 15, 0, 35, 20, 2, step);
+    addWalls(earlier, 15, 0, 35, 20, 2, step);
+    markRegion(earlier, blockStart, 1);
+    // Later: ground everywhere but under the box, and the box.
+    addGrid(later, -10, -10, -0.25, 30, 0, step);
+    addGrid(later, 8.25, -10, 40, 30, 0, step);
+    addGrid(later, 0, -10, 8, -0.25, 0, step);
+    addGrid(later, 0, 8.25, 8, 30, 0, step);
+    const std::size_t boxStart = later.size();
+    addGrid(later, 0, 0, 8, 8, 4, step);
+    addWalls(later, 0, 0, 8, 8, 4, step);
+    markRegion(later, boxStart, 1);
+
+    RegionReportParams appeared;
+    appeared.reference = &earlier; // the other epoch; the regions are in the later one
+    const std::vector<RegionStatistics> box = regionReport(later, appeared);
+    ASSERT_EQ(box.size(), 1u);
+    EXPECT_NEAR(box[0].footprintArea, 64.0, 1e-3);
+    ASSERT_TRUE(box[0].volume.has_value());
+    EXPECT_NEAR(*box[0].volume, 256.0, 1e-2); // appearance counts positive
+    EXPECT_NEAR(box[0].volumeAdded, 256.0, 1e-2);
+    EXPECT_EQ(box[0].volumeRemoved, 0.0);
+    EXPECT_NEAR(box[0].volumeCoverage, 1.0, 1e-9);
+    // The same with columns of another size: the partial ones at the edge are weighed by their part inside.
+    appeared.volumeCellSize = 0.7;
+    EXPECT_NEAR(*regionReport(later, appeared)[0].volume, 256.0, 1e-2);
+
+    RegionReportParams removed;
+    removed.reference = &later;
+    removed.regionInLaterEpoch = false; // the regions are in the earlier epoch
+    const std::vector<RegionStatistics> block = regionReport(earlier, removed);
+    ASSERT_EQ(block.size(), 1u);
+    EXPECT_NEAR(block[0].footprintArea, 400.0, 1e-2);
+    EXPECT_NEAR(*block[0].volume, -800.0, 1e-1); // removal counts negative
+    EXPECT_NEAR(block[0].volumeRemoved, 800.0, 1e-1);
+    EXPECT_EQ(block[0].volumeAdded, 0.0);
+    // Mean column heights: the walls pull the block's edge columns down, so it is less, not more.
+    removed.columnHeight = RegionReportParams::ColumnHeight::Mean;
+    const double meanVolume = *regionReport(earlier, removed)[0].volume;
+    EXPECT_LT(meanVolume, 0.0);
+    EXPECT_GT(meanVolume, -800.0);
 }
 
 TEST(RegionReport, BadInput)

@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include "PlanarPolygons.h"
+
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
 #include <scandiff/core/segmentation/RegionReport.h>
@@ -15,205 +17,116 @@ namespace scandiff {
 
 namespace {
 
-constexpr int kMaxGridCells = 4096;
-
-//! Douglas-Peucker on the open chain ring[first..last] (indices modulo size):
-//! marks the vertices to keep.
-void simplifyChain(const Polygon2d& ring, std::size_t first, std::size_t last, double tolerance, std::vector<char>& keep)
+//! The 2.5D volume between the epochs inside the region's footprint (see RegionStatistics::volume).
+void measureVolume(const PointCloud& cloud, const std::vector<std::size_t>& indices, const PointCloud& other,
+                   const RegionReportParams& params, double c, RegionStatistics& r)
 {
-    const std::size_t n = ring.size();
-    if ((last + n - first) % n < 2)
+    // Columns on a horizontal grid anchored at the footprint's box (global X, Y).
+    Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const Polygon2d& ring : r.footprint)
+        for (const Eigen::Vector2d& q : ring) {
+            lo = lo.cwiseMin(q);
+            hi = hi.cwiseMax(q);
+        }
+    if (!(lo.x() <= hi.x()))
         return;
-    const Eigen::Vector2d a = ring[first % n], b = ring[last % n];
-    const Eigen::Vector2d ab = b - a;
-    const double length = ab.norm();
-    double worst = -1.0;
-    std::size_t worstIndex = first;
-    for (std::size_t i = first + 1; i < last; ++i) {
-        const Eigen::Vector2d ap = ring[i % n] - a;
-        const double d = length > 0 ? std::abs(ab.x() * ap.y() - ab.y() * ap.x()) / length : ap.norm();
-        if (d > worst) {
-            worst = d;
-            worstIndex = i;
+    const double nxd = std::floor((hi.x() - lo.x()) / c) + 1, nyd = std::floor((hi.y() - lo.y()) / c) + 1;
+    if (nxd * nyd > 1e8)
+        throw Error(ErrorCode::InvalidArgument, "region report: the volume cell size " + std::to_string(c) +
+                                                    " m is too small for region " + std::to_string(r.id));
+    const auto nx = static_cast<std::int64_t>(nxd);
+    auto columnOf = [&](const Eigen::Vector3d& g) -> std::int64_t {
+        const double fx = std::floor((g.x() - lo.x()) / c), fy = std::floor((g.y() - lo.y()) / c);
+        if (fx < 0 || fy < 0 || fx >= nxd || fy >= nyd)
+            return -1;
+        return static_cast<std::int64_t>(fy) * nx + static_cast<std::int64_t>(fx);
+    };
+    struct Height
+    {
+        double highest = -std::numeric_limits<double>::infinity(), lowest = std::numeric_limits<double>::infinity(), sum = 0;
+        std::size_t count = 0;
+        void add(double z)
+        {
+            highest = std::max(highest, z);
+            lowest = std::min(lowest, z);
+            sum += z;
+            ++count;
         }
+        double value(RegionReportParams::ColumnHeight kind) const
+        {
+            switch (kind) {
+            case RegionReportParams::ColumnHeight::Highest: return highest;
+            case RegionReportParams::ColumnHeight::Lowest: return lowest;
+            default: return sum / static_cast<double>(count);
+            }
+        }
+    };
+    struct Column
+    {
+        Height region, other;
+    };
+    std::unordered_map<std::int64_t, Column> columns;
+    for (std::size_t i : indices) {
+        const Eigen::Vector3d g = cloud.globalPosition(i);
+        const std::int64_t key = columnOf(g);
+        if (key >= 0)
+            columns[key].region.add(g.z());
     }
-    if (worst > tolerance) {
-        keep[worstIndex % n] = 1;
-        simplifyChain(ring, first, worstIndex, tolerance, keep);
-        simplifyChain(ring, worstIndex, last, tolerance, keep);
+    for (std::size_t i = 0; i < other.size(); ++i) {
+        if (!other.positions()[i].allFinite())
+            continue;
+        const Eigen::Vector3d g = other.globalPosition(i);
+        const std::int64_t key = columnOf(g);
+        const auto it = key < 0 ? columns.end() : columns.find(key);
+        if (it != columns.end())
+            it->second.other.add(g.z());
     }
+    double added = 0.0, removed = 0.0, coveredArea = 0.0, totalArea = 0.0;
+    for (const auto& [key, column] : columns) {
+        // The column's area inside the footprint: whole inside, a part on its edge.
+        const Eigen::Vector2d cellLo = lo + c * Eigen::Vector2d(static_cast<double>(key % nx), static_cast<double>(key / nx));
+        const Eigen::Vector2d cellHi = cellLo + Eigen::Vector2d::Constant(c);
+        double area = 0.0;
+        for (const Polygon2d& ring : r.footprint)
+            area += detail::areaInRectangle(ring, cellLo, cellHi);
+        totalArea += area;
+        if (column.other.count == 0 || area == 0.0)
+            continue;
+        coveredArea += area;
+        const double regionHeight = column.region.value(params.columnHeight), otherHeight = column.other.value(params.columnHeight);
+        const double rise = params.regionInLaterEpoch ? regionHeight - otherHeight : otherHeight - regionHeight;
+        (rise > 0 ? added : removed) += std::abs(rise) * area;
+    }
+    r.volume = added - removed;
+    r.volumeAdded = added;
+    r.volumeRemoved = removed;
+    r.volumeCoverage = totalArea > 0 ? coveredArea / totalArea : 0.0;
 }
 
-Polygon2d simplifyRing(const Polygon2d& ring, double tolerance)
+//! 1.5 times the median distance of the region's points to their 4th nearest
+//! neighbour: one cell per point spacing and a half, so the sampling leaves few holes.
+double automaticOutlineCell(const std::vector<Eigen::Vector3f>& local, const BoundingBox& bounds)
 {
-    const std::size_t n = ring.size();
-    if (n <= 4)
-        return ring;
-    // Split the ring at its first vertex and the vertex farthest from it, then
-    // simplify the two chains.
-    std::size_t far = 0;
-    double best = -1.0;
-    for (std::size_t i = 1; i < n; ++i) {
-        const double d = (ring[i] - ring[0]).squaredNorm();
-        if (d > best) {
-            best = d;
-            far = i;
-        }
-    }
-    std::vector<char> keep(n, 0);
-    keep[0] = keep[far] = 1;
-    simplifyChain(ring, 0, far, tolerance, keep);
-    simplifyChain(ring, far, n, tolerance, keep);
-    Polygon2d out;
-    for (std::size_t i = 0; i < n; ++i)
-        if (keep[i])
-            out.push_back(ring[i]);
-    return out.size() >= 3 ? out : ring;
-}
-
-double signedArea(const Polygon2d& ring)
-{
-    double twice = 0.0;
-    for (std::size_t i = 0; i < ring.size(); ++i) {
-        const Eigen::Vector2d& p = ring[i];
-        const Eigen::Vector2d& q = ring[(i + 1) % ring.size()];
-        twice += p.x() * q.y() - q.x() * p.y();
-    }
-    return 0.5 * twice;
+    const octree::Octree tree(local.data(), local.size());
+    const std::size_t k = std::min<std::size_t>(5, local.size());
+    std::vector<octree::Neighbour> neighbours;
+    int level = 1;
+    for (int l = 1; l <= octree::kMaxLevel; ++l)
+        if (tree.levelStatistics(l).meanPointsPerCell >= 8.0)
+            level = l;
+    tree.nearestBatch(local.data(), local.size(), k, level, neighbours);
+    std::vector<float> fourth;
+    fourth.reserve(local.size());
+    for (std::size_t i = 0; i < local.size(); ++i)
+        fourth.push_back(std::sqrt(neighbours[i * k + k - 1].squaredDistance));
+    std::nth_element(fourth.begin(), fourth.begin() + fourth.size() / 2, fourth.end());
+    const double cell = 1.5 * fourth[fourth.size() / 2];
+    if (cell > 0.0)
+        return cell;
+    return std::max(1e-3, 1e-2 * (bounds.max - bounds.min).norm()); // a single point, or duplicates: some small square
 }
 
 } // namespace
-
-Outline2d concaveOutline(const std::vector<Eigen::Vector2d>& points, double cellSize)
-{
-    if (!(cellSize > 0.0 && std::isfinite(cellSize)))
-        throw Error(ErrorCode::InvalidArgument, "outline: the cell size must be > 0");
-    Outline2d outline;
-    Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (const auto& p : points)
-        if (p.allFinite()) {
-            lo = lo.cwiseMin(p);
-            hi = hi.cwiseMax(p);
-        }
-    if (!(lo.x() <= hi.x()))
-        return outline;
-    const double extent = (hi - lo).maxCoeff();
-    if (extent / cellSize > kMaxGridCells) {
-        const double coarser = extent / kMaxGridCells;
-        logWarning("outline: cell size " + std::to_string(cellSize) + " m gives a grid too large for an extent of " +
-                   std::to_string(extent) + " m; using " + std::to_string(coarser) + " m");
-        cellSize = coarser;
-    }
-    // Two empty cells of margin on every side, so dilation and erosion never clip.
-    constexpr int pad = 2;
-    const int nx = static_cast<int>(std::floor((hi.x() - lo.x()) / cellSize)) + 1 + 2 * pad;
-    const int ny = static_cast<int>(std::floor((hi.y() - lo.y()) / cellSize)) + 1 + 2 * pad;
-    std::vector<char> occupied(static_cast<std::size_t>(nx) * ny, 0);
-    auto at = [&](std::vector<char>& grid, int x, int y) -> char& { return grid[static_cast<std::size_t>(y) * nx + x]; };
-    for (const auto& p : points) {
-        if (!p.allFinite())
-            continue;
-        const int x = std::min(nx - 1 - pad, static_cast<int>((p.x() - lo.x()) / cellSize) + pad);
-        const int y = std::min(ny - 1 - pad, static_cast<int>((p.y() - lo.y()) / cellSize) + pad);
-        at(occupied, x, y) = 1;
-    }
-    // Closing with a 3x3 square: fills the one-cell holes that sampling leaves.
-    auto morph = [&](const std::vector<char>& in, bool dilate) {
-        std::vector<char> out(in.size(), 0);
-        for (int y = 1; y + 1 < ny; ++y)
-            for (int x = 1; x + 1 < nx; ++x) {
-                bool any = false, all = true;
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        const bool v = in[static_cast<std::size_t>(y + dy) * nx + x + dx] != 0;
-                        any = any || v;
-                        all = all && v;
-                    }
-                out[static_cast<std::size_t>(y) * nx + x] = dilate ? any : all;
-            }
-        return out;
-    };
-    std::vector<char> closed = morph(morph(occupied, true), false);
-    // Erosion may remove an isolated point's cell entirely; keep every occupied cell.
-    for (std::size_t c = 0; c < closed.size(); ++c)
-        closed[c] = closed[c] || occupied[c];
-
-    // Boundary edges, each oriented with the occupied cell on its left, so outer
-    // boundaries run counter-clockwise and hole boundaries clockwise.
-    struct Edge
-    {
-        int x0, y0, x1, y1;
-        bool used = false;
-    };
-    std::vector<Edge> edges;
-    std::unordered_map<std::int64_t, std::vector<std::size_t>> outgoing;
-    auto key = [&](int x, int y) { return static_cast<std::int64_t>(y) * (nx + 1) + x; };
-    auto addEdge = [&](int x0, int y0, int x1, int y1) {
-        outgoing[key(x0, y0)].push_back(edges.size());
-        edges.push_back({x0, y0, x1, y1});
-    };
-    for (int y = 1; y + 1 < ny; ++y)
-        for (int x = 1; x + 1 < nx; ++x) {
-            if (!at(closed, x, y))
-                continue;
-            if (!at(closed, x, y - 1))
-                addEdge(x, y, x + 1, y);
-            if (!at(closed, x + 1, y))
-                addEdge(x + 1, y, x + 1, y + 1);
-            if (!at(closed, x, y + 1))
-                addEdge(x + 1, y + 1, x, y + 1);
-            if (!at(closed, x - 1, y))
-                addEdge(x, y + 1, x, y);
-        }
-    for (std::size_t start = 0; start < edges.size(); ++start) {
-        if (edges[start].used)
-            continue;
-        std::vector<Eigen::Vector2i> loop;
-        std::size_t e = start;
-        while (!edges[e].used) {
-            edges[e].used = true;
-            loop.emplace_back(edges[e].x0, edges[e].y0);
-            const int dx = edges[e].x1 - edges[e].x0, dy = edges[e].y1 - edges[e].y0;
-            // Where two pieces touch at a corner, two edges leave the vertex:
-            // turning left keeps to the current piece, so 4-connected pieces
-            // get separate outlines.
-            std::size_t next = SIZE_MAX;
-            int bestRank = 3;
-            for (std::size_t candidate : outgoing[key(edges[e].x1, edges[e].y1)]) {
-                if (edges[candidate].used && candidate != start)
-                    continue;
-                const int cx = edges[candidate].x1 - edges[candidate].x0, cy = edges[candidate].y1 - edges[candidate].y0;
-                const int cross = dx * cy - dy * cx;
-                const int rank = cross > 0 ? 0 : (cross == 0 ? 1 : 2);
-                if (rank < bestRank) {
-                    bestRank = rank;
-                    next = candidate;
-                }
-            }
-            if (next == SIZE_MAX || next == start)
-                break;
-            e = next;
-        }
-        // Drop the vertices in the middle of straight runs.
-        Polygon2d ring;
-        const std::size_t m = loop.size();
-        for (std::size_t i = 0; i < m; ++i) {
-            const Eigen::Vector2i d0 = loop[i] - loop[(i + m - 1) % m], d1 = loop[(i + 1) % m] - loop[i];
-            if (d0.x() * d1.y() - d0.y() * d1.x() != 0)
-                ring.push_back(lo + cellSize * (loop[i].cast<double>() - Eigen::Vector2d::Constant(pad)));
-        }
-        if (ring.size() < 3)
-            continue;
-        const double area = signedArea(ring);
-        if (area <= 0)
-            continue; // a hole
-        outline.area += area;
-        outline.rings.push_back(simplifyRing(ring, 0.5 * cellSize));
-    }
-    std::sort(outline.rings.begin(), outline.rings.end(),
-              [](const Polygon2d& a, const Polygon2d& b) { return std::abs(signedArea(a)) > std::abs(signedArea(b)); });
-    return outline;
-}
 
 std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const RegionReportParams& params, ProgressObserver* progress)
 {
@@ -274,26 +187,7 @@ std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const Region
         const Eigen::Vector3d u = eigen.eigenvectors().col(2).normalized();
         const Eigen::Vector3d v = r.planeNormal.cross(u);
 
-        // Outline cell: from the spacing of the region's own points.
-        double cell = params.outlineCellSize;
-        if (cell == 0.0) {
-            const octree::Octree tree(local.data(), local.size());
-            const std::size_t k = std::min<std::size_t>(5, local.size());
-            std::vector<octree::Neighbour> neighbours;
-            int level = 1;
-            for (int l = 1; l <= octree::kMaxLevel; ++l)
-                if (tree.levelStatistics(l).meanPointsPerCell >= 8.0)
-                    level = l;
-            tree.nearestBatch(local.data(), local.size(), k, level, neighbours);
-            std::vector<float> fourth;
-            fourth.reserve(local.size());
-            for (std::size_t i = 0; i < local.size(); ++i)
-                fourth.push_back(std::sqrt(neighbours[i * k + k - 1].squaredDistance));
-            std::nth_element(fourth.begin(), fourth.begin() + fourth.size() / 2, fourth.end());
-            cell = 1.5 * fourth[fourth.size() / 2];
-            if (!(cell > 0.0)) // a single point, or duplicates: some small square
-                cell = std::max(1e-3, 1e-2 * (r.bounds.max - r.bounds.min).norm());
-        }
+        const double cell = params.outlineCellSize > 0 ? params.outlineCellSize : automaticOutlineCell(local, r.bounds);
         r.outlineCellSize = cell;
         std::vector<Eigen::Vector2d> planar;
         planar.reserve(indices.size());
@@ -302,12 +196,23 @@ std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const Region
             planar.emplace_back(d.dot(u), d.dot(v));
         }
         const Outline2d outline = concaveOutline(planar, cell);
-        r.footprintArea = outline.area;
+        r.outlineArea = outline.area;
         for (const auto& ring : outline.rings) {
             std::vector<Eigen::Vector3d> lifted;
             for (const auto& q : ring)
                 lifted.push_back(r.centroid + q.x() * u + q.y() * v);
             r.outlines.push_back(std::move(lifted));
+        }
+        // The footprint: the same outline of the points seen from above.
+        for (std::size_t j = 0; j < local.size(); ++j)
+            planar[j] = (local[j].cast<double>() - mean).head<2>();
+        const Outline2d plan = concaveOutline(planar, cell);
+        r.footprintArea = plan.area;
+        for (const auto& ring : plan.rings) {
+            Polygon2d global;
+            for (const auto& q : ring)
+                global.push_back(q + r.centroid.head<2>());
+            r.footprint.push_back(std::move(global));
         }
 
         if (distance) {
@@ -330,59 +235,8 @@ std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const Region
             }
         }
 
-        if (params.reference) {
-            // 2.5D columns on a horizontal grid anchored at the region's box.
-            const double c = params.volumeCellSize > 0 ? params.volumeCellSize : cell;
-            const Eigen::Vector2d anchor = r.bounds.min.head<2>();
-            const double nxd = std::floor((r.bounds.max.x() - anchor.x()) / c) + 1;
-            const double nyd = std::floor((r.bounds.max.y() - anchor.y()) / c) + 1;
-            if (nxd * nyd > 1e8)
-                throw Error(ErrorCode::InvalidArgument, "region report: the volume cell size " + std::to_string(c) +
-                                                            " m is too small for region " + std::to_string(id));
-            const auto nx = static_cast<std::int64_t>(nxd);
-            auto column = [&](const Eigen::Vector3d& g) -> std::int64_t {
-                const double fx = std::floor((g.x() - anchor.x()) / c), fy = std::floor((g.y() - anchor.y()) / c);
-                if (fx < 0 || fy < 0 || fx >= nxd || fy >= nyd)
-                    return -1;
-                return static_cast<std::int64_t>(fy) * nx + static_cast<std::int64_t>(fx);
-            };
-            struct Column
-            {
-                double regionZ = 0, referenceZ = 0;
-                std::size_t regionCount = 0, referenceCount = 0;
-            };
-            std::unordered_map<std::int64_t, Column> columns;
-            for (std::size_t i : indices) {
-                const Eigen::Vector3d g = cloud.globalPosition(i);
-                Column& col = columns[column(g)];
-                col.regionZ += g.z();
-                ++col.regionCount;
-            }
-            const PointCloud& ref = *params.reference;
-            for (std::size_t i = 0; i < ref.size(); ++i) {
-                if (!ref.positions()[i].allFinite())
-                    continue;
-                const Eigen::Vector3d g = ref.globalPosition(i);
-                const std::int64_t key = column(g);
-                if (key < 0)
-                    continue;
-                const auto it = columns.find(key);
-                if (it == columns.end())
-                    continue;
-                it->second.referenceZ += g.z();
-                ++it->second.referenceCount;
-            }
-            double volume = 0.0;
-            std::size_t covered = 0;
-            for (const auto& [key, col] : columns) {
-                if (col.referenceCount == 0)
-                    continue;
-                ++covered;
-                volume += (col.regionZ / col.regionCount - col.referenceZ / col.referenceCount) * c * c;
-            }
-            r.volume = volume;
-            r.volumeCoverage = columns.empty() ? 0.0 : static_cast<double>(covered) / static_cast<double>(columns.size());
-        }
+        if (params.reference)
+            measureVolume(cloud, indices, *params.reference, params, params.volumeCellSize > 0 ? params.volumeCellSize : cell, r);
         report.push_back(std::move(r));
     }
     return report;

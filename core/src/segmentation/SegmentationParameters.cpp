@@ -89,6 +89,14 @@ const std::vector<ParameterSpec>& segmentationParameters()
             ParameterSpec::real("outline-cell", "Outline cell",
                                 "Cell of the regions' concave outlines; 0 = automatic (1.5 x the 4th-neighbour spacing)", 0.0, 0.0, 1e9,
                                 "m"),
+            ParameterSpec::choice("region-epoch", "Regions are in",
+                                  "Volume: which epoch the segmented cloud is (later: the compared cloud, where appeared matter shows; "
+                                  "earlier: the reference of a both-ways C2C, where removed matter shows); the volume is later minus earlier",
+                                  {"later", "earlier"}, "later"),
+            ParameterSpec::choice("column-height", "Column height",
+                                  "Volume: each epoch's height in a grid column: its highest point (the surface seen from above), mean or lowest",
+                                  {"highest", "mean", "lowest"}, "highest"),
+            ParameterSpec::real("volume-cell", "Volume cell", "Volume: horizontal grid cell; 0 = the outline cell", 0.0, 0.0, 1e9, "m"),
         };
     }();
     return parameters;
@@ -280,6 +288,12 @@ RegionReportParams regionReportSettings(const ParameterValues& values, const Poi
     RegionReportParams p;
     p.distanceField = values.text("field");
     p.outlineCellSize = values.real("outline-cell");
+    p.volumeCellSize = values.real("volume-cell");
+    p.regionInLaterEpoch = values.text("region-epoch") == "later";
+    const std::string height = values.text("column-height");
+    p.columnHeight = height == "mean"     ? RegionReportParams::ColumnHeight::Mean
+                     : height == "lowest" ? RegionReportParams::ColumnHeight::Lowest
+                                          : RegionReportParams::ColumnHeight::Highest;
     p.reference = reference;
     return p;
 }

@@ -29,12 +29,16 @@ struct Outline2d
 //! A concave outline of 2D points. The points are rasterised on a grid of
 //! `cellSize`, one-cell gaps are closed (dilation then erosion), and the outer
 //! boundary of every 4-connected piece of occupied cells is traced along cell
-//! edges, then simplified (collinear vertices dropped, Douglas-Peucker at half a
-//! cell). A grid outline is used rather than an alpha shape because it needs no
-//! triangulation (core does not depend on CGAL), cannot self-intersect before
-//! simplification, and its one parameter has a plain meaning: the size of the
-//! smallest notch it follows. Throws Error(InvalidArgument) for cellSize <= 0.
-//! Grids wider than 4096 cells use a coarser cell (with a warning).
+//! edges; each edge is then moved onto the outermost point of its cell on that
+//! side, so the outline runs through the extreme points instead of up to a
+//! cell outside them, and simplified (collinear vertices dropped,
+//! Douglas-Peucker at half a cell). `area` is that of the moved rings before
+//! the simplification: a densely sampled rectangle gets its own area. A grid
+//! outline is used rather than an alpha shape because it needs no
+//! triangulation (core does not depend on CGAL), and its one parameter has a
+//! plain meaning: the size of the smallest notch it follows. Throws
+//! Error(InvalidArgument) for cellSize <= 0. Grids wider than 4096 cells use a
+//! coarser cell (with a warning).
 Outline2d concaveOutline(const std::vector<Eigen::Vector2d>& points, double cellSize);
 
 struct RegionReportParams
@@ -51,6 +55,15 @@ struct RegionReportParams
     const PointCloud* reference = nullptr;
     //! Horizontal cell size (m) of the 2.5D volume grid, >= 0; 0: the region's outline cell size.
     double volumeCellSize = 0.0;
+    //! Which epoch the region's cloud is: the later one (the compared cloud of
+    //! a C2C, where appeared matter shows) or the earlier one (the reference of
+    //! a both-ways C2C, where removed matter shows). The volume is always
+    //! later minus earlier, so appearance counts positive, removal negative.
+    bool regionInLaterEpoch = true;
+    //! The height of each epoch in a column: the highest point (the surface seen
+    //! from above, CloudCompare's "max"), the mean, or the lowest.
+    enum class ColumnHeight { Highest, Mean, Lowest };
+    ColumnHeight columnHeight = ColumnHeight::Highest;
 };
 
 struct RegionStatistics
@@ -62,18 +75,26 @@ struct RegionStatistics
     Eigen::Vector3d planeNormal = Eigen::Vector3d::UnitZ(); //!< of the best-fit (least-squares) plane
     //! Outline in the best-fit plane, lifted back to 3D (global), closed rings, largest first.
     std::vector<std::vector<Eigen::Vector3d>> outlines;
-    double footprintArea = 0.0;                  //!< area inside the outline, in the plane (m^2)
-    double outlineCellSize = 0.0;                //!< the grid cell used for the outline (m)
+    double outlineArea = 0.0;   //!< area inside that outline, in the best-fit plane (m^2): a wall's surface
+    double footprintArea = 0.0; //!< area of the outline of the points seen from above, horizontal (m^2)
+    //! The horizontal footprint's rings (global X, Y), largest first: the 2.5D volume is taken inside them.
+    std::vector<Polygon2d> footprint;
+    double outlineCellSize = 0.0;                //!< the grid cell used for the outlines (m)
     std::size_t distanceCount = 0;               //!< valid distance values
     double meanDistance = std::numeric_limits<double>::quiet_NaN();
     double maxDistance = std::numeric_limits<double>::quiet_NaN(); //!< the value of largest magnitude (sign kept)
     double rmsDistance = std::numeric_limits<double>::quiet_NaN();
-    //! Volume between the epochs over the region (m^3): per vertical column of
-    //! the 2.5D grid, (mean Z of the region's points - mean Z of the reference's
-    //! points) times the cell area, summed; positive where matter appeared.
-    //! Columns where the reference has no point are left out. Absent without a reference.
+    //! Volume between the epochs inside the footprint (m^3), later minus
+    //! earlier: positive where matter appeared, negative where it went. On a
+    //! horizontal grid, each column's height difference (ColumnHeight of each
+    //! epoch's points in it: the region's own points, every point of the other
+    //! epoch) times the area of the column inside the footprint, summed.
+    //! Columns where the other epoch has no point are left out. Absent without
+    //! the other epoch.
     std::optional<double> volume;
-    //! Fraction of the region's columns where the reference had points.
+    double volumeAdded = 0.0;   //!< the sum over the columns that rose (m^3, >= 0)
+    double volumeRemoved = 0.0; //!< the sum over the columns that sank (m^3, >= 0); volume = added - removed
+    //! Fraction of the footprint's area where the other epoch had points.
     double volumeCoverage = 0.0;
 };
 
