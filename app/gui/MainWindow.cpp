@@ -16,6 +16,7 @@
 #include "view/EntityColouring.h"
 
 #include <QAction>
+#include <QCloseEvent>
 #include <QActionGroup>
 #include <QApplication>
 #include <QDockWidget>
@@ -46,6 +47,7 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
     distances_ = new DistanceController(document_, this);
     splits_ = new SplitController(document_, this);
     sessions_ = new SessionController(registry_, document_, *view_, *scalarPanel_, this);
+    sessions_->setDiscardCheck([this] { return mayDiscardUnsavedWork(); });
     report(files_);
     report(distances_);
     report(splits_);
@@ -139,7 +141,8 @@ void MainWindow::buildMenus()
     file->addAction(tr("Open &session..."), sessions_, &SessionController::restoreWithDialog);
     file->addAction(tr("&Save session..."), sessions_, &SessionController::saveWithDialog)->setShortcut(QKeySequence::Save);
     file->addSeparator();
-    file->addAction(tr("&Quit"), qApp, &QApplication::quit)->setShortcut(QKeySequence::Quit);
+    // Through close(), so unsaved work is asked about whichever way one quits.
+    file->addAction(tr("&Quit"), this, &QWidget::close)->setShortcut(QKeySequence::Quit);
 
     QMenu* edit = menuBar()->addMenu(tr("&Edit"));
     edit->addAction(tr("&Delete selected"), this, [this] {
@@ -317,6 +320,41 @@ void MainWindow::dropEvent(QDropEvent* event)
         files_->open(paths);
         event->acceptProposedAction();
     }
+}
+
+bool MainWindow::mayDiscardUnsavedWork()
+{
+    const std::vector<EntityId> unsaved = document_.unsavedIds();
+    if (unsaved.empty())
+        return true;
+    QStringList names;
+    for (EntityId id : unsaved)
+        names << document_.item(id).name;
+    QMessageBox box(QMessageBox::Warning, tr("Unsaved work"),
+                    unsaved.size() == 1 ? tr("One entity holds results that are in no file:")
+                                        : tr("%1 entities hold results that are in no file:").arg(unsaved.size()),
+                    QMessageBox::NoButton, this);
+    box.setObjectName("unsaved-work");
+    constexpr int kShownNames = 8;
+    QString list = names.mid(0, kShownNames).join("\n");
+    if (names.size() > kShownNames)
+        list += tr("\nand %1 more").arg(names.size() - kShownNames);
+    box.setInformativeText(list + tr("\n\nSave them in a session first?"));
+    box.setStandardButtons(QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel);
+    box.setDefaultButton(QMessageBox::Save);
+    switch (box.exec()) {
+    case QMessageBox::Save: return sessions_->saveWithDialog();
+    case QMessageBox::Discard: return true;
+    default: return false;
+    }
+}
+
+void MainWindow::closeEvent(QCloseEvent* event)
+{
+    if (mayDiscardUnsavedWork())
+        event->accept();
+    else
+        event->ignore();
 }
 
 } // namespace scandiff::gui

@@ -54,7 +54,13 @@ public:
     //! The controller of a registered plugin tool, null if unknown.
     ToolController* toolController(const std::string& toolName) const;
 
+    //! When entities hold work in no file (computed fields, derived clouds),
+    //! asks whether to save the session first: true to go on (saved or
+    //! discarded), false to stay (Cancel, or the save did not happen).
+    bool mayDiscardUnsavedWork();
+
 protected:
+    void closeEvent(QCloseEvent* event) override;
     void dragEnterEvent(QDragEnterEvent* event) override;
     void dropEvent(QDropEvent* event) override;
 

@@ -25,6 +25,7 @@
 
 #include <QCheckBox>
 #include <QDropEvent>
+#include <QMessageBox>
 #include <QMimeData>
 #include <QComboBox>
 #include <QDoubleSpinBox>
@@ -360,6 +361,52 @@ private slots:
         window.view()->setMoving(true);
         window.view()->render();
         window.view()->setMoving(false);
+    }
+
+    void quittingAsksAboutUnsavedWork()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::MainWindow window(registry);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        // Answers the question with `button` when it comes, and notes what it said.
+        QString asked;
+        auto answerWith = [&](QMessageBox::StandardButton button) {
+            asked.clear();
+            QTimer::singleShot(50, [&asked, button] {
+                auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget());
+                if (!box || box->objectName() != "unsaved-work")
+                    return;
+                asked = box->text() + "\n" + box->informativeText();
+                box->button(button)->click();
+            });
+        };
+        QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
+        const EntityId reference = window.document().ids()[0], compared = window.document().ids()[1];
+        QVERIFY(window.document().unsavedIds().empty()); // what was opened is in its files
+
+        QVERIFY(window.distances()->runCloudToCloud(compared, reference, {}));
+        QCOMPARE(window.document().unsavedIds(), std::vector<EntityId>{compared});
+        answerWith(QMessageBox::Cancel);
+        QVERIFY(!window.close()); // Cancel: the window stays, the work too
+        QVERIFY(asked.contains(window.document().item(compared).name));
+        QVERIFY(window.isVisible());
+        QVERIFY(window.document().item(compared).points().field("c2c_distance"));
+
+        // Once exported, the results are in a file: quitting asks nothing.
+        QTemporaryDir dir;
+        QVERIFY(window.files()->exportEntity(compared, dir.filePath("compared.ply")));
+        QVERIFY(window.document().unsavedIds().empty());
+        // A derived cloud (the closest points) is unsaved until a session holds it.
+        QVERIFY(window.distances()->runCloudToCloud(compared, reference, {{"closest-points", "true"}}));
+        QCOMPARE(window.document().unsavedIds().size(), std::size_t(2));
+        QVERIFY(window.sessions()->save(dir.filePath("work.scandiff")));
+        QVERIFY(window.document().unsavedIds().empty());
+        // Discard lets it close.
+        QVERIFY(window.distances()->runCloudToCloud(reference, compared, {}));
+        answerWith(QMessageBox::Discard);
+        QVERIFY(window.close());
+        QVERIFY(asked.contains(window.document().item(reference).name));
     }
 
     void badFilesAreReportedNotFatal()

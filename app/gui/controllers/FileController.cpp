@@ -107,6 +107,7 @@ bool FileController::exportEntity(EntityId id, const QString& path)
         emit failed(result.outcome == TaskOutcome::Cancelled ? tr("Writing %1 was cancelled").arg(path) : result.error);
         return false;
     }
+    document_.markSaved(id);
     emit finished(tr("exported %1 to %2 (%3 points, %4 fields) in %5 s")
                       .arg(item->name, path)
                       .arg(item->points().size())

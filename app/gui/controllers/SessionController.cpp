@@ -176,6 +176,7 @@ bool SessionController::save(const QString& qpath)
                                                              : tr("Saving the session failed: %1").arg(result.error));
         return false;
     }
+    document_.markAllSaved();
     emit finished(tr("saved session %1 (%2 entities)").arg(qpath).arg(document_.size()));
     return true;
 }
@@ -269,19 +270,21 @@ bool SessionController::restore(const QString& qpath)
     view_.setPointSize(pointSize);
     if (camera)
         view_.setCamera(*camera);
+    document_.markAllSaved(); // derived entities are in the session's data folder
     emit finished(tr("opened session %1 (%2 entities)").arg(qpath).arg(document_.size()));
     return true;
 }
 
-void SessionController::saveWithDialog()
+bool SessionController::saveWithDialog()
 {
     const QString path = QFileDialog::getSaveFileName(parentWindow_, tr("Save session"), "session.scandiff", tr("scandiff session (*.scandiff)"));
-    if (!path.isEmpty())
-        save(path);
+    return !path.isEmpty() && save(path);
 }
 
 void SessionController::restoreWithDialog()
 {
+    if (mayDiscard_ && !mayDiscard_())
+        return;
     const QString path = QFileDialog::getOpenFileName(parentWindow_, tr("Open session"), QString(), tr("scandiff session (*.scandiff)"));
     if (!path.isEmpty())
         restore(path);

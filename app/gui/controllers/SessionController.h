@@ -12,6 +12,8 @@
 
 #include <QObject>
 
+#include <functional>
+
 class QWidget;
 
 namespace scandiff::gui {
@@ -29,8 +31,12 @@ public:
     bool save(const QString& path);
     //! Replaces the document's content with the session's.
     bool restore(const QString& path);
-    void saveWithDialog();
+    //! True once saved (false if the user cancelled the file dialog or the save failed).
+    bool saveWithDialog();
+    //! Asks `mayDiscard` first (when set): opening a session replaces the document.
     void restoreWithDialog();
+    //! Asked before the document is replaced; false keeps it.
+    void setDiscardCheck(std::function<bool()> mayDiscard) { mayDiscard_ = std::move(mayDiscard); }
 
 signals:
     void finished(const QString& summary);
@@ -42,6 +48,7 @@ private:
     CloudView& view_;
     ScalarFieldPanel& scalarPanel_;
     QWidget* parentWindow_;
+    std::function<bool()> mayDiscard_;
 };
 
 } // namespace scandiff::gui

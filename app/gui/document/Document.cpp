@@ -21,6 +21,7 @@ EntityId Document::add(QString name, io::Entity entity, EntityId parent, QString
     item->entity = std::move(entity);
     item->parent = contains(parent) ? parent : kNoEntity;
     item->sourcePath = std::move(sourcePath);
+    item->unsaved = item->sourcePath.isEmpty();
     if (const PointCloud* cloud = item->cloud(); cloud && !cloud->fields().empty())
         item->display.activeField = cloud->fields().front().name();
     const EntityId id = item->id;
@@ -118,6 +119,7 @@ void Document::replaceData(EntityId id, io::Entity entity)
         }
     if (!item->display.activeField.empty() && !has(item->display.activeField))
         item->display.activeField = fields.empty() ? std::string() : fields.front().name();
+    item->unsaved = true;
     emit dataReplaced(id);
     emit fieldsChanged(id);
     emit displayChanged(id);
@@ -131,6 +133,7 @@ void Document::addField(EntityId id, ScalarField field)
         return;
     const std::string name = field.name();
     cloud->addField(std::move(field));
+    item->unsaved = true;
     // A recomputed field starts again from its full range.
     item->display.fields.erase(name);
     item->display.activeField = name;
@@ -191,6 +194,27 @@ void Document::rename(EntityId id, const QString& name)
         item->name = name;
         emit renamed(id);
     }
+}
+
+std::vector<EntityId> Document::unsavedIds() const
+{
+    std::vector<EntityId> out;
+    for (const auto& item : items_)
+        if (item->unsaved)
+            out.push_back(item->id);
+    return out;
+}
+
+void Document::markSaved(EntityId id)
+{
+    if (Item* item = findMutable(id))
+        item->unsaved = false;
+}
+
+void Document::markAllSaved()
+{
+    for (const auto& item : items_)
+        item->unsaved = false;
 }
 
 } // namespace scandiff::gui

@@ -53,6 +53,9 @@ public:
         EntityId parent = kNoEntity;
         QString sourcePath; //!< the file it was read from, empty for derived entities
         DisplayState display;
+        //! Holds work that is in no file: a derived entity, computed fields,
+        //! moved points. Cleared when it is exported or the session saved.
+        bool unsaved = false;
 
         const PointCloud* cloud() const { return std::get_if<PointCloud>(&entity); }
         const Mesh* mesh() const { return std::get_if<Mesh>(&entity); }
@@ -95,6 +98,13 @@ public:
     //! The display of a field (defaults when never set).
     FieldDisplay fieldDisplay(EntityId id, const std::string& fieldName) const;
     void rename(EntityId id, const QString& name);
+
+    //! The entities whose work would be lost on quitting, in tree order.
+    std::vector<EntityId> unsavedIds() const;
+    //! The entity's data is now in a file (exported).
+    void markSaved(EntityId id);
+    //! Everything is in a file (the session was saved or just opened).
+    void markAllSaved();
 
 signals:
     void added(EntityId id);
