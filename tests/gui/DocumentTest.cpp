@@ -10,9 +10,11 @@
 
 #include <QComboBox>
 #include <QPushButton>
+#include <QCheckBox>
 #include <QSignalSpy>
 #include <QtTest>
 
+#include <array>
 #include <cmath>
 
 using namespace scandiff;
@@ -79,6 +81,69 @@ private slots:
         legend = gui::colourEntity(document.item(id).points(), document.item(id).display, rgba.data());
         QCOMPARE(legend.min, -2.0);
         QCOMPARE(legend.max, 2.0);
+    }
+
+    void colourRangeIsApartFromTheThresholds()
+    {
+        // The trial's C2M field: -32 to +58 m, with the changes of interest within 2 m.
+        gui::Document document;
+        PointCloud cloud;
+        cloud.resize(4);
+        ScalarField& d = cloud.addField("d");
+        const double values[4] = {-32.0, 1.0, 1.5, 58.0};
+        for (std::size_t i = 0; i < 4; ++i)
+            d.setValue(i, values[i]);
+        const EntityId id = document.add("c2m", std::move(cloud));
+        gui::FieldDisplay display;
+        display.colourLow = -2.0;
+        display.colourHigh = 2.0;
+        display.low = -1.2; // thresholds: only |d| <= 1.2 shown
+        display.high = 1.2;
+        document.setFieldDisplay(id, "d", display);
+        std::vector<std::uint8_t> rgba(16);
+        const gui::ColourLegend legend = gui::colourEntity(document.item(id).points(), document.item(id).display, rgba.data());
+        QCOMPARE(legend.min, -2.0);
+        QCOMPARE(legend.max, 2.0);
+        auto colourOf = [&](std::size_t i) { return std::array<int, 3>{rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]}; };
+        auto scaleAt = [&](double t) {
+            const auto c = display.scale.colourAt(t);
+            return std::array<int, 3>{c[0], c[1], c[2]};
+        };
+        QCOMPARE(colourOf(1), scaleAt(0.75)); // 1 m in [-2, 2]: no longer the colour of every small value
+        QCOMPARE(int(rgba[7]), 255);
+        QCOMPARE(int(rgba[11]), 0); // 1.5 m: coloured within the range but beyond the threshold, hidden
+        document.setOutsideMode(id, gui::FieldColouring::Outside::Grey);
+        display.low = -100.0;
+        display.high = 100.0;
+        document.setFieldDisplay(id, "d", display);
+        gui::colourEntity(document.item(id).points(), document.item(id).display, rgba.data());
+        QCOMPARE(colourOf(0), scaleAt(0.0)); // beyond the colour range: the end colours
+        QCOMPARE(colourOf(3), scaleAt(1.0));
+        QCOMPARE(colourOf(2), scaleAt(0.875));
+
+        // Symmetric around 0: 0 at the middle of the scale, whatever the field's extent.
+        display.colourLow = display.colourHigh = std::numeric_limits<double>::infinity();
+        display.colourLow = -display.colourLow;
+        display.symmetric = true;
+        document.setFieldDisplay(id, "d", display);
+        const gui::ColourLegend symmetric = gui::colourEntity(document.item(id).points(), document.item(id).display, rgba.data());
+        QCOMPARE(symmetric.min, -58.0);
+        QCOMPARE(symmetric.max, 58.0);
+
+        // The panel edits the same state: the colour range editor, the box, Automatic.
+        gui::ScalarFieldPanel panel(document);
+        panel.showEntity(id);
+        QVERIFY(panel.symmetricBox()->isChecked());
+        panel.symmetricBox()->setChecked(false);
+        QVERIFY(!document.fieldDisplay(id, "d").symmetric);
+        QCOMPARE(panel.colourRangeEditor()->low(), -32.0);
+        panel.colourRangeEditor()->setRange(-2.0, 2.0);
+        QCOMPARE(document.fieldDisplay(id, "d").colourLow, -2.0);
+        QCOMPARE(document.fieldDisplay(id, "d").colourHigh, 2.0);
+        QCOMPARE(document.fieldDisplay(id, "d").low, -100.0); // the thresholds did not move
+        QTest::mouseClick(panel.automaticColoursButton(), Qt::LeftButton);
+        QVERIFY(std::isinf(document.fieldDisplay(id, "d").colourLow));
+        QCOMPARE(panel.colourRangeEditor()->high(), 58.0);
     }
 
     void treeMirrorsTheDocument()

@@ -167,6 +167,11 @@ private slots:
         window.view()->setStandardView(gui::StandardView::Top);
         const gui::CameraState camera = window.view()->camera();
         const QString session = dir.filePath("work.scandiff");
+        gui::FieldDisplay narrowed = window.document().fieldDisplay(compared, "c2c_distance");
+        narrowed.colourLow = 0.125;
+        narrowed.colourHigh = 0.75;
+        narrowed.symmetric = true;
+        window.document().setFieldDisplay(compared, "c2c_distance", narrowed);
         QVERIFY(window.sessions()->save(session));
         window.document().clear();
         QCOMPARE(window.document().size(), std::size_t(0));
@@ -181,6 +186,9 @@ private slots:
         QCOMPARE(restoredCompared.display.activeField, std::string("c2c_distance"));
         QVERIFY(!restoredCompared.display.visible);
         QCOMPARE(window.document().fieldDisplay(restored[1], "c2c_distance").low, low);
+        QCOMPARE(window.document().fieldDisplay(restored[1], "c2c_distance").colourLow, 0.125);
+        QCOMPARE(window.document().fieldDisplay(restored[1], "c2c_distance").colourHigh, 0.75);
+        QVERIFY(window.document().fieldDisplay(restored[1], "c2c_distance").symmetric);
         QCOMPARE(window.document().item(restored[2]).parent, restored[1]);
         QCOMPARE(window.document().item(restored[2]).points().size(), inside);
         const gui::CameraState back = window.view()->camera();

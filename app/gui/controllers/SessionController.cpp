@@ -129,7 +129,9 @@ bool SessionController::save(const QString& qpath)
         files.emplace_back(&item.entity, file);
         json fields = json::object();
         for (const auto& [name, display] : item.display.fields)
-            fields[name] = {{"scale", display.scale.toText()}, {"low", bound(display.low)}, {"high", bound(display.high)}};
+            fields[name] = {{"scale", display.scale.toText()},          {"low", bound(display.low)},
+                            {"high", bound(display.high)},               {"colourLow", bound(display.colourLow)},
+                            {"colourHigh", bound(display.colourHigh)}, {"symmetric", display.symmetric}};
         entities.push_back({{"id", id},
                             {"name", item.name.toStdString()},
                             {"parent", item.parent},
@@ -227,6 +229,10 @@ bool SessionController::restore(const QString& qpath)
                         display.scale = *scale;
                     display.low = bound(f.at("low"), -std::numeric_limits<double>::infinity());
                     display.high = bound(f.at("high"), std::numeric_limits<double>::infinity());
+                    // Sessions written before the colour range had none: automatic.
+                    display.colourLow = bound(f.value("colourLow", json(nullptr)), -std::numeric_limits<double>::infinity());
+                    display.colourHigh = bound(f.value("colourHigh", json(nullptr)), std::numeric_limits<double>::infinity());
+                    display.symmetric = f.value("symmetric", false);
                     entry.fields[name] = display;
                 }
                 entry.entity = io::readFile(registry_.formats, path.parent_path() / e.at("data").get<std::string>(), options);

@@ -23,13 +23,20 @@ namespace scandiff::gui {
 using EntityId = int;
 constexpr EntityId kNoEntity = -1;
 
-//! How one scalar field is shown: its colour scale and the threshold range
+//! How one scalar field is shown, as in CloudCompare: the *colour range* the
+//! scale spans (values beyond it take the end colours: narrowing it shows the
+//! small changes beside large ones) and, independently, the *threshold range*
 //! (inclusive) outside which points are hidden or greyed.
 struct FieldDisplay
 {
     ColourScale scale = *ColourScale::preset("Blue-Green-Yellow-Red");
-    double low = -std::numeric_limits<double>::infinity();
-    double high = std::numeric_limits<double>::infinity();
+    double low = -std::numeric_limits<double>::infinity();  //!< threshold
+    double high = std::numeric_limits<double>::infinity();  //!< threshold
+    double colourLow = -std::numeric_limits<double>::infinity();  //!< colour range; infinite: the field's own end
+    double colourHigh = std::numeric_limits<double>::infinity();
+    //! The colour range made [-m, m] (m its largest magnitude), so 0 sits at the
+    //! scale's middle; a diverging scale always is.
+    bool symmetric = false;
 };
 
 struct DisplayState

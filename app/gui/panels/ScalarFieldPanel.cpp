@@ -51,6 +51,22 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
     outsideBox_->addItem(tr("Greyed"));
     form->addRow(tr("Outside the range"), outsideBox_);
     layout->addLayout(form);
+    // The colour range: what the scale spans, apart from what is shown.
+    colours_ = new RangeEditor(this);
+    colours_->setObjectName("colourRange");
+    layout->addWidget(new QLabel(tr("Colour range (values beyond it take the end colours):"), this));
+    layout->addWidget(colours_);
+    auto* colourRow = new QHBoxLayout;
+    symmetric_ = new QCheckBox(tr("Symmetric around 0"), this);
+    symmetric_->setObjectName("symmetric");
+    symmetric_->setToolTip(tr("The colour range becomes -m..m: 0 at the scale's middle, as for signed distances"));
+    automaticColours_ = new QPushButton(tr("Automatic"), this);
+    automaticColours_->setObjectName("automaticColours");
+    automaticColours_->setToolTip(tr("The colour range follows the field's minimum and maximum"));
+    colourRow->addWidget(symmetric_);
+    colourRow->addStretch(1);
+    colourRow->addWidget(automaticColours_);
+    layout->addLayout(colourRow);
     range_ = new RangeEditor(this);
     range_->setObjectName("thresholds");
     layout->addWidget(new QLabel(tr("Threshold range (points inside are shown):"), this));
@@ -84,6 +100,17 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
         document_.setOutsideMode(entity_, index == 1 ? FieldColouring::Outside::Grey : FieldColouring::Outside::Hide);
     });
     connect(range_, &RangeEditor::rangeChanged, this, &ScalarFieldPanel::onRangeEdited);
+    connect(colours_, &RangeEditor::rangeChanged, this, &ScalarFieldPanel::onColourRangeEdited);
+    connect(symmetric_, &QCheckBox::toggled, this, [this](bool on) {
+        if (!updating_)
+            editDisplay([on](FieldDisplay& d) { d.symmetric = on; });
+    });
+    connect(automaticColours_, &QPushButton::clicked, this, [this] {
+        editDisplay([](FieldDisplay& d) {
+            d.colourLow = -std::numeric_limits<double>::infinity();
+            d.colourHigh = std::numeric_limits<double>::infinity();
+        });
+    });
     connect(histogram_, &HistogramWidget::markedRangeEdited, this, [this](double low, double high) { range_->setRange(low, high); });
     connect(resetRange_, &QPushButton::clicked, this, [this] {
         if (const ScalarField* field = activeField()) {
@@ -167,7 +194,8 @@ void ScalarFieldPanel::refresh()
         title_->setText(tr("Select a cloud in the tree."));
     }
     const bool enabled = field != nullptr;
-    for (QWidget* w : std::initializer_list<QWidget*>{scaleBox_, editScale_, outsideBox_, range_, histogram_, resetRange_, split_})
+    for (QWidget* w : std::initializer_list<QWidget*>{scaleBox_, editScale_, outsideBox_, colours_, symmetric_, automaticColours_, range_,
+                                                      histogram_, resetRange_, split_})
         w->setEnabled(enabled);
     fieldBox_->setEnabled(item != nullptr);
     if (field) {
@@ -178,7 +206,12 @@ void ScalarFieldPanel::refresh()
         range_->setBounds(lo, hi);
         range_->setRange(std::max(lo, display.low), std::min(hi, display.high));
         histogram_->setHistogram(computeHistogram(field->values().data(), field->size(), field->offset(), kHistogramBins));
-        const auto [cmin, cmax] = colourRange(*field, display.scale);
+        const auto [cmin, cmax] = colourRange(*field, display);
+        // The colour editor spans the field, and -m..m when symmetric.
+        const bool symmetric = display.symmetric || display.scale.symmetric();
+        colours_->setBounds(symmetric ? std::min(lo, cmin) : lo, symmetric ? std::max(hi, cmax) : hi);
+        colours_->setRange(cmin, cmax);
+        symmetric_->setChecked(display.symmetric);
         histogram_->setColouring(display.scale, cmin, cmax);
         histogram_->setMarkedRange(range_->low(), range_->high());
     } else {
@@ -221,6 +254,31 @@ void ScalarFieldPanel::onRangeEdited(double low, double high)
     updating_ = false;
     histogram_->setMarkedRange(low, high);
     updateInsideCount();
+}
+
+void ScalarFieldPanel::onColourRangeEdited(double low, double high)
+{
+    if (!activeField() || updating_)
+        return;
+    FieldDisplay display = document_.fieldDisplay(entity_, activeField()->name());
+    display.colourLow = low;
+    display.colourHigh = high;
+    updating_ = true; // as for the thresholds: no rebuild while dragging
+    document_.setFieldDisplay(entity_, activeField()->name(), display);
+    updating_ = false;
+    const auto [cmin, cmax] = colourRange(*activeField(), display);
+    histogram_->setColouring(display.scale, cmin, cmax);
+}
+
+void ScalarFieldPanel::editDisplay(const std::function<void(FieldDisplay&)>& edit)
+{
+    const ScalarField* field = activeField();
+    if (!field)
+        return;
+    FieldDisplay display = document_.fieldDisplay(entity_, field->name());
+    edit(display);
+    document_.setFieldDisplay(entity_, field->name(), display);
+    refresh();
 }
 
 void ScalarFieldPanel::editScale()

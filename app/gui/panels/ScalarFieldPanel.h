@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 //! The active scalar field of the current entity: which field, its colour scale
-//! (presets or user-edited), the threshold range (double-ended slider with
+//! (presets or user-edited) and the range it spans (narrowed by hand, or
+//! symmetric around 0), the threshold range (double-ended slider with
 //! numeric boxes), what happens to points outside it (hidden or greyed), the
 //! histogram with the range marked, and "Split at thresholds". Every change goes
 //! to the Document; the view follows the document's signals.
@@ -11,8 +12,10 @@
 
 #include <QWidget>
 
+#include <functional>
 #include <vector>
 
+class QCheckBox;
 class QComboBox;
 class QLabel;
 class QPushButton;
@@ -39,6 +42,9 @@ public:
     QComboBox* scaleBox() const { return scaleBox_; }
     QComboBox* outsideBox() const { return outsideBox_; }
     RangeEditor* rangeEditor() const { return range_; }
+    RangeEditor* colourRangeEditor() const { return colours_; }
+    QCheckBox* symmetricBox() const { return symmetric_; }
+    QPushButton* automaticColoursButton() const { return automaticColours_; }
     HistogramWidget* histogram() const { return histogram_; }
     QPushButton* splitButton() const { return split_; }
     QString insideText() const;
@@ -52,6 +58,9 @@ private:
     void onFieldChosen(int index);
     void onScaleChosen(int index);
     void onRangeEdited(double low, double high);
+    void onColourRangeEdited(double low, double high);
+    //! Changes the active field's display with `edit` and stores it.
+    void editDisplay(const std::function<void(FieldDisplay&)>& edit);
     void editScale();
     void updateInsideCount();
     const ScalarField* activeField() const;
@@ -64,6 +73,9 @@ private:
     QComboBox* scaleBox_;
     QPushButton* editScale_;
     QComboBox* outsideBox_;
+    RangeEditor* colours_;
+    QCheckBox* symmetric_;
+    QPushButton* automaticColours_;
     RangeEditor* range_;
     HistogramWidget* histogram_;
     QLabel* inside_;

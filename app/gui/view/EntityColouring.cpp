@@ -6,12 +6,14 @@
 
 namespace scandiff::gui {
 
-std::pair<double, double> colourRange(const ScalarField& field, const ColourScale& scale)
+std::pair<double, double> colourRange(const ScalarField& field, const FieldDisplay& display)
 {
     const ValueRange r = field.range();
-    double lo = r.validCount > 0 ? r.min : 0.0;
-    double hi = r.validCount > 0 ? r.max : 1.0;
-    if (scale.symmetric()) {
+    double lo = std::isfinite(display.colourLow) ? display.colourLow : r.validCount > 0 ? r.min : 0.0;
+    double hi = std::isfinite(display.colourHigh) ? display.colourHigh : r.validCount > 0 ? r.max : 1.0;
+    if (lo > hi)
+        std::swap(lo, hi);
+    if (display.symmetric || display.scale.symmetric()) {
         const double m = std::max(std::abs(lo), std::abs(hi));
         lo = -m;
         hi = m;
@@ -32,8 +34,9 @@ ColourLegend legendOf(const PointCloud& points, const DisplayState& display)
     const auto it = display.fields.find(field->name());
     legend.shown = true;
     legend.title = field->name();
-    legend.scale = it == display.fields.end() ? FieldDisplay{}.scale : it->second.scale;
-    std::tie(legend.min, legend.max) = colourRange(*field, legend.scale);
+    const FieldDisplay fieldDisplay = it == display.fields.end() ? FieldDisplay{} : it->second;
+    legend.scale = fieldDisplay.scale;
+    std::tie(legend.min, legend.max) = colourRange(*field, fieldDisplay);
     return legend;
 }
 
@@ -46,7 +49,7 @@ ColourLegend colourEntity(const PointCloud& points, const DisplayState& display,
         const auto it = display.fields.find(field->name());
         const FieldDisplay fieldDisplay = it == display.fields.end() ? FieldDisplay{} : it->second;
         FieldColouring how;
-        std::tie(how.colourMin, how.colourMax) = colourRange(*field, fieldDisplay.scale);
+        std::tie(how.colourMin, how.colourMax) = colourRange(*field, fieldDisplay);
         how.visibleMin = fieldDisplay.low;
         how.visibleMax = fieldDisplay.high;
         how.outside = display.outside;

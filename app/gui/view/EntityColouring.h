@@ -22,10 +22,11 @@ struct ColourLegend
     double min = 0, max = 1;
 };
 
-//! The value range a field's colour scale spans: the field's finite range, made
-//! symmetric about 0 for a symmetric (diverging) scale; a constant field gets a
+//! The value range a field's colour scale spans: the display's colour range,
+//! each infinite end replaced by the field's finite end; made symmetric about 0
+//! when asked or for a symmetric (diverging) scale; a constant field gets a
 //! unit-wide range so it still maps to a colour.
-std::pair<double, double> colourRange(const ScalarField& field, const ColourScale& scale);
+std::pair<double, double> colourRange(const ScalarField& field, const FieldDisplay& display);
 
 //! The legend of the active field (not shown for colours or height).
 ColourLegend legendOf(const PointCloud& points, const DisplayState& display);

@@ -179,6 +179,15 @@ void HistogramWidget::paintEvent(QPaintEvent*)
     painter.setBrush(Qt::NoBrush);
     painter.drawRect(plot.adjusted(0, 0, -1, -1));
 
+    // The colour range's ends, dashed: beyond them the bars keep the end colours.
+    for (double value : {colourMin_, colourMax_}) {
+        if (!(value > axisMin() && value < axisMax()))
+            continue;
+        const int x = xOfValue(value);
+        painter.setPen(QPen(palette().color(QPalette::Dark), 1, Qt::DashLine));
+        painter.drawLine(x, plot.top(), x, plot.bottom());
+    }
+
     // Markers: a line with a small tab at the top to grab. Ends outside the axis
     // (e.g. an unbounded threshold) have no line.
     const QColor markerColour = palette().color(QPalette::WindowText);

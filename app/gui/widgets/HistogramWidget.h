@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 //! Draws a scalar field's histogram: one bar per bin, coloured as colourise
-//! would colour the bin's centre, a marked range (e.g. the visible threshold)
-//! with the outside shaded, and the value axis labelled at min, middle and max.
-//! The markers can be dragged with the mouse; hovering a bar shows its count.
+//! would colour the bin's centre, the colour range's ends dashed, a marked
+//! range (e.g. the visible threshold) with the outside shaded, and the value
+//! axis labelled at min, middle and max. The markers can be dragged with the
+//! mouse; hovering a bar shows its count.
 
 #include "colour/ColourScale.h"
 
