@@ -73,9 +73,9 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
     connect(&document_, &Document::cleared, view_, &CloudView::clear);
     connect(&document_, &Document::displayChanged, this, [this](EntityId id) {
         view_->refreshEntity(document_.item(id));
-        if (id == tree_->currentEntity())
-            showLegendOf(id);
+        updateLegend();
     });
+    connect(&document_, &Document::removed, this, [this] { updateLegend(); });
     connect(tree_, &EntityTree::currentEntityChanged, this, &MainWindow::onCurrentEntityChanged);
     connect(scalarPanel_, &ScalarFieldPanel::splitRequested, splits_, &SplitController::split);
     connect(distances_, &DistanceController::resultReady, tree_, &EntityTree::selectEntity);
@@ -202,6 +202,18 @@ void MainWindow::buildMenus()
         sizeGroup->addAction(a);
         connect(view_, &CloudView::pointSizeChanged, a, [a, size](float now) { a->setChecked(int(now) == size); });
     }
+    QMenu* afterComparison = viewMenu->addMenu(tr("&Reference after a comparison"));
+    auto* afterGroup = new QActionGroup(this);
+    const std::pair<QString, ReferenceAfterComparison> choices[] = {
+        {tr("In neutral grey"), ReferenceAfterComparison::Grey},
+        {tr("Hidden"), ReferenceAfterComparison::Hide},
+        {tr("Unchanged"), ReferenceAfterComparison::Keep}};
+    for (const auto& [label, choice] : choices) {
+        QAction* a = afterComparison->addAction(label, this, [choice = choice] { DistanceController::setReferenceAfterComparison(choice); });
+        a->setCheckable(true);
+        a->setChecked(DistanceController::referenceAfterComparison() == choice);
+        afterGroup->addAction(a);
+    }
     viewMenu->addSeparator();
     for (QDockWidget* d : findChildren<QDockWidget*>())
         viewMenu->addAction(d->toggleViewAction());
@@ -290,13 +302,22 @@ void MainWindow::onCurrentEntityChanged(EntityId id)
 {
     properties_->showEntity(id);
     scalarPanel_->showEntity(id);
-    showLegendOf(id);
+    updateLegend();
 }
 
-void MainWindow::showLegendOf(EntityId id)
+void MainWindow::updateLegend()
 {
-    const Document::Item* item = document_.find(id);
-    view_->setLegend(item && item->cloud() ? legendOf(item->points(), item->display) : ColourLegend{});
+    // The bar belongs to what is on screen: the selected entity if it is shown
+    // with a field, else the last added one that is.
+    auto legendFor = [this](EntityId id) {
+        const Document::Item* item = document_.find(id);
+        return item && item->display.visible && item->cloud() ? legendOf(item->points(), item->display) : ColourLegend{};
+    };
+    ColourLegend legend = legendFor(tree_->currentEntity());
+    const std::vector<EntityId> ids = document_.ids();
+    for (auto it = ids.rbegin(); !legend.shown && it != ids.rend(); ++it)
+        legend = legendFor(*it);
+    view_->setLegend(legend);
 }
 
 int MainWindow::openFiles(const QStringList& paths, bool quiet)

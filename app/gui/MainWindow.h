@@ -73,7 +73,9 @@ private:
     //! Console + status bar for a controller's finished/failed signals.
     template <class Controller> void report(Controller* controller);
     void onCurrentEntityChanged(EntityId id);
-    void showLegendOf(EntityId id);
+    //! The colour bar of the selected entity when it is shown with a field, else
+    //! of the last visible one with a field; none otherwise.
+    void updateLegend();
 
     const PluginRegistry& registry_;
     Document document_;

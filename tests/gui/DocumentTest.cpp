@@ -146,6 +146,43 @@ private slots:
         QCOMPARE(panel.colourRangeEditor()->high(), 58.0);
     }
 
+    void labelsGetDistinctColoursAndNeutralIsGrey()
+    {
+        gui::Document document;
+        PointCloud cloud;
+        cloud.resize(5);
+        ScalarField& ids = cloud.addField("region_id");
+        const float values[5] = {1, 2, 3, 2, std::nanf("")};
+        ids.values().assign(values, values + 5);
+        cloud.addField("distance").values() = {1, 2, 3, 2, 0};
+        const EntityId id = document.add("regions", std::move(cloud));
+        document.setActiveField(id, "region_id");
+        QVERIFY(gui::isLabelField(*document.item(id).points().field("region_id")));
+        QVERIFY(!gui::isLabelField(*document.item(id).points().field("distance"))); // a measure, whatever its values
+        std::vector<std::uint8_t> rgba(20);
+        const gui::ColourLegend legend = gui::colourEntity(document.item(id).points(), document.item(id).display, rgba.data());
+        auto colourOf = [&](std::size_t i) { return std::array<std::uint8_t, 3>{rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]}; };
+        QCOMPARE(colourOf(0), gui::labelColour(1));
+        QCOMPARE(colourOf(1), gui::labelColour(2));
+        QCOMPARE(colourOf(3), colourOf(1)); // same label, same colour
+        QVERIFY(colourOf(0) != colourOf(1) && colourOf(1) != colourOf(2) && colourOf(0) != colourOf(2));
+        // The legend lists each label with its colour, not a ramp from 1 to 3.
+        QCOMPARE(legend.categories.size(), std::size_t(3));
+        QCOMPARE(legend.categories[2].first, 3L);
+        QCOMPARE(legend.categories[2].second, gui::labelColour(3));
+        // A non-integer value makes it a measure again.
+        ScalarField fractional("region_id", 1);
+        fractional.setValue(0, 1.5);
+        QVERIFY(!gui::isLabelField(fractional));
+
+        // Neutral: one grey, no legend.
+        document.setActiveField(id, "");
+        document.setNeutral(id, true);
+        const gui::ColourLegend none = gui::colourEntity(document.item(id).points(), document.item(id).display, rgba.data());
+        QVERIFY(!none.shown);
+        QCOMPARE(colourOf(4), gui::kNeutralGrey);
+    }
+
     void treeMirrorsTheDocument()
     {
         gui::Document document;

@@ -97,6 +97,8 @@ private slots:
         QVERIFY(output.points().size() < 1001);
         QCOMPARE(output.parent, inputId); // shown under its input in the tree
         QCOMPARE(document.item(inputId).points().size(), std::size_t(1001)); // the input is untouched
+        QVERIFY(!document.item(inputId).display.visible); // and no longer drawn under the result
+        QVERIFY(output.display.visible);
         QVERIFY(finished.at(0).at(0).toString().contains("kept"));
     }
 

@@ -113,6 +113,16 @@ private slots:
         QVERIFY(distance);
         QVERIFY(comparedCloud.field("c2c_dz"));
         QCOMPARE(window.document().item(compared).display.activeField, std::string("c2c_distance"));
+        // The reference no longer competes with the distances' colours: one neutral grey.
+        QVERIFY(window.document().item(reference).display.neutral);
+        QVERIFY(window.document().item(reference).display.activeField.empty());
+        QCOMPARE(window.view()->legend().title, std::string("c2c_distance"));
+        // The colour bar follows what is shown: with the compared cloud hidden
+        // and selected, there is no bar (the reference has no field on screen).
+        window.document().setVisible(compared, false);
+        QVERIFY(!window.view()->legend().shown);
+        window.document().setVisible(compared, true);
+        QCOMPARE(window.view()->legend().title, std::string("c2c_distance"));
         QVERIFY(window.tree()->fieldRow(compared, "c2c_distance"));
         // The same numbers as core called directly.
         const CloudToCloudResult direct =
@@ -298,6 +308,8 @@ private slots:
                                            {{"field", "c2c_distance"}, {"above", "0.5"}, {"components", "true"}, {"min-points", "20"}}));
         const gui::Document::Item& item = window.document().item(compared);
         QCOMPARE(item.display.activeField, std::string("region_id"));
+        // Region ids are labels: one swatch per region in the colour bar, not a ramp.
+        QCOMPARE(window.view()->legend().categories.size(), std::size_t(2));
         const auto& report = window.segmentation()->report(compared);
         QCOMPARE(report.size(), std::size_t(2));
         // Each region is listed under its cloud with exactly its points.
@@ -306,6 +318,7 @@ private slots:
             if (window.document().item(id).parent == compared) {
                 const gui::Document::Item& region = window.document().item(id);
                 QCOMPARE(region.points().size(), report[children].pointCount);
+                QVERIFY(!region.display.visible); // not drawn over the regions' colours
                 ++children;
             }
         QCOMPARE(children, report.size());

@@ -12,6 +12,7 @@
 #include <QFormLayout>
 #include <QLabel>
 #include <QMessageBox>
+#include <QSettings>
 #include <QVBoxLayout>
 
 #include <optional>
@@ -144,8 +145,10 @@ bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId reference
             document_.addField(comparedId, std::move(**extra));
     const DistanceStatistics statistics = forward.statistics;
     document_.addField(comparedId, std::move(forward.distance)); // last: the active field
-    if (run->reverse)
+    const bool reverse = run->reverse.has_value();
+    if (reverse)
         document_.addField(referenceId, std::move(run->reverse->distance));
+    showReference(referenceId, reverse);
     if (forward.closest) {
         PointCloud closest = std::move(*forward.closest);
         document_.add(compared->name + tr(" closest points"), std::move(closest), comparedId);
@@ -181,12 +184,44 @@ bool DistanceController::runCloudToMesh(EntityId comparedId, EntityId referenceI
     const double seconds = clock.elapsed() / 1000.0;
     const DistanceStatistics statistics = result->statistics;
     document_.addField(comparedId, std::move(result->distance));
+    showReference(referenceId, false);
     emit finished(tr("C2M %1 -> %2 [%3] %4; %5 degenerate triangles; %6 s")
                       .arg(compared->name, reference->name, commandLineText(parameters), statisticsText(statistics))
                       .arg(result->degenerateTriangles)
                       .arg(seconds, 0, 'f', 3));
     emit resultReady(comparedId);
     return true;
+}
+
+namespace {
+constexpr const char* kReferenceSetting = "display/referenceAfterComparison";
+}
+
+ReferenceAfterComparison DistanceController::referenceAfterComparison()
+{
+    const QString choice = QSettings().value(kReferenceSetting, "grey").toString();
+    return choice == "hide" ? ReferenceAfterComparison::Hide : choice == "keep" ? ReferenceAfterComparison::Keep : ReferenceAfterComparison::Grey;
+}
+
+void DistanceController::setReferenceAfterComparison(ReferenceAfterComparison choice)
+{
+    QSettings().setValue(kReferenceSetting, choice == ReferenceAfterComparison::Hide   ? "hide"
+                                            : choice == ReferenceAfterComparison::Keep ? "keep"
+                                                                                       : "grey");
+}
+
+void DistanceController::showReference(EntityId referenceId, bool gotDistances)
+{
+    if (gotDistances)
+        return; // both ways: it shows its own distances, on the same scale
+    switch (referenceAfterComparison()) {
+    case ReferenceAfterComparison::Grey:
+        document_.setActiveField(referenceId, std::string());
+        document_.setNeutral(referenceId, true);
+        break;
+    case ReferenceAfterComparison::Hide: document_.setVisible(referenceId, false); break;
+    case ReferenceAfterComparison::Keep: break;
+    }
 }
 
 } // namespace scandiff::gui

@@ -40,11 +40,22 @@ private:
     ParameterForm* form_;
 };
 
+//! How the reference is shown after a comparison (a preference, kept in QSettings).
+enum class ReferenceAfterComparison
+{
+    Grey, //!< one neutral grey, so that only the distances are in colour (the default)
+    Hide, //!< hidden
+    Keep  //!< as it was
+};
+
 class DistanceController : public QObject
 {
     Q_OBJECT
 public:
     DistanceController(Document& document, QWidget* parentWindow);
+
+    static ReferenceAfterComparison referenceAfterComparison();
+    static void setReferenceAfterComparison(ReferenceAfterComparison choice);
 
     //! Opens the dialog (reference: the first suitable entity, compared: the
     //! current one or the last cloud), then runs.
@@ -62,6 +73,9 @@ signals:
     void resultReady(EntityId id);
 
 private:
+    //! Shows the reference as the preference says, unless it received distances itself (both ways).
+    void showReference(EntityId referenceId, bool gotDistances);
+
     Document& document_;
     QWidget* parentWindow_;
 };

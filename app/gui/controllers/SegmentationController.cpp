@@ -151,6 +151,9 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
         const EntityId child = document_.add(tr("region %1 (%2 points, %3 m2)").arg(s.id).arg(s.pointCount).arg(s.footprintArea, 0, 'f', 1),
                                              std::move(regionClouds[r]), inputId);
         document_.setActiveField(child, distanceField);
+        // The cloud shows every region in its own colour; a region's own cloud
+        // (its distances) is shown by ticking it, not drawn over them.
+        document_.setVisible(child, false);
         regionEntities_[inputId].push_back(child);
     }
     if (report.size() > regionClouds.size())

@@ -139,6 +139,7 @@ bool SessionController::save(const QString& qpath)
                             {"source", item.sourcePath.toStdString()},
                             {"visible", item.display.visible},
                             {"activeField", item.display.activeField},
+                            {"neutral", item.display.neutral},
                             {"outside", item.display.outside == FieldColouring::Outside::Grey ? "grey" : "hide"},
                             {"fields", fields},
                             {"provenance", provenanceJson(item.points())}});
@@ -194,6 +195,7 @@ bool SessionController::restore(const QString& qpath)
         QString name, source;
         bool visible = true;
         std::string activeField;
+        bool neutral = false;
         FieldColouring::Outside outside = FieldColouring::Outside::Hide;
         std::map<std::string, FieldDisplay> fields;
         io::Entity entity;
@@ -220,6 +222,7 @@ bool SessionController::restore(const QString& qpath)
                 entry.source = QString::fromStdString(e.value("source", std::string()));
                 entry.visible = e.value("visible", true);
                 entry.activeField = e.value("activeField", std::string());
+                entry.neutral = e.value("neutral", false);
                 entry.outside = e.value("outside", std::string("hide")) == "grey" ? FieldColouring::Outside::Grey
                                                                                   : FieldColouring::Outside::Hide;
                 const json fields = e.value("fields", json::object()); // items() must not outlive it
@@ -270,6 +273,7 @@ bool SessionController::restore(const QString& qpath)
         for (const auto& [name, display] : e.fields)
             document_.setFieldDisplay(id, name, display);
         document_.setActiveField(id, e.activeField);
+        document_.setNeutral(id, e.neutral);
         document_.setOutsideMode(id, e.outside);
         document_.setVisible(id, e.visible);
     }

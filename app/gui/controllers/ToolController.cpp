@@ -135,6 +135,7 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
 
     QString notes;
     EntityId last = kNoEntity;
+    bool addedEntities = false, updatedInputs = false;
     NamedTables tables;
     for (const OutputSpec& spec : tool_.outputs) {
         std::size_t repeat = 0;
@@ -153,14 +154,21 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
             if (spec.updatesInput && k < firstRole.size()) {
                 document_.replaceData(firstRole[k], std::move(entity));
                 last = firstRole[k];
+                updatedInputs = true;
                 continue;
             }
             const std::string& dataName = pointsOf(entity).name;
             const auto* mesh = std::get_if<Mesh>(&entity);
             const std::string name = mesh && !mesh->name.empty() ? mesh->name : dataName.empty() ? tool_.name : dataName;
             last = document_.add(QString::fromStdString(name), std::move(entity), firstInput);
+            addedEntities = true;
         }
     }
+    // A filter's result replaces its input on screen (it stays in the tree, unticked),
+    // rather than being drawn over it.
+    if (addedEntities && !updatedInputs)
+        for (EntityId input : firstRole)
+            document_.setVisible(input, false);
     if (!tables.empty())
         emit tablesReady(title, tables);
     emit finished(QString("%1 [%2]: %3; %4 s%5")

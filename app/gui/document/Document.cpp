@@ -179,6 +179,15 @@ void Document::setOutsideMode(EntityId id, FieldColouring::Outside mode)
     emit displayChanged(id);
 }
 
+void Document::setNeutral(EntityId id, bool neutral)
+{
+    Item* item = findMutable(id);
+    if (!item || item->display.neutral == neutral)
+        return;
+    item->display.neutral = neutral;
+    emit displayChanged(id);
+}
+
 FieldDisplay Document::fieldDisplay(EntityId id, const std::string& fieldName) const
 {
     const Item* item = find(id);

@@ -42,8 +42,12 @@ struct FieldDisplay
 struct DisplayState
 {
     bool visible = true;
-    //! Empty: the entity's colours, else its height.
+    //! Empty: the entity's colours, else its height (or `neutral`).
     std::string activeField;
+    //! Without an active field, one neutral grey instead of colours or height:
+    //! how a reference is shown after a comparison, so that no other rainbow
+    //! competes with the distances' scale.
+    bool neutral = false;
     FieldColouring::Outside outside = FieldColouring::Outside::Hide;
     std::map<std::string, FieldDisplay> fields; //!< by field name; absent = defaults
 };
@@ -102,6 +106,7 @@ public:
     void setActiveField(EntityId id, const std::string& fieldName);
     void setFieldDisplay(EntityId id, const std::string& fieldName, const FieldDisplay& display);
     void setOutsideMode(EntityId id, FieldColouring::Outside mode);
+    void setNeutral(EntityId id, bool neutral);
     //! The display of a field (defaults when never set).
     FieldDisplay fieldDisplay(EntityId id, const std::string& fieldName) const;
     void rename(EntityId id, const QString& name);

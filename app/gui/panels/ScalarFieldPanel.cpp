@@ -186,9 +186,10 @@ void ScalarFieldPanel::refresh()
     if (item) {
         title_->setText(tr("<b>%1</b>").arg(item->name.toHtmlEscaped()));
         fieldBox_->addItem(item->points().hasColors() ? tr("(colours)") : tr("(height)"));
+        fieldBox_->addItem(tr("(neutral grey)"));
         for (const ScalarField& f : item->points().fields())
             fieldBox_->addItem(QString::fromStdString(f.name()));
-        fieldBox_->setCurrentIndex(field ? fieldBox_->findText(QString::fromStdString(field->name())) : 0);
+        fieldBox_->setCurrentIndex(field ? fieldBox_->findText(QString::fromStdString(field->name())) : item->display.neutral ? 1 : 0);
         outsideBox_->setCurrentIndex(item->display.outside == FieldColouring::Outside::Grey ? 1 : 0);
     } else {
         title_->setText(tr("Select a cloud in the tree."));
@@ -226,7 +227,9 @@ void ScalarFieldPanel::onFieldChosen(int index)
     const Document::Item* item = document_.find(entity_);
     if (!item)
         return;
-    document_.setActiveField(entity_, index <= 0 ? std::string() : fieldBox_->itemText(index).toStdString());
+    // 0: colours or height, 1: neutral grey, then the fields.
+    document_.setNeutral(entity_, index == 1);
+    document_.setActiveField(entity_, index <= 1 ? std::string() : fieldBox_->itemText(index).toStdString());
 }
 
 void ScalarFieldPanel::onScaleChosen(int index)

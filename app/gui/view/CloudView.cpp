@@ -33,6 +33,7 @@
 #include <vtkSmartPointer.h>
 #include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
+#include <vtkVariant.h>
 #include <vtkWindowToImageFilter.h>
 
 #include <map>
@@ -312,11 +313,29 @@ void CloudView::removeEntity(EntityId id)
 
 void CloudView::setLegend(const ColourLegend& legend)
 {
+    legend_ = legend;
     if (!legend.shown) {
         scene_->scalarBar->VisibilityOff();
         renderSoon();
         return;
     }
+    vtkLookupTable* table = scene_->scalarBarTable;
+    table->ResetAnnotations();
+    if (!legend.categories.empty()) {
+        // Labels: one swatch per value present, named by the value.
+        table->IndexedLookupOn();
+        table->SetNumberOfTableValues(static_cast<vtkIdType>(legend.categories.size()));
+        for (std::size_t i = 0; i < legend.categories.size(); ++i) {
+            const auto& [value, c] = legend.categories[i];
+            table->SetTableValue(static_cast<vtkIdType>(i), c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
+            table->SetAnnotation(vtkVariant(value), std::to_string(value));
+        }
+        scene_->scalarBar->SetTitle(legend.title.c_str());
+        scene_->scalarBar->VisibilityOn();
+        renderSoon();
+        return;
+    }
+    table->IndexedLookupOff();
     constexpr int kColours = 256;
     scene_->scalarBarTable->SetNumberOfTableValues(kColours);
     for (int i = 0; i < kColours; ++i) {
@@ -337,6 +356,7 @@ void CloudView::clear()
     scene_->shown.clear();
     scene_->sceneOrigin.reset();
     scene_->scalarBar->VisibilityOff();
+    legend_ = {};
     render();
 }
 

@@ -50,6 +50,7 @@ public:
     void refreshEntity(const Document::Item& item);
     //! The colour-scale bar (hidden when `legend.shown` is false).
     void setLegend(const ColourLegend& legend);
+    const ColourLegend& legend() const { return legend_; }
     void clear();
 
     void resetCamera();
@@ -106,6 +107,7 @@ private:
     struct Scene;
     QVTKOpenGLNativeWidget* widget_;
     std::unique_ptr<Scene> scene_;
+    ColourLegend legend_;
 };
 
 } // namespace scandiff::gui

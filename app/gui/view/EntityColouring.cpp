@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <set>
 
 namespace scandiff::gui {
 
@@ -25,6 +27,73 @@ std::pair<double, double> colourRange(const ScalarField& field, const FieldDispl
     return {lo, hi};
 }
 
+bool isLabelField(const ScalarField& field)
+{
+    static const char* const kLabelNames[] = {"region_id", "primitive_id", "primitive_type", "classification", "class", "label",
+                                              "cluster", "segment"};
+    const std::string& name = field.name();
+    const bool labelName = std::find(std::begin(kLabelNames), std::end(kLabelNames), name) != std::end(kLabelNames) ||
+                           (name.size() > 3 && name.compare(name.size() - 3, 3, "_id") == 0);
+    if (!labelName)
+        return false;
+    for (std::size_t i = 0; i < field.size(); ++i)
+        if (field.hasValue(i)) {
+            const double v = field.value(i);
+            if (v != std::floor(v) || std::abs(v) > 1e9)
+                return false;
+        }
+    return true;
+}
+
+std::array<std::uint8_t, 3> labelColour(long value)
+{
+    static constexpr std::array<std::uint8_t, 3> kKelly[] = {
+        {243, 195, 0},   {135, 86, 146}, {243, 132, 0},  {161, 202, 241}, {190, 0, 50},   {194, 178, 128}, {0, 136, 86},
+        {230, 143, 172}, {0, 103, 165},  {249, 147, 121}, {96, 78, 151},  {246, 166, 0},  {179, 68, 108},  {220, 211, 0},
+        {136, 45, 23},   {141, 182, 0},  {101, 69, 34},  {226, 88, 34},   {43, 61, 38}};
+    constexpr long kCount = static_cast<long>(std::size(kKelly));
+    return kKelly[((value % kCount) + kCount) % kCount];
+}
+
+namespace {
+
+//! The values of a label field present, ascending (at most `limit`, for the legend).
+std::vector<long> labelsPresent(const ScalarField& field, std::size_t limit)
+{
+    std::set<long> values;
+    for (std::size_t i = 0; i < field.size() && values.size() <= limit; ++i)
+        if (field.hasValue(i))
+            values.insert(std::lround(field.value(i)));
+    return {values.begin(), values.end()};
+}
+
+//! Colours a label field: each value its labelColour, the thresholds as for any field.
+void colourLabels(const ScalarField& field, const FieldDisplay& display, FieldColouring::Outside outside, std::uint8_t* rgba)
+{
+    const FieldColouring how;
+    for (std::size_t i = 0; i < field.size(); ++i) {
+        std::uint8_t* c = rgba + 4 * i;
+        if (!field.hasValue(i)) {
+            c[0] = how.nanColour[0], c[1] = how.nanColour[1], c[2] = how.nanColour[2], c[3] = 255;
+            continue;
+        }
+        const double v = field.value(i);
+        if (v < display.low || v > display.high) {
+            if (outside == FieldColouring::Outside::Hide)
+                c[0] = c[1] = c[2] = c[3] = 0;
+            else
+                c[0] = how.greyColour[0], c[1] = how.greyColour[1], c[2] = how.greyColour[2], c[3] = 255;
+            continue;
+        }
+        const auto colour = labelColour(std::lround(v));
+        c[0] = colour[0], c[1] = colour[1], c[2] = colour[2], c[3] = 255;
+    }
+}
+
+constexpr std::size_t kLegendCategories = 24;
+
+} // namespace
+
 ColourLegend legendOf(const PointCloud& points, const DisplayState& display)
 {
     ColourLegend legend;
@@ -37,6 +106,9 @@ ColourLegend legendOf(const PointCloud& points, const DisplayState& display)
     const FieldDisplay fieldDisplay = it == display.fields.end() ? FieldDisplay{} : it->second;
     legend.scale = fieldDisplay.scale;
     std::tie(legend.min, legend.max) = colourRange(*field, fieldDisplay);
+    if (isLabelField(*field))
+        for (long value : labelsPresent(*field, kLegendCategories))
+            legend.categories.emplace_back(value, labelColour(value));
     return legend;
 }
 
@@ -48,6 +120,10 @@ ColourLegend colourEntity(const PointCloud& points, const DisplayState& display,
     if (field) {
         const auto it = display.fields.find(field->name());
         const FieldDisplay fieldDisplay = it == display.fields.end() ? FieldDisplay{} : it->second;
+        if (isLabelField(*field)) {
+            colourLabels(*field, fieldDisplay, display.outside, rgba);
+            return legendOf(points, display);
+        }
         FieldColouring how;
         std::tie(how.colourMin, how.colourMax) = colourRange(*field, fieldDisplay);
         how.visibleMin = fieldDisplay.low;
@@ -55,6 +131,15 @@ ColourLegend colourEntity(const PointCloud& points, const DisplayState& display,
         how.outside = display.outside;
         colourise(field->values().data(), n, field->offset(), fieldDisplay.scale, how, rgba);
         legend = {true, field->name(), fieldDisplay.scale, how.colourMin, how.colourMax};
+        return legend;
+    }
+    if (display.neutral) {
+        for (std::size_t i = 0; i < n; ++i) {
+            rgba[4 * i] = kNeutralGrey[0];
+            rgba[4 * i + 1] = kNeutralGrey[1];
+            rgba[4 * i + 2] = kNeutralGrey[2];
+            rgba[4 * i + 3] = 255;
+        }
         return legend;
     }
     if (points.hasColors()) {

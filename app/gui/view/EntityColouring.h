@@ -7,8 +7,10 @@
 
 #include "document/Document.h"
 
+#include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace scandiff::gui {
@@ -20,7 +22,26 @@ struct ColourLegend
     std::string title;
     ColourScale scale = *ColourScale::preset("Blue-Green-Yellow-Red");
     double min = 0, max = 1;
+    //! For a label field: each value present (ascending) and its colour; the
+    //! legend is then a list of swatches, not a ramp.
+    std::vector<std::pair<long, std::array<std::uint8_t, 3>>> categories;
 };
+
+//! Whether a field holds labels rather than measures: its name says so
+//! (region_id, primitive_id, primitive_type, classification, label, cluster,
+//! or any name ending in "_id") and every value is an integer. Such a field
+//! is drawn with distinct colours per value, not on a ramp where 1 and 2
+//! would be two shades of blue.
+bool isLabelField(const ScalarField& field);
+
+//! The colour of label `value`: 19 colours of high mutual contrast in turn
+//! (Kelly's list of 1965, without its white, black and grey, which the
+//! background, the greyed points and the no-value points use), so
+//! neighbouring ids differ.
+std::array<std::uint8_t, 3> labelColour(long value);
+
+//! The neutral grey of a reference shown without its colours.
+inline constexpr std::array<std::uint8_t, 3> kNeutralGrey{185, 185, 185};
 
 //! The value range a field's colour scale spans: the display's colour range,
 //! each infinite end replaced by the field's finite end; made symmetric about 0
