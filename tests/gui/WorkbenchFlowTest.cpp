@@ -430,6 +430,33 @@ private slots:
         QVERIFY(asked.contains(window.document().item(reference).name));
     }
 
+    void aLocalCloudBesideGeoreferencedOnesKeepsItsPrecision()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::MainWindow window(registry);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        // The trial's mix: a UTM scan first, then a local one 5.4e6 m away, whose
+        // 1 mm steps float32 cannot hold at that distance (0.5 m apart there).
+        PointCloud utm;
+        utm.setOrigin({512000, 5403000, 300});
+        utm.positions() = {{0, 0, 0}, {10, 10, 1}};
+        window.document().add("utm", std::move(utm));
+        PointCloud local;
+        local.positions() = {{0.001f, 0.002f, 0.003f}, {1, 1, 1}};
+        const EntityId localId = window.document().add("local", std::move(local));
+        Eigen::Vector3d offset;
+        Eigen::Vector3f first;
+        QVERIFY(window.view()->shownFrame(localId, offset, first));
+        // Drawn from its own floats, placed by a double offset: nothing rounded.
+        QCOMPARE(first, Eigen::Vector3f(0.001f, 0.002f, 0.003f));
+        QCOMPARE(offset, Eigen::Vector3d(-512000, -5403000, -300));
+        // The camera still speaks global coordinates.
+        window.view()->zoomToEntity(localId);
+        const gui::CameraState camera = window.view()->camera();
+        QVERIFY(std::abs(camera.focalPoint[0] - 0.5) < 0.01 && std::abs(camera.focalPoint[1] - 0.5) < 0.01);
+    }
+
     void badFilesAreReportedNotFatal()
     {
         const PluginRegistry registry = makePluginRegistry();

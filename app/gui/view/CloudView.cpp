@@ -99,8 +99,6 @@ struct CloudView::Shown
     };
     bool isCloud = true;
     std::size_t pointCount = 0;
-    //! Positions shifted to the scene origin when the entity's origin differs; else empty.
-    std::vector<Eigen::Vector3f> shifted;
     std::vector<std::uint8_t> rgba; //!< 4 bytes per point, what the chunks' colour arrays show
     std::vector<Chunk> chunks;
 };
@@ -215,14 +213,13 @@ void CloudView::addEntity(const Document::Item& item)
     s.pointCount = points.size();
     // The document never moves or resizes a shown entity's positions, and the
     // view drops an entity before any further render once it is removed.
+    // Each entity keeps its own float positions, exact about its own origin;
+    // where that origin lies in the scene is its actor's position, in double.
+    // VTK composes the actor's and the camera's matrices in double before the
+    // one float matrix the GPU gets, so a local cloud beside UTM ones keeps
+    // its millimetres (adding the offset to the floats made it stripes).
     const float* xyz = points.positions().front().data();
-    if (points.origin() != *scene_->sceneOrigin) {
-        const Eigen::Vector3f delta = (points.origin() - *scene_->sceneOrigin).cast<float>();
-        s.shifted.resize(points.size());
-        for (std::size_t i = 0; i < points.size(); ++i)
-            s.shifted[i] = points.positions()[i] + delta;
-        xyz = s.shifted.front().data();
-    }
+    const Eigen::Vector3d offset = points.origin() - *scene_->sceneOrigin;
     static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "positions are packed xyz triples");
 
     if (!s.isCloud) { // a mesh: one piece, its triangles index every vertex
@@ -242,6 +239,7 @@ void CloudView::addEntity(const Document::Item& item)
         c.fullMapper->SetInputData(c.full);
         c.fullMapper->ScalarVisibilityOff();
         c.actor = vtkSmartPointer<vtkActor>::New();
+        c.actor->SetPosition(offset.x(), offset.y(), offset.z());
         c.actor->SetMapper(c.fullMapper);
         c.actor->GetProperty()->SetColor(0.85, 0.85, 0.8);
         scene_->renderer->AddActor(c.actor);
@@ -265,6 +263,7 @@ void CloudView::addEntity(const Document::Item& item)
             c.fullMapper->SetColorModeToDirectScalars();
             c.fullMapper->ScalarVisibilityOn();
             c.actor = vtkSmartPointer<vtkActor>::New();
+            c.actor->SetPosition(offset.x(), offset.y(), offset.z());
             c.actor->SetMapper(c.fullMapper);
             c.actor->GetProperty()->SetPointSize(scene_->pointSize);
             c.actor->ForceOpaqueOn();
@@ -426,6 +425,21 @@ void CloudView::setParallelProjection(bool parallel)
 }
 
 bool CloudView::parallelProjection() const { return scene_->renderer->GetActiveCamera()->GetParallelProjection() != 0; }
+
+bool CloudView::shownFrame(EntityId id, Eigen::Vector3d& offset, Eigen::Vector3f& firstPosition) const
+{
+    const auto it = scene_->shown.find(id);
+    if (it == scene_->shown.end() || it->second.chunks.empty())
+        return false;
+    const Shown::Chunk& c = it->second.chunks.front();
+    double position[3];
+    c.actor->GetPosition(position);
+    offset = {position[0], position[1], position[2]};
+    double p[3];
+    c.full->GetPoints()->GetPoint(0, p);
+    firstPosition = Eigen::Vector3d(p[0], p[1], p[2]).cast<float>();
+    return true;
+}
 
 CameraState CloudView::camera() const
 {

@@ -71,6 +71,10 @@ public:
     std::size_t interactiveBudget() const;
     //! The stride used while moving (1 = no decimation); for tests.
     std::size_t interactiveStride() const;
+    //! Where an entity's own frame sits in the scene (its actors' position, in
+    //! double) and the first float position its actors draw: for tests of the
+    //! precision of mixed frames. False if the entity is not shown.
+    bool shownFrame(EntityId id, Eigen::Vector3d& offset, Eigen::Vector3f& firstPosition) const;
     //! Switches the decimated drawing on or off as a camera move would.
     void setMoving(bool moving);
 
