@@ -76,6 +76,7 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
         updateLegend();
     });
     connect(&document_, &Document::removed, this, [this] { updateLegend(); });
+    connect(&document_, &Document::fieldsChanged, this, [this] { updateRegionExport(); });
     connect(tree_, &EntityTree::currentEntityChanged, this, &MainWindow::onCurrentEntityChanged);
     connect(scalarPanel_, &ScalarFieldPanel::splitRequested, splits_, &SplitController::split);
     connect(distances_, &DistanceController::resultReady, tree_, &EntityTree::selectEntity);
@@ -136,7 +137,8 @@ void MainWindow::buildMenus()
     connect(files_, &FileController::recentFilesChanged, this, [this, recent] { files_->fillRecentMenu(recent); });
     file->addAction(tr("&Export selected..."), this, [this] { files_->exportWithDialog(tree_->selectedEntities()); })
         ->setShortcut(QKeySequence(tr("Ctrl+E")));
-    file->addAction(tr("Export re&gions (PLY, DXF, CSV)..."), this, [this] { segmentation_->exportRegionsWithDialog(tree_->currentEntity()); });
+    regionExportActions_.push_back(
+        file->addAction(tr("Export re&gions (PLY, DXF, CSV)..."), this, [this] { segmentation_->exportRegionsWithDialog(tree_->currentEntity()); }));
     file->addSeparator();
     file->addAction(tr("Open &session..."), sessions_, &SessionController::restoreWithDialog);
     file->addAction(tr("&Save session..."), sessions_, &SessionController::saveWithDialog)->setShortcut(QKeySequence::Save);
@@ -238,6 +240,8 @@ void MainWindow::buildMenus()
     QAction* exportRegions = new QAction(tr("Export regions (PLY, DXF, CSV)..."), tree_);
     connect(exportRegions, &QAction::triggered, this, [this] { segmentation_->exportRegionsWithDialog(tree_->currentEntity()); });
     tree_->addAction(exportRegions);
+    regionExportActions_.push_back(exportRegions);
+    updateRegionExport();
     QAction* remove = new QAction(tr("Delete"), tree_);
     connect(remove, &QAction::triggered, this, [this] {
         for (EntityId id : tree_->selectedEntities(false))
@@ -303,6 +307,17 @@ void MainWindow::onCurrentEntityChanged(EntityId id)
     properties_->showEntity(id);
     scalarPanel_->showEntity(id);
     updateLegend();
+    updateRegionExport();
+}
+
+void MainWindow::updateRegionExport()
+{
+    // Only a cloud with regions can export them (it would ask for a folder, then fail).
+    const bool possible = segmentation_->hasRegions(tree_->currentEntity());
+    for (QAction* action : regionExportActions_) {
+        action->setEnabled(possible);
+        action->setToolTip(possible ? QString() : tr("Segment the changes first: the selected cloud has no regions"));
+    }
 }
 
 void MainWindow::updateLegend()

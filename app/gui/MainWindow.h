@@ -12,6 +12,7 @@
 #include <QStringList>
 
 #include <map>
+#include <vector>
 
 namespace scandiff::gui {
 
@@ -76,9 +77,12 @@ private:
     //! The colour bar of the selected entity when it is shown with a field, else
     //! of the last visible one with a field; none otherwise.
     void updateLegend();
+    //! Export regions is offered only for a cloud that has regions.
+    void updateRegionExport();
 
     const PluginRegistry& registry_;
     Document document_;
+    std::vector<QAction*> regionExportActions_;
     CloudView* view_;
     EntityTree* tree_ = nullptr;
     PropertiesPanel* properties_ = nullptr;

@@ -136,6 +136,20 @@ ParameterSpec ParameterSpec::asFieldOf(std::string role) const
     return s;
 }
 
+ParameterSpec ParameterSpec::onlyWith(std::string parameter) const
+{
+    ParameterSpec s = *this;
+    s.usedWith = std::move(parameter);
+    return s;
+}
+
+ParameterSpec ParameterSpec::withZeroMeaning(std::string meaning) const
+{
+    ParameterSpec s = *this;
+    s.zeroMeans = std::move(meaning);
+    return s;
+}
+
 ParameterSpec ParameterSpec::asAlternative(std::string group) const
 {
     ParameterSpec s = asOptional();

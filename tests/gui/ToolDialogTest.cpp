@@ -2,10 +2,12 @@
 // Qt Test, offscreen platform: the generated tool dialog and the tool controller,
 // driven through their widgets as a user would.
 #include "document/Document.h"
+#include "controllers/SegmentationController.h"
 #include "controllers/ToolController.h"
 #include "tools/ParameterForm.h"
 #include "tools/ToolDialog.h"
 
+#include <scandiff/core/segmentation/SegmentationParameters.h>
 #include <scandiff/plugins/PluginRegistry.h>
 
 #include <QCheckBox>
@@ -179,6 +181,59 @@ private slots:
         auto* combo = sampleDialog.findChild<QComboBox*>("input-input");
         QVERIFY(combo);
         QCOMPARE(combo->count(), 1); // the clouds are not offered
+    }
+
+    void segmentationDialogOffersChoicesFromTheData()
+    {
+        gui::Document document;
+        PointCloud cloud;
+        cloud.resize(3);
+        ScalarField& d = cloud.addField("c2m_distance");
+        d.values() = {0.0f, 1.0f, 2.0f};
+        cloud.addField("intensity").values() = {5.0f, 6.0f, 7.0f};
+        const gui::EntityId id = document.add("epoch", std::move(cloud));
+        document.setActiveField(id, "c2m_distance");
+        // The panel's threshold, as the user left it: low end at 0.5.
+        gui::FieldDisplay display = document.fieldDisplay(id, "c2m_distance");
+        display.low = 0.5;
+        document.setFieldDisplay(id, "c2m_distance", display);
+
+        gui::SegmentationDialog dialog(document, id);
+        gui::ParameterForm* form = dialog.findChild<gui::ParameterForm*>();
+        QVERIFY(form);
+        // The field is a choice of the cloud's fields, the shown one selected.
+        auto* field = qobject_cast<QComboBox*>(form->editor("field"));
+        QVERIFY(field);
+        QCOMPARE(field->count(), 2);
+        QCOMPARE(field->currentText(), QString("c2m_distance"));
+        // The exclusive methods are one choice; the threshold is the panel's.
+        QComboBox* method = form->groupChoice("method");
+        QVERIFY(method);
+        QCOMPARE(method->currentData().toString(), QString("above"));
+        QCOMPARE(dialog.values().at("above"), std::string("0.5"));
+        QVERIFY(form->isShown("above") && !form->isShown("range") && !form->isShown("kmeans"));
+        // The statistical test's own parameters show only with it.
+        QVERIFY(!form->isShown("neighbours") && !form->isShown("confidence"));
+        method->setCurrentIndex(method->findData("stat-test"));
+        QVERIFY(form->isShown("neighbours") && form->isShown("stat-test") && !form->isShown("above"));
+        QVERIFY(dialog.values().count("stat-test") && !dialog.values().count("above"));
+        // Components' own parameters show with it; propagation replaces the methods.
+        QVERIFY(!form->isShown("connectivity"));
+        qobject_cast<QCheckBox*>(form->editor("components"))->setChecked(true);
+        QVERIFY(form->isShown("connectivity") && form->isShown("min-points"));
+        QVERIFY(!form->isShown("alpha"));
+        qobject_cast<QCheckBox*>(form->editor("propagate"))->setChecked(true);
+        QVERIFY(form->isShown("alpha") && !method->isVisibleTo(&dialog) && !form->isShown("stat-test"));
+        QVERIFY(!dialog.values().count("stat-test")); // what the CLI would refuse together is not given
+        QVERIFY(resolveParameters(segmentationParameters(), dialog.values(), "segment").boolean("propagate"));
+        // 0 says what it means.
+        QCOMPARE(qobject_cast<QSpinBox*>(form->editor("level"))->specialValueText(), QString("automatic"));
+
+        // Both thresholds set: the range is proposed.
+        display.high = 1.5;
+        document.setFieldDisplay(id, "c2m_distance", display);
+        gui::SegmentationDialog ranged(document, id);
+        QCOMPARE(ranged.values().at("range"), std::string("0.5 1.5"));
     }
 
     void alternativesAndRequiredParametersInTheForm()

@@ -23,6 +23,7 @@
 #include <scandiff/io/FileIO.h>
 #include <scandiff/plugins/PluginRegistry.h>
 
+#include <QAction>
 #include <QCheckBox>
 #include <QDropEvent>
 #include <QMessageBox>
@@ -304,8 +305,20 @@ private slots:
 
         // The demo's compared epoch holds two changes seen from it: the raised
         // block (+2 m) and the appeared box (the removed area has no points there).
+        // Export regions is not offered for a cloud without regions.
+        QList<QAction*> regionExports;
+        for (QAction* action : window.findChildren<QAction*>())
+            if (action->text().remove('&').startsWith("Export regions"))
+                regionExports << action;
+        QCOMPARE(regionExports.size(), 2); // File menu and the tree's menu
+        window.tree()->selectEntity(compared);
+        for (QAction* action : regionExports)
+            QVERIFY(!action->isEnabled());
         QVERIFY(window.segmentation()->run(compared, reference,
                                            {{"field", "c2c_distance"}, {"above", "0.5"}, {"components", "true"}, {"min-points", "20"}}));
+        window.tree()->selectEntity(compared);
+        for (QAction* action : regionExports)
+            QVERIFY(action->isEnabled());
         const gui::Document::Item& item = window.document().item(compared);
         QCOMPARE(item.display.activeField, std::string("region_id"));
         // Region ids are labels: one swatch per region in the colour bar, not a ramp.

@@ -54,11 +54,32 @@ SegmentationDialog::SegmentationDialog(const Document& document, EntityId input,
     entities->addRow(tr("Other epoch (volume)"), reference_);
     layout->addLayout(entities);
     form_ = new ParameterForm(segmentationParameters(), this);
-    // The field to segment is the one the user is looking at.
+    // The field: a choice of the cloud's fields, the one the user is looking at
+    // first; the method: the panel's thresholds when the user set some (a range
+    // when both ends are set, "above" when only the low one is).
     const auto followInput = [this, &document] {
         const Document::Item* item = document.find(this->input());
-        if (item && !item->display.activeField.empty())
-            form_->setValue("field", QString::fromStdString(item->display.activeField));
+        auto* fields = qobject_cast<QComboBox*>(form_->editor("field"));
+        if (!item || !fields)
+            return;
+        fields->clear();
+        for (const ScalarField& f : item->points().fields())
+            fields->addItem(QString::fromStdString(f.name()));
+        const std::string& active = item->display.activeField;
+        if (active.empty())
+            return;
+        form_->setValue("field", QString::fromStdString(active));
+        const ScalarField* field = item->points().field(active);
+        const auto it = item->display.fields.find(active);
+        if (!field || it == item->display.fields.end())
+            return;
+        const ValueRange range = field->range();
+        const bool lowSet = std::isfinite(it->second.low) && it->second.low > range.min;
+        const bool highSet = std::isfinite(it->second.high) && it->second.high < range.max;
+        if (lowSet && highSet)
+            form_->setValue("range", QString("%1 %2").arg(it->second.low, 0, 'g', 10).arg(it->second.high, 0, 'g', 10));
+        else if (lowSet)
+            form_->setValue("above", QString::number(it->second.low, 'g', 10));
     };
     followInput();
     connect(input_, qOverload<int>(&QComboBox::currentIndexChanged), this, followInput);
@@ -209,6 +230,15 @@ bool SegmentationController::exportRegions(EntityId id, const QString& folder, b
                       .arg(files.regionClouds.size())
                       .arg(dxfPoints ? tr(" (outlines, labels and points)") : QString()));
     return true;
+}
+
+bool SegmentationController::hasRegions(EntityId id) const
+{
+    for (const auto& [parent, children] : regionEntities_)
+        if (std::find(children.begin(), children.end(), id) != children.end())
+            id = parent;
+    const Document::Item* item = document_.find(id);
+    return item && item->cloud() && item->points().field("region_id");
 }
 
 void SegmentationController::exportRegionsWithDialog(EntityId id)

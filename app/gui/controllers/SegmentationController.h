@@ -62,6 +62,8 @@ public:
     bool exportRegions(EntityId id, const QString& folder, bool dxfPoints = false);
     //! Asks for the folder, then whether the DXF should hold the points too.
     void exportRegionsWithDialog(EntityId id);
+    //! Whether `id` (or, for a region's own entity, its cloud) has regions to export.
+    bool hasRegions(EntityId id) const;
 
     static constexpr std::size_t kMaxRegionEntities = 100;
 

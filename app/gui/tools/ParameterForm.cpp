@@ -11,8 +11,10 @@
 #include <QFormLayout>
 #include <QHBoxLayout>
 #include <QLineEdit>
+#include <QSignalBlocker>
 #include <QSpinBox>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -40,6 +42,8 @@ QWidget* makeEditor(const ParameterSpec& p, QWidget* parent)
         box->setValue(static_cast<int>(std::get<std::int64_t>(p.defaultValue)));
         if (!p.unit.empty())
             box->setSuffix(" " + QString::fromStdString(p.unit));
+        if (!p.zeroMeans.empty() && p.minimum == 0) // the minimum shows as its meaning
+            box->setSpecialValueText(QString::fromStdString(p.zeroMeans));
         return box;
     }
     case ParameterType::Real: {
@@ -49,6 +53,8 @@ QWidget* makeEditor(const ParameterSpec& p, QWidget* parent)
         box->setValue(std::get<double>(p.defaultValue));
         if (!p.unit.empty())
             box->setSuffix(" " + QString::fromStdString(p.unit));
+        if (!p.zeroMeans.empty() && p.minimum == 0)
+            box->setSpecialValueText(QString::fromStdString(p.zeroMeans));
         return box;
     }
     case ParameterType::Boolean: {
@@ -105,18 +111,43 @@ std::string editorText(const ParameterSpec& p, QWidget* editor)
 ParameterForm::ParameterForm(const std::vector<ParameterSpec>& parameters, QWidget* parent)
     : QWidget(parent), parameters_(parameters)
 {
-    auto* form = new QFormLayout(this);
-    form->setContentsMargins(0, 0, 0, 0);
+    form_ = new QFormLayout(this);
+    form_->setContentsMargins(0, 0, 0, 0);
     for (const ParameterSpec& p : parameters_) {
         QWidget* editor = makeEditor(p, this);
         editor->setObjectName(QString::fromStdString(p.name));
         editor->setToolTip(helpText(p));
         editors_[p.name] = editor;
+        // A switch others depend on shows or hides them.
+        if (auto* check = qobject_cast<QCheckBox*>(editor))
+            connect(check, &QCheckBox::toggled, this, &ParameterForm::updateVisibility);
         if (!p.optional) {
-            form->addRow(QString::fromStdString(p.label), editor);
+            form_->addRow(QString::fromStdString(p.label), editor);
+            rows_[p.name] = editor;
             continue;
         }
-        // An optional value: the checkbox says whether it is given at all.
+        // Alternatives ("--radius R | --knn K"): one choice, the group's first
+        // proposed; only the chosen one's row shows.
+        if (!p.alternativeGroup.empty() && !groupChoices_.count(p.alternativeGroup)) {
+            auto* choice = new QComboBox(this);
+            choice->setObjectName(QString::fromStdString(p.alternativeGroup + "-choice"));
+            for (const ParameterSpec& member : parameters_)
+                if (member.alternativeGroup == p.alternativeGroup) {
+                    choice->addItem(QString::fromStdString(member.label), QString::fromStdString(member.name));
+                    choice->setItemData(choice->count() - 1, helpText(member), Qt::ToolTipRole);
+                }
+            QString title = QString::fromStdString(p.alternativeGroup);
+            title[0] = title[0].toUpper();
+            form_->addRow(title, choice);
+            groupChoices_[p.alternativeGroup] = choice;
+            connect(choice, QOverload<int>::of(&QComboBox::currentIndexChanged), this, [this, group = p.alternativeGroup](int) {
+                QComboBox* box = groupChoices_.at(group);
+                const std::string chosen = box->currentData().toString().toStdString();
+                enablers_.at(chosen)->setChecked(true);
+            });
+        }
+        // An optional value: the checkbox says whether it is given at all (hidden
+        // for an alternative: the group's choice sets it).
         auto* row = new QWidget(this);
         auto* layout = new QHBoxLayout(row);
         layout->setContentsMargins(0, 0, 0, 0);
@@ -126,26 +157,79 @@ ParameterForm::ParameterForm(const std::vector<ParameterSpec>& parameters, QWidg
         layout->addWidget(enabler);
         layout->addWidget(editor, 1);
         editor->setEnabled(false);
+        enabler->setVisible(p.alternativeGroup.empty());
         connect(enabler, &QCheckBox::toggled, editor, &QWidget::setEnabled);
+        connect(enabler, &QCheckBox::toggled, this, &ParameterForm::updateVisibility);
         enablers_[p.name] = enabler;
-        form->addRow(QString::fromStdString(p.label), row);
+        rows_[p.name] = row;
+        form_->addRow(QString::fromStdString(p.label), row);
     }
-    // Alternatives ("--radius R | --knn K"): switching one on switches the
-    // others of its group off, and the group's first is proposed.
+    // Switching one alternative on switches the others of its group off and
+    // moves the group's choice to it.
     std::map<std::string, std::vector<QCheckBox*>> groups;
     for (const ParameterSpec& p : parameters_)
         if (p.optional && !p.alternativeGroup.empty())
             groups[p.alternativeGroup].push_back(enablers_.at(p.name));
     for (const auto& [group, members] : groups) {
-        for (QCheckBox* member : members)
-            connect(member, &QCheckBox::toggled, this, [member, members](bool on) {
+        QComboBox* choice = groupChoices_.at(group);
+        for (std::size_t i = 0; i < members.size(); ++i) {
+            QCheckBox* member = members[i];
+            connect(member, &QCheckBox::toggled, this, [member, members, choice, i](bool on) {
                 if (!on)
                     return;
                 for (QCheckBox* other : members)
                     if (other != member)
                         other->setChecked(false);
+                const QSignalBlocker quiet(choice);
+                choice->setCurrentIndex(static_cast<int>(i));
             });
+        }
         members.front()->setChecked(true);
+    }
+    updateVisibility();
+}
+
+bool ParameterForm::isGiven(const std::string& name) const
+{
+    const auto spec = std::find_if(parameters_.begin(), parameters_.end(), [&](const ParameterSpec& p) { return p.name == name; });
+    if (spec == parameters_.end())
+        return true;
+    if (spec->optional && !enablers_.at(name)->isChecked())
+        return false;
+    if (!spec->usedWith.empty() && !conditionHolds(*spec))
+        return false; // chosen, but inside a part that does not apply
+    if (spec->type == ParameterType::Boolean)
+        return static_cast<QCheckBox*>(editors_.at(name))->isChecked();
+    return true;
+}
+
+bool ParameterForm::conditionHolds(const ParameterSpec& p) const
+{
+    if (p.usedWith.empty())
+        return true;
+    const bool negated = p.usedWith.front() == '!';
+    const bool given = isGiven(negated ? p.usedWith.substr(1) : p.usedWith);
+    return negated ? !given : given;
+}
+
+void ParameterForm::updateVisibility()
+{
+    for (const ParameterSpec& p : parameters_) {
+        const bool chosen = p.alternativeGroup.empty() || enablers_.at(p.name)->isChecked();
+        const bool shown = chosen && conditionHolds(p);
+        QWidget* row = rows_.at(p.name);
+        row->setVisible(shown);
+        if (QWidget* label = form_->labelForField(row))
+            label->setVisible(shown);
+    }
+    // A group's choice shows when its members apply at all.
+    for (const auto& [group, choice] : groupChoices_) {
+        bool applies = false;
+        for (const ParameterSpec& p : parameters_)
+            applies = applies || (p.alternativeGroup == group && conditionHolds(p));
+        choice->setVisible(applies);
+        if (QWidget* label = form_->labelForField(choice))
+            label->setVisible(applies);
     }
 }
 
@@ -155,6 +239,8 @@ std::map<std::string, std::string> ParameterForm::values() const
     for (const ParameterSpec& p : parameters_) {
         if (p.optional && !enablers_.at(p.name)->isChecked())
             continue;
+        if (p.optional && !conditionHolds(p))
+            continue; // switched on, but in a part that does not apply
         out[p.name] = editorText(p, editors_.at(p.name));
     }
     return out;

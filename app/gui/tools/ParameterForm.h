@@ -2,7 +2,10 @@
 #pragma once
 //! A form generated from parameter declarations (ParameterSpec): one widget per
 //! parameter, initialised with its default, limited to its range, with its help
-//! as tooltip. An optional parameter gets a checkbox that switches it on. There
+//! as tooltip. An optional parameter gets a checkbox that switches it on;
+//! alternatives are one choice showing only the chosen one's row; a parameter
+//! used only with another shows only when that one is given; a 0 that means
+//! "automatic" says so. There
 //! is no second copy of any default: values() gives text the declarations parse,
 //! exactly as the command line's options do.
 
@@ -15,6 +18,8 @@
 #include <vector>
 
 class QCheckBox;
+class QComboBox;
+class QFormLayout;
 class QDialog;
 class QVBoxLayout;
 
@@ -36,10 +41,28 @@ public:
     //! The checkbox of an optional parameter, null otherwise.
     QCheckBox* enabler(const std::string& parameterName) const;
 
+    //! The combo box choosing among the alternatives of `group`, null if none.
+    QComboBox* groupChoice(const std::string& group) const
+    {
+        const auto it = groupChoices_.find(group);
+        return it == groupChoices_.end() ? nullptr : it->second;
+    }
+    //! Whether a parameter's row is shown (its alternative chosen, its condition met).
+    bool isShown(const std::string& parameterName) const { return rows_.count(parameterName) && !rows_.at(parameterName)->isHidden(); }
+
 private:
+    //! Whether `name` is given: an optional one switched on, a switch on, anything else.
+    bool isGiven(const std::string& name) const;
+    //! Whether `p.usedWith` holds.
+    bool conditionHolds(const ParameterSpec& p) const;
+    void updateVisibility();
+
     std::vector<ParameterSpec> parameters_;
+    QFormLayout* form_ = nullptr;
     std::map<std::string, QWidget*> editors_;
     std::map<std::string, QCheckBox*> enablers_;
+    std::map<std::string, QWidget*> rows_;              //!< the field widget of each parameter's row
+    std::map<std::string, QComboBox*> groupChoices_;    //!< by alternative group
 };
 
 //! Parameter text as `scandiff-cli` options ("--knn 12 --signed"): flags only

@@ -30,7 +30,8 @@ ParameterSpec clampParameter()
 
 ParameterSpec octreeLevelParameter(const std::string& automatic)
 {
-    return ParameterSpec::integer("octree-level", "Octree level", "Octree level 1..21; 0 = automatic (" + automatic + ")", 0, 0, 21);
+    return ParameterSpec::integer("octree-level", "Octree level", "Octree level 1..21; 0 = automatic (" + automatic + ")", 0, 0, 21)
+        .withZeroMeaning("automatic");
 }
 
 void checkClamp(const ParameterValues& values)

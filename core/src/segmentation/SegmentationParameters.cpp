@@ -36,59 +36,80 @@ const std::vector<ParameterSpec>& segmentationParameters()
         const ConnectedComponentsParams cc;
         const PropagationParams propagation;
         return std::vector<ParameterSpec>{
-            ParameterSpec::text("field", "Field", "Scalar field to segment (the distances)", "c2c_distance"),
+            ParameterSpec::text("field", "Field", "Scalar field to segment (the distances)", "c2c_distance").asFieldOf("input"),
             ParameterSpec::boolean("absolute", "Absolute values", "Segment |value| (signed distances as unsigned ones)", false),
-            ParameterSpec::text("range", "Range", "Changed: values in [A, B], given as 'A B' or 'A,B' (§3.2.1)").asOptional(),
-            ParameterSpec::real("above", "Above", "Changed: values >= this threshold (§3.2.1)", 0.1, -1e30, 1e30).asOptional(),
+            ParameterSpec::real("above", "Above", "Changed: values >= this threshold (§3.2.1)", 0.1, -1e30, 1e30)
+                .asAlternative("method")
+                .onlyWith("!propagate"),
+            ParameterSpec::text("range", "Range", "Changed: values in [A, B], given as 'A B' or 'A,B' (§3.2.1)")
+                .asAlternative("method")
+                .onlyWith("!propagate"),
             ParameterSpec::integer("kmeans", "K-means classes",
                                    "Changed: K-means with this many classes, all but the one nearest 0 (§3.2.2)", 2, 2, 64)
-                .asOptional(),
+                .asAlternative("method")
+                .onlyWith("!propagate"),
             ParameterSpec::choice("stat-test", "Local statistical test",
                                   "Changed: the local chi-square test against this noise model (§3.2.3)", {"gaussian", "weibull"},
                                   "weibull")
-                .asOptional(),
+                .asAlternative("method")
+                .onlyWith("!propagate"),
             ParameterSpec::integer("neighbours", "Test neighbours", "stat-test: n nearest neighbours per test (sqrt(n) classes)",
-                                   chi.neighbours, 4, 1024, "points"),
+                                   chi.neighbours, 4, 1024, "points")
+                .onlyWith("stat-test"),
             ParameterSpec::real("confidence", "Confidence", "stat-test: confidence of the test (the chi-square quantile)",
-                                chi.confidence, 0.5, 0.999999),
+                                chi.confidence, 0.5, 0.999999)
+                .onlyWith("stat-test"),
             ParameterSpec::real("chi2-threshold", "Chi-square cut", "stat-test: cut on the chi-square distance instead of the quantile",
                                 20.0, 0.0, 1e12)
-                .asOptional(),
+                .asOptional()
+                .onlyWith("stat-test"),
             ParameterSpec::text("fit-box", "Unchanged zone",
                                 "stat-test: fit the noise on the points inside X0,Y0,Z0,X1,Y1,Z1 (global coordinates) instead of "
                                 "the whole field")
-                .asOptional(),
+                .asOptional()
+                .onlyWith("stat-test"),
             ParameterSpec::text("noise", "Noise parameters",
                                 "stat-test: known noise parameters instead of a fit: MEAN,SIGMA (gaussian) or SHAPE,SCALE (weibull)")
-                .asOptional(),
+                .asOptional()
+                .onlyWith("stat-test"),
             ParameterSpec::boolean("components", "Connected components",
                                    "Group the changed points by connected components on the octree grid (§3.2.4); without it "
                                    "all changed points form region 1",
                                    false),
             ParameterSpec::integer("level", "Octree level",
                                    "Grid of the components / propagation: octree level 1..21 of the cloud's cube; 0 = automatic",
-                                   cc.level, 0, 21),
+                                   cc.level, 0, 21)
+                .withZeroMeaning("automatic"),
             ParameterSpec::choice("connectivity", "Connectivity", "Adjacent cells: faces (6), + edges (18), + corners (26)",
-                                  {"6", "18", "26"}, "26"),
+                                  {"6", "18", "26"}, "26")
+                .onlyWith("components"),
             ParameterSpec::integer("min-points", "Minimum region size", "Smaller regions are dropped",
-                                   static_cast<std::int64_t>(cc.minPoints), 1, 1000000000, "points"),
+                                   static_cast<std::int64_t>(cc.minPoints), 1, 1000000000, "points")
+                .onlyWith("components"),
             ParameterSpec::boolean("propagate", "Front propagation",
                                    "Segment by gradient-constrained fast marching (§3.3) instead of a classification", false),
             ParameterSpec::real("alpha", "Alpha", "propagate: speed exp(alpha (|grad|_j - |grad|_i)) (eq. 3.11)", propagation.alpha,
-                                0.0, 1e4),
+                                0.0, 1e4)
+                .onlyWith("propagate"),
             ParameterSpec::real("min-seed", "Minimum seed value", "propagate: regions start only from values >= this", 0.1, -1e30,
                                 1e30)
-                .asOptional(),
+                .asOptional()
+                .onlyWith("propagate"),
             ParameterSpec::real("stop-speed", "Stop speed", "propagate: the front does not cross where the speed falls below this",
-                                propagation.stopSpeed, 1e-12, 1.0),
+                                propagation.stopSpeed, 1e-12, 1.0)
+                .onlyWith("propagate"),
             ParameterSpec::real("gradient-radius", "Gradient radius", "propagate: neighbourhood radius of the gradient; 0 = automatic",
-                                0.0, 0.0, 1e9, "m"),
+                                0.0, 0.0, 1e9, "m")
+                .onlyWith("propagate")
+                .withZeroMeaning("automatic"),
             ParameterSpec::real("smoothing", "Gradient smoothing", "propagate: Gaussian smoothing of the gradient norm, sigma", 0.05,
                                 1e-9, 1e9, "m")
-                .asOptional(),
+                .asOptional()
+                .onlyWith("propagate"),
             ParameterSpec::real("outline-cell", "Outline cell",
                                 "Cell of the regions' concave outlines; 0 = automatic (1.5 x the 4th-neighbour spacing)", 0.0, 0.0, 1e9,
-                                "m"),
+                                "m")
+                .withZeroMeaning("automatic"),
             ParameterSpec::choice("region-epoch", "Regions are in",
                                   "Volume: which epoch the segmented cloud is (later: the compared cloud, where appeared matter shows; "
                                   "earlier: the reference of a both-ways C2C, where removed matter shows); the volume is later minus earlier",
@@ -96,7 +117,8 @@ const std::vector<ParameterSpec>& segmentationParameters()
             ParameterSpec::choice("column-height", "Column height",
                                   "Volume: each epoch's height in a grid column: its highest point (the surface seen from above), mean or lowest",
                                   {"highest", "mean", "lowest"}, "highest"),
-            ParameterSpec::real("volume-cell", "Volume cell", "Volume: horizontal grid cell; 0 = the outline cell", 0.0, 0.0, 1e9, "m"),
+            ParameterSpec::real("volume-cell", "Volume cell", "Volume: horizontal grid cell; 0 = the outline cell", 0.0, 0.0, 1e9, "m")
+                .withZeroMeaning("the outline cell"),
         };
     }();
     return parameters;

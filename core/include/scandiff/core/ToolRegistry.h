@@ -63,6 +63,15 @@ struct ParameterSpec
     //! points), their global coordinates as numbers, a group per line (';'
     //! between groups on the command line). The workbench fills it by picking.
     std::vector<std::string> pickedOn;
+    //! The parameter matters only with this other one given (an alternative
+    //! chosen, an optional value switched on, a switch turned on): "neighbours"
+    //! of the statistical test, "alpha" of the propagation; "!name": only
+    //! without it. The GUI shows it only then (and gives an optional one only
+    //! then); the CLI lists it as usual.
+    std::string usedWith;
+    //! Integer/Real: what 0 stands for ("automatic"); the GUI writes it in
+    //! place of the number.
+    std::string zeroMeans;
 
     static ParameterSpec integer(std::string name, std::string label, std::string description, std::int64_t defaultValue,
                                  std::int64_t minimum, std::int64_t maximum, std::string unit = {});
@@ -84,6 +93,10 @@ struct ParameterSpec
     ParameterSpec asFieldOf(std::string role = "input") const;
     //! The same declaration, picked in the view on these roles (see `pickedOn`).
     ParameterSpec pickedAlternatelyOn(std::vector<std::string> roles) const;
+    //! The same declaration, used only with `parameter` (see `usedWith`).
+    ParameterSpec onlyWith(std::string parameter) const;
+    //! The same declaration, 0 standing for `meaning` (see `zeroMeans`).
+    ParameterSpec withZeroMeaning(std::string meaning) const;
 
     //! Parses user text ("12", "0.5", "true", "plane") into a valid value.
     //! Throws Error(InvalidArgument) naming the parameter and its valid range.
