@@ -27,12 +27,19 @@
 #include <QMessageBox>
 #include <QMimeData>
 #include <QPushButton>
+#include <QSettings>
 #include <QStatusBar>
 #include <QToolBar>
 
 #include <set>
 
 namespace scandiff::gui {
+
+namespace {
+constexpr const char* kGeometrySetting = "window/geometry";
+constexpr const char* kLayoutSetting = "window/layout";
+} // namespace
+
 
 MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
     : QMainWindow(parent), registry_(registry), view_(new CloudView(this))
@@ -121,11 +128,17 @@ void MainWindow::buildDocks()
     properties_ = new PropertiesPanel(document_, this);
     scalarPanel_ = new ScalarFieldPanel(document_, this);
     console_ = new ConsolePanel(this);
-    dock(tr("Entities"), tree_, Qt::LeftDockWidgetArea);
+    QDockWidget* entitiesDock = dock(tr("Entities"), tree_, Qt::LeftDockWidgetArea);
     dock(tr("Properties"), properties_, Qt::LeftDockWidgetArea);
-    dock(tr("Scalar field"), scalarPanel_, Qt::RightDockWidgetArea);
+    QDockWidget* scalarDock = dock(tr("Scalar field"), scalarPanel_, Qt::RightDockWidgetArea);
     QDockWidget* consoleDock = dock(tr("Console"), console_, Qt::BottomDockWidgetArea);
+    // Wide enough for names, UTM coordinates and field ranges at 1680 px.
+    resizeDocks({entitiesDock, scalarDock}, {340, 360}, Qt::Horizontal);
     resizeDocks({consoleDock}, {140}, Qt::Vertical);
+    // Then the layout the user left last time, if any.
+    const QSettings settings;
+    restoreGeometry(settings.value(kGeometrySetting).toByteArray());
+    restoreState(settings.value(kLayoutSetting).toByteArray());
 }
 
 void MainWindow::buildMenus()
@@ -387,10 +400,14 @@ bool MainWindow::mayDiscardUnsavedWork()
 
 void MainWindow::closeEvent(QCloseEvent* event)
 {
-    if (mayDiscardUnsavedWork())
-        event->accept();
-    else
+    if (!mayDiscardUnsavedWork()) {
         event->ignore();
+        return;
+    }
+    QSettings settings; // the panels where the user put them, for next time
+    settings.setValue(kGeometrySetting, saveGeometry());
+    settings.setValue(kLayoutSetting, saveState());
+    event->accept();
 }
 
 } // namespace scandiff::gui

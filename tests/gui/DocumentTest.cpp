@@ -6,6 +6,7 @@
 #include "panels/EntityTree.h"
 #include "panels/ScalarFieldPanel.h"
 #include "view/EntityColouring.h"
+#include "widgets/HistogramWidget.h"
 #include "widgets/RangeEditor.h"
 
 #include <QComboBox>
@@ -181,6 +182,28 @@ private slots:
         const gui::ColourLegend none = gui::colourEntity(document.item(id).points(), document.item(id).display, rgba.data());
         QVERIFY(!none.shown);
         QCOMPARE(colourOf(4), gui::kNeutralGrey);
+    }
+
+    void panelForgetsThePreviousFieldOnACloudWithout()
+    {
+        gui::Document document;
+        gui::ScalarFieldPanel panel(document);
+        const EntityId withField = document.add("four", fourPoints());
+        gui::FieldDisplay display = document.fieldDisplay(withField, "d");
+        display.low = 0.5;
+        display.high = 1.5;
+        document.setFieldDisplay(withField, "d", display);
+        panel.showEntity(withField);
+        QCOMPARE(panel.rangeEditor()->low(), 0.5);
+        PointCloud plain;
+        plain.resize(2);
+        const EntityId byHeight = document.add("plain", std::move(plain));
+        panel.showEntity(byHeight);
+        // No range or marker of the previous cloud stays on show.
+        QCOMPARE(panel.rangeEditor()->low(), 0.0);
+        QCOMPARE(panel.rangeEditor()->high(), 1.0);
+        QVERIFY(std::isinf(panel.histogram()->markedLow()) && std::isinf(panel.histogram()->markedHigh()));
+        QCOMPARE(panel.histogram()->histogram().finiteCount, std::size_t(0));
     }
 
     void treeMirrorsTheDocument()

@@ -25,6 +25,7 @@
 
 #include <QAction>
 #include <QCheckBox>
+#include <QDockWidget>
 #include <QDropEvent>
 #include <QMessageBox>
 #include <QMimeData>
@@ -441,6 +442,26 @@ private slots:
         answerWith(QMessageBox::Discard);
         QVERIFY(window.close());
         QVERIFY(asked.contains(window.document().item(reference).name));
+    }
+
+    void thePanelLayoutIsRemembered()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        {
+            gui::MainWindow window(registry);
+            window.show();
+            QVERIFY(QTest::qWaitForWindowExposed(&window));
+            auto* console = window.findChild<QDockWidget*>("Console");
+            QVERIFY(console && console->isVisible());
+            console->hide();
+            QVERIFY(window.close()); // nothing unsaved: no question
+        }
+        gui::MainWindow again(registry);
+        again.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&again));
+        QVERIFY(!again.findChild<QDockWidget*>("Console")->isVisible());
+        again.findChild<QDockWidget*>("Console")->show();
+        QVERIFY(again.close());
     }
 
     void aLocalCloudBesideGeoreferencedOnesKeepsItsPrecision()

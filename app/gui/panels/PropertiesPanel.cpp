@@ -38,6 +38,7 @@ PropertiesPanel::PropertiesPanel(const Document& document, QWidget* parent) : QT
     setColumnCount(2);
     setHeaderLabels({tr("Property"), tr("Value")});
     header()->setSectionResizeMode(0, QHeaderView::ResizeToContents);
+    setTextElideMode(Qt::ElideMiddle); // a long path keeps its file name in sight
     setRootIsDecorated(true);
     connect(&document_, &Document::fieldsChanged, this, [this](EntityId id) {
         if (id == entity_)
@@ -80,6 +81,7 @@ void PropertiesPanel::rebuild()
         auto* row = parent ? new QTreeWidgetItem(parent) : new QTreeWidgetItem(this);
         row->setText(0, key);
         row->setText(1, value);
+        row->setToolTip(1, value); // whole, when the column is narrower than a path or coordinates
         return row;
     };
     if (const Document::Item* item = document_.find(entity_)) {

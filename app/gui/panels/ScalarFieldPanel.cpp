@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace scandiff::gui {
 
@@ -216,7 +217,14 @@ void ScalarFieldPanel::refresh()
         histogram_->setColouring(display.scale, cmin, cmax);
         histogram_->setMarkedRange(range_->low(), range_->high());
     } else {
+        // Nothing of the previous entity's field stays on show.
+        for (RangeEditor* editor : {range_, colours_}) {
+            editor->setBounds(0.0, 1.0);
+            editor->setRange(0.0, 1.0);
+        }
+        symmetric_->setChecked(false);
         histogram_->setHistogram({});
+        histogram_->setMarkedRange(-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
     }
     updating_ = false;
     updateInsideCount();

@@ -382,7 +382,7 @@ void CloudView::zoomToEntity(EntityId id)
 void CloudView::setStandardView(StandardView view)
 {
     // Direction from the focal point to the camera, and the up vector.
-    Eigen::Vector3d eye, up(0, 0, 1);
+    Eigen::Vector3d eye(0, 0, 1), up(0, 0, 1);
     switch (view) {
     case StandardView::Top: eye = {0, 0, 1}; up = {0, 1, 0}; break;
     case StandardView::Bottom: eye = {0, 0, -1}; up = {0, 1, 0}; break;

@@ -130,7 +130,7 @@ ColourLegend colourEntity(const PointCloud& points, const DisplayState& display,
         how.visibleMax = fieldDisplay.high;
         how.outside = display.outside;
         colourise(field->values().data(), n, field->offset(), fieldDisplay.scale, how, rgba);
-        legend = {true, field->name(), fieldDisplay.scale, how.colourMin, how.colourMax};
+        legend = {true, field->name(), fieldDisplay.scale, how.colourMin, how.colourMax, {}};
         return legend;
     }
     if (display.neutral) {
@@ -167,7 +167,7 @@ ColourLegend colourEntity(const PointCloud& points, const DisplayState& display,
     how.colourMax = zmin < zmax ? zmax : how.colourMin + 1.0;
     const ColourScale scale = *ColourScale::preset("Blue-Green-Yellow-Red");
     colourise(heights.data(), n, 0.0, scale, how, rgba);
-    legend = {true, "height", scale, how.colourMin + points.origin().z(), how.colourMax + points.origin().z()};
+    legend = {true, "height", scale, how.colourMin + points.origin().z(), how.colourMax + points.origin().z(), {}};
     return legend;
 }
 
