@@ -11,6 +11,7 @@
 #include "panels/EntityTree.h"
 #include "panels/PropertiesPanel.h"
 #include "panels/ScalarFieldPanel.h"
+#include "tools/MeasurePanel.h"
 #include "tools/TableDialog.h"
 #include "view/CloudView.h"
 #include "view/EntityColouring.h"
@@ -88,6 +89,12 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
     connect(scalarPanel_, &ScalarFieldPanel::splitRequested, splits_, &SplitController::split);
     connect(distances_, &DistanceController::resultReady, tree_, &EntityTree::selectEntity);
     connect(splits_, &SplitController::resultReady, tree_, &EntityTree::selectEntity);
+    connect(view_, &CloudView::pointPicked, measure_, &MeasurePanel::addPick);
+    connect(view_, &CloudView::pickModeChanged, this, [this](bool on) {
+        if (!on) // picking turned off (P, Escape...): measuring ends with it
+            measure_->setMeasuring(false);
+    });
+    connect(measure_, &MeasurePanel::annotationsChanged, view_, &CloudView::setAnnotations);
     connect(view_, &CloudView::pointPicked, this, [this](EntityId id, std::size_t index) {
         properties_->showPickedPoint(id, index);
         const QString text = describePoint(document_.item(id), index);
@@ -132,6 +139,9 @@ void MainWindow::buildDocks()
     dock(tr("Properties"), properties_, Qt::LeftDockWidgetArea);
     QDockWidget* scalarDock = dock(tr("Scalar field"), scalarPanel_, Qt::RightDockWidgetArea);
     QDockWidget* consoleDock = dock(tr("Console"), console_, Qt::BottomDockWidgetArea);
+    measure_ = new MeasurePanel(document_, this);
+    QDockWidget* measureDock = dock(tr("Measure"), measure_, Qt::RightDockWidgetArea);
+    measureDock->hide(); // until View > Measure
     // Wide enough for names, UTM coordinates and field ranges at 1680 px.
     resizeDocks({entitiesDock, scalarDock}, {340, 360}, Qt::Horizontal);
     resizeDocks({consoleDock}, {140}, Qt::Vertical);
@@ -208,6 +218,21 @@ void MainWindow::buildMenus()
     connect(pick, &QAction::toggled, view_, &CloudView::setPickMode);
     connect(view_, &CloudView::pickModeChanged, pick, &QAction::setChecked);
     viewBar->addAction(pick);
+    QAction* measure = viewMenu->addAction(tr("&Measure"));
+    measure->setObjectName("measureAction");
+    measure->setCheckable(true);
+    measure->setShortcut(QKeySequence(tr("M")));
+    measure->setToolTip(tr("Click points: a distance (with dX, dY, dZ), an angle, a polygon's area"));
+    connect(measure, &QAction::toggled, this, [this](bool on) {
+        if (on)
+            findChild<QDockWidget*>("Measure")->show();
+        measure_->setMeasuring(on);
+    });
+    connect(measure_, &MeasurePanel::measuringChanged, this, [this, measure](bool on) {
+        measure->setChecked(on);
+        view_->setPickMode(on);
+    });
+    viewBar->addAction(measure);
     QMenu* sizes = viewMenu->addMenu(tr("Point si&ze"));
     auto* sizeGroup = new QActionGroup(this);
     for (int size : {1, 2, 3, 4, 6, 8}) {

@@ -21,6 +21,7 @@ class ConsolePanel;
 class DistanceController;
 class EntityTree;
 class FileController;
+class MeasurePanel;
 class PropertiesPanel;
 class ScalarFieldPanel;
 class SegmentationController;
@@ -47,6 +48,7 @@ public:
     PropertiesPanel* properties() const { return properties_; }
     ScalarFieldPanel* scalarPanel() const { return scalarPanel_; }
     ConsolePanel* console() const { return console_; }
+    MeasurePanel* measure() const { return measure_; }
     FileController* files() const { return files_; }
     DistanceController* distances() const { return distances_; }
     SplitController* splits() const { return splits_; }
@@ -88,6 +90,7 @@ private:
     PropertiesPanel* properties_ = nullptr;
     ScalarFieldPanel* scalarPanel_ = nullptr;
     ConsolePanel* console_ = nullptr;
+    MeasurePanel* measure_ = nullptr;
     FileController* files_ = nullptr;
     DistanceController* distances_ = nullptr;
     SplitController* splits_ = nullptr;

@@ -5,6 +5,7 @@
 // and restore the session. Answers are checked against core called directly
 // and against brute-force counts.
 #include "MainWindow.h"
+#include "tools/MeasurePanel.h"
 #include "controllers/DistanceController.h"
 #include "controllers/FileController.h"
 #include "controllers/SegmentationController.h"
@@ -442,6 +443,50 @@ private slots:
         answerWith(QMessageBox::Discard);
         QVERIFY(window.close());
         QVERIFY(asked.contains(window.document().item(reference).name));
+    }
+
+    void measuringDistancesAnglesAndAreas()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::MainWindow window(registry);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        QCOMPARE(window.openFiles({kReference}, true), 1);
+        const EntityId id = window.document().ids().front();
+        const PointCloud& cloud = window.document().item(id).points();
+        window.view()->setStandardView(gui::StandardView::Top);
+        // View > Measure (M): the panel shows and clicks in the view add points.
+        auto* action = window.findChild<QAction*>("measureAction");
+        QVERIFY(action);
+        action->setChecked(true);
+        QVERIFY(window.measure()->measuring() && window.view()->pickMode());
+        QVERIFY(window.findChild<QDockWidget*>("Measure")->isVisible());
+        QVERIFY(window.view()->pickAt(window.view()->width() / 2, window.view()->height() / 2));
+        QCOMPARE(window.measure()->measurements().back().size(), std::size_t(1));
+        window.measure()->undoLastPoint();
+        // Two known points: their distance and components, as core computes them.
+        window.measure()->addPick(id, 0);
+        window.measure()->addPick(id, 100);
+        const Eigen::Vector3d a = cloud.globalPosition(0), b = cloud.globalPosition(100);
+        QVERIFY(window.measure()->resultText().contains(QString("Distance: %1 m").arg((b - a).norm(), 0, 'f', 3)));
+        QVERIFY(window.measure()->resultText().contains(QString::number(b.z() - a.z(), 'f', 3)));
+        QCOMPARE(window.view()->annotationCount(), std::size_t(1)); // drawn with its label
+        // A third point: the angle; "New" keeps the measurement and starts another.
+        window.measure()->addPick(id, 200);
+        QVERIFY(window.measure()->resultText().contains("Angle at point 2"));
+        window.measure()->startNew();
+        window.measure()->addPoint({0, 0, 0});
+        window.measure()->addPoint({4, 0, 0});
+        window.measure()->addPoint({4, 3, 0});
+        window.measure()->addPoint({0, 3, 0});
+        QVERIFY(window.measure()->resultText().contains(QString::fromUtf8("area 12.000 m²")));
+        QCOMPARE(window.view()->annotationCount(), std::size_t(2));
+        QCOMPARE(window.measure()->measurements().size(), std::size_t(2));
+        // Turning picking off ends measuring.
+        window.view()->setPickMode(false);
+        QVERIFY(!window.measure()->measuring() && !action->isChecked());
+        window.measure()->deleteAll();
+        QCOMPARE(window.view()->annotationCount(), std::size_t(0));
     }
 
     void thePanelLayoutIsRemembered()

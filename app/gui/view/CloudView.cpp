@@ -9,6 +9,7 @@
 #include <QVTKOpenGLNativeWidget.h>
 
 #include <vtkActor.h>
+#include <vtkBillboardTextActor3D.h>
 #include <vtkBoundingBox.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
@@ -120,6 +121,10 @@ struct CloudView::Scene
     bool settling = false; //!< decimated after a colour change, until the settle timer fires
     bool renderPending = false;
     bool pickMode = false;
+    // Measurements: one polydata of paths and marks, and a label per measurement.
+    vtkNew<vtkPolyData> annotations;
+    vtkNew<vtkActor> annotationActor;
+    std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels;
 };
 
 
@@ -356,6 +361,7 @@ void CloudView::clear()
     scene_->sceneOrigin.reset();
     scene_->scalarBar->VisibilityOff();
     legend_ = {};
+    setAnnotations({});
     render();
 }
 
@@ -425,6 +431,62 @@ void CloudView::setParallelProjection(bool parallel)
 }
 
 bool CloudView::parallelProjection() const { return scene_->renderer->GetActiveCamera()->GetParallelProjection() != 0; }
+
+void CloudView::setAnnotations(const std::vector<Annotation>& annotations)
+{
+    for (auto& label : scene_->labels)
+        scene_->renderer->RemoveActor(label);
+    scene_->labels.clear();
+    annotationCount_ = annotations.size();
+    const Eigen::Vector3d origin = scene_->sceneOrigin.value_or(Eigen::Vector3d::Zero());
+    vtkNew<vtkPoints> points;
+    vtkNew<vtkCellArray> lines, marks;
+    for (const Annotation& a : annotations) {
+        if (a.points.empty())
+            continue;
+        std::vector<vtkIdType> ids;
+        for (const Eigen::Vector3d& p : a.points) {
+            const Eigen::Vector3d local = p - origin; // in double, then small
+            ids.push_back(points->InsertNextPoint(local.x(), local.y(), local.z()));
+            marks->InsertNextCell(1, &ids.back());
+        }
+        if (a.closed && ids.size() > 2)
+            ids.push_back(ids.front());
+        if (ids.size() > 1)
+            lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+        if (!a.label.empty()) {
+            auto label = vtkSmartPointer<vtkBillboardTextActor3D>::New();
+            label->SetInput(a.label.c_str());
+            const Eigen::Vector3d at = a.points.back() - origin;
+            label->SetPosition(at.x(), at.y(), at.z());
+            label->SetDisplayOffset(10, 10);
+            label->GetTextProperty()->SetFontSize(14);
+            label->GetTextProperty()->SetColor(1.0, 1.0, 0.6);
+            label->GetTextProperty()->SetBackgroundColor(0.1, 0.1, 0.1);
+            label->GetTextProperty()->SetBackgroundOpacity(0.7);
+            scene_->renderer->AddActor(label);
+            scene_->labels.push_back(label);
+        }
+    }
+    scene_->annotations->SetPoints(points);
+    scene_->annotations->SetLines(lines);
+    scene_->annotations->SetVerts(marks);
+    if (!scene_->annotationActor->GetMapper()) {
+        vtkNew<vtkPolyDataMapper> mapper;
+        mapper->SetInputData(scene_->annotations);
+        // Drawn over the points they measure, not hidden among them.
+        mapper->SetRelativeCoincidentTopologyLineOffsetParameters(0, -66000);
+        mapper->SetRelativeCoincidentTopologyPointOffsetParameter(-66000);
+        scene_->annotationActor->SetMapper(mapper);
+        scene_->annotationActor->GetProperty()->SetColor(1.0, 0.2, 0.8);
+        scene_->annotationActor->GetProperty()->SetLineWidth(2.5f);
+        scene_->annotationActor->GetProperty()->SetPointSize(9.0f);
+        scene_->annotationActor->GetProperty()->RenderPointsAsSpheresOn();
+        scene_->renderer->AddActor(scene_->annotationActor);
+    }
+    scene_->annotations->Modified();
+    renderSoon();
+}
 
 bool CloudView::shownFrame(EntityId id, Eigen::Vector3d& offset, Eigen::Vector3f& firstPosition) const
 {

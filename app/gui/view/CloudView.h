@@ -48,6 +48,17 @@ public:
     void removeEntity(EntityId id);
     //! Re-reads visibility and colours of an entity from its display state.
     void refreshEntity(const Document::Item& item);
+    //! Marks drawn over the clouds (measurements): each a path through its
+    //! points (global coordinates), closed when asked, its points marked, and
+    //! its label written beside its last point, facing the camera.
+    struct Annotation
+    {
+        std::vector<Eigen::Vector3d> points;
+        bool closed = false;
+        std::string label;
+    };
+    void setAnnotations(const std::vector<Annotation>& annotations);
+    std::size_t annotationCount() const { return annotationCount_; }
     //! The colour-scale bar (hidden when `legend.shown` is false).
     void setLegend(const ColourLegend& legend);
     const ColourLegend& legend() const { return legend_; }
@@ -112,6 +123,7 @@ private:
     QVTKOpenGLNativeWidget* widget_;
     std::unique_ptr<Scene> scene_;
     ColourLegend legend_;
+    std::size_t annotationCount_ = 0;
 };
 
 } // namespace scandiff::gui
