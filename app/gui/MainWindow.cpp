@@ -56,6 +56,7 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
     splits_ = new SplitController(document_, this);
     sessions_ = new SessionController(registry_, document_, *view_, *scalarPanel_, this);
     sessions_->setDiscardCheck([this] { return mayDiscardUnsavedWork(); });
+    sessions_->setMeasurePanel(measure_);
     report(files_);
     report(distances_);
     report(splits_);

@@ -482,6 +482,14 @@ private slots:
         QVERIFY(window.measure()->resultText().contains(QString::fromUtf8("area 12.000 m²")));
         QCOMPARE(window.view()->annotationCount(), std::size_t(2));
         QCOMPARE(window.measure()->measurements().size(), std::size_t(2));
+        // Kept in the session.
+        QTemporaryDir dir;
+        QVERIFY(window.sessions()->save(dir.filePath("m.scandiff")));
+        window.measure()->deleteAll();
+        QVERIFY(window.sessions()->restore(dir.filePath("m.scandiff")));
+        QCOMPARE(window.measure()->measurements().size(), std::size_t(3)); // two kept, a new one begun
+        QCOMPARE(window.measure()->measurements()[0][1], b);
+        QCOMPARE(window.view()->annotationCount(), std::size_t(2));
         // Turning picking off ends measuring.
         window.view()->setPickMode(false);
         QVERIFY(!window.measure()->measuring() && !action->isChecked());

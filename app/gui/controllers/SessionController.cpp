@@ -2,6 +2,7 @@
 #include "controllers/SessionController.h"
 
 #include "TaskRunner.h"
+#include "tools/MeasurePanel.h"
 #include "panels/ScalarFieldPanel.h"
 #include "view/CloudView.h"
 
@@ -147,11 +148,21 @@ bool SessionController::save(const QString& qpath)
     json scales = json::array();
     for (const ColourScale& s : scalarPanel_.customScales())
         scales.push_back(s.toText());
+    json measurements = json::array();
+    if (measure_)
+        for (const auto& points : measure_->measurements())
+            if (!points.empty()) {
+                json list = json::array();
+                for (const Eigen::Vector3d& p : points)
+                    list.push_back({p.x(), p.y(), p.z()});
+                measurements.push_back(list);
+            }
     const json session = {{"scandiffSession", kSessionVersion},
                           {"entities", entities},
                           {"customScales", scales},
                           {"camera", cameraJson(view_.camera())},
-                          {"pointSize", view_.pointSize()}};
+                          {"pointSize", view_.pointSize()},
+                          {"measurements", measurements}};
 
     const TaskResult result = runTask(parentWindow_, tr("Saving session"), [&](ProgressObserver& progress) {
         // A previous save stays whole until the new one is: its data folder is
@@ -204,6 +215,7 @@ bool SessionController::restore(const QString& qpath)
     std::vector<ColourScale> scales;
     std::optional<CameraState> camera;
     float pointSize = 2.0f;
+    std::vector<std::vector<Eigen::Vector3d>> measurements;
     const TaskResult result = runTask(parentWindow_, tr("Opening session"), [&](ProgressObserver& progress) {
         std::ifstream in(path);
         if (!in)
@@ -253,6 +265,12 @@ bool SessionController::restore(const QString& qpath)
             if (session.contains("camera"))
                 camera = cameraFrom(session.at("camera"));
             pointSize = session.value("pointSize", 2.0f);
+            for (const json& list : session.value("measurements", json::array())) {
+                std::vector<Eigen::Vector3d> points;
+                for (const json& p : list)
+                    points.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
+                measurements.push_back(std::move(points));
+            }
         } catch (const json::exception& e) {
             throw Error(ErrorCode::InvalidData, path.string() + " is not a valid scandiff session: " + e.what());
         }
@@ -280,6 +298,8 @@ bool SessionController::restore(const QString& qpath)
     view_.setPointSize(pointSize);
     if (camera)
         view_.setCamera(*camera);
+    if (measure_)
+        measure_->setMeasurements(std::move(measurements));
     document_.markAllSaved(); // derived entities are in the session's data folder
     emit finished(tr("opened session %1 (%2 entities)").arg(qpath).arg(document_.size()));
     return true;

@@ -18,6 +18,8 @@ class QWidget;
 
 namespace scandiff::gui {
 
+class MeasurePanel;
+
 class CloudView;
 class ScalarFieldPanel;
 
@@ -35,6 +37,8 @@ public:
     bool saveWithDialog();
     //! Asks `mayDiscard` first (when set): opening a session replaces the document.
     void restoreWithDialog();
+    //! The measurements saved and restored with the session (none when unset).
+    void setMeasurePanel(MeasurePanel* panel) { measure_ = panel; }
     //! Asked before the document is replaced; false keeps it.
     void setDiscardCheck(std::function<bool()> mayDiscard) { mayDiscard_ = std::move(mayDiscard); }
 
@@ -49,6 +53,7 @@ private:
     ScalarFieldPanel& scalarPanel_;
     QWidget* parentWindow_;
     std::function<bool()> mayDiscard_;
+    MeasurePanel* measure_ = nullptr;
 };
 
 } // namespace scandiff::gui
