@@ -219,6 +219,17 @@ void MainWindow::buildMenus()
     connect(pick, &QAction::toggled, view_, &CloudView::setPickMode);
     connect(view_, &CloudView::pickModeChanged, pick, &QAction::setChecked);
     viewBar->addAction(pick);
+    QAction* scissors = viewMenu->addAction(tr("Segment by polygon (scissors)"));
+    scissors->setObjectName("scissorsAction");
+    scissors->setCheckable(true);
+    scissors->setShortcut(QKeySequence(tr("T")));
+    scissors->setToolTip(tr("Left clicks draw a polygon, a right click closes it: what is shown inside becomes a cloud of its own"));
+    connect(scissors, &QAction::toggled, view_, &CloudView::setScissorsMode);
+    connect(view_, &CloudView::scissorsModeChanged, scissors, &QAction::setChecked);
+    connect(view_, &CloudView::polygonDrawn, this, [this](const std::vector<Eigen::Vector2d>& polygon, const Eigen::Matrix4d& projection) {
+        splits_->cutWithPolygon(polygon, projection, [this](EntityId id, std::size_t i) { return view_->isPointShown(id, i); });
+    });
+    viewBar->addAction(scissors);
     QAction* measure = viewMenu->addAction(tr("&Measure"));
     measure->setObjectName("measureAction");
     measure->setCheckable(true);

@@ -497,6 +497,66 @@ private slots:
         QCOMPARE(window.view()->annotationCount(), std::size_t(0));
     }
 
+    void scissorsCutWhatIsShownInsideThePolygon()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::MainWindow window(registry);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        QCOMPARE(window.openFiles({kCompared}, true), 1);
+        const EntityId id = window.document().ids().front();
+        window.view()->setStandardView(gui::StandardView::Iso);
+        // Hide the highest points by a threshold on a field: they must not be cut.
+        ScalarField height("height", window.document().item(id).points().size());
+        const PointCloud& cloud = window.document().item(id).points();
+        for (std::size_t i = 0; i < cloud.size(); ++i)
+            height.values()[i] = static_cast<float>(cloud.globalPosition(i).z());
+        window.document().addField(id, std::move(height));
+        gui::FieldDisplay display = window.document().fieldDisplay(id, "height");
+        display.high = 360.0;
+        window.document().setFieldDisplay(id, "height", display);
+        // A triangle drawn in the middle of the view.
+        auto* action = window.findChild<QAction*>("scissorsAction");
+        QVERIFY(action);
+        action->setChecked(true);
+        QVERIFY(window.view()->scissorsMode());
+        const double w = window.view()->width(), h = window.view()->height();
+        const std::vector<Eigen::Vector2d> triangle{{0.3 * w, 0.3 * h}, {0.8 * w, 0.4 * h}, {0.4 * w, 0.8 * h}};
+        for (const Eigen::Vector2d& v : triangle)
+            window.view()->addScissorsVertex(v.x(), v.y());
+        const Eigen::Matrix4d projection = window.view()->globalToWidgetPixels();
+        window.view()->finishScissors();
+        QVERIFY(!window.view()->scissorsMode() && !action->isChecked());
+        // Brute force: project each point, keep those shown and inside the triangle.
+        auto insideTriangle = [&](const Eigen::Vector2d& p) {
+            int sign = 0;
+            for (int k = 0; k < 3; ++k) {
+                const Eigen::Vector2d a = triangle[k], b = triangle[(k + 1) % 3];
+                const double cross = (b - a).x() * (p - a).y() - (b - a).y() * (p - a).x();
+                const int s = cross > 0 ? 1 : -1;
+                if (sign == 0)
+                    sign = s;
+                else if (s != sign)
+                    return false;
+            }
+            return true;
+        };
+        std::size_t expected = 0;
+        for (std::size_t i = 0; i < cloud.size(); ++i) {
+            const Eigen::Vector4d q = projection * cloud.globalPosition(i).homogeneous();
+            if (q.w() > 0 && cloud.globalPosition(i).z() <= 360.0 && insideTriangle(q.head<2>() / q.w()))
+                ++expected;
+        }
+        QVERIFY(expected > 0);
+        const std::vector<EntityId> ids = window.document().ids();
+        QCOMPARE(ids.size(), std::size_t(3));
+        QCOMPARE(window.document().item(ids[1]).points().size(), expected);
+        QCOMPARE(window.document().item(ids[1]).points().size() + window.document().item(ids[2]).points().size(), cloud.size());
+        QVERIFY(!window.document().item(id).display.visible);
+        QVERIFY(window.document().item(ids[1]).display.visible && !window.document().item(ids[2]).display.visible);
+        QCOMPARE(window.document().item(ids[1]).display.activeField, std::string("height"));
+    }
+
     void thePanelLayoutIsRemembered()
     {
         const PluginRegistry registry = makePluginRegistry();

@@ -109,6 +109,50 @@ TEST(Merge, CloudsWithDifferentShiftsKeepTheirMillimetres)
     EXPECT_EQ(test::errorCodeOf([&] { mergeClouds({}); }), ErrorCode::InvalidArgument);
 }
 
+TEST(Crop, ScreenPolygonsEqualBruteForceInTopAndPerspectiveViews)
+{
+    PointCloud cloud = test::randomPlaneCloud(3000, 10.0, 9);
+    cloud.setOrigin(Eigen::Vector3d(600000, 4000000, 10));
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        cloud.positions()[i].z() = static_cast<float>(i % 7);
+    // A top view, 50 pixels per metre, screen y downwards, the scan's corner at pixel (100, 600).
+    Eigen::Matrix4d top = Eigen::Matrix4d::Identity();
+    top(0, 0) = 50, top(0, 3) = 100 - 50 * 600000.0;
+    top(1, 1) = -50, top(1, 3) = 600 + 50 * 4000000.0;
+    const std::vector<Eigen::Vector2d> lShape{{100, 600}, {400, 600}, {400, 500}, {200, 500}, {200, 300}, {100, 300}};
+    const std::vector<std::size_t> inside = pointsInScreenPolygon(cloud, top, lShape);
+    std::vector<std::size_t> expected;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const double x = cloud.globalPosition(i).x() - 600000, y = cloud.globalPosition(i).y() - 4000000;
+        if ((x > 0 && x < 6 && y > 0 && y < 2) || (x > 0 && x < 2 && y > 0 && y < 6))
+            expected.push_back(i);
+    }
+    EXPECT_EQ(inside, expected); // the same L as the crop's, drawn on the screen
+    EXPECT_FALSE(inside.empty());
+
+    // A perspective view looking down from 20 m above the scan's middle:
+    // (x, y, z) -> (f x / d, f y / d) with d = 30 - z the depth; points behind it are out.
+    Eigen::Matrix4d perspective = Eigen::Matrix4d::Zero();
+    const double f = 500;
+    perspective(0, 0) = f, perspective(0, 3) = -f * 600005.0;
+    perspective(1, 1) = f, perspective(1, 3) = -f * 4000005.0;
+    perspective(3, 2) = -1, perspective(3, 3) = 30 + 10; // w = 30 - (z - 10): the eye at global z 40
+    const std::vector<Eigen::Vector2d> square{{-100, -100}, {100, -100}, {100, 100}, {-100, 100}};
+    const std::vector<std::size_t> seen = pointsInScreenPolygon(cloud, perspective, square);
+    expected.clear();
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Eigen::Vector3d g = cloud.globalPosition(i);
+        const double depth = 40 - g.z();
+        const double u = f * (g.x() - 600005) / depth, v = f * (g.y() - 4000005) / depth;
+        if (u > -100 && u < 100 && v > -100 && v < 100)
+            expected.push_back(i);
+    }
+    EXPECT_EQ(seen, expected);
+    perspective(3, 3) = 10 - 100; // the eye below everything, looking the other way: nothing is in front
+    EXPECT_TRUE(pointsInScreenPolygon(cloud, perspective, square).empty());
+    EXPECT_EQ(test::errorCodeOf([&] { pointsInScreenPolygon(cloud, top, {{0, 0}, {1, 1}}); }), ErrorCode::InvalidArgument);
+}
+
 TEST(Crop, BoxesAndPolygonsEqualBruteForce)
 {
     PointCloud cloud = test::randomPlaneCloud(3000, 10.0, 9);

@@ -3,6 +3,9 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/FieldRange.h>
+#include <scandiff/core/processing/CloudEditing.h>
+
+#include <algorithm>
 
 namespace scandiff::gui {
 
@@ -59,6 +62,55 @@ std::pair<EntityId, EntityId> SplitController::split(EntityId id, const std::str
         emit failed(QString::fromStdString(e.what()));
         return {kNoEntity, kNoEntity};
     }
+}
+
+int SplitController::cutWithPolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Matrix4d& globalToPixels,
+                                    const std::function<bool(EntityId, std::size_t)>& shown)
+{
+    int cut = 0;
+    EntityId lastInside = kNoEntity;
+    for (EntityId id : document_.ids()) {
+        const Document::Item* item = document_.find(id);
+        if (!item || !item->cloud() || !item->display.visible)
+            continue;
+        std::vector<std::size_t> inside;
+        try {
+            inside = pointsInScreenPolygon(*item->cloud(), globalToPixels, polygon);
+        } catch (const Error& e) {
+            emit failed(QString::fromStdString(e.what()));
+            return cut;
+        }
+        inside.erase(std::remove_if(inside.begin(), inside.end(), [&](std::size_t i) { return !shown(id, i); }), inside.end());
+        if (inside.empty())
+            continue;
+        const std::vector<std::size_t> outside = complementOf(inside, item->cloud()->size());
+        const QString name = item->name;
+        const DisplayState display = item->display;
+        PointCloud insidePart = item->cloud()->subset(inside), outsidePart = item->cloud()->subset(outside);
+        // The parts look as their cloud did: active field, scales, thresholds.
+        auto dress = [this, &display](EntityId part) {
+            for (const auto& [field, fieldDisplay] : display.fields)
+                document_.setFieldDisplay(part, field, fieldDisplay);
+            document_.setActiveField(part, display.activeField);
+            document_.setOutsideMode(part, display.outside);
+            document_.setNeutral(part, display.neutral);
+        };
+        lastInside = document_.add(name + tr(" (inside polygon)"), std::move(insidePart), id);
+        dress(lastInside);
+        if (!outside.empty()) {
+            const EntityId rest = document_.add(name + tr(" (outside polygon)"), std::move(outsidePart), id);
+            dress(rest);
+            document_.setVisible(rest, false);
+        }
+        document_.setVisible(id, false);
+        emit finished(tr("segment by polygon %1: %2 points inside, %3 outside").arg(name).arg(inside.size()).arg(outside.size()));
+        ++cut;
+    }
+    if (cut == 0)
+        emit failed(tr("segment by polygon: no shown point lies inside the polygon"));
+    else
+        emit resultReady(lastInside);
+    return cut;
 }
 
 } // namespace scandiff::gui

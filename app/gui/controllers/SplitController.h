@@ -5,6 +5,11 @@
 
 #include "document/Document.h"
 
+#include <Eigen/Core>
+
+#include <functional>
+#include <vector>
+
 #include <QObject>
 
 namespace scandiff::gui {
@@ -19,6 +24,15 @@ public:
     //! not added); returns their ids (kNoEntity for a part not added). With no
     //! point inside, nothing changes and failed() explains why.
     std::pair<EntityId, EntityId> split(EntityId id, const std::string& field, double low, double high);
+
+    //! The scissors: every visible cloud's points shown inside `polygon` (screen
+    //! pixels; `globalToPixels` the projection it was drawn with, see core's
+    //! pointsInScreenPolygon) become a cloud under it, the rest another,
+    //! unticked; the cloud itself is hidden. Points hidden by thresholds are
+    //! not inside (they stay in the rest: nothing is lost). Returns how many
+    //! clouds were cut.
+    int cutWithPolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Matrix4d& globalToPixels,
+                       const std::function<bool(EntityId, std::size_t)>& shown);
 
 signals:
     void finished(const QString& summary);

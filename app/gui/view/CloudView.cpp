@@ -9,6 +9,7 @@
 #include <QVTKOpenGLNativeWidget.h>
 
 #include <vtkActor.h>
+#include <vtkActor2D.h>
 #include <vtkBillboardTextActor3D.h>
 #include <vtkBoundingBox.h>
 #include <vtkCallbackCommand.h>
@@ -19,6 +20,7 @@
 #include <vtkTypeInt32Array.h>
 #include <vtkInteractorStyleTrackballCamera.h>
 #include <vtkLookupTable.h>
+#include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkPointData.h>
@@ -26,7 +28,9 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
+#include <vtkPolyDataMapper2D.h>
 #include <vtkProperty.h>
+#include <vtkProperty2D.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
@@ -125,6 +129,11 @@ struct CloudView::Scene
     vtkNew<vtkPolyData> annotations;
     vtkNew<vtkActor> annotationActor;
     std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels;
+    // Scissors: the polygon being drawn, in widget pixels, and its outline on screen.
+    bool scissorsMode = false;
+    std::vector<Eigen::Vector2d> scissors;
+    vtkNew<vtkPolyData> scissorsOutline;
+    vtkNew<vtkActor2D> scissorsActor;
 };
 
 
@@ -133,11 +142,24 @@ class CloudView::PickCommand : public vtkCommand
 {
 public:
     static PickCommand* New() { return new PickCommand; }
-    void Execute(vtkObject* caller, unsigned long, void*) override
+    void Execute(vtkObject* caller, unsigned long event, void*) override
     {
-        if (!view || !view->scene_->pickMode)
+        if (!view)
             return;
         const int* pos = static_cast<vtkRenderWindowInteractor*>(caller)->GetEventPosition();
+        if (view->scene_->scissorsMode) {
+            // Device pixels from the bottom-left to widget pixels from the top-left.
+            const double ratio = view->widget_->devicePixelRatioF();
+            const int height = view->scene_->window->GetSize()[1];
+            if (event == vtkCommand::LeftButtonPressEvent)
+                view->addScissorsVertex(pos[0] / ratio, (height - 1 - pos[1]) / ratio);
+            else
+                view->finishScissors();
+            AbortFlagOn();
+            return;
+        }
+        if (!view->scene_->pickMode || event != vtkCommand::LeftButtonPressEvent)
+            return;
         view->pickAtDevicePixel(pos[0], pos[1]);
         AbortFlagOn();
     }
@@ -198,6 +220,13 @@ CloudView::CloudView(QWidget* parent) : QWidget(parent), scene_(std::make_unique
     vtkNew<PickCommand> onClick;
     onClick->view = this;
     interactor->AddObserver(vtkCommand::LeftButtonPressEvent, onClick, 10.0f);
+    interactor->AddObserver(vtkCommand::RightButtonPressEvent, onClick, 10.0f);
+    vtkNew<vtkPolyDataMapper2D> scissorsMapper;
+    scissorsMapper->SetInputData(scene_->scissorsOutline);
+    scene_->scissorsActor->SetMapper(scissorsMapper);
+    scene_->scissorsActor->GetProperty()->SetColor(1.0, 0.9, 0.2);
+    scene_->scissorsActor->GetProperty()->SetLineWidth(2.0f);
+    scene_->renderer->AddActor2D(scene_->scissorsActor);
 }
 
 CloudView::~CloudView() = default;
@@ -589,6 +618,81 @@ void CloudView::setDecimated(Shown& s, bool moving)
         }
         c.actor->SetMapper(decimate ? c.decimatedMapper.Get() : c.fullMapper.Get());
     }
+}
+
+void CloudView::setScissorsMode(bool on)
+{
+    if (scene_->scissorsMode == on)
+        return;
+    scene_->scissorsMode = on;
+    scene_->scissors.clear();
+    addScissorsVertex(std::numeric_limits<double>::quiet_NaN(), 0); // redraws the (empty) outline
+    if (on)
+        setPickMode(false);
+    widget_->setCursor(on ? Qt::CrossCursor : Qt::ArrowCursor);
+    emit scissorsModeChanged(on);
+}
+
+bool CloudView::scissorsMode() const { return scene_->scissorsMode; }
+
+void CloudView::addScissorsVertex(double x, double y)
+{
+    if (std::isfinite(x))
+        scene_->scissors.emplace_back(x, y);
+    // The outline in VTK's display pixels (device pixels from the bottom-left),
+    // closed back to the first vertex so the user sees what will be cut.
+    const double ratio = widget_->devicePixelRatioF();
+    const int height = scene_->window->GetSize()[1];
+    vtkNew<vtkPoints> points;
+    vtkNew<vtkCellArray> lines;
+    std::vector<vtkIdType> ids;
+    for (const Eigen::Vector2d& v : scene_->scissors)
+        ids.push_back(points->InsertNextPoint(v.x() * ratio, height - 1 - v.y() * ratio, 0));
+    if (ids.size() > 2)
+        ids.push_back(ids.front());
+    if (ids.size() > 1)
+        lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+    scene_->scissorsOutline->SetPoints(points);
+    scene_->scissorsOutline->SetLines(lines);
+    scene_->scissorsOutline->Modified();
+    renderSoon();
+}
+
+void CloudView::finishScissors()
+{
+    if (!scene_->scissorsMode)
+        return;
+    const std::vector<Eigen::Vector2d> polygon = scene_->scissors;
+    setScissorsMode(false);
+    if (polygon.size() >= 3)
+        emit polygonDrawn(polygon, globalToWidgetPixels());
+}
+
+Eigen::Matrix4d CloudView::globalToWidgetPixels() const
+{
+    vtkCamera* camera = scene_->renderer->GetActiveCamera();
+    const double width = std::max(1, widget_->width()), height = std::max(1, widget_->height());
+    vtkMatrix4x4* clip = camera->GetCompositeProjectionTransformMatrix(width / height, -1, 1);
+    Eigen::Matrix4d sceneToClip;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+            sceneToClip(r, c) = clip->GetElement(r, c);
+    // Clip coordinates to pixels, still homogeneous: x from -1..1 to 0..width,
+    // y from 1..-1 (up) to 0..height (down).
+    Eigen::Matrix4d toPixels = Eigen::Matrix4d::Identity();
+    toPixels(0, 0) = width / 2, toPixels(0, 3) = width / 2;
+    toPixels(1, 1) = -height / 2, toPixels(1, 3) = height / 2;
+    Eigen::Matrix4d fromGlobal = Eigen::Matrix4d::Identity();
+    fromGlobal.block<3, 1>(0, 3) = -scene_->sceneOrigin.value_or(Eigen::Vector3d::Zero());
+    return toPixels * sceneToClip * fromGlobal;
+}
+
+bool CloudView::isPointShown(EntityId id, std::size_t index) const
+{
+    const auto it = scene_->shown.find(id);
+    if (it == scene_->shown.end() || !it->second.isCloud || index >= it->second.pointCount)
+        return false;
+    return it->second.rgba[4 * index + 3] != 0;
 }
 
 void CloudView::setPickMode(bool on)

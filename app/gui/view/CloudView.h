@@ -89,6 +89,20 @@ public:
     //! Switches the decimated drawing on or off as a camera move would.
     void setMoving(bool moving);
 
+    //! Scissors: left clicks draw a polygon on the screen, a right click (or
+    //! finishScissors) closes it and emits polygonDrawn; turning the mode off
+    //! drops an unfinished polygon.
+    void setScissorsMode(bool on);
+    bool scissorsMode() const;
+    //! A vertex at widget pixel (x, y from the top-left), as a click in scissors mode adds.
+    void addScissorsVertex(double x, double y);
+    void finishScissors();
+    //! Global coordinates (homogeneous) to widget pixels (x right, y down),
+    //! before the division by w: what the camera shows where.
+    Eigen::Matrix4d globalToWidgetPixels() const;
+    //! Whether a point of a shown cloud is drawn (not hidden by its thresholds).
+    bool isPointShown(EntityId id, std::size_t index) const;
+
     //! In pick mode a left click picks the nearest point instead of rotating.
     void setPickMode(bool on);
     bool pickMode() const;
@@ -107,6 +121,9 @@ public:
 signals:
     void pointPicked(EntityId id, std::size_t index);
     void pickModeChanged(bool on);
+    void scissorsModeChanged(bool on);
+    //! A closed polygon in widget pixels and the projection it was drawn with.
+    void polygonDrawn(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Matrix4d& globalToPixels);
     //! The view changed these itself (a session restored them): menus follow.
     void pointSizeChanged(float size);
     void projectionChanged(bool parallel);

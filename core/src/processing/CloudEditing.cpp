@@ -263,6 +263,50 @@ std::vector<std::size_t> pointsInPolygon(const PointCloud& cloud, const CropPoly
     return out;
 }
 
+namespace {
+
+//! Even-odd crossing number of (x, y) against the closed polygon v.
+bool insidePolygon(const std::vector<Eigen::Vector2d>& v, double x, double y)
+{
+    bool in = false;
+    for (std::size_t j = 0, k = v.size() - 1; j < v.size(); k = j++)
+        if ((v[j].y() > y) != (v[k].y() > y)) {
+            const double cross = v[k].x() + (y - v[k].y()) * (v[j].x() - v[k].x()) / (v[j].y() - v[k].y());
+            if (x < cross)
+                in = !in;
+        }
+    return in;
+}
+
+} // namespace
+
+std::vector<std::size_t> pointsInScreenPolygon(const PointCloud& cloud, const Eigen::Matrix4d& globalToScreen,
+                                               const std::vector<Eigen::Vector2d>& polygon)
+{
+    if (polygon.size() < 3)
+        throw Error(ErrorCode::InvalidArgument, "segment by polygon: a polygon needs at least 3 vertices");
+    for (const auto& v : polygon)
+        if (!v.allFinite())
+            throw Error(ErrorCode::InvalidArgument, "segment by polygon: the polygon's vertices must be finite");
+    // The cloud's origin folded into the matrix, in double: each point is then
+    // projected from its small local coordinates.
+    Eigen::Matrix4d toOrigin = Eigen::Matrix4d::Identity();
+    toOrigin.block<3, 1>(0, 3) = cloud.origin();
+    const Eigen::Matrix4d localToScreen = globalToScreen * toOrigin;
+    std::vector<char> inside(cloud.size(), 0);
+    forEachPoint(cloud.size(), [&](std::size_t i) {
+        const Eigen::Vector4d h = localToScreen * cloud.positions()[i].cast<double>().homogeneous();
+        if (!(h.w() > 0) || !h.allFinite())
+            return; // behind the eye, or not a point
+        inside[i] = insidePolygon(polygon, h.x() / h.w(), h.y() / h.w());
+    });
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        if (inside[i])
+            out.push_back(i);
+    return out;
+}
+
 std::vector<std::size_t> complementOf(const std::vector<std::size_t>& sorted, std::size_t count)
 {
     std::vector<std::size_t> out;

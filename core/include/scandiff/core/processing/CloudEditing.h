@@ -73,6 +73,14 @@ std::vector<std::size_t> pointsInBox(const PointCloud& cloud, const CropBox& box
 //! (even-odd rule, so a self-crossing polygon keeps what a fill would).
 //! Throws Error(InvalidArgument) for fewer than 3 vertices or an axis outside 0..2.
 std::vector<std::size_t> pointsInPolygon(const PointCloud& cloud, const CropPolygon& polygon);
+//! Indices (increasing) of the points that a view shows inside a polygon
+//! drawn on the screen (the scissors): `globalToScreen` takes global
+//! coordinates (homogeneous) to the screen's, before the division by w; the
+//! polygon's vertices are in the same screen units. Points behind the eye
+//! (w <= 0) are outside. Even-odd rule. Throws Error(InvalidArgument) for fewer
+//! than 3 vertices or non-finite ones.
+std::vector<std::size_t> pointsInScreenPolygon(const PointCloud& cloud, const Eigen::Matrix4d& globalToScreen,
+                                               const std::vector<Eigen::Vector2d>& polygon);
 //! The complement of a sorted index list among `count` points.
 std::vector<std::size_t> complementOf(const std::vector<std::size_t>& sorted, std::size_t count);
 
