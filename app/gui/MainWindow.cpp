@@ -18,6 +18,7 @@
 
 #include <QAction>
 #include <QCloseEvent>
+#include <QColorDialog>
 #include <QActionGroup>
 #include <QApplication>
 #include <QDockWidget>
@@ -39,6 +40,7 @@ namespace scandiff::gui {
 namespace {
 constexpr const char* kGeometrySetting = "window/geometry";
 constexpr const char* kLayoutSetting = "window/layout";
+constexpr const char* kBackgroundSetting = "display/background";
 } // namespace
 
 
@@ -254,6 +256,18 @@ void MainWindow::buildMenus()
         sizeGroup->addAction(a);
         connect(view_, &CloudView::pointSizeChanged, a, [a, size](float now) { a->setChecked(int(now) == size); });
     }
+    viewMenu->addAction(tr("&Background colour..."), this, [this] {
+        const QColor chosen = QColorDialog::getColor(QSettings().value(kBackgroundSetting).value<QColor>(), this, tr("Background colour"));
+        if (!chosen.isValid())
+            return; // the dialog was cancelled
+        QSettings().setValue(kBackgroundSetting, chosen);
+        view_->setBackground(chosen);
+    });
+    viewMenu->addAction(tr("Default &background"), this, [this] {
+        QSettings().remove(kBackgroundSetting);
+        view_->setBackground(QColor());
+    });
+    view_->setBackground(QSettings().value(kBackgroundSetting).value<QColor>());
     QMenu* afterComparison = viewMenu->addMenu(tr("&Reference after a comparison"));
     auto* afterGroup = new QActionGroup(this);
     const std::pair<QString, ReferenceAfterComparison> choices[] = {
@@ -292,6 +306,19 @@ void MainWindow::buildMenus()
     tree_->addAction(exportRegions);
     regionExportActions_.push_back(exportRegions);
     updateRegionExport();
+    QAction* pointSize = new QAction(tr("Point size..."), tree_);
+    connect(pointSize, &QAction::triggered, this, [this] {
+        const std::vector<EntityId> ids = tree_->selectedEntities(false);
+        if (ids.empty())
+            return;
+        bool ok = false;
+        const int size = QInputDialog::getInt(this, tr("Point size"), tr("Pixels for the selected entities (0: the view's size)"),
+                                              static_cast<int>(document_.item(ids.front()).display.pointSize), 0, 20, 1, &ok);
+        if (ok)
+            for (EntityId id : ids)
+                document_.setPointSize(id, static_cast<float>(size));
+    });
+    tree_->addAction(pointSize);
     QAction* remove = new QAction(tr("Delete"), tree_);
     connect(remove, &QAction::triggered, this, [this] {
         for (EntityId id : tree_->selectedEntities(false))

@@ -557,6 +557,35 @@ private slots:
         QCOMPARE(window.document().item(ids[1]).display.activeField, std::string("height"));
     }
 
+    void pointSizesShadingAndBackground()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::MainWindow window(registry);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
+        const EntityId a = window.document().ids()[0], b = window.document().ids()[1];
+        // An entity with its own point size keeps it when the view's changes.
+        window.document().setPointSize(a, 6.0f);
+        window.view()->setPointSize(3.0f);
+        QCOMPARE(window.view()->entityPointSize(a), 6.0f);
+        QCOMPARE(window.view()->entityPointSize(b), 3.0f);
+        window.document().setPointSize(a, 0.0f); // back to the view's
+        QCOMPARE(window.view()->entityPointSize(a), 3.0f);
+        // A cloud with normals is drawn lit by them; one without is not.
+        QVERIFY(!window.view()->isShaded(a));
+        PointCloud withNormals;
+        withNormals.positions() = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+        withNormals.enableNormals().assign(3, Eigen::Vector3f::UnitZ());
+        const EntityId lit = window.document().add("with normals", std::move(withNormals));
+        QVERIFY(window.view()->isShaded(lit));
+        // A plain background, and back to the gradient.
+        window.view()->setBackground(QColor(255, 255, 255));
+        QCOMPARE(window.view()->background(), QColor(255, 255, 255));
+        window.view()->setBackground(QColor());
+        QVERIFY(!window.view()->background().isValid());
+    }
+
     void thePanelLayoutIsRemembered()
     {
         const PluginRegistry registry = makePluginRegistry();

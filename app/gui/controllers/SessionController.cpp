@@ -141,6 +141,7 @@ bool SessionController::save(const QString& qpath)
                             {"visible", item.display.visible},
                             {"activeField", item.display.activeField},
                             {"neutral", item.display.neutral},
+                            {"pointSize", item.display.pointSize},
                             {"outside", item.display.outside == FieldColouring::Outside::Grey ? "grey" : "hide"},
                             {"fields", fields},
                             {"provenance", provenanceJson(item.points())}});
@@ -207,6 +208,7 @@ bool SessionController::restore(const QString& qpath)
         bool visible = true;
         std::string activeField;
         bool neutral = false;
+        float pointSize = 0;
         FieldColouring::Outside outside = FieldColouring::Outside::Hide;
         std::map<std::string, FieldDisplay> fields;
         io::Entity entity;
@@ -235,6 +237,7 @@ bool SessionController::restore(const QString& qpath)
                 entry.visible = e.value("visible", true);
                 entry.activeField = e.value("activeField", std::string());
                 entry.neutral = e.value("neutral", false);
+                entry.pointSize = e.value("pointSize", 0.0f);
                 entry.outside = e.value("outside", std::string("hide")) == "grey" ? FieldColouring::Outside::Grey
                                                                                   : FieldColouring::Outside::Hide;
                 const json fields = e.value("fields", json::object()); // items() must not outlive it
@@ -292,6 +295,7 @@ bool SessionController::restore(const QString& qpath)
             document_.setFieldDisplay(id, name, display);
         document_.setActiveField(id, e.activeField);
         document_.setNeutral(id, e.neutral);
+        document_.setPointSize(id, e.pointSize);
         document_.setOutsideMode(id, e.outside);
         document_.setVisible(id, e.visible);
     }

@@ -188,6 +188,15 @@ void Document::setNeutral(EntityId id, bool neutral)
     emit displayChanged(id);
 }
 
+void Document::setPointSize(EntityId id, float pixels)
+{
+    Item* item = findMutable(id);
+    if (!item || item->display.pointSize == pixels)
+        return;
+    item->display.pointSize = pixels;
+    emit displayChanged(id);
+}
+
 FieldDisplay Document::fieldDisplay(EntityId id, const std::string& fieldName) const
 {
     const Item* item = find(id);

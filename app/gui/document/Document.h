@@ -48,6 +48,8 @@ struct DisplayState
     //! how a reference is shown after a comparison, so that no other rainbow
     //! competes with the distances' scale.
     bool neutral = false;
+    //! The entity's own point size in pixels; 0: the view's.
+    float pointSize = 0;
     FieldColouring::Outside outside = FieldColouring::Outside::Hide;
     std::map<std::string, FieldDisplay> fields; //!< by field name; absent = defaults
 };
@@ -107,6 +109,7 @@ public:
     void setFieldDisplay(EntityId id, const std::string& fieldName, const FieldDisplay& display);
     void setOutsideMode(EntityId id, FieldColouring::Outside mode);
     void setNeutral(EntityId id, bool neutral);
+    void setPointSize(EntityId id, float pixels);
     //! The display of a field (defaults when never set).
     FieldDisplay fieldDisplay(EntityId id, const std::string& fieldName) const;
     void rename(EntityId id, const QString& name);

@@ -97,6 +97,7 @@ struct CloudView::Shown
     {
         std::size_t begin = 0, count = 0;
         vtkSmartPointer<vtkPolyData> full, decimated;
+        vtkSmartPointer<vtkFloatArray> normals; //!< a view on the cloud's normals, when it has some
         vtkSmartPointer<vtkPolyDataMapper> fullMapper, decimatedMapper;
         vtkSmartPointer<vtkUnsignedCharArray> colours;
         vtkSmartPointer<vtkActor> actor;
@@ -104,6 +105,7 @@ struct CloudView::Shown
     };
     bool isCloud = true;
     std::size_t pointCount = 0;
+    float ownPointSize = 0; //!< the entity's own point size; 0: the view's
     std::vector<std::uint8_t> rgba; //!< 4 bytes per point, what the chunks' colour arrays show
     std::vector<Chunk> chunks;
 };
@@ -292,6 +294,14 @@ void CloudView::addEntity(const Document::Item& item)
             c.colours->SetName("display colours");
             c.colours->SetArray(s.rgba.data() + 4 * begin, static_cast<vtkIdType>(4 * c.count), /*save*/ 1);
             c.full->GetPointData()->SetScalars(c.colours);
+            if (points.hasNormals()) {
+                // Shading by the normals, as CloudCompare lights clouds that have them:
+                // the shape reads at once. A view on the cloud's normals, no copy.
+                c.normals = vtkSmartPointer<vtkFloatArray>::New();
+                c.normals->SetNumberOfComponents(3);
+                c.normals->SetArray(const_cast<float*>(points.normals()[begin].data()), static_cast<vtkIdType>(3 * c.count), 1);
+                c.full->GetPointData()->SetNormals(c.normals);
+            }
             c.fullMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
             c.fullMapper->SetInputData(c.full);
             c.fullMapper->SetColorModeToDirectScalars();
@@ -317,8 +327,12 @@ void CloudView::refreshEntity(const Document::Item& item)
         return;
     Shown& s = it->second;
     const bool visibilityChanged = s.chunks.front().actor->GetVisibility() != int(item.display.visible);
-    for (auto& c : s.chunks)
+    s.ownPointSize = item.display.pointSize;
+    for (auto& c : s.chunks) {
         c.actor->SetVisibility(item.display.visible);
+        if (s.isCloud)
+            c.actor->GetProperty()->SetPointSize(s.ownPointSize > 0 ? s.ownPointSize : scene_->pointSize);
+    }
     if (visibilityChanged)
         updateStride();
     if (s.isCloud) {
@@ -441,7 +455,7 @@ void CloudView::setPointSize(float size)
         emit pointSizeChanged(size);
     }
     for (auto& [id, s] : scene_->shown)
-        if (s.isCloud)
+        if (s.isCloud && s.ownPointSize <= 0) // an entity with its own size keeps it
             for (auto& c : s.chunks)
                 c.actor->GetProperty()->SetPointSize(size);
     render();
@@ -515,6 +529,42 @@ void CloudView::setAnnotations(const std::vector<Annotation>& annotations)
     }
     scene_->annotations->Modified();
     renderSoon();
+}
+
+void CloudView::setBackground(const QColor& colour)
+{
+    // Invalid: the default gradient, dark at the bottom.
+    scene_->renderer->SetGradientBackground(!colour.isValid());
+    if (colour.isValid()) {
+        scene_->renderer->SetBackground(colour.redF(), colour.greenF(), colour.blueF());
+    } else {
+        scene_->renderer->SetBackground(0.10, 0.11, 0.14);
+        scene_->renderer->SetBackground2(0.32, 0.34, 0.40);
+    }
+    render();
+}
+
+QColor CloudView::background() const
+{
+    if (scene_->renderer->GetGradientBackground())
+        return {};
+    double rgb[3];
+    scene_->renderer->GetBackground(rgb);
+    return QColor::fromRgbF(rgb[0], rgb[1], rgb[2]);
+}
+
+bool CloudView::isShaded(EntityId id) const
+{
+    const auto it = scene_->shown.find(id);
+    return it != scene_->shown.end() && !it->second.chunks.empty() && it->second.chunks.front().normals;
+}
+
+float CloudView::entityPointSize(EntityId id) const
+{
+    const auto it = scene_->shown.find(id);
+    if (it == scene_->shown.end() || it->second.chunks.empty())
+        return 0;
+    return static_cast<float>(it->second.chunks.front().actor->GetProperty()->GetPointSize());
 }
 
 bool CloudView::shownFrame(EntityId id, Eigen::Vector3d& offset, Eigen::Vector3f& firstPosition) const
@@ -609,6 +659,8 @@ void CloudView::setDecimated(Shown& s, bool moving)
             c.decimated = vtkSmartPointer<vtkPolyData>::New();
             c.decimated->SetPoints(c.full->GetPoints());
             c.decimated->GetPointData()->SetScalars(c.colours);
+            if (c.normals)
+                c.decimated->GetPointData()->SetNormals(c.normals);
             c.decimated->SetVerts(vertexCells(c.count, scene_->stride));
             c.decimatedMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
             c.decimatedMapper->SetInputData(c.decimated);

@@ -11,6 +11,7 @@
 #include "view/EntityColouring.h"
 
 #include <QSurfaceFormat>
+#include <QColor>
 #include <QWidget>
 
 #include <array>
@@ -68,6 +69,14 @@ public:
     void zoomToEntity(EntityId id);
     void setStandardView(StandardView view);
     void setPointSize(float size);
+    //! The point size an entity is drawn with (its own, or the view's), 0 if not shown.
+    float entityPointSize(EntityId id) const;
+    //! One plain colour behind the clouds; an invalid colour: the default gradient.
+    void setBackground(const QColor& colour);
+    //! The plain background colour, invalid for the default gradient.
+    QColor background() const;
+    //! Whether an entity is drawn lit by its normals.
+    bool isShaded(EntityId id) const;
     float pointSize() const;
     void setParallelProjection(bool parallel);
     bool parallelProjection() const;
