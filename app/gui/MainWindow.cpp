@@ -173,6 +173,17 @@ void MainWindow::buildMenus()
     file->addAction(tr("&Quit"), this, &QWidget::close)->setShortcut(QKeySequence::Quit);
 
     QMenu* edit = menuBar()->addMenu(tr("&Edit"));
+    // One level of undo for a deletion, a tool's change of an entity, a computed field.
+    QAction* undo = edit->addAction(tr("Undo"), &document_, &Document::undo);
+    undo->setObjectName("undoAction");
+    undo->setShortcut(QKeySequence::Undo);
+    const auto followUndo = [this, undo] {
+        undo->setEnabled(document_.canUndo());
+        undo->setText(document_.undoText());
+    };
+    connect(&document_, &Document::undoChanged, undo, followUndo);
+    followUndo();
+    edit->addSeparator();
     edit->addAction(tr("&Delete selected"), this, [this] {
         for (EntityId id : tree_->selectedEntities(false))
             document_.remove(id);

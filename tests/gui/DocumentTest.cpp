@@ -206,6 +206,47 @@ private slots:
         QCOMPARE(panel.histogram()->histogram().finiteCount, std::size_t(0));
     }
 
+    void undoRestoresADeletionAChangeAndAField()
+    {
+        gui::Document document;
+        gui::EntityTree tree(document);
+        QVERIFY(!document.canUndo());
+        const EntityId parent = document.add("four", fourPoints());
+        const EntityId child = document.add("part", fourPoints(), parent);
+        document.setVisible(child, false);
+        // A deletion (with its descendant) comes back with ids, tree and display.
+        document.remove(parent);
+        QVERIFY(!document.contains(parent) && !document.contains(child));
+        QVERIFY(document.canUndo());
+        QVERIFY(document.undoText().contains("four"));
+        document.undo();
+        QVERIFY(document.contains(parent) && document.contains(child));
+        QCOMPARE(document.item(child).parent, parent);
+        QVERIFY(!document.item(child).display.visible);
+        QCOMPARE(tree.entityRow(child)->parent(), tree.entityRow(parent));
+        QVERIFY(!document.canUndo());
+        // A tool's change of the data comes back exactly.
+        PointCloud moved = fourPoints();
+        moved.positions()[0] = {9, 9, 9};
+        document.replaceData(parent, std::move(moved));
+        QCOMPARE(document.item(parent).points().positions()[0], Eigen::Vector3f(9, 9, 9));
+        document.undo();
+        QCOMPARE(document.item(parent).points().positions()[0], Eigen::Vector3f(0, 0, 0));
+        // A recomputed field gets its previous values back; a new one goes.
+        ScalarField again("d", 4);
+        document.addField(parent, std::move(again));
+        QVERIFY(std::isnan(document.item(parent).points().field("d")->value(0)));
+        document.undo();
+        QCOMPARE(document.item(parent).points().field("d")->value(1), 1.0);
+        document.addField(parent, ScalarField("extra", 4));
+        document.undo();
+        QVERIFY(!document.item(parent).points().field("extra"));
+        // Opening a session (clear) forgets it.
+        document.remove(child);
+        document.clear();
+        QVERIFY(!document.canUndo());
+    }
+
     void treeMirrorsTheDocument()
     {
         gui::Document document;

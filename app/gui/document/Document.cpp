@@ -32,22 +32,37 @@ EntityId Document::add(QString name, io::Entity entity, EntityId parent, QString
 
 void Document::remove(EntityId id)
 {
-    if (!contains(id))
+    const Item* item = find(id);
+    if (!item)
         return;
+    UndoStep step;
+    step.kind = UndoKind::Removal;
+    step.name = item->name;
+    removeWithoutUndo(id, step.removed);
+    remember(std::move(step));
+}
+
+void Document::removeWithoutUndo(EntityId id, std::vector<std::unique_ptr<Item>>& taken)
+{
     // Children first, so observers never see an orphan.
     std::vector<EntityId> children;
     for (const auto& item : items_)
         if (item->parent == id)
             children.push_back(item->id);
     for (EntityId child : children)
-        remove(child);
-    items_.erase(std::remove_if(items_.begin(), items_.end(), [id](const auto& item) { return item->id == id; }), items_.end());
+        removeWithoutUndo(child, taken);
+    const auto it = std::find_if(items_.begin(), items_.end(), [id](const auto& item) { return item->id == id; });
+    if (it == items_.end())
+        return;
+    taken.push_back(std::move(*it));
+    items_.erase(it);
     emit removed(id);
 }
 
 void Document::clear()
 {
     items_.clear();
+    remember({});
     emit cleared();
 }
 
@@ -100,12 +115,27 @@ void Document::replaceData(EntityId id, io::Entity entity)
     for (const auto& f : item->points().fields())
         oldFields.push_back(f.name());
     emit aboutToReplaceData(id);
-    Mesh* mesh = std::get_if<Mesh>(&item->entity);
+    UndoStep step;
+    step.kind = UndoKind::Replacement;
+    step.name = item->name;
+    step.id = id;
+    step.previousDisplay = item->display;
+    io::Entity previous = std::move(item->entity);
+    const Mesh* oldMesh = std::get_if<Mesh>(&previous);
     PointCloud* cloud = std::get_if<PointCloud>(&entity);
-    if (mesh && cloud && cloud->size() == mesh->vertices.size())
-        mesh->vertices = std::move(*cloud);
-    else
+    if (oldMesh && cloud && cloud->size() == oldMesh->vertices.size()) {
+        // New vertices for a mesh: its triangles stay.
+        Mesh mesh;
+        mesh.name = oldMesh->name;
+        mesh.triangles = oldMesh->triangles;
+        mesh.vertices = std::move(*cloud);
+        item->entity = std::move(mesh);
+    } else {
         item->entity = std::move(entity);
+    }
+    step.previousData = std::move(previous);
+    if (!undoing_)
+        remember(std::move(step));
     const auto& fields = item->points().fields();
     const auto has = [&](const std::string& name) {
         return std::any_of(fields.begin(), fields.end(), [&](const ScalarField& f) { return f.name() == name; });
@@ -132,6 +162,17 @@ void Document::addField(EntityId id, ScalarField field)
     if (!cloud)
         return;
     const std::string name = field.name();
+    if (!undoing_) {
+        UndoStep step;
+        step.kind = UndoKind::Field;
+        step.name = item->name;
+        step.id = id;
+        step.fieldName = name;
+        step.previousDisplay = item->display;
+        if (const ScalarField* previous = cloud->field(name))
+            step.previousField = *previous;
+        remember(std::move(step));
+    }
     cloud->addField(std::move(field));
     item->unsaved = true;
     // A recomputed field starts again from its full range.
@@ -233,6 +274,62 @@ void Document::markAllSaved()
 {
     for (const auto& item : items_)
         item->unsaved = false;
+}
+
+void Document::remember(UndoStep step)
+{
+    undo_ = std::move(step);
+    emit undoChanged();
+}
+
+QString Document::undoText() const
+{
+    switch (undo_.kind) {
+    case UndoKind::Removal: return tr("Undo delete '%1'").arg(undo_.name);
+    case UndoKind::Replacement: return tr("Undo the change of '%1'").arg(undo_.name);
+    case UndoKind::Field: return tr("Undo field %1 of '%2'").arg(QString::fromStdString(undo_.fieldName), undo_.name);
+    case UndoKind::None: break;
+    }
+    return tr("Undo");
+}
+
+void Document::undo()
+{
+    UndoStep step = std::move(undo_);
+    undo_ = {};
+    undoing_ = true;
+    switch (step.kind) {
+    case UndoKind::Removal:
+        // Parents first (they were removed last), each with its id, parent and display.
+        for (auto it = step.removed.rbegin(); it != step.removed.rend(); ++it) {
+            const EntityId id = (*it)->id;
+            items_.push_back(std::move(*it));
+            emit added(id);
+        }
+        break;
+    case UndoKind::Replacement:
+        if (contains(step.id)) {
+            replaceData(step.id, std::move(*step.previousData));
+            findMutable(step.id)->display = step.previousDisplay;
+            emit displayChanged(step.id);
+        }
+        break;
+    case UndoKind::Field:
+        if (Item* item = findMutable(step.id); item && item->cloud()) {
+            auto& cloud = std::get<PointCloud>(item->entity);
+            if (step.previousField)
+                cloud.addField(std::move(*step.previousField));
+            else
+                cloud.removeField(step.fieldName);
+            item->display = step.previousDisplay;
+            emit fieldsChanged(step.id);
+            emit displayChanged(step.id);
+        }
+        break;
+    case UndoKind::None: break;
+    }
+    undoing_ = false;
+    emit undoChanged();
 }
 
 } // namespace scandiff::gui

@@ -16,6 +16,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace scandiff::gui {
@@ -114,6 +115,15 @@ public:
     FieldDisplay fieldDisplay(EntityId id, const std::string& fieldName) const;
     void rename(EntityId id, const QString& name);
 
+    //! One level of undo for what changes data: a removal (with the entity's
+    //! descendants), a replacement of an entity's data (a tool that moved or
+    //! edited it), a field added or recomputed. The next such change replaces
+    //! it; clear() forgets it. What was undone is restored with its id, place
+    //! in the tree and display.
+    bool canUndo() const { return undo_.kind != UndoKind::None; }
+    //! "Undo delete 'site-2019'", for the menu.
+    QString undoText() const;
+    void undo();
     //! The entities whose work would be lost on quitting, in tree order.
     std::vector<EntityId> unsavedIds() const;
     //! The entity's data is now in a file (exported).
@@ -131,9 +141,27 @@ signals:
     void cleared();
     void aboutToReplaceData(EntityId id);
     void dataReplaced(EntityId id);
+    //! What undo() would do changed.
+    void undoChanged();
 
 private:
     Item* findMutable(EntityId id);
+    void removeWithoutUndo(EntityId id, std::vector<std::unique_ptr<Item>>& taken);
+    enum class UndoKind { None, Removal, Replacement, Field };
+    struct UndoStep
+    {
+        UndoKind kind = UndoKind::None;
+        QString name;                                //!< the entity's, for the menu
+        std::vector<std::unique_ptr<Item>> removed;  //!< Removal: the entity and its descendants, parents first
+        EntityId id = kNoEntity;                     //!< Replacement, Field
+        std::optional<io::Entity> previousData;      //!< Replacement
+        DisplayState previousDisplay;                //!< Replacement, Field
+        std::string fieldName;                       //!< Field
+        std::optional<ScalarField> previousField;    //!< Field: the one it replaced, if any
+    };
+    void remember(UndoStep step);
+    UndoStep undo_;
+    bool undoing_ = false;
     // unique_ptr keeps each entity in place while the vector grows: the view and
     // running tools may hold references to it.
     std::vector<std::unique_ptr<Item>> items_;
