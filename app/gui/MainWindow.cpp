@@ -41,6 +41,8 @@ namespace {
 constexpr const char* kGeometrySetting = "window/geometry";
 constexpr const char* kLayoutSetting = "window/layout";
 constexpr const char* kBackgroundSetting = "display/background";
+constexpr const char* kEdlSetting = "display/eyeDomeLighting";
+constexpr const char* kScaleBarSetting = "display/scaleBar";
 } // namespace
 
 
@@ -267,6 +269,25 @@ void MainWindow::buildMenus()
         sizeGroup->addAction(a);
         connect(view_, &CloudView::pointSizeChanged, a, [a, size](float now) { a->setChecked(int(now) == size); });
     }
+    // Display options, remembered from one start to the next.
+    QAction* edl = viewMenu->addAction(tr("&Eye-Dome Lighting"));
+    edl->setObjectName("edlAction");
+    edl->setCheckable(true);
+    edl->setToolTip(tr("Shade clouds by their depth on screen: reliefs read without normals"));
+    connect(edl, &QAction::toggled, this, [this](bool on) {
+        QSettings().setValue(kEdlSetting, on);
+        view_->setEyeDomeLighting(on);
+    });
+    edl->setChecked(QSettings().value(kEdlSetting, false).toBool());
+    QAction* scaleBar = viewMenu->addAction(tr("S&cale bar"));
+    scaleBar->setObjectName("scaleBarAction");
+    scaleBar->setCheckable(true);
+    connect(scaleBar, &QAction::toggled, this, [this](bool on) {
+        QSettings().setValue(kScaleBarSetting, on);
+        view_->setScaleBar(on);
+    });
+    scaleBar->setChecked(QSettings().value(kScaleBarSetting, true).toBool());
+    view_->setScaleBar(scaleBar->isChecked());
     viewMenu->addAction(tr("&Background colour..."), this, [this] {
         const QColor chosen = QColorDialog::getColor(QSettings().value(kBackgroundSetting).value<QColor>(), this, tr("Background colour"));
         if (!chosen.isValid())

@@ -579,6 +579,29 @@ private slots:
         withNormals.enableNormals().assign(3, Eigen::Vector3f::UnitZ());
         const EntityId lit = window.document().add("with normals", std::move(withNormals));
         QVERIFY(window.view()->isShaded(lit));
+        // The scale bar: a round length, about a fifth of the view, and as many
+        // pixels on screen as the camera really gives that length at the focal point.
+        window.view()->setStandardView(gui::StandardView::Top);
+        window.view()->setScaleBar(true);
+        const double length = window.view()->scaleBarLength();
+        const double decade = std::pow(10.0, std::floor(std::log10(length)));
+        const double mantissa = length / decade;
+        QVERIFY(std::abs(mantissa - 1) < 1e-9 || std::abs(mantissa - 2) < 1e-9 || std::abs(mantissa - 5) < 1e-9);
+        const double viewMetres = window.view()->metresPerPixel() * window.view()->width();
+        QVERIFY(length <= viewMetres / 5 + 1e-9 && length > viewMetres / 12.5);
+        const gui::CameraState camera = window.view()->camera();
+        const Eigen::Vector3d focus(camera.focalPoint[0], camera.focalPoint[1], camera.focalPoint[2]);
+        const Eigen::Matrix4d toPixels = window.view()->globalToWidgetPixels();
+        const Eigen::Vector4d p0 = toPixels * focus.homogeneous(), p1 = toPixels * (focus + Eigen::Vector3d(length, 0, 0)).homogeneous();
+        const double onScreen = (p1.head<2>() / p1.w() - p0.head<2>() / p0.w()).norm();
+        QVERIFY2(std::abs(onScreen - length / window.view()->metresPerPixel()) < 0.01 * onScreen, qPrintable(QString::number(onScreen)));
+        window.view()->setScaleBar(false);
+        QCOMPARE(window.view()->scaleBarLength(), length); // the length is still what it would show
+        // Eye-Dome Lighting switches on and off.
+        window.view()->setEyeDomeLighting(true);
+        QVERIFY(window.view()->eyeDomeLighting());
+        window.view()->render();
+        window.view()->setEyeDomeLighting(false);
         // A plain background, and back to the gradient.
         window.view()->setBackground(QColor(255, 255, 255));
         QCOMPARE(window.view()->background(), QColor(255, 255, 255));

@@ -21,6 +21,10 @@
 #include <vtkInteractorStyleTrackballCamera.h>
 #include <vtkLookupTable.h>
 #include <vtkMatrix4x4.h>
+#include <vtkEDLShading.h>
+#include <vtkTextActor.h>
+#include <vtkOpenGLRenderer.h>
+#include <vtkRenderStepsPass.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkPointData.h>
@@ -114,6 +118,10 @@ struct CloudView::Scene
 {
     vtkNew<vtkGenericOpenGLRenderWindow> window;
     vtkNew<vtkRenderer> renderer;
+    //! The flat overlays (colour bar, scale bar, scissors) on a layer of their
+    //! own, drawn after the clouds: the Eye-Dome Lighting pass of the main
+    //! layer must not shade them.
+    vtkNew<vtkRenderer> overlay;
     vtkNew<vtkScalarBarActor> scalarBar;
     vtkNew<vtkLookupTable> scalarBarTable;
     vtkNew<vtkPointPicker> picker;
@@ -131,6 +139,14 @@ struct CloudView::Scene
     vtkNew<vtkPolyData> annotations;
     vtkNew<vtkActor> annotationActor;
     std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels;
+    bool eyeDomeLighting = false;
+    // The scale bar: a line of a round length (1, 2 or 5 x 10^k m) about a
+    // fifth of the view wide, its length written above it, sized before each
+    // frame from the camera (at the focal point's depth in perspective).
+    bool scaleBarShown = true;
+    vtkNew<vtkPolyData> scaleBarLine;
+    vtkNew<vtkActor2D> scaleBarActor;
+    vtkNew<vtkTextActor> scaleBarText;
     // Scissors: the polygon being drawn, in widget pixels, and its outline on screen.
     bool scissorsMode = false;
     std::vector<Eigen::Vector2d> scissors;
@@ -183,6 +199,11 @@ CloudView::CloudView(QWidget* parent) : QWidget(parent), scene_(std::make_unique
     layout->addWidget(widget_);
     widget_->setRenderWindow(scene_->window);
     scene_->window->AddRenderer(scene_->renderer);
+    scene_->window->SetNumberOfLayers(2);
+    scene_->overlay->SetLayer(1);
+    scene_->overlay->InteractiveOff();
+    scene_->overlay->SetActiveCamera(scene_->renderer->GetActiveCamera());
+    scene_->window->AddRenderer(scene_->overlay);
     scene_->renderer->GradientBackgroundOn();
     scene_->renderer->SetBackground(0.10, 0.11, 0.14);
     scene_->renderer->SetBackground2(0.32, 0.34, 0.40);
@@ -197,7 +218,7 @@ CloudView::CloudView(QWidget* parent) : QWidget(parent), scene_(std::make_unique
     scene_->scalarBar->UnconstrainedFontSizeOn();
     scene_->scalarBar->SetLabelFormat("%-#8.4g");
     scene_->scalarBar->VisibilityOff();
-    scene_->renderer->AddViewProp(scene_->scalarBar);
+    scene_->overlay->AddViewProp(scene_->scalarBar);
     scene_->picker->SetTolerance(0.005);
 
     // CloudCompare-like navigation: trackball rotation, pan, zoom.
@@ -228,7 +249,20 @@ CloudView::CloudView(QWidget* parent) : QWidget(parent), scene_(std::make_unique
     scene_->scissorsActor->SetMapper(scissorsMapper);
     scene_->scissorsActor->GetProperty()->SetColor(1.0, 0.9, 0.2);
     scene_->scissorsActor->GetProperty()->SetLineWidth(2.0f);
-    scene_->renderer->AddActor2D(scene_->scissorsActor);
+    scene_->overlay->AddActor2D(scene_->scissorsActor);
+    vtkNew<vtkPolyDataMapper2D> scaleBarMapper;
+    scaleBarMapper->SetInputData(scene_->scaleBarLine);
+    scene_->scaleBarActor->SetMapper(scaleBarMapper);
+    scene_->scaleBarActor->GetProperty()->SetColor(1, 1, 1);
+    scene_->scaleBarActor->GetProperty()->SetLineWidth(2.0f);
+    scene_->overlay->AddActor2D(scene_->scaleBarActor);
+    scene_->scaleBarText->GetTextProperty()->SetFontSize(13);
+    scene_->scaleBarText->GetTextProperty()->SetJustificationToCentered();
+    scene_->overlay->AddActor2D(scene_->scaleBarText);
+    auto beforeFrame = vtkSmartPointer<vtkCallbackCommand>::New();
+    beforeFrame->SetClientData(this);
+    beforeFrame->SetCallback([](vtkObject*, unsigned long, void* self, void*) { static_cast<CloudView*>(self)->updateScaleBar(); });
+    scene_->renderer->AddObserver(vtkCommand::StartEvent, beforeFrame);
 }
 
 CloudView::~CloudView() = default;
@@ -529,6 +563,83 @@ void CloudView::setAnnotations(const std::vector<Annotation>& annotations)
     }
     scene_->annotations->Modified();
     renderSoon();
+}
+
+void CloudView::setEyeDomeLighting(bool on)
+{
+    scene_->eyeDomeLighting = on;
+    auto* renderer = vtkOpenGLRenderer::SafeDownCast(scene_->renderer);
+    if (!renderer)
+        return;
+    if (on) {
+        // The usual steps (opaque, translucent, overlays) rendered through EDL.
+        vtkNew<vtkRenderStepsPass> steps;
+        vtkNew<vtkEDLShading> edl;
+        edl->SetDelegatePass(steps);
+        renderer->SetPass(edl);
+    } else {
+        renderer->SetPass(nullptr);
+    }
+    render();
+}
+
+bool CloudView::eyeDomeLighting() const { return scene_->eyeDomeLighting; }
+
+void CloudView::setScaleBar(bool on)
+{
+    scene_->scaleBarShown = on;
+    render();
+}
+
+bool CloudView::scaleBar() const { return scene_->scaleBarShown; }
+
+double CloudView::metresPerPixel() const
+{
+    vtkCamera* camera = scene_->renderer->GetActiveCamera();
+    const int* size = scene_->renderer->GetSize();
+    const double height = std::max(1, size[1]);
+    if (camera->GetParallelProjection())
+        return 2.0 * camera->GetParallelScale() / height;
+    const double halfAngle = camera->GetViewAngle() * 3.14159265358979323846 / 360.0;
+    return 2.0 * camera->GetDistance() * std::tan(halfAngle) / height;
+}
+
+double CloudView::scaleBarLength() const
+{
+    // The round length nearest below a fifth of the view's width.
+    const double target = metresPerPixel() * std::max(1, scene_->renderer->GetSize()[0]) / 5.0;
+    if (!(target > 0) || !std::isfinite(target))
+        return 0.0;
+    const double decade = std::pow(10.0, std::floor(std::log10(target)));
+    for (double step : {5.0, 2.0, 1.0})
+        if (step * decade <= target)
+            return step * decade;
+    return decade;
+}
+
+void CloudView::updateScaleBar()
+{
+    const double length = scene_->scaleBarShown && !scene_->shown.empty() ? scaleBarLength() : 0.0;
+    scene_->scaleBarActor->SetVisibility(length > 0);
+    scene_->scaleBarText->SetVisibility(length > 0);
+    if (!(length > 0))
+        return;
+    const double pixels = length / metresPerPixel();
+    const int* size = scene_->renderer->GetSize();
+    const double right = size[0] - 110.0, left = right - pixels, y = 18.0; // bottom right, clear of the colour bar
+    vtkNew<vtkPoints> points;
+    for (const auto& [x, dy] : std::vector<std::pair<double, double>>{{left, 5}, {left, 0}, {right, 0}, {right, 5}})
+        points->InsertNextPoint(x, y + dy, 0);
+    vtkNew<vtkCellArray> line;
+    const vtkIdType ids[4] = {0, 1, 2, 3};
+    line->InsertNextCell(4, ids);
+    scene_->scaleBarLine->SetPoints(points);
+    scene_->scaleBarLine->SetLines(line);
+    const QString text = length >= 1000 ? QString("%1 km").arg(length / 1000) : length >= 1 ? QString("%1 m").arg(length)
+                         : length >= 0.01                                      ? QString("%1 cm").arg(length * 100)
+                                                                               : QString("%1 mm").arg(length * 1000);
+    scene_->scaleBarText->SetInput(text.toUtf8().constData());
+    scene_->scaleBarText->SetPosition((left + right) / 2, y + 8);
 }
 
 void CloudView::setBackground(const QColor& colour)

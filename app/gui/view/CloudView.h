@@ -73,6 +73,17 @@ public:
     float entityPointSize(EntityId id) const;
     //! One plain colour behind the clouds; an invalid colour: the default gradient.
     void setBackground(const QColor& colour);
+    //! Eye-Dome Lighting (VTK's EDL pass): shades clouds without normals by
+    //! their depth differences on screen, so a façade's reliefs read.
+    void setEyeDomeLighting(bool on);
+    bool eyeDomeLighting() const;
+    //! A scale bar at the bottom of the view, its length labelled in metres.
+    void setScaleBar(bool on);
+    bool scaleBar() const;
+    //! The length the scale bar shows now (m), 0 when hidden or nothing is shown.
+    double scaleBarLength() const;
+    //! The size of a screen pixel at the focal point's depth (m).
+    double metresPerPixel() const;
     //! The plain background colour, invalid for the default gradient.
     QColor background() const;
     //! Whether an entity is drawn lit by its normals.
@@ -142,6 +153,7 @@ private:
     struct Shown;
     static constexpr std::size_t kChunkPoints = 1u << 18;
     void updateStride();
+    void updateScaleBar();
     void setDecimated(Shown& shown, bool moving);
     QTimer* settleTimer_ = nullptr;
     bool pickAtDevicePixel(int x, int y);
