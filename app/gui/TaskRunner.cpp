@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "TaskRunner.h"
 
+#include <limits>
+
 #include <scandiff/core/Error.h>
 
 #include <QApplication>
@@ -9,6 +11,7 @@
 #include <QKeyEvent>
 #include <QProgressDialog>
 #include <QThread>
+#include <QTimer>
 #include <QWindow>
 
 namespace scandiff::gui {
@@ -102,7 +105,11 @@ TaskResult runTask(QWidget* parent, const QString& title, const std::function<vo
     QProgressDialog dialog(title, QObject::tr("Cancel"), 0, 1000, parent);
     dialog.setWindowTitle(title);
     dialog.setWindowModality(Qt::ApplicationModal);
-    dialog.setMinimumDuration(400);
+    // Shown after 400 ms whatever the progress says: QProgressDialog's own rule
+    // (shown once the estimated total exceeds the delay) left the first read
+    // of a session with an empty window and no dialog.
+    dialog.setMinimumDuration(std::numeric_limits<int>::max());
+    QTimer::singleShot(400, &dialog, [&dialog] { dialog.show(); });
     dialog.setAutoClose(false);
     dialog.setAutoReset(false);
     QObject::connect(

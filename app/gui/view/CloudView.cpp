@@ -445,7 +445,10 @@ void CloudView::clear()
 void CloudView::resetCamera()
 {
     scene_->renderer->ResetCamera();
-    render();
+    // Decimated first, full detail once nothing else happens: opening big
+    // files shows each cloud at once instead of an empty window while a
+    // software renderer draws millions of points.
+    renderInteractively();
 }
 
 void CloudView::zoomToEntity(EntityId id)
