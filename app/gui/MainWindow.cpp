@@ -122,7 +122,11 @@ template <class Controller> void MainWindow::report(Controller* controller)
         statusBar()->showMessage(summary);
     });
     connect(controller, &Controller::failed, this, [this](const QString& message) {
-        console_->error(message);
+        // The user stopping a run is no error: every controller says "... was cancelled".
+        if (message.contains(tr(" was cancelled")))
+            console_->info(message);
+        else
+            console_->error(message);
         statusBar()->showMessage(message);
     });
 }

@@ -5,6 +5,7 @@
 // and restore the session. Answers are checked against core called directly
 // and against brute-force counts.
 #include "MainWindow.h"
+#include "panels/ConsolePanel.h"
 #include "tools/MeasurePanel.h"
 #include "controllers/DistanceController.h"
 #include "controllers/FileController.h"
@@ -682,6 +683,11 @@ private slots:
         wrongEntries.close();
         QVERIFY(!window.sessions()->restore(dir.filePath("y.scandiff")));
         QCOMPARE(window.document().size(), std::size_t(1));
+        // A run the user cancelled is logged as such, not as an error.
+        emit window.files()->failed("Opening big.ply was cancelled");
+        const QString log = window.console()->toPlainText();
+        QVERIFY(log.trimmed().endsWith("Opening big.ply was cancelled"));
+        QVERIFY(!log.trimmed().split('\n').last().contains("error:"));
     }
 };
 
