@@ -45,6 +45,18 @@ using gui::EntityId;
 
 namespace {
 
+//! A workbench window, as each flow starts: the plugins, the window shown and exposed.
+struct Workbench
+{
+    PluginRegistry registry = makePluginRegistry();
+    gui::MainWindow window{registry};
+    bool shown()
+    {
+        window.show();
+        return QTest::qWaitForWindowExposed(&window);
+    }
+};
+
 const QString kReference = SCANDIFF_SAMPLE_DATA_DIR "/demo/site-2019.ply";
 const QString kCompared = SCANDIFF_SAMPLE_DATA_DIR "/demo/site-2024.ply";
 
@@ -92,10 +104,9 @@ private slots:
 
     void openComputeThresholdSplitExportRestore()
     {
-        const PluginRegistry registry = makePluginRegistry();
-        gui::MainWindow window(registry);
-        window.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
 
         // Open the demo pair.
         QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
@@ -172,7 +183,7 @@ private slots:
         QTemporaryDir dir;
         const QString exported = dir.filePath("changes.ply");
         QVERIFY(window.files()->exportEntity(insidePart.id, exported));
-        const PointCloud readBack = io::readPointCloud(registry.formats, exported.toStdString());
+        const PointCloud readBack = io::readPointCloud(workbench.registry.formats, exported.toStdString());
         QCOMPARE(readBack.size(), inside);
         QVERIFY(readBack.field("c2c_dx"));
         QCOMPARE(readBack.field("c2c_distance")->values(), insidePart.points().field("c2c_distance")->values());
@@ -214,16 +225,15 @@ private slots:
 
     void processingToolsFromTheMenusDeclarations()
     {
-        const PluginRegistry registry = makePluginRegistry();
-        gui::MainWindow window(registry);
-        window.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
         QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
         const EntityId reference = window.document().ids()[0], compared = window.document().ids()[1];
         const std::size_t points = window.document().item(reference).points().size();
 
         // Every tool has its menu entry, under its category.
-        for (const ToolSpec& tool : registry.tools.tools())
+        for (const ToolSpec& tool : workbench.registry.tools.tools())
             QVERIFY2(window.toolController(tool.name), tool.name.c_str());
 
         // Normals: the entity in the view is replaced by the same points with normals.
@@ -272,10 +282,9 @@ private slots:
 
     void pickingShowsEveryFieldOfThePoint()
     {
-        const PluginRegistry registry = makePluginRegistry();
-        gui::MainWindow window(registry);
-        window.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
         QCOMPARE(window.openFiles({kReference}, true), 1);
         const EntityId id = window.document().ids().front();
         window.view()->setStandardView(gui::StandardView::Top);
@@ -293,10 +302,9 @@ private slots:
 
     void segmentTheChangesAndExportTheRegions()
     {
-        const PluginRegistry registry = makePluginRegistry();
-        gui::MainWindow window(registry);
-        window.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
         QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
         const EntityId reference = window.document().ids()[0], compared = window.document().ids()[1];
         QVERIFY(window.distances()->runCloudToCloud(compared, reference, {}));
@@ -353,7 +361,7 @@ private slots:
         QFile csv(dir.filePath("regions.csv"));
         QVERIFY(csv.open(QIODevice::ReadOnly));
         QCOMPARE(QString(csv.readAll()).trimmed().split('\n').size(), 3); // header + two regions
-        const PointCloud all = io::readPointCloud(registry.formats, dir.filePath("regions.ply").toStdString());
+        const PointCloud all = io::readPointCloud(workbench.registry.formats, dir.filePath("regions.ply").toStdString());
         QCOMPARE(all.size(), report[0].pointCount + report[1].pointCount);
         QVERIFY(all.field("region_id"));
         // The DXF holds outlines and labels; with the points option, one POINT
@@ -376,10 +384,9 @@ private slots:
 
     void dropRecentAndDecimation()
     {
-        const PluginRegistry registry = makePluginRegistry();
-        gui::MainWindow window(registry);
-        window.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
         // A file dropped on the window opens, and joins the recent files.
         auto* mime = new QMimeData;
         mime->setUrls({QUrl::fromLocalFile(kReference)});
@@ -402,10 +409,9 @@ private slots:
 
     void quittingAsksAboutUnsavedWork()
     {
-        const PluginRegistry registry = makePluginRegistry();
-        gui::MainWindow window(registry);
-        window.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
         // Answers the question with `button` when it comes, and notes what it said.
         QString asked;
         auto answerWith = [&](QMessageBox::StandardButton button) {
@@ -448,10 +454,9 @@ private slots:
 
     void measuringDistancesAnglesAndAreas()
     {
-        const PluginRegistry registry = makePluginRegistry();
-        gui::MainWindow window(registry);
-        window.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
         QCOMPARE(window.openFiles({kReference}, true), 1);
         const EntityId id = window.document().ids().front();
         const PointCloud& cloud = window.document().item(id).points();
@@ -500,10 +505,9 @@ private slots:
 
     void scissorsCutWhatIsShownInsideThePolygon()
     {
-        const PluginRegistry registry = makePluginRegistry();
-        gui::MainWindow window(registry);
-        window.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
         QCOMPARE(window.openFiles({kCompared}, true), 1);
         const EntityId id = window.document().ids().front();
         window.view()->setStandardView(gui::StandardView::Iso);
@@ -560,10 +564,9 @@ private slots:
 
     void pointSizesShadingAndBackground()
     {
-        const PluginRegistry registry = makePluginRegistry();
-        gui::MainWindow window(registry);
-        window.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
         QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
         const EntityId a = window.document().ids()[0], b = window.document().ids()[1];
         // An entity with its own point size keeps it when the view's changes.
@@ -632,10 +635,9 @@ private slots:
 
     void aLocalCloudBesideGeoreferencedOnesKeepsItsPrecision()
     {
-        const PluginRegistry registry = makePluginRegistry();
-        gui::MainWindow window(registry);
-        window.show();
-        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
         // The trial's mix: a UTM scan first, then a local one 5.4e6 m away, whose
         // 1 mm steps float32 cannot hold at that distance (0.5 m apart there).
         PointCloud utm;

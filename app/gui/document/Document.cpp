@@ -84,6 +84,15 @@ const Document::Item* Document::find(EntityId id) const
 
 Document::Item* Document::findMutable(EntityId id) { return const_cast<Item*>(find(id)); }
 
+template <class Value> void Document::setDisplayMember(EntityId id, Value DisplayState::*member, const Value& value)
+{
+    Item* item = findMutable(id);
+    if (!item || item->display.*member == value)
+        return;
+    item->display.*member = value;
+    emit displayChanged(id);
+}
+
 const Document::Item& Document::item(EntityId id) const
 {
     const Item* item = find(id);
@@ -184,11 +193,7 @@ void Document::addField(EntityId id, ScalarField field)
 
 void Document::setVisible(EntityId id, bool visible)
 {
-    Item* item = findMutable(id);
-    if (!item || item->display.visible == visible)
-        return;
-    item->display.visible = visible;
-    emit displayChanged(id);
+    setDisplayMember(id, &DisplayState::visible, visible);
 }
 
 void Document::setActiveField(EntityId id, const std::string& fieldName)
@@ -213,29 +218,17 @@ void Document::setFieldDisplay(EntityId id, const std::string& fieldName, const 
 
 void Document::setOutsideMode(EntityId id, FieldColouring::Outside mode)
 {
-    Item* item = findMutable(id);
-    if (!item || item->display.outside == mode)
-        return;
-    item->display.outside = mode;
-    emit displayChanged(id);
+    setDisplayMember(id, &DisplayState::outside, mode);
 }
 
 void Document::setNeutral(EntityId id, bool neutral)
 {
-    Item* item = findMutable(id);
-    if (!item || item->display.neutral == neutral)
-        return;
-    item->display.neutral = neutral;
-    emit displayChanged(id);
+    setDisplayMember(id, &DisplayState::neutral, neutral);
 }
 
 void Document::setPointSize(EntityId id, float pixels)
 {
-    Item* item = findMutable(id);
-    if (!item || item->display.pointSize == pixels)
-        return;
-    item->display.pointSize = pixels;
-    emit displayChanged(id);
+    setDisplayMember(id, &DisplayState::pointSize, pixels);
 }
 
 FieldDisplay Document::fieldDisplay(EntityId id, const std::string& fieldName) const

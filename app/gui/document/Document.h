@@ -146,6 +146,8 @@ signals:
 
 private:
     Item* findMutable(EntityId id);
+    //! Sets one member of an entity's display state; signals only a real change.
+    template <class Value> void setDisplayMember(EntityId id, Value DisplayState::*member, const Value& value);
     void removeWithoutUndo(EntityId id, std::vector<std::unique_ptr<Item>>& taken);
     enum class UndoKind { None, Removal, Replacement, Field };
     struct UndoStep
