@@ -189,6 +189,10 @@ void MainWindow::buildMenus()
     };
     connect(&document_, &Document::undoChanged, undo, followUndo);
     followUndo();
+    QAction* extract = edit->addAction(tr("Extract inside the clipping box"), this, [this] { splits_->extractInBox(view_->clippingBox()); });
+    extract->setObjectName("extractInBoxAction");
+    extract->setEnabled(false);
+    connect(view_, &CloudView::clippingBoxChanged, extract, &QAction::setEnabled);
     edit->addSeparator();
     edit->addAction(tr("&Delete selected"), this, [this] {
         for (EntityId id : tree_->selectedEntities(false))
@@ -249,6 +253,13 @@ void MainWindow::buildMenus()
         splits_->cutWithPolygon(polygon, projection, [this](EntityId id, std::size_t i) { return view_->isPointShown(id, i); });
     });
     viewBar->addAction(scissors);
+    QAction* clipping = viewMenu->addAction(tr("&Clipping box"));
+    clipping->setObjectName("clippingAction");
+    clipping->setCheckable(true);
+    clipping->setToolTip(tr("A box with handles: only what is inside is drawn; Edit > Extract inside the clipping box cuts it out"));
+    connect(clipping, &QAction::toggled, view_, [this](bool on) { view_->setClippingBox(on); });
+    connect(view_, &CloudView::clippingBoxChanged, clipping, &QAction::setChecked);
+    viewBar->addAction(clipping);
     QAction* measure = viewMenu->addAction(tr("&Measure"));
     measure->setObjectName("measureAction");
     measure->setCheckable(true);

@@ -67,6 +67,22 @@ std::pair<EntityId, EntityId> SplitController::split(EntityId id, const std::str
 int SplitController::cutWithPolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Matrix4d& globalToPixels,
                                     const std::function<bool(EntityId, std::size_t)>& shown)
 {
+    return cutVisibleClouds(tr("segment by polygon"), tr("inside polygon"), tr("outside polygon"), [&](EntityId id, const PointCloud& cloud) {
+        std::vector<std::size_t> inside = pointsInScreenPolygon(cloud, globalToPixels, polygon);
+        inside.erase(std::remove_if(inside.begin(), inside.end(), [&](std::size_t i) { return !shown(id, i); }), inside.end());
+        return inside;
+    });
+}
+
+int SplitController::extractInBox(const CropBox& box)
+{
+    return cutVisibleClouds(tr("extract in the clipping box"), tr("in box"), tr("outside box"),
+                            [&](EntityId, const PointCloud& cloud) { return pointsInBox(cloud, box); });
+}
+
+int SplitController::cutVisibleClouds(const QString& what, const QString& insideName, const QString& outsideName,
+                                      const std::function<std::vector<std::size_t>(EntityId, const PointCloud&)>& select)
+{
     int cut = 0;
     EntityId lastInside = kNoEntity;
     for (EntityId id : document_.ids()) {
@@ -75,12 +91,11 @@ int SplitController::cutWithPolygon(const std::vector<Eigen::Vector2d>& polygon,
             continue;
         std::vector<std::size_t> inside;
         try {
-            inside = pointsInScreenPolygon(*item->cloud(), globalToPixels, polygon);
+            inside = select(id, *item->cloud());
         } catch (const Error& e) {
             emit failed(QString::fromStdString(e.what()));
             return cut;
         }
-        inside.erase(std::remove_if(inside.begin(), inside.end(), [&](std::size_t i) { return !shown(id, i); }), inside.end());
         if (inside.empty())
             continue;
         const std::vector<std::size_t> outside = complementOf(inside, item->cloud()->size());
@@ -95,19 +110,19 @@ int SplitController::cutWithPolygon(const std::vector<Eigen::Vector2d>& polygon,
             document_.setOutsideMode(part, display.outside);
             document_.setNeutral(part, display.neutral);
         };
-        lastInside = document_.add(name + tr(" (inside polygon)"), std::move(insidePart), id);
+        lastInside = document_.add(QString("%1 (%2)").arg(name, insideName), std::move(insidePart), id);
         dress(lastInside);
         if (!outside.empty()) {
-            const EntityId rest = document_.add(name + tr(" (outside polygon)"), std::move(outsidePart), id);
+            const EntityId rest = document_.add(QString("%1 (%2)").arg(name, outsideName), std::move(outsidePart), id);
             dress(rest);
             document_.setVisible(rest, false);
         }
         document_.setVisible(id, false);
-        emit finished(tr("segment by polygon %1: %2 points inside, %3 outside").arg(name).arg(inside.size()).arg(outside.size()));
+        emit finished(tr("%1 %2: %3 points inside, %4 outside").arg(what, name).arg(inside.size()).arg(outside.size()));
         ++cut;
     }
     if (cut == 0)
-        emit failed(tr("segment by polygon: no shown point lies inside the polygon"));
+        emit failed(tr("%1: no shown cloud has a point inside").arg(what));
     else
         emit resultReady(lastInside);
     return cut;

@@ -5,6 +5,8 @@
 
 #include "document/Document.h"
 
+#include <scandiff/core/processing/CloudEditing.h>
+
 #include <Eigen/Core>
 
 #include <functional>
@@ -34,12 +36,21 @@ public:
     int cutWithPolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Matrix4d& globalToPixels,
                        const std::function<bool(EntityId, std::size_t)>& shown);
 
+    //! The clipping box's "Extract inside": every visible cloud's points in
+    //! `box` (global coordinates) become a cloud under it, the rest another,
+    //! unticked; the cloud is hidden. Returns how many clouds were cut.
+    int extractInBox(const CropBox& box);
+
 signals:
     void finished(const QString& summary);
     void failed(const QString& message);
     void resultReady(EntityId id);
 
 private:
+    //! What both cuts share: `select` picks each visible cloud's inside points.
+    int cutVisibleClouds(const QString& what, const QString& insideName, const QString& outsideName,
+                         const std::function<std::vector<std::size_t>(EntityId, const PointCloud&)>& select);
+
     Document& document_;
 };
 

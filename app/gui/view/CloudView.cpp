@@ -25,6 +25,11 @@
 #include <vtkTextActor.h>
 #include <vtkOpenGLRenderer.h>
 #include <vtkRenderStepsPass.h>
+#include <vtkBoxRepresentation.h>
+#include <vtkBoxWidget2.h>
+#include <vtkPlane.h>
+#include <vtkPlanes.h>
+#include <vtkTransform.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkPointData.h>
@@ -140,6 +145,9 @@ struct CloudView::Scene
     vtkNew<vtkActor> annotationActor;
     std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels;
     bool eyeDomeLighting = false;
+    vtkNew<vtkBoxWidget2> clipWidget;
+    vtkNew<vtkBoxRepresentation> clipBox;
+    bool clipping = false;
     // The scale bar: a line of a round length (1, 2 or 5 x 10^k m) about a
     // fifth of the view wide, its length written above it, sized before each
     // frame from the camera (at the focal point's depth in perspective).
@@ -352,6 +360,8 @@ void CloudView::addEntity(const Document::Item& item)
     }
     updateStride();
     refreshEntity(item);
+    if (scene_->clipping)
+        applyClipping();
 }
 
 void CloudView::refreshEntity(const Document::Item& item)
@@ -568,6 +578,112 @@ void CloudView::setAnnotations(const std::vector<Annotation>& annotations)
     renderSoon();
 }
 
+void CloudView::setClippingBox(bool on)
+{
+    if (on == scene_->clipping)
+        return;
+    scene_->clipping = on;
+    if (on) {
+        if (!scene_->clipWidget->GetInteractor()) { // first use (GetRepresentation would make a default one)
+            scene_->clipBox->SetPlaceFactor(1.0);
+            scene_->clipBox->HandlesOn();
+            scene_->clipWidget->SetInteractor(widget_->interactor());
+            scene_->clipWidget->SetDefaultRenderer(scene_->renderer);
+            scene_->clipWidget->SetRepresentation(scene_->clipBox);
+            auto moved = vtkSmartPointer<vtkCallbackCommand>::New();
+            moved->SetClientData(this);
+            moved->SetCallback([](vtkObject*, unsigned long, void* self, void*) { static_cast<CloudView*>(self)->applyClipping(); });
+            scene_->clipWidget->AddObserver(vtkCommand::InteractionEvent, moved);
+        }
+        // Around what is shown.
+        double bounds[6];
+        scene_->renderer->ComputeVisiblePropBounds(bounds);
+        if (bounds[0] <= bounds[1])
+            scene_->clipBox->PlaceWidget(bounds);
+        scene_->clipWidget->On();
+    } else {
+        scene_->clipWidget->Off();
+    }
+    applyClipping();
+    emit clippingBoxChanged(on);
+}
+
+bool CloudView::clippingBoxOn() const { return scene_->clipping; }
+
+void CloudView::setClippingBox(const CropBox& box)
+{
+    // The representation is placed axis-aligned, then turned and moved by its transform.
+    const Eigen::Vector3d origin = scene_->sceneOrigin.value_or(Eigen::Vector3d::Zero());
+    const Eigen::Vector3d half = box.size / 2;
+    double bounds[6] = {-half.x(), half.x(), -half.y(), half.y(), -half.z(), half.z()};
+    scene_->clipBox->PlaceWidget(bounds);
+    vtkNew<vtkTransform> transform;
+    vtkNew<vtkMatrix4x4> matrix;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c)
+            matrix->SetElement(r, c, box.rotation(r, c));
+        matrix->SetElement(r, 3, box.centre[r] - origin[r]);
+    }
+    transform->SetMatrix(matrix);
+    scene_->clipBox->SetTransform(transform);
+    applyClipping();
+}
+
+CropBox CloudView::clippingBox() const
+{
+    // The box's corners in the scene: an axis-aligned box turned and moved, so
+    // its centre and edges give back the centre, the sizes and the rotation.
+    vtkPolyData* outline = vtkPolyData::New();
+    scene_->clipBox->GetPolyData(outline); // 8 corners first, then face centres and the middle
+    auto corner = [&](int i) {
+        double p[3];
+        outline->GetPoint(i, p);
+        return Eigen::Vector3d(p[0], p[1], p[2]);
+    };
+    // vtkBoxRepresentation numbers its corners as a hexahedron: 0-1 along x, 0-3 along y, 0-4 along z.
+    const Eigen::Vector3d c0 = corner(0), ex = corner(1) - c0, ey = corner(3) - c0, ez = corner(4) - c0;
+    outline->Delete();
+    CropBox box;
+    box.size = {ex.norm(), ey.norm(), ez.norm()};
+    box.centre = c0 + (ex + ey + ez) / 2 + scene_->sceneOrigin.value_or(Eigen::Vector3d::Zero());
+    for (int a = 0; a < 3; ++a) {
+        const Eigen::Vector3d edge = a == 0 ? ex : a == 1 ? ey : ez;
+        box.rotation.col(a) = edge.norm() > 0 ? Eigen::Vector3d(edge.normalized()) : Eigen::Vector3d::Unit(a);
+    }
+    return box;
+}
+
+void CloudView::applyClipping()
+{
+    vtkNew<vtkPlanes> planes;
+    if (scene_->clipping)
+        scene_->clipBox->GetPlanes(planes);
+    for (auto& [id, s] : scene_->shown)
+        for (auto& c : s.chunks)
+            for (vtkPolyDataMapper* mapper : {c.fullMapper.Get(), c.decimatedMapper.Get()}) {
+                if (!mapper)
+                    continue;
+                // The planes are in the scene's frame; a chunk's points sit at its actor's offset.
+                mapper->RemoveAllClippingPlanes();
+                if (!scene_->clipping)
+                    continue;
+                double offset[3];
+                c.actor->GetPosition(offset);
+                for (int k = 0; k < planes->GetNumberOfPlanes(); ++k) {
+                    vtkPlane* plane = planes->GetPlane(k);
+                    double origin[3], normal[3];
+                    plane->GetOrigin(origin);
+                    plane->GetNormal(normal);
+                    vtkNew<vtkPlane> local;
+                    local->SetOrigin(origin[0] - offset[0], origin[1] - offset[1], origin[2] - offset[2]);
+                    // The box's faces face outwards; a mapper keeps the side a plane faces.
+                    local->SetNormal(-normal[0], -normal[1], -normal[2]);
+                    mapper->AddClippingPlane(local);
+                }
+            }
+    render();
+}
+
 void CloudView::setEyeDomeLighting(bool on)
 {
     scene_->eyeDomeLighting = on;
@@ -780,6 +896,7 @@ void CloudView::setDecimated(Shown& s, bool moving)
             c.decimatedMapper->SetInputData(c.decimated);
             c.decimatedMapper->SetColorModeToDirectScalars();
             c.decimatedMapper->ScalarVisibilityOn();
+            c.decimatedMapper->SetClippingPlanes(c.fullMapper->GetClippingPlanes()); // the clipping box holds for it too
             c.decimatedStride = scene_->stride;
         }
         c.actor->SetMapper(decimate ? c.decimatedMapper.Get() : c.fullMapper.Get());

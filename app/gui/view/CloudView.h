@@ -10,6 +10,8 @@
 #include "document/Document.h"
 #include "view/EntityColouring.h"
 
+#include <scandiff/core/processing/CloudEditing.h>
+
 #include <QSurfaceFormat>
 #include <QColor>
 #include <QWidget>
@@ -120,6 +122,14 @@ public:
     //! Global coordinates (homogeneous) to widget pixels (x right, y down),
     //! before the division by w: what the camera shows where.
     Eigen::Matrix4d globalToWidgetPixels() const;
+    //! The clipping box (CloudCompare's): a box with handles to move, turn and
+    //! resize, drawn around the shown clouds when switched on; only what is
+    //! inside it is drawn. Its place, in global coordinates, is what
+    //! "Extract inside" cuts with.
+    void setClippingBox(bool on);
+    bool clippingBoxOn() const;
+    void setClippingBox(const CropBox& box);
+    CropBox clippingBox() const;
     //! Whether a point of a shown cloud is drawn (not hidden by its thresholds).
     bool isPointShown(EntityId id, std::size_t index) const;
 
@@ -142,6 +152,7 @@ signals:
     void pointPicked(EntityId id, std::size_t index);
     void pickModeChanged(bool on);
     void scissorsModeChanged(bool on);
+    void clippingBoxChanged(bool on);
     //! A closed polygon in widget pixels and the projection it was drawn with.
     void polygonDrawn(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Matrix4d& globalToPixels);
     //! The view changed these itself (a session restored them): menus follow.
@@ -154,6 +165,8 @@ private:
     static constexpr std::size_t kChunkPoints = 1u << 18;
     void updateStride();
     void updateScaleBar();
+    //! Clips every chunk's mappers to the box's six faces (or none).
+    void applyClipping();
     void setDecimated(Shown& shown, bool moving);
     QTimer* settleTimer_ = nullptr;
     bool pickAtDevicePixel(int x, int y);
