@@ -31,6 +31,7 @@
 #include <QPushButton>
 #include <QSettings>
 #include <QStatusBar>
+#include <QTimer>
 #include <QToolBar>
 
 #include <set>
@@ -249,8 +250,11 @@ void MainWindow::buildMenus()
     scissors->setToolTip(tr("Left clicks draw a polygon, a right click closes it: what is shown inside becomes a cloud of its own"));
     connect(scissors, &QAction::toggled, view_, &CloudView::setScissorsMode);
     connect(view_, &CloudView::scissorsModeChanged, scissors, &QAction::setChecked);
+    // Deferred: the cut changes the document, which must not happen inside VTK's mouse event.
     connect(view_, &CloudView::polygonDrawn, this, [this](const std::vector<Eigen::Vector2d>& polygon, const Eigen::Matrix4d& projection) {
-        splits_->cutWithPolygon(polygon, projection, [this](EntityId id, std::size_t i) { return view_->isPointShown(id, i); });
+        QTimer::singleShot(0, this, [this, polygon, projection] {
+            splits_->cutWithPolygon(polygon, projection, [this](EntityId id, std::size_t i) { return view_->isPointShown(id, i); });
+        });
     });
     viewBar->addAction(scissors);
     QAction* clipping = viewMenu->addAction(tr("&Clipping box"));
@@ -368,7 +372,12 @@ void MainWindow::buildMenus()
     tree_->addAction(pointSize);
     QAction* remove = new QAction(tr("Delete"), tree_);
     connect(remove, &QAction::triggered, this, [this] {
-        for (EntityId id : tree_->selectedEntities(false))
+        const std::vector<EntityId> ids = tree_->selectedEntities(false);
+        // One Ctrl+Z brings back everything this deletion took.
+        const Document::UndoGroup group(document_, ids.size() == 1 && document_.find(ids.front())
+                                                       ? tr("delete '%1'").arg(document_.item(ids.front()).name)
+                                                       : tr("delete of %1 entities").arg(ids.size()));
+        for (EntityId id : ids)
             document_.remove(id);
     });
     tree_->addAction(remove);

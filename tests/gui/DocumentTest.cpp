@@ -40,6 +40,17 @@ PointCloud fourPoints()
 
 } // namespace
 
+//! Whether `f` throws (anything).
+template <class F> bool throwsAnything(F&& f)
+{
+    try {
+        f();
+    } catch (...) {
+        return true;
+    }
+    return false;
+}
+
 class DocumentTest : public QObject
 {
     Q_OBJECT
@@ -241,6 +252,26 @@ private slots:
         document.addField(parent, ScalarField("extra", 4));
         document.undo();
         QVERIFY(!document.item(parent).points().field("extra"));
+        // A group (a deletion of several entities, a tool's outputs) is undone as one.
+        const EntityId third = document.add("third", fourPoints());
+        {
+            const gui::Document::UndoGroup group(document, "delete of 2 entities");
+            document.remove(child);
+            document.remove(third);
+        }
+        QCOMPARE(document.undoText(), QString("Undo delete of 2 entities"));
+        document.undo();
+        QVERIFY(document.contains(child) && document.contains(third));
+        // Undoing a change keeps what the user set on the display since.
+        PointCloud changed = fourPoints();
+        document.replaceData(parent, std::move(changed));
+        document.setVisible(parent, false);
+        document.undo();
+        QVERIFY(!document.item(parent).display.visible);
+        // A field that cannot be added (wrong size) leaves the undo step as it was.
+        document.addField(parent, ScalarField("kept", 4));
+        QVERIFY(throwsAnything([&] { document.addField(parent, ScalarField("bad", 3)); }));
+        QCOMPARE(document.undoText(), QString("Undo field kept of 'four'"));
         // Opening a session (clear) forgets it.
         document.remove(child);
         document.clear();

@@ -221,6 +221,9 @@ private slots:
         QVERIFY(!form->isShown("connectivity"));
         qobject_cast<QCheckBox*>(form->editor("components"))->setChecked(true);
         QVERIFY(form->isShown("connectivity") && form->isShown("min-points"));
+        qobject_cast<QCheckBox*>(form->editor("components"))->setChecked(false);
+        QVERIFY(form->isShown("min-points")); // the single region and the propagation use it too
+        qobject_cast<QCheckBox*>(form->editor("components"))->setChecked(true);
         QVERIFY(!form->isShown("alpha"));
         qobject_cast<QCheckBox*>(form->editor("propagate"))->setChecked(true);
         QVERIFY(form->isShown("alpha") && !method->isVisibleTo(&dialog) && !form->isShown("stat-test"));

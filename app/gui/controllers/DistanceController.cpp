@@ -139,6 +139,7 @@ bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId reference
         return false;
     }
     const double seconds = clock.elapsed() / 1000.0;
+    const Document::UndoGroup group(document_, tr("C2C"));
     CloudToCloudResult& forward = run->forward;
     for (auto* extra : {&forward.dx, &forward.dy, &forward.dz, &forward.visibility})
         if (*extra)
@@ -183,6 +184,7 @@ bool DistanceController::runCloudToMesh(EntityId comparedId, EntityId referenceI
     }
     const double seconds = clock.elapsed() / 1000.0;
     const DistanceStatistics statistics = result->statistics;
+    const Document::UndoGroup group(document_, tr("C2M"));
     document_.addField(comparedId, std::move(result->distance));
     showReference(referenceId, false);
     emit finished(tr("C2M %1 -> %2 [%3] %4; %5 degenerate triangles; %6 s")

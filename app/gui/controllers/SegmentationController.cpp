@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <utility>
 
 namespace scandiff::gui {
 
@@ -139,10 +140,10 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
         emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("Segmentation was cancelled") : outcome.error);
         return false;
     }
-    // A new run replaces the regions of the previous one.
-    for (EntityId old : regionEntities_[inputId])
+    // A new run replaces the regions of the previous one (a copy: removing
+    // them updates regionEntities_ through the document's signal).
+    for (EntityId old : std::exchange(regionEntities_[inputId], {}))
         document_.remove(old);
-    regionEntities_[inputId].clear();
     const std::string summary = run->summary;
     std::vector<ScalarField> fields = std::move(run->fields);
     // region_id last: it becomes the active field, coloured by region.
@@ -182,6 +183,9 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
     reports_[inputId] = std::move(report);
     distanceFields_[inputId] = distanceField;
     document_.setActiveField(inputId, "region_id");
+    // The regions, report and export state live here; bringing back the
+    // previous fields alone would leave them describing this run.
+    document_.forgetUndo();
     emit finished(tr("segment %1 [%2]: %3; %4 s")
                       .arg(input->name, commandLineText(parameters), QString::fromStdString(summary))
                       .arg(clock.elapsed() / 1000.0, 0, 'f', 3));

@@ -134,6 +134,7 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
     const double seconds = clock.elapsed() / 1000.0;
 
     QString notes;
+    const Document::UndoGroup group(document_, title);
     EntityId last = kNoEntity;
     bool addedEntities = false, updatedInputs = false;
     NamedTables tables;

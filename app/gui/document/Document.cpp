@@ -143,8 +143,7 @@ void Document::replaceData(EntityId id, io::Entity entity)
         item->entity = std::move(entity);
     }
     step.previousData = std::move(previous);
-    if (!undoing_)
-        remember(std::move(step));
+    remember(std::move(step));
     const auto& fields = item->points().fields();
     const auto has = [&](const std::string& name) {
         return std::any_of(fields.begin(), fields.end(), [&](const ScalarField& f) { return f.name() == name; });
@@ -171,18 +170,16 @@ void Document::addField(EntityId id, ScalarField field)
     if (!cloud)
         return;
     const std::string name = field.name();
-    if (!undoing_) {
-        UndoStep step;
-        step.kind = UndoKind::Field;
-        step.name = item->name;
-        step.id = id;
-        step.fieldName = name;
-        step.previousDisplay = item->display;
-        if (const ScalarField* previous = cloud->field(name))
-            step.previousField = *previous;
-        remember(std::move(step));
-    }
-    cloud->addField(std::move(field));
+    UndoStep step;
+    step.kind = UndoKind::Field;
+    step.name = item->name;
+    step.id = id;
+    step.fieldName = name;
+    step.previousDisplay = item->display;
+    if (const ScalarField* previous = cloud->field(name))
+        step.previousField = *previous;
+    cloud->addField(std::move(field)); // may throw (a size mismatch): nothing is remembered then
+    remember(std::move(step));
     item->unsaved = true;
     // A recomputed field starts again from its full range.
     item->display.fields.erase(name);
@@ -269,18 +266,55 @@ void Document::markAllSaved()
         item->unsaved = false;
 }
 
+Document::UndoGroup::UndoGroup(Document& document, QString text) : document_(document)
+{
+    if (document_.groupDepth_++ == 0) {
+        document_.undo_.clear();
+        document_.groupText_ = std::move(text);
+        emit document_.undoChanged();
+    }
+}
+
+Document::UndoGroup::~UndoGroup()
+{
+    if (--document_.groupDepth_ == 0) {
+        if (document_.undo_.empty())
+            document_.groupText_.clear();
+        emit document_.undoChanged();
+    }
+}
+
 void Document::remember(UndoStep step)
 {
-    undo_ = std::move(step);
+    if (undoing_)
+        return;
+    if (groupDepth_ == 0) {
+        undo_.clear();
+        groupText_.clear();
+    }
+    if (step.kind != UndoKind::None)
+        undo_.push_back(std::move(step));
+    emit undoChanged();
+}
+
+void Document::forgetUndo()
+{
+    undo_.clear();
+    groupText_.clear();
     emit undoChanged();
 }
 
 QString Document::undoText() const
 {
-    switch (undo_.kind) {
-    case UndoKind::Removal: return tr("Undo delete '%1'").arg(undo_.name);
-    case UndoKind::Replacement: return tr("Undo the change of '%1'").arg(undo_.name);
-    case UndoKind::Field: return tr("Undo field %1 of '%2'").arg(QString::fromStdString(undo_.fieldName), undo_.name);
+    if (undo_.empty())
+        return tr("Undo");
+    if (!groupText_.isEmpty())
+        return tr("Undo %1").arg(groupText_);
+    const UndoStep& step = undo_.back();
+    switch (step.kind) {
+    case UndoKind::Removal: return tr("Undo delete '%1'").arg(step.name);
+    case UndoKind::Replacement: return tr("Undo the change of '%1'").arg(step.name);
+    case UndoKind::Field: return tr("Undo field %1 of '%2'").arg(QString::fromStdString(step.fieldName), step.name);
     case UndoKind::None: break;
     }
     return tr("Undo");
@@ -288,9 +322,18 @@ QString Document::undoText() const
 
 void Document::undo()
 {
-    UndoStep step = std::move(undo_);
-    undo_ = {};
+    std::vector<UndoStep> steps = std::move(undo_);
+    undo_.clear();
+    groupText_.clear();
     undoing_ = true;
+    for (auto it = steps.rbegin(); it != steps.rend(); ++it) // newest first
+        undoStep(*it);
+    undoing_ = false;
+    emit undoChanged();
+}
+
+void Document::undoStep(UndoStep& step)
+{
     switch (step.kind) {
     case UndoKind::Removal:
         // Parents first (they were removed last), each with its id, parent and display.
@@ -301,9 +344,16 @@ void Document::undo()
         }
         break;
     case UndoKind::Replacement:
-        if (contains(step.id)) {
+        if (Item* item = findMutable(step.id)) {
+            // The data and the display of its fields come back; visibility,
+            // point size and the like stay as the user has set them since.
+            const bool visible = item->display.visible, neutral = item->display.neutral;
+            const float pointSize = item->display.pointSize;
             replaceData(step.id, std::move(*step.previousData));
-            findMutable(step.id)->display = step.previousDisplay;
+            item->display = step.previousDisplay;
+            item->display.visible = visible;
+            item->display.neutral = neutral;
+            item->display.pointSize = pointSize;
             emit displayChanged(step.id);
         }
         break;
@@ -314,15 +364,21 @@ void Document::undo()
                 cloud.addField(std::move(*step.previousField));
             else
                 cloud.removeField(step.fieldName);
-            item->display = step.previousDisplay;
+            // Only this field's display and the choice of the active field go back.
+            const auto previous = step.previousDisplay.fields.find(step.fieldName);
+            if (previous != step.previousDisplay.fields.end())
+                item->display.fields[step.fieldName] = previous->second;
+            else
+                item->display.fields.erase(step.fieldName);
+            item->display.activeField = step.previousDisplay.activeField;
+            if (!item->display.activeField.empty() && !cloud.field(item->display.activeField))
+                item->display.activeField.clear();
             emit fieldsChanged(step.id);
             emit displayChanged(step.id);
         }
         break;
     case UndoKind::None: break;
     }
-    undoing_ = false;
-    emit undoChanged();
 }
 
 } // namespace scandiff::gui

@@ -120,10 +120,28 @@ public:
     //! edited it), a field added or recomputed. The next such change replaces
     //! it; clear() forgets it. What was undone is restored with its id, place
     //! in the tree and display.
-    bool canUndo() const { return undo_.kind != UndoKind::None; }
+    bool canUndo() const { return !undo_.empty(); }
     //! "Undo delete 'site-2019'", for the menu.
     QString undoText() const;
     void undo();
+    //! Forgets what undo() would do (a controller whose own state would no
+    //! longer match the data it brought back).
+    void forgetUndo();
+
+    //! The changes made while it lives form one undo step named `text` (a
+    //! deletion of several entities, a tool's outputs, a distance run's fields),
+    //! undone together, newest first. Nests: the outermost group counts.
+    class UndoGroup
+    {
+    public:
+        UndoGroup(Document& document, QString text);
+        ~UndoGroup();
+        UndoGroup(const UndoGroup&) = delete;
+        UndoGroup& operator=(const UndoGroup&) = delete;
+
+    private:
+        Document& document_;
+    };
     //! The entities whose work would be lost on quitting, in tree order.
     std::vector<EntityId> unsavedIds() const;
     //! The entity's data is now in a file (exported).
@@ -154,7 +172,7 @@ private:
     {
         UndoKind kind = UndoKind::None;
         QString name;                                //!< the entity's, for the menu
-        std::vector<std::unique_ptr<Item>> removed;  //!< Removal: the entity and its descendants, parents first
+        std::vector<std::unique_ptr<Item>> removed;  //!< Removal: the entity and its descendants, children first
         EntityId id = kNoEntity;                     //!< Replacement, Field
         std::optional<io::Entity> previousData;      //!< Replacement
         DisplayState previousDisplay;                //!< Replacement, Field
@@ -162,7 +180,10 @@ private:
         std::optional<ScalarField> previousField;    //!< Field: the one it replaced, if any
     };
     void remember(UndoStep step);
-    UndoStep undo_;
+    void undoStep(UndoStep& step);
+    std::vector<UndoStep> undo_; //!< one user action: its steps in the order made
+    QString groupText_;          //!< the open group's name, else empty
+    int groupDepth_ = 0;
     bool undoing_ = false;
     // unique_ptr keeps each entity in place while the vector grows: the view and
     // running tools may hold references to it.

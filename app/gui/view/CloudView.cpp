@@ -145,6 +145,7 @@ struct CloudView::Scene
     vtkNew<vtkActor> annotationActor;
     std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels;
     bool eyeDomeLighting = false;
+    vtkSmartPointer<vtkEDLShading> edl;
     vtkNew<vtkBoxWidget2> clipWidget;
     vtkNew<vtkBoxRepresentation> clipBox;
     bool clipping = false;
@@ -284,8 +285,11 @@ void CloudView::addEntity(const Document::Item& item)
     }
     if (points.empty())
         return;
-    if (!scene_->sceneOrigin)
+    if (!scene_->sceneOrigin) {
         scene_->sceneOrigin = points.origin();
+        if (!annotations_.empty())
+            setAnnotations(std::vector<Annotation>(annotations_)); // in the new frame
+    }
     Shown& s = scene_->shown[item.id];
     s.isCloud = item.cloud() != nullptr;
     s.pointCount = points.size();
@@ -448,7 +452,7 @@ void CloudView::clear()
     scene_->sceneOrigin.reset();
     scene_->scalarBar->VisibilityOff();
     legend_ = {};
-    setAnnotations({});
+    setAnnotations(std::vector<Annotation>(annotations_)); // the frame is gone: redrawn once a cloud sets one
     render();
 }
 
@@ -524,6 +528,7 @@ bool CloudView::parallelProjection() const { return scene_->renderer->GetActiveC
 
 void CloudView::setAnnotations(const std::vector<Annotation>& annotations)
 {
+    annotations_ = annotations; // kept global: redrawn if the scene's origin changes
     for (auto& label : scene_->labels)
         scene_->renderer->RemoveActor(label);
     scene_->labels.clear();
@@ -554,6 +559,7 @@ void CloudView::setAnnotations(const std::vector<Annotation>& annotations)
             label->GetTextProperty()->SetColor(1.0, 1.0, 0.6);
             label->GetTextProperty()->SetBackgroundColor(0.1, 0.1, 0.1);
             label->GetTextProperty()->SetBackgroundOpacity(0.7);
+            label->PickableOff();
             scene_->renderer->AddActor(label);
             scene_->labels.push_back(label);
         }
@@ -572,6 +578,8 @@ void CloudView::setAnnotations(const std::vector<Annotation>& annotations)
         scene_->annotationActor->GetProperty()->SetLineWidth(2.5f);
         scene_->annotationActor->GetProperty()->SetPointSize(9.0f);
         scene_->annotationActor->GetProperty()->RenderPointsAsSpheresOn();
+        scene_->annotationActor->PickableOff(); // a click on a measured point picks the cloud's point
+        scene_->annotationActor->UseBoundsOff(); // nor does it count for "zoom to all"
         scene_->renderer->AddActor(scene_->annotationActor);
     }
     scene_->annotations->Modified();
@@ -693,11 +701,14 @@ void CloudView::setEyeDomeLighting(bool on)
     if (on) {
         // The usual steps (opaque, translucent, overlays) rendered through EDL.
         vtkNew<vtkRenderStepsPass> steps;
-        vtkNew<vtkEDLShading> edl;
-        edl->SetDelegatePass(steps);
-        renderer->SetPass(edl);
+        scene_->edl = vtkSmartPointer<vtkEDLShading>::New();
+        scene_->edl->SetDelegatePass(steps);
+        renderer->SetPass(scene_->edl);
     } else {
         renderer->SetPass(nullptr);
+        if (scene_->edl) // its framebuffers go with the GL context it made them in
+            scene_->edl->ReleaseGraphicsResources(scene_->window);
+        scene_->edl = nullptr;
     }
     render();
 }
@@ -980,6 +991,8 @@ bool CloudView::isPointShown(EntityId id, std::size_t index) const
 
 void CloudView::setPickMode(bool on)
 {
+    if (on)
+        setScissorsMode(false); // one use of the left click at a time
     if (scene_->pickMode == on)
         return;
     scene_->pickMode = on;

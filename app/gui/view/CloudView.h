@@ -175,6 +175,7 @@ private:
     std::unique_ptr<Scene> scene_;
     ColourLegend legend_;
     std::size_t annotationCount_ = 0;
+    std::vector<Annotation> annotations_; //!< as given (global coordinates)
 };
 
 } // namespace scandiff::gui

@@ -19,7 +19,7 @@ namespace {
 
 //! The 2.5D volume between the epochs inside the region's footprint (see RegionStatistics::volume).
 void measureVolume(const PointCloud& cloud, const std::vector<std::size_t>& indices, const PointCloud& other,
-                   const RegionReportParams& params, double c, RegionStatistics& r)
+                   const RegionReportParams& params, double c, RegionStatistics& r, const ProgressTicker* ticker)
 {
     // Columns on a horizontal grid anchored at the footprint's box (global X, Y).
     Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -81,22 +81,25 @@ void measureVolume(const PointCloud& cloud, const std::vector<std::size_t>& indi
         if (it != columns.end())
             it->second.other.add(g.z());
     }
-    double added = 0.0, removed = 0.0, coveredArea = 0.0, totalArea = 0.0;
+    // Each column weighs its area inside the footprint; coverage is the share
+    // of the whole footprint's area whose columns both epochs reach.
+    const detail::FootprintCells cells(r.footprint, lo, c);
+    double added = 0.0, removed = 0.0, coveredArea = 0.0;
+    std::size_t visited = 0;
     for (const auto& [key, column] : columns) {
-        // The column's area inside the footprint: whole inside, a part on its edge.
-        const Eigen::Vector2d cellLo = lo + c * Eigen::Vector2d(static_cast<double>(key % nx), static_cast<double>(key / nx));
-        const Eigen::Vector2d cellHi = cellLo + Eigen::Vector2d::Constant(c);
-        double area = 0.0;
-        for (const Polygon2d& ring : r.footprint)
-            area += detail::areaInRectangle(ring, cellLo, cellHi);
-        totalArea += area;
-        if (column.other.count == 0 || area == 0.0)
+        if (++visited % 4096 == 0 && ticker)
+            ticker->checkCancel();
+        if (column.other.count == 0)
+            continue;
+        const double area = cells.areaIn(key % nx, key / nx);
+        if (area == 0.0)
             continue;
         coveredArea += area;
         const double regionHeight = column.region.value(params.columnHeight), otherHeight = column.other.value(params.columnHeight);
         const double rise = params.regionInLaterEpoch ? regionHeight - otherHeight : otherHeight - regionHeight;
         (rise > 0 ? added : removed) += std::abs(rise) * area;
     }
+    const double totalArea = cells.totalArea();
     r.volume = added - removed;
     r.volumeAdded = added;
     r.volumeRemoved = removed;
@@ -236,7 +239,7 @@ std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const Region
         }
 
         if (params.reference)
-            measureVolume(cloud, indices, *params.reference, params, params.volumeCellSize > 0 ? params.volumeCellSize : cell, r);
+            measureVolume(cloud, indices, *params.reference, params, params.volumeCellSize > 0 ? params.volumeCellSize : cell, r, &ticker);
         report.push_back(std::move(r));
     }
     return report;

@@ -83,9 +83,9 @@ const std::vector<ParameterSpec>& segmentationParameters()
             ParameterSpec::choice("connectivity", "Connectivity", "Adjacent cells: faces (6), + edges (18), + corners (26)",
                                   {"6", "18", "26"}, "26")
                 .onlyWith("components"),
+            // Used by every mode (components, propagation, the single region): always shown.
             ParameterSpec::integer("min-points", "Minimum region size", "Smaller regions are dropped",
-                                   static_cast<std::int64_t>(cc.minPoints), 1, 1000000000, "points")
-                .onlyWith("components"),
+                                   static_cast<std::int64_t>(cc.minPoints), 1, 1000000000, "points"),
             ParameterSpec::boolean("propagate", "Front propagation",
                                    "Segment by gradient-constrained fast marching (§3.3) instead of a classification", false),
             ParameterSpec::real("alpha", "Alpha", "propagate: speed exp(alpha (|grad|_j - |grad|_i)) (eq. 3.11)", propagation.alpha,
