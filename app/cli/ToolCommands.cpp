@@ -4,6 +4,7 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/io/AtomicFile.h>
+#include <scandiff/io/DxfWriter.h>
 #include <scandiff/io/ResultFiles.h>
 
 #include <nlohmann/json.hpp>
@@ -26,6 +27,7 @@ const char* kindName(DataKind kind)
     case DataKind::Mesh: return "mesh";
     case DataKind::Table: return "table (CSV)";
     case DataKind::Transform: return "4x4 matrix (text)";
+    case DataKind::Drawing: return "drawing (DXF)";
     }
     return "";
 }
@@ -36,6 +38,8 @@ std::string extensionFor(const OutputSpec& spec, const OutputData& data, const s
         return table->plainNumbers ? ".txt" : ".csv";
     if (spec.kind == DataKind::Transform)
         return ".txt";
+    if (spec.kind == DataKind::Drawing)
+        return ".dxf";
     return cloudExtension;
 }
 
@@ -159,6 +163,8 @@ void emitOutput(const OutputSpec& spec, ToolOutput& output, const std::filesyste
         io::writeMatrix(*matrix, path);
     } else if (path.empty()) {
         return;
+    } else if (const auto* drawing = std::get_if<Drawing>(&output.data)) {
+        io::writeDrawingDxf(*drawing, path);
     } else if (auto* cloud = std::get_if<PointCloud>(&output.data)) {
         Entity* firstInput = nullptr;
         if (spec.updatesInput && !tool.inputs.empty() && loaded.byRole.count(tool.inputs.front().role))

@@ -16,12 +16,16 @@
 #include "view/CloudView.h"
 #include "view/EntityColouring.h"
 
+#include <scandiff/core/Error.h>
+#include <scandiff/io/DxfWriter.h>
+
 #include <QAction>
 #include <QCloseEvent>
 #include <QColorDialog>
 #include <QActionGroup>
 #include <QApplication>
 #include <QDockWidget>
+#include <QFileDialog>
 #include <QDragEnterEvent>
 #include <QDropEvent>
 #include <QInputDialog>
@@ -413,6 +417,17 @@ void MainWindow::buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu)
         connect(controller, &ToolController::tablesReady, this, [this](const QString& title, const NamedTables& tables) {
             auto* window = new TableDialog(title, tables, this);
             window->show();
+        });
+        connect(controller, &ToolController::drawingReady, this, [this](const QString& title, const Drawing& drawing) {
+            const QString path = QFileDialog::getSaveFileName(this, tr("Save %1 as DXF").arg(title), "sections.dxf", tr("DXF drawing (*.dxf)"));
+            if (path.isEmpty())
+                return;
+            try {
+                io::writeDrawingDxf(drawing, path.toStdString());
+                console_->info(tr("wrote %1 (%2 polylines)").arg(path).arg(drawing.polylines.size()));
+            } catch (const Error& e) {
+                console_->error(QString::fromStdString(e.what()));
+            }
         });
     }
 }

@@ -9,6 +9,8 @@
 
 #include <scandiff/io/DxfWriter.h>
 
+#include <map>
+
 #include "internal/Formats.h"
 
 #include <scandiff/core/Error.h>
@@ -562,5 +564,30 @@ FormatHandler dxfFormat()
 }
 
 } // namespace detail
+
+void writeDrawingDxf(const Drawing& drawing, const std::filesystem::path& path)
+{
+    DxfDrawing dxf;
+    std::map<std::string, int> colours;
+    auto declare = [&](const std::string& layer) {
+        if (colours.count(layer))
+            return;
+        // Six plain AutoCAD colours (red, yellow, green, cyan, blue, magenta) in turn.
+        const int colour = 1 + static_cast<int>(colours.size() % 6);
+        colours[layer] = colour;
+        dxf.addLayer(layer, colour);
+    };
+    for (const DrawingPolyline& line : drawing.polylines) {
+        if (line.points.size() < 2)
+            continue;
+        declare(line.layer);
+        dxf.addPolyline(line.layer, line.points, line.closed);
+    }
+    for (const DrawingText& text : drawing.texts) {
+        declare(text.layer);
+        dxf.addText(text.layer, text.position, text.height, text.text);
+    }
+    dxf.write(path);
+}
 
 } // namespace scandiff::io

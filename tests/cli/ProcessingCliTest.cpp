@@ -5,6 +5,7 @@
 
 #include <scandiff/core/Error.h>
 
+#include "DxfCheck.h"
 #include "TestSupport.h"
 
 #include <Eigen/Geometry>
@@ -145,4 +146,38 @@ TEST(ProcessingCli, MeshThenSampleThenCompare)
     // sample-mesh refuses a point cloud.
     r = test::runCliInProcess(registry, {"sample-mesh", input, "--count", "10"});
     EXPECT_EQ(r.status, 2);
+}
+
+TEST(ProcessingCli, SectionsWriteSlabsATableAndADxfDrawing)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    const auto input = terrain(registry, dir / "t.ply", 3, 0).string();
+    const auto out = dir / "out";
+    std::filesystem::create_directories(out);
+    const test::CliRun r = test::runCliInProcess(
+        registry, {"sections", input, "--axis", "x", "--thickness", "0.2", "--step", "2", "--out-dir", out.string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("sections across x"), std::string::npos) << r.out;
+    // The drawing: a layer per section, closed polylines, as DXF.
+    ASSERT_TRUE(std::filesystem::exists(out / "sections.dxf"));
+    const test::DxfCheck dxf = test::checkDxf(out / "sections.dxf"); // read and audited by ezdxf
+    EXPECT_EQ(dxf.exitStatus, 0);
+    EXPECT_GE(dxf.count("POLYLINE"), 5);
+    for (const char* layer : {"POLYLINE@SECTION_0001", "POLYLINE@SECTION_0005"})
+        EXPECT_GE(dxf.count(layer), 1) << layer;
+    // One slab cloud per section, each exactly the points within 10 cm of its middle.
+    ASSERT_TRUE(std::filesystem::exists(out / "table.csv"));
+    const PointCloud all = io::readPointCloud(registry.formats, input);
+    std::size_t slabs = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(out))
+        if (entry.path().extension() == ".ply") {
+            const PointCloud slab = io::readPointCloud(registry.formats, entry.path());
+            ASSERT_GT(slab.size(), 0u);
+            const double middle = slab.globalPosition(0).x();
+            for (std::size_t i = 0; i < slab.size(); ++i)
+                ASSERT_LT(std::abs(slab.globalPosition(i).x() - middle), 0.2 + 1e-6);
+            ++slabs;
+        }
+    EXPECT_EQ(slabs, 5u); // middles at 0.1, 2.1, 4.1, 6.1, 8.1 m of a 10 m terrain
 }

@@ -239,6 +239,27 @@ private slots:
         QCOMPARE(ranged.values().at("range"), std::string("0.5 1.5"));
     }
 
+    void aDrawingOutputIsOfferedForSaving()
+    {
+        const PluginRegistry registry = makePluginRegistry();
+        gui::Document document;
+        PointCloud block;
+        for (int i = 0; i <= 20; ++i)
+            for (int j = 0; j <= 10; ++j)
+                block.positions().emplace_back(0.1f * i, 0.1f * j, 0.0f);
+        const gui::EntityId id = document.add("block", std::move(block));
+        gui::ToolController controller(*registry.tools.find("sections"), document, nullptr);
+        QSignalSpy drawings(&controller, &gui::ToolController::drawingReady);
+        QSignalSpy tables(&controller, &gui::ToolController::tablesReady);
+        QVERIFY(controller.run(id, {{"axis", "x"}, {"thickness", "0.12"}, {"step", "0.5"}, {"first", "0.25"}}));
+        // The drawing goes to the window (which asks where to save it), the slabs into the tree.
+        QCOMPARE(drawings.count(), 1);
+        const auto drawing = drawings.at(0).at(1).value<scandiff::Drawing>();
+        QCOMPARE(drawing.polylines.size(), std::size_t(4)); // sections at 0.25, 0.75, 1.25, 1.75 m, two columns each
+        QCOMPARE(tables.count(), 1);
+        QCOMPARE(document.size(), std::size_t(1 + 4));
+    }
+
     void alternativesAndRequiredParametersInTheForm()
     {
         const PluginRegistry registry = makePluginRegistry();

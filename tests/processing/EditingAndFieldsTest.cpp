@@ -5,6 +5,7 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/processing/CloudEditing.h>
+#include <scandiff/core/processing/CrossSections.h>
 #include <scandiff/core/processing/FieldOperations.h>
 
 #include <Eigen/Geometry>
@@ -151,6 +152,47 @@ TEST(Crop, ScreenPolygonsEqualBruteForceInTopAndPerspectiveViews)
     perspective(3, 3) = 10 - 100; // the eye below everything, looking the other way: nothing is in front
     EXPECT_TRUE(pointsInScreenPolygon(cloud, perspective, square).empty());
     EXPECT_EQ(test::errorCodeOf([&] { pointsInScreenPolygon(cloud, top, {{0, 0}, {1, 1}}); }), ErrorCode::InvalidArgument);
+}
+
+TEST(CrossSections, SlabsHoldExactlyTheirPointsAndOutlineTheSection)
+{
+    // A solid block 4 x 2 x 1 m sampled every 5 cm, at UTM coordinates.
+    PointCloud block;
+    block.setOrigin({512000, 5403000, 300});
+    for (int i = 0; i <= 80; ++i)
+        for (int j = 0; j <= 40; ++j)
+            for (int k = 0; k <= 20; ++k)
+                block.positions().emplace_back(0.05f * i, 0.05f * j, 0.05f * k);
+    CrossSectionParams params;
+    params.axis = 0;
+    params.thickness = 0.06; // one layer of points per slab
+    params.step = 1.0;
+    params.first = 512000.5;
+    params.last = 512003.5;
+    const std::vector<CrossSection> sections = crossSections(block, params);
+    ASSERT_EQ(sections.size(), 4u);
+    for (std::size_t s = 0; s < sections.size(); ++s) {
+        EXPECT_DOUBLE_EQ(sections[s].position, 512000.5 + static_cast<double>(s));
+        std::vector<std::size_t> expected;
+        for (std::size_t i = 0; i < block.size(); ++i)
+            if (std::abs(block.globalPosition(i).x() - sections[s].position) <= 0.03)
+                expected.push_back(i);
+        ASSERT_EQ(sections[s].indices, expected);
+        EXPECT_EQ(expected.size(), 41u * 21u);
+        // The section of the block: a 2 x 1 m rectangle, in the slab's middle plane.
+        EXPECT_NEAR(sections[s].area, 2.0, 1e-4);
+        ASSERT_EQ(sections[s].outlines.size(), 1u);
+        for (const Eigen::Vector3d& v : sections[s].outlines[0])
+            ASSERT_DOUBLE_EQ(v.x(), sections[s].position);
+    }
+    // Slabs thicker than the step share points; a range of no slab and a bad axis are refused.
+    params.thickness = 1.5;
+    EXPECT_GT(crossSections(block, params)[1].indices.size(), 41u * 21u * 20u);
+    params.axis = 3;
+    EXPECT_EQ(test::errorCodeOf([&] { crossSections(block, params); }), ErrorCode::InvalidArgument);
+    params.axis = 0;
+    params.step = 1e-9;
+    EXPECT_EQ(test::errorCodeOf([&] { crossSections(block, params); }), ErrorCode::InvalidArgument);
 }
 
 TEST(Crop, BoxesAndPolygonsEqualBruteForce)

@@ -138,12 +138,17 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
     EntityId last = kNoEntity;
     bool addedEntities = false, updatedInputs = false;
     NamedTables tables;
+    std::vector<std::pair<QString, Drawing>> drawings;
     for (const OutputSpec& spec : tool_.outputs) {
         std::size_t repeat = 0;
         for (ToolOutput* output : result->findAll(spec.role)) {
             const std::size_t k = repeat++;
             if (auto* table = std::get_if<Table>(&output->data)) {
                 tables.emplace_back(spec.label, std::move(*table));
+                continue;
+            }
+            if (auto* drawing = std::get_if<Drawing>(&output->data)) {
+                drawings.emplace_back(QString::fromStdString(spec.label), std::move(*drawing));
                 continue;
             }
             if (auto* matrix = std::get_if<Eigen::Matrix4d>(&output->data)) {
@@ -172,6 +177,8 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
             document_.setVisible(input, false);
     if (!tables.empty())
         emit tablesReady(title, tables);
+    for (auto& [label, drawing] : drawings)
+        emit drawingReady(title + " - " + label, drawing);
     emit finished(QString("%1 [%2]: %3; %4 s%5")
                       .arg(QString::fromStdString(tool_.name), commandLine(choice, parameters),
                            QString::fromStdString(result->summary))

@@ -106,9 +106,11 @@ void measureVolume(const PointCloud& cloud, const std::vector<std::size_t>& indi
     r.volumeCoverage = totalArea > 0 ? coveredArea / totalArea : 0.0;
 }
 
-//! 1.5 times the median distance of the region's points to their 4th nearest
-//! neighbour: one cell per point spacing and a half, so the sampling leaves few holes.
-double automaticOutlineCell(const std::vector<Eigen::Vector3f>& local, const BoundingBox& bounds)
+} // namespace
+
+// 1.5 times the median distance of the region's points to their 4th nearest
+// neighbour: one cell per point spacing and a half, so the sampling leaves few holes.
+double outlineCellFor(const std::vector<Eigen::Vector3f>& local, const BoundingBox& bounds)
 {
     const octree::Octree tree(local.data(), local.size());
     const std::size_t k = std::min<std::size_t>(5, local.size());
@@ -129,7 +131,6 @@ double automaticOutlineCell(const std::vector<Eigen::Vector3f>& local, const Bou
     return std::max(1e-3, 1e-2 * (bounds.max - bounds.min).norm()); // a single point, or duplicates: some small square
 }
 
-} // namespace
 
 std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const RegionReportParams& params, ProgressObserver* progress)
 {
@@ -190,7 +191,7 @@ std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const Region
         const Eigen::Vector3d u = eigen.eigenvectors().col(2).normalized();
         const Eigen::Vector3d v = r.planeNormal.cross(u);
 
-        const double cell = params.outlineCellSize > 0 ? params.outlineCellSize : automaticOutlineCell(local, r.bounds);
+        const double cell = params.outlineCellSize > 0 ? params.outlineCellSize : outlineCellFor(local, r.bounds);
         r.outlineCellSize = cell;
         std::vector<Eigen::Vector2d> planar;
         planar.reserve(indices.size());

@@ -8,6 +8,7 @@
 //! second copy of any default. Values are checked against their declaration
 //! before the tool runs, so a run function only sees valid parameters.
 
+#include <scandiff/core/Drawing.h>
 #include <scandiff/core/Entity.h>
 #include <scandiff/core/PointCloud.h>
 #include <scandiff/core/Progress.h>
@@ -127,7 +128,7 @@ private:
 
 //! What a tool takes or gives. A Cloud input also accepts a mesh (its
 //! vertices); a Mesh input needs triangles.
-enum class DataKind { Cloud, Mesh, Table, Transform };
+enum class DataKind { Cloud, Mesh, Table, Transform, Drawing };
 
 //! One input of a tool: an entity, or several, playing a role.
 struct InputSpec
@@ -186,7 +187,7 @@ private:
     std::map<std::string, std::vector<Ref>> entities_;
 };
 
-using OutputData = std::variant<PointCloud, Mesh, Table, Eigen::Matrix4d>;
+using OutputData = std::variant<PointCloud, Mesh, Table, Eigen::Matrix4d, Drawing>;
 
 struct ToolOutput
 {

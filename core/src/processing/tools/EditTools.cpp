@@ -1,15 +1,17 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Tools: clone, merge, transform, crop.
+// Tools: clone, merge, transform, crop, cross-sections.
 #include "processing/tools/ToolGroups.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/TextLists.h>
 #include <scandiff/core/processing/CloudEditing.h>
+#include <scandiff/core/processing/CrossSections.h>
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -303,6 +305,69 @@ void addCropTool(ToolRegistry& registry)
     registry.add(std::move(tool));
 }
 
+void addSectionsTool(ToolRegistry& registry)
+{
+    ToolSpec tool = oneCloudTool(
+        "sections", "Cross-sections", "Edit",
+        "Cuts slabs of a given thickness across the cloud, perpendicular to an axis, one every step (CloudCompare's "
+        "cross-sections): each slab's points as a cloud, the outline of each section in its plane as a drawing (DXF), "
+        "and a table of the sections.",
+        OutputSpec{"sections", "Sections", DataKind::Drawing, false});
+    OutputSpec slabs{"slab", "Slab", DataKind::Cloud, false};
+    slabs.repeated = true;
+    tool.outputs.push_back(slabs);
+    tool.outputs.push_back(OutputSpec{"table", "Sections", DataKind::Table, false});
+    const CrossSectionParams defaults;
+    tool.parameters = {
+        ParameterSpec::choice("axis", "Axis", "The slabs are perpendicular to this axis", {"x", "y", "z"}, "x"),
+        ParameterSpec::real("thickness", "Thickness", "Of each slab", defaults.thickness, 1e-9, 1e9, "m").asRequired(),
+        ParameterSpec::real("step", "Step", "Between the slabs' middles", defaults.step, 1e-9, 1e9, "m").asRequired(),
+        ParameterSpec::real("first", "First", "The first slab's middle (global coordinate on the axis); default: the cloud's start",
+                            0.0, -1e12, 1e12, "m")
+            .asOptional(),
+        ParameterSpec::real("last", "Last", "The last slab's middle; default: the cloud's end", 0.0, -1e12, 1e12, "m").asOptional(),
+        ParameterSpec::real("outline-cell", "Outline cell", "Cell of the section outlines", 0.0, 0.0, 1e9, "m")
+            .withZeroMeaning("automatic"),
+    };
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        const PointCloud& input = inputs.cloud();
+        CrossSectionParams params;
+        params.axis = values.text("axis")[0] - 'x';
+        params.thickness = values.real("thickness");
+        params.step = values.real("step");
+        if (values.has("first"))
+            params.first = values.real("first");
+        if (values.has("last"))
+            params.last = values.real("last");
+        params.outlineCell = values.real("outline-cell");
+        const std::vector<CrossSection> sections = crossSections(input, params, progress);
+        ToolResult result;
+        Drawing drawing;
+        Table table;
+        table.columns = {"section", "position", "points", "area", "rings"};
+        for (std::size_t k = 0; k < sections.size(); ++k) {
+            const CrossSection& s = sections[k];
+            char layer[32];
+            std::snprintf(layer, sizeof layer, "SECTION_%04zu", k + 1);
+            for (const auto& ring : s.outlines)
+                drawing.polylines.push_back({layer, ring, true});
+            table.rows.push_back({static_cast<double>(k + 1), s.position, static_cast<double>(s.indices.size()), s.area,
+                                  static_cast<double>(s.outlines.size())});
+        }
+        result.add("sections", std::move(drawing));
+        for (std::size_t k = 0; k < sections.size(); ++k) {
+            PointCloud slab = input.subset(sections[k].indices);
+            slab.name = describe(input.name.empty() ? "section" : input.name, "_section_", k + 1);
+            result.add("slab", std::move(slab));
+        }
+        result.add("table", std::move(table));
+        result.summary = describe(sections.size(), " sections across ", values.text("axis"), " every ", params.step, " m, ",
+                                  params.thickness, " m thick");
+        return result;
+    };
+    registry.add(std::move(tool));
+}
+
 } // namespace
 
 void registerEditTools(ToolRegistry& registry)
@@ -312,6 +377,7 @@ void registerEditTools(ToolRegistry& registry)
     addTransformTool(registry);
     addUndoTransformTool(registry);
     addCropTool(registry);
+    addSectionsTool(registry);
 }
 
 } // namespace scandiff::detail

@@ -11,6 +11,7 @@
 //! '_' only (anything else becomes '_'), at most 31 characters; DXF compares
 //! them without regard to case, so "Points" and "POINTS" are one layer.
 
+#include <scandiff/core/Drawing.h>
 #include <scandiff/core/PointCloud.h>
 #include <scandiff/io/FileIO.h>
 
@@ -63,5 +64,11 @@ private:
     //! The coordinates of every entity, in order: entities keep a range of it.
     std::vector<Eigen::Vector3d> vertices_;
 };
+
+//! Writes a tool's drawing as DXF (R12): each layer in turn one of the six
+//! basic colours, its closed or open polylines as 3D polylines, its texts.
+//! Polylines of fewer than 2 points are skipped. Throws Error(Io), or
+//! Error(InvalidArgument) for non-finite coordinates.
+void writeDrawingDxf(const Drawing& drawing, const std::filesystem::path& path);
 
 } // namespace scandiff::io

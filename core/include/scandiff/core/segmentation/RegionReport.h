@@ -41,6 +41,12 @@ struct Outline2d
 //! coarser cell (with a warning).
 Outline2d concaveOutline(const std::vector<Eigen::Vector2d>& points, double cellSize);
 
+//! The automatic outline cell of points: 1.5 times the median distance of the
+//! points to their 4th nearest neighbour (one cell per point spacing and a
+//! half, so the sampling leaves few holes); `bounds` sizes a fallback for a
+//! lone point or duplicates.
+double outlineCellFor(const std::vector<Eigen::Vector3f>& points, const BoundingBox& bounds);
+
 struct RegionReportParams
 {
     //! Field holding the region id of each point (NaN: no region).
