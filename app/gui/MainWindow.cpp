@@ -34,6 +34,7 @@
 #include <QMimeData>
 #include <QPushButton>
 #include <QSettings>
+#include <QSplitter>
 #include <QStatusBar>
 #include <QTimer>
 #include <QToolBar>
@@ -118,6 +119,10 @@ MainWindow::~MainWindow()
 {
     disconnect(&document_, nullptr, this, nullptr);
     view_->clear();
+    if (secondView_) { // its arrays, too, view the document's points
+        disconnect(&document_, nullptr, secondView_, nullptr);
+        secondView_->clear();
+    }
 }
 
 template <class Controller> void MainWindow::report(Controller* controller)
@@ -268,6 +273,11 @@ void MainWindow::buildMenus()
     connect(clipping, &QAction::toggled, view_, [this](bool on) { view_->setClippingBox(on); });
     connect(view_, &CloudView::clippingBoxChanged, clipping, &QAction::setChecked);
     viewBar->addAction(clipping);
+    QAction* sideBySide = viewMenu->addAction(tr("Second &view, side by side"));
+    sideBySide->setObjectName("sideBySideAction");
+    sideBySide->setCheckable(true);
+    sideBySide->setToolTip(tr("Two views with one camera: the first cloud opened on the left, the others on the right"));
+    connect(sideBySide, &QAction::toggled, this, &MainWindow::setSideBySide);
     QAction* measure = viewMenu->addAction(tr("&Measure"));
     measure->setObjectName("measureAction");
     measure->setCheckable(true);
@@ -466,6 +476,49 @@ void MainWindow::updateRegionExport()
         action->setEnabled(possible);
         action->setToolTip(possible ? QString() : tr("Segment the changes first: the selected cloud has no regions"));
     }
+}
+
+void MainWindow::setSideBySide(bool on)
+{
+    if (on && !secondView_) {
+        // The second view follows the document as the first does, with its camera.
+        secondView_ = new CloudView(this);
+        auto* splitter = new QSplitter(Qt::Horizontal, this);
+        takeCentralWidget();
+        splitter->addWidget(view_);
+        splitter->addWidget(secondView_);
+        setCentralWidget(splitter);
+        splitter->show();
+        view_->show();
+        CloudView* second = secondView_;
+        connect(&document_, &Document::added, second, [this, second](EntityId id) { second->addEntity(document_.item(id)); });
+        connect(&document_, &Document::removed, second, &CloudView::removeEntity);
+        connect(&document_, &Document::aboutToReplaceData, second, &CloudView::removeEntity);
+        connect(&document_, &Document::dataReplaced, second, [this, second](EntityId id) { second->addEntity(document_.item(id)); });
+        connect(&document_, &Document::cleared, second, &CloudView::clear);
+        connect(&document_, &Document::displayChanged, second, [this, second](EntityId id) { second->refreshEntity(document_.item(id)); });
+        for (EntityId id : document_.ids())
+            second->addEntity(document_.item(id));
+        second->followCamera(*view_);
+    }
+    if (!secondView_)
+        return;
+    // One epoch on each side: the first cloud opened on the left, the others on the right.
+    std::vector<EntityId> clouds;
+    for (EntityId id : document_.ids())
+        if (document_.item(id).cloud() && document_.item(id).parent == kNoEntity)
+            clouds.push_back(id);
+    for (EntityId id : document_.ids()) {
+        const bool left = !clouds.empty() && id == clouds.front();
+        view_->setShownHere(id, !on || left || clouds.size() < 2);
+        secondView_->setShownHere(id, !left || clouds.size() < 2);
+    }
+    secondView_->setVisible(on);
+    if (on)
+        if (auto* splitter = qobject_cast<QSplitter*>(centralWidget())) {
+            const int half = std::max(1, splitter->width() / 2);
+            splitter->setSizes({half, half}); // two equal halves, whatever the views' size hints
+        }
 }
 
 void MainWindow::updateLegend()

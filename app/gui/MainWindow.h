@@ -44,6 +44,11 @@ public:
 
     Document& document() { return document_; }
     CloudView* view() const { return view_; }
+    //! The right-hand view of View > Second view, null until first shown.
+    CloudView* secondView() const { return secondView_; }
+    //! Two views side by side with one camera, the first cloud opened on the
+    //! left and the others on the right; off: one view showing everything.
+    void setSideBySide(bool on);
     EntityTree* tree() const { return tree_; }
     PropertiesPanel* properties() const { return properties_; }
     ScalarFieldPanel* scalarPanel() const { return scalarPanel_; }
@@ -86,6 +91,7 @@ private:
     Document document_;
     std::vector<QAction*> regionExportActions_;
     CloudView* view_;
+    CloudView* secondView_ = nullptr;
     EntityTree* tree_ = nullptr;
     PropertiesPanel* properties_ = nullptr;
     ScalarFieldPanel* scalarPanel_ = nullptr;

@@ -653,6 +653,36 @@ private slots:
         QVERIFY(!extract->isEnabled());
     }
 
+    void twoEpochsSideBySideWithOneCamera()
+    {
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
+        QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
+        const EntityId earlier = window.document().ids()[0], later = window.document().ids()[1];
+        auto* action = window.findChild<QAction*>("sideBySideAction");
+        QVERIFY(action);
+        action->setChecked(true);
+        gui::CloudView* right = window.secondView();
+        QVERIFY(right && right->isVisible());
+        QVERIFY(right->width() > window.view()->width() / 2 && window.view()->width() > right->width() / 2); // two halves
+        // An epoch on each side.
+        QVERIFY(window.view()->isShownHere(earlier) && !window.view()->isShownHere(later));
+        QVERIFY(right->isShownHere(later) && !right->isShownHere(earlier));
+        // One camera: a standard view in the left one is the right one's too.
+        window.view()->setStandardView(gui::StandardView::Top);
+        const gui::CameraState leftCamera = window.view()->camera(), rightCamera = right->camera();
+        for (int k = 0; k < 3; ++k)
+            QCOMPARE(rightCamera.position[k], leftCamera.position[k]);
+        // A field computed later shows on its side.
+        QVERIFY(window.distances()->runCloudToCloud(later, earlier, {}));
+        QVERIFY(right->isShownHere(later));
+        // Off: one view with everything the tree ticks.
+        action->setChecked(false);
+        QVERIFY(!right->isVisible());
+        QVERIFY(window.view()->isShownHere(later));
+    }
+
     void thePanelLayoutIsRemembered()
     {
         const PluginRegistry registry = makePluginRegistry();

@@ -115,6 +115,7 @@ struct CloudView::Shown
     bool isCloud = true;
     std::size_t pointCount = 0;
     float ownPointSize = 0; //!< the entity's own point size; 0: the view's
+    bool documentVisible = true; //!< its tick in the tree; the view may still hide it (setShownHere)
     std::vector<std::uint8_t> rgba; //!< 4 bytes per point, what the chunks' colour arrays show
     std::vector<Chunk> chunks;
 };
@@ -374,10 +375,12 @@ void CloudView::refreshEntity(const Document::Item& item)
     if (it == scene_->shown.end())
         return;
     Shown& s = it->second;
-    const bool visibilityChanged = s.chunks.front().actor->GetVisibility() != int(item.display.visible);
+    s.documentVisible = item.display.visible;
+    const bool visible = item.display.visible && !hiddenHere_.count(item.id);
+    const bool visibilityChanged = s.chunks.front().actor->GetVisibility() != int(visible);
     s.ownPointSize = item.display.pointSize;
     for (auto& c : s.chunks) {
-        c.actor->SetVisibility(item.display.visible);
+        c.actor->SetVisibility(visible);
         if (s.isCloud)
             c.actor->GetProperty()->SetPointSize(s.ownPointSize > 0 ? s.ownPointSize : scene_->pointSize);
     }
@@ -690,6 +693,42 @@ void CloudView::applyClipping()
                 }
             }
     render();
+}
+
+void CloudView::setShownHere(EntityId id, bool shown)
+{
+    if (shown)
+        hiddenHere_.erase(id);
+    else
+        hiddenHere_.insert(id);
+    const auto it = scene_->shown.find(id);
+    if (it == scene_->shown.end())
+        return;
+    for (auto& c : it->second.chunks)
+        c.actor->SetVisibility(shown && it->second.documentVisible);
+    updateStride();
+    renderSoon();
+}
+
+bool CloudView::isShownHere(EntityId id) const
+{
+    const auto it = scene_->shown.find(id);
+    return it != scene_->shown.end() && !it->second.chunks.empty() && it->second.chunks.front().actor->GetVisibility();
+}
+
+void CloudView::followCamera(CloudView& leader)
+{
+    // One camera for both: a move in either view moves the other.
+    vtkCamera* camera = leader.scene_->renderer->GetActiveCamera();
+    scene_->renderer->SetActiveCamera(camera);
+    scene_->overlay->SetActiveCamera(camera);
+    for (CloudView* view : {this, &leader}) {
+        auto redraw = vtkSmartPointer<vtkCallbackCommand>::New();
+        redraw->SetClientData(view);
+        redraw->SetCallback([](vtkObject*, unsigned long, void* self, void*) { static_cast<CloudView*>(self)->renderSoon(); });
+        camera->AddObserver(vtkCommand::ModifiedEvent, redraw);
+    }
+    renderSoon();
 }
 
 void CloudView::setEyeDomeLighting(bool on)

@@ -18,6 +18,7 @@
 
 #include <array>
 #include <memory>
+#include <set>
 
 class QTimer;
 class QVTKOpenGLNativeWidget;
@@ -75,6 +76,13 @@ public:
     float entityPointSize(EntityId id) const;
     //! One plain colour behind the clouds; an invalid colour: the default gradient.
     void setBackground(const QColor& colour);
+    //! This view's own choice to hide an entity the tree shows (side-by-side
+    //! views: an epoch on each side).
+    void setShownHere(EntityId id, bool shown);
+    //! Whether the entity is drawn in this view (ticked, and not hidden here).
+    bool isShownHere(EntityId id) const;
+    //! Shares `leader`'s camera: both views then move together.
+    void followCamera(CloudView& leader);
     //! Eye-Dome Lighting (VTK's EDL pass): shades clouds without normals by
     //! their depth differences on screen, so a façade's reliefs read.
     void setEyeDomeLighting(bool on);
@@ -176,6 +184,7 @@ private:
     ColourLegend legend_;
     std::size_t annotationCount_ = 0;
     std::vector<Annotation> annotations_; //!< as given (global coordinates)
+    std::set<EntityId> hiddenHere_;        //!< hidden in this view only
 };
 
 } // namespace scandiff::gui
