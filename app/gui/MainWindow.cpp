@@ -29,6 +29,7 @@
 #include <QDragEnterEvent>
 #include <QDropEvent>
 #include <QInputDialog>
+#include <QLineEdit>
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QMimeData>
@@ -201,6 +202,22 @@ void MainWindow::buildMenus()
     followUndo();
     QAction* extract = edit->addAction(tr("Extract inside the clipping box"), this, [this] { splits_->extractInBox(view_->clippingBox()); });
     extract->setObjectName("extractInBoxAction");
+    // The box by numbers, as the crop tool's --obox takes them.
+    QAction* boxNumbers = edit->addAction(tr("Clipping box by numbers..."), this, [this] {
+        bool ok = false;
+        const QString text = QInputDialog::getText(this, tr("Clipping box"),
+                                                   tr("Centre X,Y,Z, sizes X,Y,Z (m), heading, pitch, roll (degrees):"),
+                                                   QLineEdit::Normal, QString::fromStdString(orientedBoxText(view_->clippingBox())), &ok);
+        if (!ok)
+            return;
+        try {
+            view_->setClippingBox(parseOrientedBox(text.toStdString()));
+        } catch (const Error& e) {
+            QMessageBox::warning(this, tr("Clipping box"), QString::fromStdString(e.what()));
+        }
+    });
+    boxNumbers->setEnabled(false);
+    connect(view_, &CloudView::clippingBoxChanged, boxNumbers, &QAction::setEnabled);
     extract->setEnabled(false);
     connect(view_, &CloudView::clippingBoxChanged, extract, &QAction::setEnabled);
     edit->addSeparator();

@@ -195,6 +195,17 @@ TEST(CrossSections, SlabsHoldExactlyTheirPointsAndOutlineTheSection)
     EXPECT_EQ(test::errorCodeOf([&] { crossSections(block, params); }), ErrorCode::InvalidArgument);
 }
 
+TEST(Crop, OrientedBoxTextRoundTrips)
+{
+    const CropBox box = parseOrientedBox("512345.5,5403210.25,312.75,40,25,300,30,5,-10");
+    EXPECT_NEAR(box.size.y(), 25.0, 1e-12);
+    const CropBox back = parseOrientedBox(orientedBoxText(box));
+    EXPECT_LT((back.centre - box.centre).norm(), 1e-4);
+    EXPECT_LT((back.size - box.size).norm(), 1e-4);
+    EXPECT_LT((back.rotation - box.rotation).norm(), 1e-6);
+    EXPECT_EQ(test::errorCodeOf([] { parseOrientedBox("1,2,3,4,5"); }), ErrorCode::InvalidArgument);
+}
+
 TEST(Crop, BoxesAndPolygonsEqualBruteForce)
 {
     PointCloud cloud = test::randomPlaneCloud(3000, 10.0, 9);

@@ -2,6 +2,7 @@
 #include <scandiff/core/processing/CloudEditing.h>
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/TextLists.h>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -11,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 
@@ -205,6 +207,37 @@ PointCloud transformCloud(const PointCloud& cloud, const Eigen::Matrix4d& matrix
     }
     out.transformHistory().push_back({matrix, description});
     return out;
+}
+
+CropBox parseOrientedBox(const std::string& text)
+{
+    const std::vector<double> v = parseNumberList(text, "the oriented box");
+    if (v.size() != 6 && v.size() != 7 && v.size() != 9)
+        throw Error(ErrorCode::InvalidArgument, "an oriented box is CX,CY,CZ,SX,SY,SZ[,HEADING[,PITCH,ROLL]] (sizes in m, angles in degrees)");
+    CropBox box;
+    box.centre = Eigen::Vector3d(v[0], v[1], v[2]);
+    box.size = Eigen::Vector3d(v[3], v[4], v[5]);
+    const double heading = v.size() > 6 ? v[6] : 0, pitch = v.size() > 7 ? v[7] : 0, roll = v.size() > 8 ? v[8] : 0;
+    // Heading about Z, then pitch about Y, then roll about X, as sensor poses.
+    box.rotation = (Eigen::AngleAxisd(heading * 3.14159265358979323846 / 180, Eigen::Vector3d::UnitZ()) *
+                    Eigen::AngleAxisd(pitch * 3.14159265358979323846 / 180, Eigen::Vector3d::UnitY()) *
+                    Eigen::AngleAxisd(roll * 3.14159265358979323846 / 180, Eigen::Vector3d::UnitX()))
+                       .toRotationMatrix();
+    return box;
+}
+
+std::string orientedBoxText(const CropBox& box)
+{
+    // The inverse of Rz(heading) Ry(pitch) Rx(roll).
+    const Eigen::Matrix3d& r = box.rotation;
+    const double degrees = 180.0 / 3.14159265358979323846;
+    const double heading = std::atan2(r(1, 0), r(0, 0)) * degrees;
+    const double pitch = std::asin(std::clamp(-r(2, 0), -1.0, 1.0)) * degrees;
+    const double roll = std::atan2(r(2, 1), r(2, 2)) * degrees;
+    char text[256];
+    std::snprintf(text, sizeof text, "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.6g,%.6g,%.6g", box.centre.x(), box.centre.y(), box.centre.z(),
+                  box.size.x(), box.size.y(), box.size.z(), heading, pitch, roll);
+    return text;
 }
 
 std::vector<std::size_t> pointsInBox(const PointCloud& cloud, const CropBox& box)

@@ -217,23 +217,6 @@ void addUndoTransformTool(ToolRegistry& registry)
     registry.add(std::move(tool));
 }
 
-CropBox parseOrientedBox(const std::string& text)
-{
-    const std::vector<double> v = parseNumberList(text, "the oriented box");
-    if (v.size() != 6 && v.size() != 7 && v.size() != 9)
-        throw Error(ErrorCode::InvalidArgument, "crop: --obox is CX,CY,CZ,SX,SY,SZ[,HEADING[,PITCH,ROLL]] (sizes in m, angles in degrees)");
-    CropBox box;
-    box.centre = Eigen::Vector3d(v[0], v[1], v[2]);
-    box.size = Eigen::Vector3d(v[3], v[4], v[5]);
-    const double heading = v.size() > 6 ? v[6] : 0, pitch = v.size() > 7 ? v[7] : 0, roll = v.size() > 8 ? v[8] : 0;
-    // Heading about Z, then pitch about Y, then roll about X, as sensor poses.
-    box.rotation = (Eigen::AngleAxisd(heading * kPi / 180, Eigen::Vector3d::UnitZ()) *
-                    Eigen::AngleAxisd(pitch * kPi / 180, Eigen::Vector3d::UnitY()) *
-                    Eigen::AngleAxisd(roll * kPi / 180, Eigen::Vector3d::UnitX()))
-                       .toRotationMatrix();
-    return box;
-}
-
 CropPolygon parsePolygon(const std::string& text, const std::string& axis)
 {
     CropPolygon polygon;

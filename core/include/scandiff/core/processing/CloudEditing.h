@@ -67,6 +67,13 @@ struct CropPolygon
     int axis = 2;
 };
 
+//! A box from text "CX,CY,CZ,SX,SY,SZ[,HEADING[,PITCH,ROLL]]": centre and side
+//! lengths (m), then degrees about Z, Y and X in turn (as sensor poses).
+//! Throws Error(InvalidArgument).
+CropBox parseOrientedBox(const std::string& text);
+//! The text parseOrientedBox reads back as the same box (to 0.1 mm and 1e-6 degree).
+std::string orientedBoxText(const CropBox& box);
+
 //! Indices (increasing) of the points inside the box, faces included.
 std::vector<std::size_t> pointsInBox(const PointCloud& cloud, const CropBox& box);
 //! Indices (increasing) of the points whose projection lies inside the polygon
