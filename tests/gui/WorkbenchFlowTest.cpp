@@ -5,6 +5,7 @@
 // and restore the session. Answers are checked against core called directly
 // and against brute-force counts.
 #include "MainWindow.h"
+#include "controllers/GlobalShiftDialog.h"
 #include "panels/ConsolePanel.h"
 #include "tools/MeasurePanel.h"
 #include "controllers/DistanceController.h"
@@ -396,7 +397,15 @@ private slots:
         QApplication::sendEvent(&window, &enter);
         QVERIFY(enter.isAccepted());
         QDropEvent drop(QPointF(200, 200), Qt::CopyAction, mime, Qt::LeftButton, Qt::NoModifier);
+        // A dropped UTM file asks the global-shift question: take the suggested origin.
+        QTimer answer;
+        connect(&answer, &QTimer::timeout, [] {
+            if (auto* dialog = qobject_cast<gui::GlobalShiftDialog*>(QApplication::activeModalWidget()))
+                dialog->accept();
+        });
+        answer.start(50);
         QApplication::sendEvent(&window, &drop);
+        answer.stop();
         delete mime;
         QCOMPARE(window.document().size(), std::size_t(1));
         QCOMPARE(window.files()->recentFiles().value(0), QFileInfo(kReference).absoluteFilePath());
@@ -681,6 +690,37 @@ private slots:
         action->setChecked(false);
         QVERIFY(!right->isVisible());
         QVERIFY(window.view()->isShownHere(later));
+    }
+
+    void largeCoordinatesAskForTheGlobalShift()
+    {
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
+        // The question, answered as a user would: an origin of one's own, for the whole session.
+        const Eigen::Vector3d chosen(512700, 5403500, 300);
+        bool asked = false;
+        QTimer::singleShot(100, [&] {
+            auto* dialog = qobject_cast<gui::GlobalShiftDialog*>(QApplication::activeModalWidget());
+            if (!dialog)
+                return;
+            asked = true;
+            dialog->setOrigin(chosen);
+            dialog->findChild<QCheckBox*>()->setChecked(true);
+            dialog->accept();
+        });
+        QCOMPARE(window.files()->open({kReference}).size(), std::size_t(1));
+        QVERIFY(asked);
+        const PointCloud& first = window.document().item(window.document().ids()[0]).points();
+        QCOMPARE(first.origin(), chosen);
+        // Every coordinate is still where it was, to float rounding of local values.
+        const PointCloud original = io::readPointCloud(workbench.registry.formats, kReference.toStdString());
+        for (std::size_t i = 0; i < original.size(); i += 97)
+            QVERIFY((first.globalPosition(i) - original.globalPosition(i)).norm() < 1e-3);
+        // The next file takes the same origin without a question; "Same as last" remembers it.
+        QCOMPARE(window.files()->open({kCompared}).size(), std::size_t(1));
+        QCOMPARE(window.document().item(window.document().ids()[1]).points().origin(), chosen);
+        QCOMPARE(*gui::GlobalShiftDialog::lastOrigin(), chosen);
     }
 
     void thePanelLayoutIsRemembered()

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "controllers/FileController.h"
+#include "controllers/GlobalShiftDialog.h"
 
 #include "TaskRunner.h"
 
@@ -68,6 +69,10 @@ std::vector<EntityId> FileController::open(const QStringList& paths, bool quiet)
                 QMessageBox::warning(parentWindow_, tr("Cannot open file"), message);
             continue;
         }
+        if (auto* cloud = std::get_if<PointCloud>(&*entity))
+            chooseOrigin(path, *cloud, quiet);
+        else
+            chooseOrigin(path, std::get<Mesh>(*entity).vertices, quiet);
         const bool isMesh = std::holds_alternative<Mesh>(*entity);
         const std::size_t points = isMesh ? std::get<Mesh>(*entity).vertices.size() : std::get<PointCloud>(*entity).size();
         const QString absolute = QFileInfo(path).absoluteFilePath();
@@ -80,6 +85,39 @@ std::vector<EntityId> FileController::open(const QStringList& paths, bool quiet)
                           .arg(clock.elapsed() / 1000.0, 0, 'f', 3));
     }
     return loaded;
+}
+
+void FileController::chooseOrigin(const QString& path, PointCloud& points, bool quiet)
+{
+    // Small coordinates need no question: the reader kept the origin at 0.
+    if (points.empty() || points.origin().cwiseAbs().maxCoeff() < 1.0)
+        return;
+    std::optional<Eigen::Vector3d> origin = sessionOrigin_;
+    if (!origin && !quiet) {
+        GlobalShiftDialog dialog(path, points.origin(), points.globalPosition(0), parentWindow_);
+        if (dialog.exec() == QDialog::Accepted) {
+            origin = dialog.origin();
+            GlobalShiftDialog::rememberOrigin(*origin); // for "Same as last"
+            if (dialog.forTheWholeSession())
+                sessionOrigin_ = origin;
+        }
+    }
+    if (!origin || *origin == points.origin())
+        return;
+    // The floats become relative to the chosen origin; refused when that would
+    // put them so far from it that float32 could not hold a millimetre.
+    const BoundingBox box = points.bounds();
+    const double reach = std::max((box.min - *origin).cwiseAbs().maxCoeff(), (box.max - *origin).cwiseAbs().maxCoeff());
+    if (reach > 8192.0) {
+        emit failed(tr("%1: the origin %2, %3, %4 is %5 m from the points; kept the suggested one to keep every millimetre")
+                        .arg(QFileInfo(path).fileName())
+                        .arg(origin->x(), 0, 'f', 3)
+                        .arg(origin->y(), 0, 'f', 3)
+                        .arg(origin->z(), 0, 'f', 3)
+                        .arg(reach, 0, 'f', 0));
+        return;
+    }
+    points.shiftOrigin(*origin);
 }
 
 void FileController::openWithDialog()

@@ -9,6 +9,10 @@
 #include <scandiff/plugins/PluginRegistry.h>
 
 #include <QObject>
+
+#include <Eigen/Core>
+
+#include <optional>
 #include <QStringList>
 
 class QMenu;
@@ -44,6 +48,10 @@ signals:
 
 private:
     void remember(const QString& path);
+    //! A cloud far from 0 (the reader chose an origin): the global-shift
+    //! question, unless `quiet` or answered for the whole session.
+    void chooseOrigin(const QString& path, PointCloud& points, bool quiet);
+    std::optional<Eigen::Vector3d> sessionOrigin_; //!< "for every file of this session"
     const PluginRegistry& registry_;
     Document& document_;
     QWidget* parentWindow_;
