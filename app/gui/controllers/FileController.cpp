@@ -69,10 +69,13 @@ std::vector<EntityId> FileController::open(const QStringList& paths, bool quiet)
                 QMessageBox::warning(parentWindow_, tr("Cannot open file"), message);
             continue;
         }
+        // The time the user takes to answer the global-shift question is not the file's.
+        const qint64 readMilliseconds = clock.elapsed();
         if (auto* cloud = std::get_if<PointCloud>(&*entity))
             chooseOrigin(path, *cloud, quiet);
         else
             chooseOrigin(path, std::get<Mesh>(*entity).vertices, quiet);
+        clock.restart();
         const bool isMesh = std::holds_alternative<Mesh>(*entity);
         const std::size_t points = isMesh ? std::get<Mesh>(*entity).vertices.size() : std::get<PointCloud>(*entity).size();
         const QString absolute = QFileInfo(path).absoluteFilePath();
@@ -82,7 +85,7 @@ std::vector<EntityId> FileController::open(const QStringList& paths, bool quiet)
                           .arg(absolute)
                           .arg(points)
                           .arg(isMesh ? tr("vertices") : tr("points"))
-                          .arg(clock.elapsed() / 1000.0, 0, 'f', 3));
+                          .arg((readMilliseconds + clock.elapsed()) / 1000.0, 0, 'f', 3));
     }
     return loaded;
 }
