@@ -61,15 +61,12 @@ SegmentationDialog::SegmentationDialog(const Document& document, EntityId input,
     const auto followInput = [this, &document] {
         const Document::Item* item = document.find(this->input());
         auto* fields = qobject_cast<QComboBox*>(form_->editor("field"));
-        if (!item || !fields)
+        if (!fields)
             return;
-        fields->clear();
-        for (const ScalarField& f : item->points().fields())
-            fields->addItem(QString::fromStdString(f.name()));
+        listFieldsOf(fields, item);
+        if (!item || item->display.activeField.empty())
+            return;
         const std::string& active = item->display.activeField;
-        if (active.empty())
-            return;
-        form_->setValue("field", QString::fromStdString(active));
         const ScalarField* field = item->points().field(active);
         const auto it = item->display.fields.find(active);
         if (!field || it == item->display.fields.end())

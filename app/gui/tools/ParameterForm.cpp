@@ -279,6 +279,20 @@ QCheckBox* ParameterForm::enabler(const std::string& parameterName) const
     return it == enablers_.end() ? nullptr : it->second;
 }
 
+void listFieldsOf(QComboBox* box, const Document::Item* item)
+{
+    const QString typed = box->currentText();
+    box->clear();
+    if (!item)
+        return;
+    for (const auto& f : item->points().fields())
+        box->addItem(QString::fromStdString(f.name()));
+    if (!item->display.activeField.empty())
+        box->setCurrentText(QString::fromStdString(item->display.activeField));
+    else if (!typed.isEmpty() && box->findText(typed) >= 0)
+        box->setCurrentText(typed);
+}
+
 QString commandLineText(const std::map<std::string, std::string>& parameters)
 {
     QStringList parts;

@@ -9,6 +9,8 @@
 //! is no second copy of any default: values() gives text the declarations parse,
 //! exactly as the command line's options do.
 
+#include "document/Document.h"
+
 #include <scandiff/core/ToolRegistry.h>
 
 #include <QWidget>
@@ -64,6 +66,11 @@ private:
     std::map<std::string, QWidget*> rows_;              //!< the field widget of each parameter's row
     std::map<std::string, QComboBox*> groupChoices_;    //!< by alternative group
 };
+
+//! Fills a field parameter's list with the fields of `item` (none if null),
+//! its active field selected (what the user is looking at), else the text
+//! typed before if it is one of them.
+void listFieldsOf(QComboBox* box, const Document::Item* item);
 
 //! Parameter text as `scandiff-cli` options ("--knn 12 --signed"): flags only
 //! when on, so the console's line can be pasted into a batch script.

@@ -148,19 +148,7 @@ ToolDialog::ToolDialog(const ToolSpec& tool, const Document& document, const Too
         if (!box || picker == pickers_.end() || !picker->single)
             continue;
         QComboBox* entities = picker->single;
-        const auto fill = [box, entities, &document] {
-            const QString typed = box->currentText();
-            box->clear();
-            if (const Document::Item* item = document.find(entities->currentData().toInt()))
-                for (const auto& f : item->points().fields())
-                    box->addItem(QString::fromStdString(f.name()));
-            // The entity's active field first: what the user is looking at.
-            if (const Document::Item* item = document.find(entities->currentData().toInt());
-                item && !item->display.activeField.empty())
-                box->setCurrentText(QString::fromStdString(item->display.activeField));
-            else if (!typed.isEmpty() && box->findText(typed) >= 0)
-                box->setCurrentText(typed);
-        };
+        const auto fill = [box, entities, &document] { listFieldsOf(box, document.find(entities->currentData().toInt())); };
         fill();
         connect(entities, QOverload<int>::of(&QComboBox::currentIndexChanged), box, fill);
     }

@@ -63,17 +63,15 @@ std::vector<CrossSection> crossSections(const PointCloud& cloud, const CrossSect
         std::vector<Eigen::Vector3f> local;
         Eigen::Vector3d mean = Eigen::Vector3d::Zero();
         BoundingBox slabBox;
-        for (std::size_t i : section.indices) {
-            local.push_back(cloud.positions()[i]);
-            mean += cloud.positions()[i].cast<double>();
-        }
-        mean /= static_cast<double>(local.size());
         slabBox.empty = false;
         slabBox.min = slabBox.max = cloud.globalPosition(section.indices.front());
         for (std::size_t i : section.indices) {
+            local.push_back(cloud.positions()[i]);
+            mean += cloud.positions()[i].cast<double>();
             slabBox.min = slabBox.min.cwiseMin(cloud.globalPosition(i));
             slabBox.max = slabBox.max.cwiseMax(cloud.globalPosition(i));
         }
+        mean /= static_cast<double>(local.size());
         const double cell = params.outlineCell > 0 ? params.outlineCell : outlineCellFor(local, slabBox);
         std::vector<Eigen::Vector2d> planar;
         planar.reserve(local.size());
