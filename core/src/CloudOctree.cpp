@@ -6,10 +6,14 @@
 
 namespace scandiff {
 
-octree::Octree buildOctree(const PointCloud& cloud, std::optional<octree::CubicBox> box)
+octree::Octree buildOctree(const PointCloud& cloud, std::optional<octree::CubicBox> box, const ProgressObserver* cancel)
 {
+    const std::function<void()> checkpoint = [cancel] {
+        if (cancel->cancelRequested())
+            throw Error(ErrorCode::Cancelled, "cancelled by the user");
+    };
     try {
-        return octree::Octree(cloud.positions().data(), cloud.size(), box);
+        return octree::Octree(cloud.positions().data(), cloud.size(), box, cancel ? checkpoint : std::function<void()>{});
     } catch (const std::invalid_argument& e) {
         throw Error(ErrorCode::InvalidData, "cloud '" + cloud.name + "': " + e.what());
     }

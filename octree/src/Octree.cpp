@@ -65,7 +65,7 @@ void offer(std::vector<Neighbour>& heap, std::size_t k, const Neighbour& candida
 //! Only the low significantBits of the codes are sorted on (the caller knows
 //! the rest are zero: a batch's codes at level L have 3L bits); keys already in
 //! order are left as they are after one parallel check.
-void radixSort(std::vector<KeyedIndex>& keys, int significantBits = 64)
+void radixSort(std::vector<KeyedIndex>& keys, int significantBits = 64, const std::function<void()>& checkpoint = {})
 {
     const std::size_t n = keys.size();
     const bool sorted = tbb::parallel_reduce(
@@ -84,6 +84,8 @@ void radixSort(std::vector<KeyedIndex>& keys, int significantBits = 64)
     std::vector<KeyedIndex> buffer(n);
     std::vector<std::array<std::size_t, 256>> counts(blocks);
     for (int pass = 0; pass < passes; ++pass) {
+        if (checkpoint)
+            checkpoint();
         const int shift = 8 * pass;
         tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
             auto& c = counts[b];
@@ -131,7 +133,8 @@ MortonCode clampedCellCode(const Eigen::Vector3f& p, const CubicBox& box, double
 
 } // namespace
 
-std::vector<std::uint32_t> mortonOrder(const Eigen::Vector3f* points, std::size_t count, const CubicBox& box)
+std::vector<std::uint32_t> mortonOrder(const Eigen::Vector3f* points, std::size_t count, const CubicBox& box,
+                                       const std::function<void()>& checkpoint)
 {
     const double scale = static_cast<double>(kCellsPerAxisAtMaxLevel) / box.size;
     std::vector<KeyedIndex> keyed(count);
@@ -142,7 +145,7 @@ std::vector<std::uint32_t> mortonOrder(const Eigen::Vector3f* points, std::size_
             keyed[i] = {code, static_cast<std::uint32_t>(i)};
         }
     });
-    radixSort(keyed);
+    radixSort(keyed, 64, checkpoint);
     std::vector<std::uint32_t> order(count);
     for (std::size_t i = 0; i < count; ++i)
         order[i] = keyed[i].index;
@@ -174,7 +177,8 @@ CubicBox CubicBox::enclosingBoth(const CubicBox& a, const CubicBox& b)
     return box;
 }
 
-Octree::Octree(const Eigen::Vector3f* points, std::size_t count, std::optional<CubicBox> box)
+Octree::Octree(const Eigen::Vector3f* points, std::size_t count, std::optional<CubicBox> box,
+               const std::function<void()>& checkpoint)
     : points_(points)
 {
     if (count == 0)
@@ -188,6 +192,8 @@ Octree::Octree(const Eigen::Vector3f* points, std::size_t count, std::optional<C
     if (!(box_.size > 0) || !std::isfinite(box_.size))
         throw std::invalid_argument("the octree's bounding cube must have a finite, positive size");
 
+    if (checkpoint)
+        checkpoint();
     const double scale = static_cast<double>(kCellsPerAxisAtMaxLevel) / box_.size;
     std::vector<KeyedIndex> keyed(count);
     std::atomic<bool> outside{false};
@@ -205,7 +211,9 @@ Octree::Octree(const Eigen::Vector3f* points, std::size_t count, std::optional<C
     });
     if (outside)
         throw std::invalid_argument("some points lie outside the octree's bounding cube");
-    radixSort(keyed);
+    radixSort(keyed, 64, checkpoint);
+    if (checkpoint)
+        checkpoint();
     codes_.resize(count);
     indices_.resize(count);
     for (std::size_t i = 0; i < count; ++i) {
@@ -214,6 +222,8 @@ Octree::Octree(const Eigen::Vector3f* points, std::size_t count, std::optional<C
     }
     keyed.clear();
     keyed.shrink_to_fit();
+    if (checkpoint)
+        checkpoint();
 
     // Per-level statistics in one pass: two consecutive codes first differ at the
     // level of their highest differing bit triplet; a new cell starts there and at

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Registration against known motions: ICP from a 25 degree start, the 4-DOF
 // constraint, changed scenes, meshes, UTM coordinates, degenerate geometry.
+#include "StageWatcher.h"
 #include "SyntheticSite.h"
 #include "TestSupport.h"
 
@@ -247,6 +248,26 @@ TEST(Icp, BadInput)
     IcpParams limited;
     limited.maxDistance = 1.0;
     EXPECT_EQ(test::errorCodeOf([&] { icpRegister(far, &here, nullptr, limited); }), ErrorCode::InvalidData);
+}
+
+TEST(Icp, CancelIsHeardWhileEveryPointGetsItsResidual)
+{
+    // After the iterations, every moving point is matched once more for its
+    // residual: on 2 M points that took 3 s with no poll. It now goes by
+    // chunks of 65 536 points, each a poll; Cancel there stops the run.
+    const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    const Scene scene = makeScene(test::rigidMotionAbout(2, 0, 0, Eigen::Vector3d(0.1, 0, 0), origin), 300000, false, origin);
+    IcpParams params;
+    test::StageWatcher watch("residual of every point", 0);
+    icpRegister(scene.moving, &scene.reference, nullptr, params, &watch);
+    EXPECT_GE(watch.polls(), 4u);
+    test::StageWatcher cancel("residual of every point", 2);
+    EXPECT_EQ(test::errorCodeOf([&] { icpRegister(scene.moving, &scene.reference, nullptr, params, &cancel); }),
+              ErrorCode::Cancelled);
+    // And the reference's octree, built before the first iteration, hears it too.
+    test::CancelAtOnce atOnce;
+    EXPECT_EQ(test::errorCodeOf([&] { icpRegister(scene.moving, &scene.reference, nullptr, params, &atOnce); }),
+              ErrorCode::Cancelled);
 }
 
 TEST(PointPairs, ExactFromThreePairsAndClosedFormFromTenNoisyOnes)

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Normals against analytic surfaces, and every orientation method.
+#include "StageWatcher.h"
 #include "SyntheticClouds.h"
 #include "TestSupport.h"
 
@@ -229,17 +230,32 @@ TEST(Normals, DegenerateNeighbourhoodsAndBadInput)
 
 TEST(Normals, CancelStopsTheFit)
 {
-    struct CancelAtOnce : ProgressObserver
-    {
-        void beginStage(const std::string&) override {}
-        void report(double) override {}
-        bool cancelRequested() const override { return true; }
-    } cancel;
+    test::CancelAtOnce cancel;
     const PointCloud sphere = test::sphereCloud(200000, 1.0);
     EXPECT_EQ(test::errorCodeOf([&] { computeNormals(sphere, NormalParams{}, &cancel); }), ErrorCode::Cancelled);
     NormalParams byRadius;
     byRadius.radius = 0.02;
     EXPECT_EQ(test::errorCodeOf([&] { computeNormals(sphere, byRadius, &cancel); }), ErrorCode::Cancelled);
+    // The octree build itself hears it (it is linear but takes a second on ten million points).
+    EXPECT_EQ(test::errorCodeOf([&] { buildOctree(sphere, std::nullopt, &cancel); }), ErrorCode::Cancelled);
+}
+
+TEST(Normals, TheSpanningTreeHearsCancelWhileSortingItsEdges)
+{
+    // 300 000 points, 10 neighbours: 3 M edges whose sort and Kruskal pass
+    // took 1.3 s on 2 M points with only two polls, at their ends. Now the
+    // sort's comparisons and the pass ask every 2^20 steps.
+    const PointCloud sphere = test::sphereCloud(300000, 1.0);
+    std::vector<Eigen::Vector3f> normals = computeNormals(sphere, NormalParams{}).normals;
+    NormalOrientation mst = parseNormalOrientation("mst");
+    test::StageWatcher watch("spanning tree", 0);
+    std::vector<Eigen::Vector3f> oriented = normals;
+    orientNormals(sphere, oriented, mst, &watch);
+    EXPECT_GE(watch.polls(), 5u);
+    test::StageWatcher cancel("spanning tree", 3);
+    oriented = normals;
+    EXPECT_EQ(test::errorCodeOf([&] { orientNormals(sphere, oriented, mst, &cancel); }), ErrorCode::Cancelled);
+    EXPECT_EQ(cancel.polls(), 3u);
 }
 
 TEST(Normals, SomePointsOnlyGiveTheNormalsOfTheWholeCloud)

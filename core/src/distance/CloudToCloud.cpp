@@ -108,9 +108,9 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
     // A stage of its own, so the bar moves and Cancel is heard between the two
     // (each is linear, about 0.1 s per million points on two cores).
     ProgressTicker preparing(progress, "Ordering the points and building the octree", 2);
-    const std::vector<std::uint32_t> order = octree::mortonOrder(queries, n, cube);
+    const std::vector<std::uint32_t> order = octree::mortonOrder(queries, n, cube, [&preparing] { preparing.checkCancel(); });
     preparing.step();
-    const octree::Octree tree = buildOctree(reference, cube);
+    const octree::Octree tree = buildOctree(reference, cube, progress);
     preparing.step();
 
     // With a k-neighbourhood model, the k nearest reference points of each

@@ -214,7 +214,7 @@ ScalarField gaussianSmoothing(const PointCloud& cloud, const std::string& fieldN
     result.setOffset(field.offset());
     if (cloud.empty())
         return result;
-    const octree::Octree tree = buildOctree(cloud);
+    const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     const double inverse = 1.0 / (2 * sigma * sigma);
     ProgressTicker ticker(progress, "Gaussian smoothing", cloud.size());
     // Neighbours beyond 3 sigma weigh less than 1.2 % of the point itself.

@@ -36,7 +36,7 @@ FeatureResult computeLocalFeatures(const PointCloud& cloud, const FeatureParams&
     const bool all = !params.density && !params.roughness && !params.curvature && !params.verticality;
     const bool density = all || params.density, roughness = all || params.roughness, curvature = all || params.curvature,
                verticality = all || params.verticality;
-    const octree::Octree tree = buildOctree(cloud);
+    const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     const std::size_t n = cloud.size();
     const auto& positions = cloud.positions();
     const double r = params.radius;

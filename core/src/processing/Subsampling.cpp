@@ -47,7 +47,7 @@ std::vector<std::size_t> spatialSubsample(const PointCloud& cloud, double minDis
         throw Error(ErrorCode::InvalidArgument, "spatial subsampling: the minimum distance must be > 0");
     if (cloud.empty())
         return {};
-    const octree::Octree tree = buildOctree(cloud);
+    const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     const std::size_t n = cloud.size();
     const auto& order = tree.sortedIndices();
     const auto& positions = cloud.positions();
@@ -171,7 +171,7 @@ std::vector<std::size_t> octreeSubsample(const PointCloud& cloud, int level, Pro
         throw Error(ErrorCode::InvalidArgument, "octree subsampling: the level must be in [1, 21]");
     if (cloud.empty())
         return {};
-    const octree::Octree tree = buildOctree(cloud);
+    const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     const auto& order = tree.sortedIndices();
     const auto& positions = cloud.positions();
     const double size = tree.cellSize(level);

@@ -38,7 +38,7 @@ ConnectedComponentsResult connectedComponents(const PointCloud& cloud, const std
 
     // The grid is the octree of the whole cloud, so its cells (and the level's
     // meaning) do not depend on the selection.
-    const octree::Octree tree = buildOctree(cloud);
+    const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     ConnectedComponentsResult result;
     result.level = params.level > 0 ? params.level : tree.levelForMeanPopulation(10.0);
     result.cellSize = tree.cellSize(result.level);

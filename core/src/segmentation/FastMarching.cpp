@@ -185,7 +185,7 @@ GradientResult gradientNorm(const PointCloud& cloud, const std::string& fieldNam
     if (params.smoothingSigma && !(*params.smoothingSigma > 0.0 && std::isfinite(*params.smoothingSigma)))
         throw Error(ErrorCode::InvalidArgument, "gradient: the smoothing sigma must be > 0");
     checkCloud(cloud, "gradient");
-    const octree::Octree tree = buildOctree(cloud);
+    const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     GradientResult result;
     result.radius = params.radius > 0 ? params.radius : tree.cellSize(tree.levelNearestMeanPopulation(16.0));
     const std::size_t n = cloud.size();
@@ -283,7 +283,7 @@ FastMarchingResult fastMarching(const PointCloud& cloud, const std::vector<std::
     if (params.level < 0 || params.level > octree::kMaxLevel)
         throw Error(ErrorCode::InvalidArgument, "fast marching: the level must be in [1, 21] (0: automatic)");
     checkCloud(cloud, "fast marching");
-    const octree::Octree tree = buildOctree(cloud);
+    const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     FastMarchingResult result;
     result.level = params.level > 0 ? params.level : tree.levelNearestMeanPopulation(4.0);
     const CellGrid grid = makeGrid(tree, result.level);
@@ -366,7 +366,7 @@ PropagationResult propagationSegmentation(const PointCloud& cloud, const std::st
 
     PropagationResult result;
     result.gradient = gradientNorm(cloud, fieldName, params.gradient, progress).norm;
-    const octree::Octree tree = buildOctree(cloud);
+    const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     result.level = params.level > 0 ? params.level : tree.levelNearestMeanPopulation(8.0);
     const CellGrid grid = makeGrid(tree, result.level);
     result.cellSize = grid.h;

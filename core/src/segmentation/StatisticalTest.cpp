@@ -303,7 +303,7 @@ LocalChiSquareResult localChiSquareTest(const PointCloud& cloud, const std::stri
         valueClass[i] = static_cast<std::int8_t>(std::min<std::size_t>(k - 1, static_cast<std::size_t>(std::max(0.0, f) * k)));
     }
 
-    const octree::Octree tree = buildOctree(cloud);
+    const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     const int level = params.octreeLevel > 0 ? params.octreeLevel
                                              : tree.levelNearestMeanPopulation(std::max(8.0, 1.5 * static_cast<double>(n)));
     result.chiSquare = ScalarField(fields::kChiSquare, size);

@@ -20,7 +20,7 @@ OutlierFilterResult statisticalOutliers(const PointCloud& cloud, const OutlierFi
         throw Error(ErrorCode::InvalidArgument, "outlier filter: k must be in [1, 1000], got " + std::to_string(params.neighbours));
     if (!(params.nSigma >= 0.0 && params.nSigma <= 100.0))
         throw Error(ErrorCode::InvalidArgument, "outlier filter: n_sigma must be in [0, 100]");
-    const octree::Octree tree = buildOctree(cloud);
+    const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     const std::size_t n = cloud.size();
     const auto k = static_cast<std::size_t>(params.neighbours);
     // Cells holding about k+1 points keep the ring search short.

@@ -250,7 +250,7 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
                                                 " points, fewer than the minimum support (" + std::to_string(params.minPoints) + ")");
     ProgressTicker ticker(progress, "Primitives", 100);
     PrimitiveDetectionResult result;
-    const octree::Octree tree = buildOctree(cloud);
+    const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     const ScanScale scale = estimateScale(cloud, tree);
     result.epsilon = params.epsilon ? *params.epsilon : std::max(3.0 * scale.noise, 1e-6);
     result.clusterEpsilon = params.clusterEpsilon ? *params.clusterEpsilon : std::max(3.0 * scale.spacing, result.epsilon);
@@ -313,6 +313,7 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
     // clearly better than a plane becomes a plane when a plane holds its
     // points within epsilon, and is dropped otherwise.
     for (const detail::RansacShape& shape : found) {
+        ticker.checkCancel(); // before each shape, kept or not: a refit can take a few tenths of a second
         std::vector<Eigen::Vector3d> members;
         members.reserve(shape.members.size());
         for (std::uint32_t i : shape.members)
@@ -335,7 +336,6 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
         if (detected.primitive.kind == PrimitiveKind::Cylinder || detected.primitive.kind == PrimitiveKind::Cone)
             detected.length = lengthAlong(detected.primitive, members, centre);
         result.primitives.push_back(std::move(detected));
-        ticker.checkCancel();
     }
     ticker.step(20);
 
@@ -346,6 +346,7 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
         merged = false;
         for (std::size_t a = 0; a < result.primitives.size() && !merged; ++a)
             for (std::size_t b = a + 1; b < result.primitives.size() && !merged; ++b) {
+                ticker.checkCancel();
                 DetectedPrimitive& first = result.primitives[a];
                 DetectedPrimitive& second = result.primitives[b];
                 if (first.primitive.kind != second.primitive.kind)

@@ -161,7 +161,7 @@ IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud
         throw Error(ErrorCode::InvalidData, "registration: the reference cloud '" + referenceCloud->name + "' is empty");
     const std::unique_ptr<detail::ReferenceSurface> surface =
         referenceMesh ? detail::meshSurface(*referenceMesh)
-                      : detail::cloudSurface(*referenceCloud, true, params.normalNeighbours);
+                      : detail::cloudSurface(*referenceCloud, true, params.normalNeighbours, progress);
     return detail::icpOnSurface(moving, *surface, params, progress);
 }
 
@@ -334,25 +334,37 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
     report.degeneracy = degeneracyWarning(normalMatrix, dofCount(params.constraint.dof), params.constraint.axis, report.eigenvalues);
 
     // Every moving point, moved: its residual, and whether the last
-    // iteration's rules keep it.
+    // iteration's rules keep it. In chunks, each a step of its own stage: on a
+    // large cloud this pass (closest points and the reference normals they
+    // need) takes longer than all the iterations, and Cancel must be heard.
     const std::size_t n = moving.size();
-    std::vector<Eigen::Vector3d> all(n);
-    for (std::size_t i = 0; i < n; ++i)
-        all[i] = moving.positions()[i].allFinite() ? Eigen::Vector3d(motion * (moving.globalPosition(i) - origin))
-                                                   : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
     IcpParams final = params;
     final.overlap = 1.0; // the trimming of the last iteration is applied as its cutoff
-    Correspondences last;
-    correspond(surface, all, final, std::min(threshold, c.cutoff), last, params.maxDistance.value_or(kInfinity));
+    const double finalThreshold = std::min(threshold, c.cutoff);
     result.residual = ScalarField(fields::kRegistrationResidual, n);
     result.excluded = ScalarField(fields::kRegistrationExcluded, n);
     std::vector<double> magnitudes;
-    for (std::size_t i = 0; i < n; ++i) {
-        if (std::isfinite(last.residual[i]))
-            result.residual.setValue(i, last.residual[i]);
-        result.excluded.setValue(i, last.used[i] ? 0.0 : 1.0);
-        if (last.used[i])
-            magnitudes.push_back(std::abs(last.residual[i]));
+    constexpr std::size_t kChunk = 1 << 16;
+    ProgressTicker residualTicker(progress, "Registration: residual of every point", (n + kChunk - 1) / kChunk);
+    std::vector<Eigen::Vector3d> chunk;
+    Correspondences last;
+    for (std::size_t begin = 0; begin < n; begin += kChunk) {
+        const std::size_t end = std::min(n, begin + kChunk);
+        chunk.resize(end - begin);
+        for (std::size_t i = begin; i < end; ++i)
+            chunk[i - begin] = moving.positions()[i].allFinite()
+                                   ? Eigen::Vector3d(motion * (moving.globalPosition(i) - origin))
+                                   : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+        correspond(surface, chunk, final, finalThreshold, last, params.maxDistance.value_or(kInfinity));
+        for (std::size_t i = begin; i < end; ++i) {
+            const std::size_t k = i - begin;
+            if (std::isfinite(last.residual[k]))
+                result.residual.setValue(i, last.residual[k]);
+            result.excluded.setValue(i, last.used[k] ? 0.0 : 1.0);
+            if (last.used[k])
+                magnitudes.push_back(std::abs(last.residual[k]));
+        }
+        residualTicker.step();
     }
     double sum2 = 0;
     for (double m : magnitudes)

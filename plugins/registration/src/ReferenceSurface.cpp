@@ -26,8 +26,8 @@ Eigen::Vector3d boxCentre(const PointCloud& cloud)
 class CloudSurface : public ReferenceSurface
 {
 public:
-    CloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours)
-        : cloud_(cloud), tree_(buildOctree(cloud))
+    CloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours, const ProgressObserver* cancel)
+        : cloud_(cloud), tree_(buildOctree(cloud, std::nullopt, cancel))
     {
         origin_ = boxCentre(cloud);
         // The cloud's frame relative to ours: a query q (our frame) is the
@@ -147,9 +147,10 @@ private:
 
 } // namespace
 
-std::unique_ptr<ReferenceSurface> cloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours)
+std::unique_ptr<ReferenceSurface> cloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours,
+                                               const ProgressObserver* cancel)
 {
-    return std::make_unique<CloudSurface>(cloud, needNormals, normalNeighbours);
+    return std::make_unique<CloudSurface>(cloud, needNormals, normalNeighbours, cancel);
 }
 
 std::unique_ptr<ReferenceSurface> meshSurface(const Mesh& mesh)

@@ -45,7 +45,8 @@ protected:
 //! A cloud: `needNormals` fits them when the cloud has none (a plane on
 //! `normalNeighbours` points, turned towards +Z), each where a closest point
 //! first lands. The cloud must outlive the surface.
-std::unique_ptr<ReferenceSurface> cloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours);
+std::unique_ptr<ReferenceSurface> cloudSurface(const PointCloud& cloud, bool needNormals, std::size_t normalNeighbours,
+                                               const ProgressObserver* cancel = nullptr);
 //! A mesh (triangle normals by vertex order). The mesh must outlive the surface.
 std::unique_ptr<ReferenceSurface> meshSurface(const Mesh& mesh);
 

@@ -103,7 +103,7 @@ std::vector<Station> prepare(const std::vector<const PointCloud*>& clouds, const
     ProgressTicker ticker(progress, "Stations: octrees", clouds.size());
     for (std::size_t k = 0; k < clouds.size(); ++k) {
         stations[k].cloud = clouds[k];
-        stations[k].surface = detail::cloudSurface(*clouds[k], true, 12);
+        stations[k].surface = detail::cloudSurface(*clouds[k], true, 12, progress);
         ticker.step(); // a station's octree takes a while: Cancel is heard between them
     }
     worldOrigin = stations[0].surface->frameOrigin();

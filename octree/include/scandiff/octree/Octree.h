@@ -98,14 +98,18 @@ struct QueryStatistics
 //! (points outside the box are clamped to its faces; non-finite ones come
 //! last). Processing queries in this order keeps neighbours together in cache
 //! and lets batch queries share work between points of one cell.
-std::vector<std::uint32_t> mortonOrder(const Eigen::Vector3f* points, std::size_t count, const CubicBox& box);
+std::vector<std::uint32_t> mortonOrder(const Eigen::Vector3f* points, std::size_t count, const CubicBox& box,
+                                       const std::function<void()>& checkpoint = {});
 
 class Octree
 {
 public:
     //! Throws std::invalid_argument for an empty array, more than 2^32-1 points,
-    //! or a non-finite coordinate (naming the point index).
-    Octree(const Eigen::Vector3f* points, std::size_t count, std::optional<CubicBox> box = std::nullopt);
+    //! or a non-finite coordinate (naming the point index). `checkpoint`, when
+    //! given, is called between the phases of the build (a few tens of
+    //! milliseconds per million points each) so a caller can stop it by throwing.
+    Octree(const Eigen::Vector3f* points, std::size_t count, std::optional<CubicBox> box = std::nullopt,
+           const std::function<void()>& checkpoint = {});
 
     std::size_t size() const { return codes_.size(); }
     const CubicBox& box() const { return box_; }
