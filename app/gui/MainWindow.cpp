@@ -133,11 +133,12 @@ template <class Controller> void MainWindow::report(Controller* controller)
         statusBar()->showMessage(summary);
     });
     connect(controller, &Controller::failed, this, [this](const QString& message) {
-        // The user stopping a run is no error: every controller says "... was cancelled".
-        if (message.contains(tr(" was cancelled")))
-            console_->info(message);
-        else
-            console_->error(message);
+        console_->error(message);
+        statusBar()->showMessage(message);
+    });
+    // The user stopping a run is no error.
+    connect(controller, &Controller::cancelled, this, [this](const QString& message) {
+        console_->info(message);
         statusBar()->showMessage(message);
     });
 }

@@ -796,7 +796,7 @@ private slots:
         QVERIFY(!window.sessions()->restore(dir.filePath("y.scandiff")));
         QCOMPARE(window.document().size(), std::size_t(1));
         // A run the user cancelled is logged as such, not as an error.
-        emit window.files()->failed("Opening big.ply was cancelled");
+        emit window.files()->cancelled("Opening big.ply was cancelled");
         const QString log = window.console()->toPlainText();
         QVERIFY(log.trimmed().endsWith("Opening big.ply was cancelled"));
         QVERIFY(!log.trimmed().split('\n').last().contains("error:"));

@@ -135,7 +135,10 @@ bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId reference
         run = scandiff::runCloudToCloud(*compared->cloud(), *reference->cloud(), values, &progress);
     });
     if (outcome.outcome != TaskOutcome::Done) {
-        emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("C2C was cancelled") : outcome.error);
+        if (outcome.outcome == TaskOutcome::Cancelled)
+            emit cancelled(tr("C2C was cancelled"));
+        else
+            emit failed(outcome.error);
         return false;
     }
     const double seconds = clock.elapsed() / 1000.0;
@@ -179,7 +182,10 @@ bool DistanceController::runCloudToMesh(EntityId comparedId, EntityId referenceI
         result = cloudToMesh(*compared->cloud(), *reference->mesh(), params, &progress);
     });
     if (outcome.outcome != TaskOutcome::Done) {
-        emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("C2M was cancelled") : outcome.error);
+        if (outcome.outcome == TaskOutcome::Cancelled)
+            emit cancelled(tr("C2M was cancelled"));
+        else
+            emit failed(outcome.error);
         return false;
     }
     const double seconds = clock.elapsed() / 1000.0;

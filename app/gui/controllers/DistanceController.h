@@ -69,6 +69,8 @@ public:
 signals:
     void finished(const QString& summary);
     void failed(const QString& message);
+    //! The user stopped a run: no error, nothing changed.
+    void cancelled(const QString& message);
     //! The entity whose new field should be shown.
     void resultReady(EntityId id);
 

@@ -63,10 +63,13 @@ std::vector<EntityId> FileController::open(const QStringList& paths, bool quiet)
             entity = io::readFile(registry_.formats, path.toStdString(), options);
         });
         if (result.outcome != TaskOutcome::Done) {
-            const QString message = result.outcome == TaskOutcome::Cancelled ? tr("Opening %1 was cancelled").arg(path) : result.error;
-            emit failed(message);
-            if (!quiet && result.outcome == TaskOutcome::Failed)
-                QMessageBox::warning(parentWindow_, tr("Cannot open file"), message);
+            if (result.outcome == TaskOutcome::Cancelled) {
+                emit cancelled(tr("Opening %1 was cancelled").arg(path));
+                continue;
+            }
+            emit failed(result.error);
+            if (!quiet)
+                QMessageBox::warning(parentWindow_, tr("Cannot open file"), result.error);
             continue;
         }
         // The time the user takes to answer the global-shift question is not the file's.
@@ -145,7 +148,10 @@ bool FileController::exportEntity(EntityId id, const QString& path)
         io::writeFile(registry_.formats, item->entity, path.toStdString(), options);
     });
     if (result.outcome != TaskOutcome::Done) {
-        emit failed(result.outcome == TaskOutcome::Cancelled ? tr("Writing %1 was cancelled").arg(path) : result.error);
+        if (result.outcome == TaskOutcome::Cancelled)
+            emit cancelled(tr("Writing %1 was cancelled").arg(path));
+        else
+            emit failed(result.error);
         return false;
     }
     document_.markSaved(id);

@@ -134,7 +134,10 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
         run = runSegmentation(*input->cloud(), *values, &progress);
     });
     if (outcome.outcome != TaskOutcome::Done) {
-        emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("Segmentation was cancelled") : outcome.error);
+        if (outcome.outcome == TaskOutcome::Cancelled)
+            emit cancelled(tr("Segmentation was cancelled"));
+        else
+            emit failed(outcome.error);
         return false;
     }
     // A new run replaces the regions of the previous one (a copy: removing
@@ -161,7 +164,10 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
         }
     });
     if (outcome.outcome != TaskOutcome::Done) {
-        emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("Measuring the regions was cancelled") : outcome.error);
+        if (outcome.outcome == TaskOutcome::Cancelled)
+            emit cancelled(tr("Measuring the regions was cancelled"));
+        else
+            emit failed(outcome.error);
         return false;
     }
     const std::string distanceField = values->text("field");
@@ -222,7 +228,10 @@ bool SegmentationController::exportRegions(EntityId id, const QString& folder, b
         files = io::exportRegions(registry_.formats, cloud, report, folder.toStdString(), options);
     });
     if (outcome.outcome != TaskOutcome::Done) {
-        emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("Export was cancelled") : outcome.error);
+        if (outcome.outcome == TaskOutcome::Cancelled)
+            emit cancelled(tr("Export was cancelled"));
+        else
+            emit failed(outcome.error);
         return false;
     }
     emit finished(tr("exported %1 regions of %2 to %3: regions.ply, %4 region files, regions.dxf%5, regions.csv")

@@ -187,8 +187,10 @@ bool SessionController::save(const QString& qpath)
         fs::remove_all(previous, ec);
     });
     if (result.outcome != TaskOutcome::Done) {
-        emit failed(result.outcome == TaskOutcome::Cancelled ? tr("Saving the session was cancelled; the previous one is unchanged")
-                                                             : tr("Saving the session failed: %1").arg(result.error));
+        if (result.outcome == TaskOutcome::Cancelled)
+            emit cancelled(tr("Saving the session was cancelled; the previous one is unchanged"));
+        else
+            emit failed(tr("Saving the session failed: %1").arg(result.error));
         return false;
     }
     document_.markAllSaved();
@@ -279,8 +281,10 @@ bool SessionController::restore(const QString& qpath)
         }
     });
     if (result.outcome != TaskOutcome::Done) {
-        emit failed(result.outcome == TaskOutcome::Cancelled ? tr("Opening the session was cancelled")
-                                                             : tr("Opening the session failed: %1").arg(result.error));
+        if (result.outcome == TaskOutcome::Cancelled)
+            emit cancelled(tr("Opening the session was cancelled"));
+        else
+            emit failed(tr("Opening the session failed: %1").arg(result.error));
         return false;
     }
     document_.clear();

@@ -45,6 +45,8 @@ public:
 signals:
     void finished(const QString& summary);
     void failed(const QString& message);
+    //! The user stopped a run: no error, nothing changed.
+    void cancelled(const QString& message);
 
 private:
     const PluginRegistry& registry_;

@@ -44,6 +44,8 @@ public:
 signals:
     void finished(const QString& summary);
     void failed(const QString& message);
+    //! The user stopped a run: no error, nothing changed.
+    void cancelled(const QString& message);
     void resultReady(EntityId id);
 
 private:

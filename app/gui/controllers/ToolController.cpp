@@ -128,7 +128,10 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
         result = tool_.execute(inputs, values, &progress);
     });
     if (outcome.outcome != TaskOutcome::Done) {
-        emit failed(outcome.outcome == TaskOutcome::Cancelled ? tr("%1 was cancelled").arg(title) : outcome.error);
+        if (outcome.outcome == TaskOutcome::Cancelled)
+            emit cancelled(tr("%1 was cancelled").arg(title));
+        else
+            emit failed(outcome.error);
         return false;
     }
     const double seconds = clock.elapsed() / 1000.0;

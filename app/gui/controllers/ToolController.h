@@ -49,6 +49,8 @@ signals:
     void pickModeRequested(bool on);
     void finished(const QString& summary);
     void failed(const QString& message);
+    //! The user stopped a run: no error, nothing changed.
+    void cancelled(const QString& message);
     //! The entity the run created or changed last (the tree selects it).
     void resultReady(EntityId id);
     //! The run's table outputs, for the window that shows them (and saves them as CSV).
