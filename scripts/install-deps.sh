@@ -8,12 +8,20 @@ packages=(
   libeigen3-dev libtbb-dev libmuparser-dev
   qtbase5-dev libqt5opengl5-dev
   libvtk9-dev libvtk9-qt-dev libopenmpi-dev
-  libpcl-dev libflann-dev libcgal-dev libassimp-dev liblzf-dev
+  libpcl-dev libflann-dev libcgal-dev liblzf-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
   python3 python3-ezdxf
   xvfb xauth imagemagick xdotool
 )
+
+# Optional groups: "fuzz" adds clang and its libFuzzer runtime (scripts/fuzz.sh).
+for group in "$@"; do
+  case "$group" in
+    fuzz) packages+=(clang-14 libclang-rt-14-dev) ;;
+    *) echo "install-deps: unknown group '$group' (known: fuzz)" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${packages[@]}"; do

@@ -437,7 +437,9 @@ ParameterValues resolveParameters(const std::vector<ParameterSpec>& parameters,
     for (const auto& p : parameters)
         if (!p.optional)
             values.set(p.name, p.defaultValue);
-    for (const auto& [key, text] : userText) {
+    for (const auto& entry : userText) {
+        const std::string& key = entry.first; // a named variable: a lambda may not capture a structured binding before C++20
+        const std::string& text = entry.second;
         const auto spec = std::find_if(parameters.begin(), parameters.end(), [&](const ParameterSpec& p) { return p.name == key; });
         if (spec == parameters.end())
             throw Error(ErrorCode::InvalidArgument, owner + " has no parameter '" + key + "'");

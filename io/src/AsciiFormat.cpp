@@ -55,6 +55,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <unordered_set>
 #include <vector>
 
 namespace scandiff::io::detail {
@@ -144,8 +145,14 @@ private:
     std::size_t lineNumber_ = 0;
 };
 
-//! Splits a line into values. Whitespace mode takes runs of spaces and tabs as
-//! one separator; character mode splits on one character and trims the values.
+//! More values than this in a row is not a table of points (the widest real
+//! exports hold a few dozen attributes). Splitting stops one value past it, so
+//! a hostile single line of a gigabyte costs no more than a normal row.
+constexpr std::size_t kMaxColumns = 1024;
+
+//! Splits a line into values (at most kMaxColumns + 1). Whitespace mode takes
+//! runs of spaces and tabs as one separator; character mode splits on one
+//! character and trims the values.
 class Splitter
 {
 public:
@@ -165,6 +172,8 @@ public:
                     ++i;
                 if (i > start)
                     tokens.push_back(line.substr(start, i - start));
+                if (tokens.size() > kMaxColumns)
+                    return;
             }
             return;
         }
@@ -178,7 +187,7 @@ public:
         while (true) {
             const std::size_t pos = line.find(separator_, start);
             tokens.push_back(trim(line.substr(start, pos == std::string_view::npos ? std::string_view::npos : pos - start)));
-            if (pos == std::string_view::npos)
+            if (pos == std::string_view::npos || tokens.size() > kMaxColumns)
                 break;
             start = pos + 1;
         }
@@ -189,8 +198,8 @@ private:
     bool whitespace_;
 };
 
-//! Splits on any usual separator: for deciding whether a line is data or header
-//! before the separator is known.
+//! Splits on any usual separator (at most kMaxColumns + 1 values): for deciding
+//! whether a line is data or header before the separator is known.
 void splitAny(std::string_view line, std::vector<std::string_view>& tokens)
 {
     tokens.clear();
@@ -204,6 +213,8 @@ void splitAny(std::string_view line, std::vector<std::string_view>& tokens)
             ++i;
         if (i > start)
             tokens.push_back(line.substr(start, i - start));
+        if (tokens.size() > kMaxColumns)
+            return;
     }
 }
 
@@ -222,6 +233,7 @@ struct Mapping
 {
     std::vector<Column> columns;
     std::vector<std::string> fieldNames;
+    std::unordered_set<std::string> usedNames; // fieldNames as a set: a new name is checked in constant time
 
     bool has(Role role) const
     {
@@ -234,8 +246,9 @@ struct Mapping
     void addField(std::string name)
     {
         const std::string base = name;
-        for (int k = 2; std::find(fieldNames.begin(), fieldNames.end(), name) != fieldNames.end(); ++k)
+        for (int k = 2; usedNames.count(name) != 0; ++k)
             name = base + "_" + std::to_string(k);
+        usedNames.insert(name);
         Column c;
         c.role = Role::Field;
         c.field = fieldNames.size();
@@ -370,6 +383,8 @@ public:
         std::vector<std::string_view> tokens;
         splitter.split(firstRow_, tokens);
         columnCount_ = tokens.size();
+        if (columnCount_ > kMaxColumns)
+            failAtLine(firstRowLine_, "more than " + std::to_string(kMaxColumns) + " values in a row: not a table of points");
         if (columnCount_ < 3)
             failAtLine(firstRowLine_, "a point needs at least 3 values (x y z), found " + std::to_string(columnCount_));
         mapping_ = chooseMapping(headerLines, splitter);

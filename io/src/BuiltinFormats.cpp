@@ -9,7 +9,7 @@ void registerBuiltinFormats(FormatRegistry& registry)
     registry.add(detail::asciiFormat());
     registry.add(detail::lasFormat());
     registry.add(detail::pcdFormat());
-    registry.add(detail::assimpMeshFormat());
+    registry.add(detail::meshFormat());
     registry.add(detail::dxfFormat());
 }
 

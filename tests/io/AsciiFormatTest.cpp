@@ -253,6 +253,31 @@ TEST(AsciiFormat, HeaderNamesTheColumns)
     EXPECT_EQ(cloud.field("Classification")->value(1), 5.0);
 }
 
+TEST(AsciiFormat, AThousandColumnsAreReadAndMoreAreRefused)
+{
+    // 1024 values a row are read (1021 fields, named apart in linear time);
+    // beyond, and on a hostile single line of a quarter million numbers (it
+    // took 8 s and 65,536 fields), a clear error after 1025 values.
+    std::string row;
+    for (int i = 0; i < 1024; ++i)
+        row += (i ? " " : "") + std::to_string(i);
+    const PointCloud wide = readText("wide.xyz", row + "\n" + row + "\n");
+    EXPECT_EQ(wide.size(), 2u);
+    EXPECT_EQ(wide.fields().size(), 1021u);
+    std::string line;
+    for (int i = 0; i < 65536; ++i)
+        line += "1.5 ";
+    for (const std::string& text : {row + " 1024\n", line + "\n"}) {
+        try {
+            readText("long.xyz", text);
+            ADD_FAILURE() << "accepted";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), ErrorCode::InvalidData);
+            EXPECT_NE(std::string(e.what()).find("more than 1024 values in a row"), std::string::npos) << e.what();
+        }
+    }
+}
+
 TEST(AsciiFormat, CommentedHeaderWithFloatColoursAndNormals)
 {
     const PointCloud cloud = readText("c.xyz", "# exported\n#  nx ny nz x y z rf gf bf\n"

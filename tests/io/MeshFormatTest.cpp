@@ -15,7 +15,7 @@ namespace {
 io::FormatRegistry meshFormats()
 {
     io::FormatRegistry registry;
-    registry.add(io::detail::assimpMeshFormat());
+    registry.add(io::detail::meshFormat());
     return registry;
 }
 
@@ -91,7 +91,7 @@ TEST(MeshFormats, GeoreferencedObjWritesFullPrecision)
     const auto registry = meshFormats();
     const auto path = test::tempDir() / "utm.obj";
     io::writeMesh(registry, pyramid({512345.678, 5423456.789, 100.0}), path);
-    // The text carries every digit; reading goes through assimp's float (documented limit).
+    // The text carries every digit, and reading keeps them (MeshFormats.ReadingKeepsDoublePrecision).
     EXPECT_NE(test::readBytes(path).find("v 512345.678 5423456.789 100"), std::string::npos);
 }
 
@@ -125,4 +125,107 @@ TEST(MeshFormats, GarbageAndPointOnlyFilesAreErrors)
             EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
         }
     }
+}
+
+TEST(MeshFormats, ReadingKeepsDoublePrecision)
+{
+    // OBJ and OFF carry doubles: a UTM vertex comes back to the micrometre
+    // when read in its own frame (through float, as assimp read them, it was
+    // off by up to 9 mm whatever the frame).
+    const auto registry = meshFormats();
+    const Mesh original = pyramid({512345.678, 5423456.789, 100.0});
+    io::ReadOptions sameFrame;
+    sameFrame.origin = original.vertices.origin();
+    for (const char* name : {"utm.obj", "utm.off"}) {
+        const auto path = test::tempDir() / name;
+        io::writeMesh(registry, original, path);
+        const Mesh back = io::readMesh(registry, path, sameFrame);
+        ASSERT_EQ(back.vertices.size(), 5u) << name;
+        for (std::size_t i = 0; i < 5; ++i)
+            ASSERT_LT((back.vertices.globalPosition(i) - original.vertices.globalPosition(i)).norm(), 1e-6) << name << " vertex " << i;
+    }
+}
+
+TEST(MeshFormats, ObjIndexFormsPolygonsColoursAndNormals)
+{
+    const auto registry = meshFormats();
+    const auto dir = test::tempDir();
+    // 1-based and negative indices, v/t/n, v//n and v forms, a quad (two
+    // triangles), vertex colours, a comment after the values, statements read past.
+    test::writeText(dir / "forms.obj", "mtllib x.mtl\no thing\n"
+                                       "v 0 0 0 1 0 0\nv 1 0 0 0 1 0 # a comment\nv 1 1 0 0 0 1\nv 0 1 0 1 1 1\n"
+                                       "vt 0 0\nvn 0 0 1\ng side\nusemtl a\ns off\n"
+                                       "f 1/1/1 2/1/1 3/1/1\nf -4//1 -2//1 -1//1\nf 1//1 2//1 3//1 4//1\n");
+    const Mesh m = io::readMesh(registry, dir / "forms.obj");
+    ASSERT_EQ(m.vertices.size(), 4u);
+    ASSERT_EQ(m.triangles.size(), 4u);
+    EXPECT_EQ(m.triangles[1], (Triangle{0, 2, 3}));
+    EXPECT_EQ(m.triangles[2], (Triangle{0, 1, 2}));
+    EXPECT_EQ(m.triangles[3], (Triangle{0, 2, 3}));
+    ASSERT_TRUE(m.vertices.hasColors());
+    EXPECT_EQ(m.vertices.colors()[1], (Rgb8{0, 255, 0}));
+    ASSERT_TRUE(m.vertices.hasNormals());
+    EXPECT_EQ(m.vertices.normals()[3], Eigen::Vector3f(0, 0, 1));
+    // Wrong indices name the line.
+    test::writeText(dir / "zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
+    test::writeText(dir / "ahead.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n");
+    test::writeText(dir / "normal.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n");
+    for (const char* name : {"zero.obj", "ahead.obj", "normal.obj"})
+        EXPECT_EQ(test::errorCodeOf([&] { io::readMesh(registry, dir / name); }), ErrorCode::InvalidData) << name;
+    try {
+        io::readMesh(registry, dir / "ahead.obj");
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+    }
+}
+
+TEST(MeshFormats, OffVariants)
+{
+    const auto registry = meshFormats();
+    const auto dir = test::tempDir();
+    // Counts on the first line, comments, a quad, an edge (no surface: read
+    // past), normals and colours (0..255 integers, and 0..1 reals).
+    test::writeText(dir / "counts.off", "OFF 4 3 0\n# corners\n0 0 0\n1 0 0\n1 1 0 # third\n0 1 0\n4 0 1 2 3\n2 0 1\n3 0 1 3\n");
+    const Mesh counts = io::readMesh(registry, dir / "counts.off");
+    EXPECT_EQ(counts.vertices.size(), 4u);
+    EXPECT_EQ(counts.triangles.size(), 3u);
+    test::writeText(dir / "cn.off", "CNOFF\n3 1 0\n0 0 0 0 0 1 255 0 0 255\n1 0 0 0 0 1 0 255 0 255\n0 1 0 0 0 1 0 0 255 255\n3 0 1 2\n");
+    const Mesh cn = io::readMesh(registry, dir / "cn.off");
+    ASSERT_TRUE(cn.vertices.hasNormals() && cn.vertices.hasColors());
+    EXPECT_EQ(cn.vertices.colors()[1], (Rgb8{0, 255, 0}));
+    EXPECT_EQ(cn.vertices.normals()[2], Eigen::Vector3f(0, 0, 1));
+    test::writeText(dir / "reals.off", "COFF\n3 1 0\n0 0 0 1 0 0\n1 0 0 0 0.5 0\n0 1 0 0 0 1\n3 0 1 2\n");
+    EXPECT_EQ(io::readMesh(registry, dir / "reals.off").vertices.colors()[1], (Rgb8{0, 128, 0}));
+    // Lying counts are refused before anything is allocated; bad indices name the line.
+    test::writeText(dir / "lying.off", "OFF\n4000000000 1 0\n0 0 0\n");
+    test::writeText(dir / "wide.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2000000000 0 1 2\n");
+    test::writeText(dir / "index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n");
+    test::writeText(dir / "binary.off", "OFF BINARY\n3 1 0\n");
+    for (const char* name : {"lying.off", "wide.off", "index.off", "binary.off"}) {
+        try {
+            io::readMesh(registry, dir / name);
+            ADD_FAILURE() << name << " was accepted";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), ErrorCode::InvalidData) << e.what();
+            EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+        }
+    }
+}
+
+TEST(MeshFormats, StlBinaryStartingWithSolidAndMergedCorners)
+{
+    // Many binary STL headers start with "solid": the size decides.
+    const auto registry = meshFormats();
+    const auto dir = test::tempDir();
+    io::writeMesh(registry, pyramid(), dir / "p.stl");
+    std::string bytes = test::readBytes(dir / "p.stl");
+    bytes.replace(0, 5, "solid");
+    test::writeText(dir / "solid.stl", bytes);
+    const Mesh m = io::readMesh(registry, dir / "solid.stl");
+    EXPECT_EQ(m.triangles.size(), 6u);
+    EXPECT_EQ(m.vertices.size(), 5u); // corners shared by facets merged
+    EXPECT_FALSE(m.vertices.hasNormals());
+    // One byte short is neither binary nor ASCII.
+    test::writeText(dir / "short.stl", bytes.substr(0, bytes.size() - 1));
+    EXPECT_EQ(test::errorCodeOf([&] { io::readMesh(registry, dir / "short.stl"); }), ErrorCode::InvalidData);
 }

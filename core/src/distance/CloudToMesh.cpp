@@ -645,8 +645,11 @@ CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference,
         tbb::parallel_sort(references.begin(), references.end());
         index.triangles.resize(references.size());
         for (std::size_t i = 0; i < references.size(); ++i) {
-            if (i == 0 || references[i].code != references[i - 1].code) {
-                index.cellCodes.push_back(references[i].code);
+            // By value: push_back takes a reference, and a reference to a
+            // member of the packed struct would be misaligned.
+            const MortonCode code = references[i].code;
+            if (i == 0 || code != references[i - 1].code) {
+                index.cellCodes.push_back(code);
                 index.cellFirst.push_back(i);
             }
             index.triangles[i] = references[i].triangle;

@@ -10,7 +10,7 @@ FormatHandler plyFormat();        // PlyFormat.cpp
 FormatHandler asciiFormat();      // AsciiFormat.cpp
 FormatHandler lasFormat();        // LasFormat.cpp
 FormatHandler pcdFormat();        // PcdFormat.cpp
-FormatHandler assimpMeshFormat(); // AssimpMeshFormat.cpp
+FormatHandler meshFormat();       // MeshFormats.cpp (readers in MeshReaders.cpp)
 FormatHandler dxfFormat();        // DxfWriter.cpp (export only)
 
 } // namespace scandiff::io::detail

@@ -3,7 +3,7 @@
 //! Reading and writing clouds and meshes, by file extension.
 //!
 //! A FormatRegistry maps extensions to format handlers. The built-in formats
-//! (PLY, ASCII XYZ/TXT/CSV/PTS/ASC, LAS, OBJ/STL/OFF via assimp, DXF export) are
+//! (PLY, ASCII XYZ/TXT/CSV/PTS/ASC, LAS, OBJ/STL/OFF read and written here, DXF export) are
 //! registered by registerBuiltinFormats(); plugins add more (PCD comes from the
 //! PCL plugin). Every writer goes through AtomicFile: an existing output file is
 //! never left half-written.

@@ -1,105 +1,23 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-//! OBJ, STL and OFF meshes. Reading goes through assimp, which knows the many
-//! dialects of these formats (ASCII and binary STL, OBJ groups and polygons, OFF
-//! variants). Writing is done here by hand: assimp's exporters take a float
-//! scene, while these text formats can carry the full double precision of
-//! georeferenced coordinates, and the three writers are a few lines each.
-//!
-//! Known limit: Debian's assimp is built with float coordinates, so a mesh file
-//! with coordinates beyond ~1e4 m loses sub-millimetre precision when read
-//! (STL is float32 by definition anyway). PLY keeps doubles: prefer it for
-//! georeferenced meshes.
+//! OBJ, STL and OFF meshes: read by MeshReaders.cpp, written here. The
+//! writers are ours too: these text formats carry the full double precision of
+//! georeferenced coordinates, and each is a few lines.
 
 #include "internal/Formats.h"
+#include "internal/MeshReaders.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
 #include <scandiff/io/AtomicFile.h>
 
-#include <assimp/Importer.hpp>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
-
 #include <charconv>
 #include <cstring>
-#include <functional>
 
 namespace scandiff::io::detail {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-Entity readWithAssimp(const fs::path& path, const ReadOptions& options)
-{
-    ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), 1);
-    Assimp::Importer importer;
-    // Triangulate polygons, merge the per-face vertices of STL, keep everything
-    // else as stored (no normals invented, no vertices reordered beyond merging).
-    unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices;
-    // STL stores one normal per facet; copied to the corners they would keep
-    // every shared vertex apart, so they are dropped before merging.
-    if (lowerExtension(path) == "stl")
-        flags |= aiProcess_DropNormals;
-    const aiScene* scene = importer.ReadFile(path.string(), flags);
-    if (!scene || !scene->mRootNode)
-        throw Error(ErrorCode::InvalidData, path.string() + ": cannot read mesh: " + importer.GetErrorString());
-
-    std::vector<Eigen::Vector3d> vertices;
-    std::vector<Eigen::Vector3f> normals;
-    bool allHaveNormals = true;
-    std::vector<Triangle> triangles;
-    std::function<void(const aiNode*, const aiMatrix4x4&)> visit = [&](const aiNode* node, const aiMatrix4x4& parent) {
-        const aiMatrix4x4 transform = parent * node->mTransformation;
-        aiMatrix3x3 rotation(transform);
-        for (unsigned m = 0; m < node->mNumMeshes; ++m) {
-            const aiMesh* mesh = scene->mMeshes[node->mMeshes[m]];
-            const auto base = static_cast<std::uint32_t>(vertices.size());
-            for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
-                const aiVector3D p = transform * mesh->mVertices[v];
-                vertices.emplace_back(p.x, p.y, p.z);
-                if (mesh->HasNormals()) {
-                    aiVector3D n = rotation * mesh->mNormals[v];
-                    normals.emplace_back(n.x, n.y, n.z);
-                }
-            }
-            allHaveNormals = allHaveNormals && mesh->HasNormals();
-            for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
-                const aiFace& face = mesh->mFaces[f];
-                if (face.mNumIndices != 3)
-                    continue; // points and lines left by Triangulate
-                triangles.push_back({base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
-            }
-        }
-        for (unsigned c = 0; c < node->mNumChildren; ++c)
-            visit(node->mChildren[c], transform);
-    };
-    visit(scene->mRootNode, aiMatrix4x4());
-
-    Mesh mesh;
-    BoundingBox box;
-    for (const auto& v : vertices) {
-        if (!v.allFinite())
-            throw Error(ErrorCode::InvalidData, path.string() + ": a vertex has a non-finite coordinate");
-        box.min = box.empty ? v : box.min.cwiseMin(v);
-        box.max = box.empty ? v : box.max.cwiseMax(v);
-        box.empty = false;
-    }
-    if (triangles.empty())
-        throw Error(ErrorCode::InvalidData, path.string() + ": the file holds no triangle");
-    const Eigen::Vector3d origin = options.origin ? *options.origin : suggestOrigin(box);
-    mesh.vertices.setOrigin(origin);
-    mesh.vertices.resize(vertices.size());
-    auto& positions = mesh.vertices.positions();
-    for (std::size_t i = 0; i < vertices.size(); ++i)
-        positions[i] = (vertices[i] - origin).cast<float>();
-    if (allHaveNormals && normals.size() == vertices.size())
-        mesh.vertices.enableNormals() = std::move(normals);
-    mesh.triangles = std::move(triangles);
-    mesh.checkConsistency();
-    ticker.step();
-    return mesh;
-}
 
 //! Shortest text that reads back to the same double.
 void appendNumber(std::string& out, double v)
@@ -220,12 +138,12 @@ void writeStl(const Mesh& mesh, const fs::path& path, const WriteOptions& option
 
 } // namespace
 
-FormatHandler assimpMeshFormat()
+FormatHandler meshFormat()
 {
     FormatHandler handler;
     handler.name = "Mesh (OBJ/STL/OFF)";
     handler.extensions = {"obj", "stl", "off"};
-    handler.read = readWithAssimp;
+    handler.read = [](const fs::path& path, const ReadOptions& options) -> Entity { return readMeshFile(path, options); };
     handler.writeMesh = [](const Mesh& mesh, const fs::path& path, const WriteOptions& options) {
         const std::string ext = lowerExtension(path);
         if (ext == "obj")

@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+//! The fuzzing corpus, read in every `make test`: each file of
+//! tests/fuzz/corpus/<extension>/ (seeds, and inputs the fuzzers found
+//! interesting) and each reproducer of tests/data/fuzz-found (files that once
+//! crashed, hung or leaked a reader) must be read or refused with a
+//! scandiff::Error naming the file; never a crash, never another exception.
+//! Under `make sanitize` the same test runs with AddressSanitizer and
+//! UndefinedBehaviorSanitizer.
+
+#include "TestSupport.h"
+
+#include <scandiff/core/Error.h>
+#include <scandiff/io/FileIO.h>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <set>
+
+using namespace scandiff;
+namespace fs = std::filesystem;
+
+namespace {
+
+io::FormatRegistry formats()
+{
+    io::FormatRegistry registry;
+    io::registerBuiltinFormats(registry);
+    return registry;
+}
+
+//! Reads `file` as a file of extension `extension` (corpus files are named by
+//! their hash): a copy with that extension in the test's folder.
+void readOrRefuse(const io::FormatRegistry& registry, const fs::path& file, const std::string& extension, const fs::path& scratch)
+{
+    SCOPED_TRACE(file.string());
+    const fs::path copy = scratch / ("input." + extension);
+    fs::copy_file(file, copy, fs::copy_options::overwrite_existing);
+    try {
+        io::readFile(registry, copy);
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(copy.string()), std::string::npos) << "the message names the file: " << e.what();
+        EXPECT_NE(e.code(), ErrorCode::Internal) << e.what();
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "not a scandiff::Error: " << e.what();
+    }
+}
+
+} // namespace
+
+TEST(FuzzCorpus, EveryFileIsReadOrRefusedCleanly)
+{
+    const io::FormatRegistry registry = formats();
+    const fs::path scratch = test::tempDir();
+    std::set<std::string> extensions;
+    std::size_t files = 0;
+    for (const auto& folder : fs::directory_iterator(SCANDIFF_FUZZ_CORPUS_DIR)) {
+        if (!folder.is_directory())
+            continue;
+        const std::string extension = folder.path().filename().string();
+        extensions.insert(extension);
+        for (const auto& entry : fs::directory_iterator(folder.path()))
+            if (entry.is_regular_file()) {
+                readOrRefuse(registry, entry.path(), extension, scratch);
+                ++files;
+            }
+    }
+    // Every reader has its corpus.
+    for (const char* extension : {"ply", "pcd", "las", "xyz", "obj", "stl", "off"})
+        EXPECT_TRUE(extensions.count(extension)) << "no corpus for ." << extension;
+    EXPECT_GT(files, 7u);
+}
+
+TEST(FuzzCorpus, EveryReproducerIsRefusedOrReadCleanly)
+{
+    const io::FormatRegistry registry = formats();
+    const fs::path scratch = test::tempDir();
+    std::size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(test::dataPath("fuzz-found")))
+        if (entry.path().extension() != ".md") {
+            readOrRefuse(registry, entry.path(), entry.path().extension().string().substr(1), scratch);
+            ++files;
+        }
+    EXPECT_EQ(files, 17u);
+}

@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+//! libFuzzer harness of one reader: the input bytes are written to a file of
+//! the reader's extension (SCANDIFF_FUZZ_EXTENSION, one executable per reader)
+//! and read through the registry, as the CLI and the workbench read files. A
+//! scandiff::Error is the expected answer to a broken file; a crash, a leak, a
+//! timeout or an allocation past -rss_limit_mb is a bug. Built with
+//! -DSCANDIFF_FUZZ=ON (clang); see docs/reliability.md for how to run it.
+
+#include <scandiff/core/Error.h>
+#include <scandiff/io/FileIO.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+
+#ifndef SCANDIFF_FUZZ_EXTENSION
+#error "SCANDIFF_FUZZ_EXTENSION must name the reader's extension"
+#endif
+
+namespace {
+
+const scandiff::io::FormatRegistry& formats()
+{
+    static const scandiff::io::FormatRegistry registry = [] {
+        scandiff::io::FormatRegistry r;
+        scandiff::io::registerBuiltinFormats(r);
+        return r;
+    }();
+    return registry;
+}
+
+//! One file per process in memory-backed /dev/shm when it exists.
+const std::filesystem::path& inputPath()
+{
+    static const std::filesystem::path path = [] {
+        const std::filesystem::path shm = "/dev/shm";
+        const std::filesystem::path dir = std::filesystem::exists(shm) ? shm : std::filesystem::temp_directory_path();
+        return dir / ("scandiff-fuzz-" + std::to_string(::getpid()) + "." SCANDIFF_FUZZ_EXTENSION);
+    }();
+    return path;
+}
+
+} // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
+{
+    {
+        std::ofstream out(inputPath(), std::ios::binary | std::ios::trunc);
+        out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+    }
+    try {
+        scandiff::io::readFile(formats(), inputPath());
+    } catch (const scandiff::Error&) {
+        // A clean refusal: what a broken file must give.
+    }
+    return 0;
+}
