@@ -18,6 +18,7 @@ PointCloud PointCloud::clone() const
     copy.fields_ = fields_;
     copy.sensors_ = sensors_;
     copy.history_ = history_;
+    copy.grid_ = grid_;
     return copy;
 }
 
@@ -132,6 +133,7 @@ PointCloud PointCloud::subset(const std::vector<std::size_t>& indices) const
     out.origin_ = origin_;
     out.sensors_ = sensors_;
     out.history_ = history_;
+    out.grid_ = grid_;
     out.positions_.reserve(indices.size());
     for (std::size_t i : indices) {
         if (i >= positions_.size())

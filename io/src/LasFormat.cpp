@@ -614,6 +614,7 @@ Entity readLas(const fs::path& path, const ReadOptions& options)
 
     PointCloud cloud;
     cloud.setOrigin(chooseOrigin(h, records, options));
+    cloud.setSourceGrid(CoordinateGrid{h.offset, h.scale});
     double gpsTimeOffset = 0.0;
     if (formatHasGpsTime(format) && count > 0) {
         // Relative to the first time, float32 keeps 1 µs over ±8 s and 61 µs over
@@ -916,6 +917,19 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
     for (int a = 0; a < 3; ++a)
         chooseQuantization(path, cloud.origin()[a], bounds.min[a], bounds.max[a], bounds.empty, lasOffset[a],
                            lasScale[a]);
+    // Points read from a LAS file go back on its grid (the same scale and
+    // offset, so the same integers) when they still fit it.
+    if (const auto& grid = cloud.sourceGrid(); grid && !bounds.empty) {
+        bool fits = true;
+        for (int a = 0; a < 3; ++a) {
+            const double reach = std::max(std::abs(bounds.min[a] - grid->offset[a]), std::abs(bounds.max[a] - grid->offset[a]));
+            fits = fits && grid->scale[a] > 0 && reach / grid->scale[a] <= 2147483000.0;
+        }
+        if (fits) {
+            lasOffset = grid->offset;
+            lasScale = grid->scale;
+        }
+    }
     const Eigen::Vector3d inverseScale = lasScale.cwiseInverse();
     const Eigen::Vector3d shift = cloud.origin() - lasOffset;
 

@@ -492,6 +492,10 @@ struct VertexSink
         static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "positions must be packed xyz floats");
         static_assert(sizeof(Rgb8) == 3, "colours must be packed rgb bytes");
         targets_.clear();
+        // An empty element (`element vertex 0`) has no arrays: pointer
+        // arithmetic on their null data would be undefined, and nothing is put.
+        if (!positions && !stagedXyz)
+            return;
         for (const Slot& s : layout.slots) {
             Target t;
             switch (s.role) {

@@ -6,6 +6,7 @@
 #include "internal/Formats.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/processing/CloudEditing.h>
 #include <scandiff/core/Log.h>
 #include <scandiff/io/FileIO.h>
 
@@ -516,6 +517,42 @@ TEST(LasFormat, HandBuiltLas12Format1DecodesAsTheSpecSays)
     EXPECT_EQ(cloud.field("scanner_channel"), nullptr);
     EXPECT_EQ(cloud.field("nir"), nullptr);
     EXPECT_TRUE(log.warnings.empty());
+}
+
+TEST(LasFormat, RoundTripKeepsTheScaleOffsetAndIntegers)
+{
+    // A file at 1 cm (scale 0.01) written back: the same scale and offset in
+    // the header and the same integer coordinates in every record (the writer
+    // used to pick 0.1 mm, moving points off the input's grid). Through a crop
+    // (a subset) too; a transformation leaves the grid.
+    const fs::path dir = test::tempDir();
+    test::writeText(dir / "in.las", makeLas12Format1().str());
+    const auto registry = lasRegistry();
+    const PointCloud cloud = io::readPointCloud(registry, dir / "in.las");
+    ASSERT_TRUE(cloud.sourceGrid());
+    io::writePointCloud(registry, cloud, dir / "out.las");
+    io::writePointCloud(registry, cloud.subset({1}), dir / "subset.las");
+    const std::string in = test::readBytes(dir / "in.las"), out = test::readBytes(dir / "out.las"),
+                      subset = test::readBytes(dir / "subset.las");
+    const auto number = [](const std::string& bytes, std::size_t at, auto type) {
+        decltype(type) v;
+        std::memcpy(&v, bytes.data() + at, sizeof v);
+        return v;
+    };
+    for (std::size_t a = 0; a < 3; ++a) {
+        EXPECT_EQ(number(out, 131 + 8 * a, double{}), number(in, 131 + 8 * a, double{})) << "scale " << a;
+        EXPECT_EQ(number(out, 155 + 8 * a, double{}), number(in, 155 + 8 * a, double{})) << "offset " << a;
+    }
+    const auto records = [&](const std::string& bytes) { return static_cast<std::size_t>(number(bytes, 96, std::uint32_t{})); };
+    const auto length = [&](const std::string& bytes) { return static_cast<std::size_t>(number(bytes, 94 + 11, std::uint16_t{})); };
+    for (std::size_t i = 0; i < 2; ++i)
+        for (std::size_t a = 0; a < 3; ++a) {
+            const std::int32_t original = number(in, records(in) + i * length(in) + 4 * a, std::int32_t{});
+            EXPECT_EQ(number(out, records(out) + i * length(out) + 4 * a, std::int32_t{}), original) << "point " << i << " axis " << a;
+            if (i == 1)
+                EXPECT_EQ(number(subset, records(subset) + 4 * a, std::int32_t{}), original) << "subset axis " << a;
+        }
+    EXPECT_FALSE(transformCloud(cloud, Eigen::Matrix4d::Identity(), "test").sourceGrid());
 }
 
 TEST(LasFormat, HandBuiltLas14Format10DecodesAsTheSpecSays)

@@ -71,6 +71,12 @@ PointCloud mergeClouds(const std::vector<const PointCloud*>& clouds, ProgressObs
     PointCloud merged;
     merged.name = "merged";
     merged.setOrigin(sameOrigin ? clouds.front()->origin() : suggestOrigin(bounds));
+    // Clouds read from one survey's files share their grid: the merge keeps it.
+    bool sameGrid = true;
+    for (const PointCloud* c : clouds)
+        sameGrid = sameGrid && c->sourceGrid() == clouds.front()->sourceGrid();
+    if (sameGrid)
+        merged.setSourceGrid(clouds.front()->sourceGrid());
     merged.resize(total);
     if (colours)
         merged.enableColors();
@@ -164,6 +170,7 @@ PointCloud transformCloud(const PointCloud& cloud, const Eigen::Matrix4d& matrix
     if (!(std::abs(determinant) > 1e-12))
         throw Error(ErrorCode::InvalidArgument, "transform: the matrix is singular (it would flatten the cloud)");
     PointCloud out = cloud.clone();
+    out.setSourceGrid(std::nullopt); // moved points leave the file's grid
     // The moved cloud's bounds from the moved corners of its box, for its origin.
     BoundingBox moved;
     const BoundingBox box = cloud.bounds();

@@ -37,6 +37,16 @@ struct AppliedTransform
     std::string description; //!< "rotate z 30 deg about 0,0,0", "matrix from T.txt"...
 };
 
+//! The integer grid a file stored the coordinates on (LAS: coordinate =
+//! offset + scale * integer). Kept so that writing LAS again gives the same
+//! integers; dropped by anything that moves the points off it.
+struct CoordinateGrid
+{
+    Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+    Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+    friend bool operator==(const CoordinateGrid& a, const CoordinateGrid& b) { return a.offset == b.offset && a.scale == b.scale; }
+};
+
 struct BoundingBox
 {
     Eigen::Vector3d min = Eigen::Vector3d::Constant(0.0);
@@ -105,6 +115,11 @@ public:
     std::vector<AppliedTransform>& transformHistory() { return history_; }
     const std::vector<AppliedTransform>& transformHistory() const { return history_; }
 
+    //! The grid of the file the points came from (LAS), if any: clone() and
+    //! subset() keep it, a transformation drops it.
+    const std::optional<CoordinateGrid>& sourceGrid() const { return grid_; }
+    void setSourceGrid(std::optional<CoordinateGrid> grid) { grid_ = std::move(grid); }
+
     //! Bounding box of the global coordinates, ignoring non-finite positions.
     BoundingBox bounds() const;
 
@@ -127,6 +142,7 @@ private:
     std::vector<ScalarField> fields_;
     std::vector<SensorPose> sensors_;
     std::vector<AppliedTransform> history_;
+    std::optional<CoordinateGrid> grid_;
 };
 
 //! Chooses an origin for global coordinates spanning `bounds`: zero when float32
