@@ -33,6 +33,8 @@
 #include <limits>
 #include <string>
 #include <string_view>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace scandiff::io::detail {
@@ -402,6 +404,8 @@ VertexLayout makeVertexLayout(const PlyElement& e, const Context& ctx)
     VertexLayout layout;
     layout.slotOfProperty.assign(e.properties.size(), -1);
     bool hasAxis[3] = {false, false, false};
+    std::unordered_set<std::string> usedNames;          // the field names so far
+    std::unordered_map<std::string, int> nextSuffix;    // per base name, the next "_k" to try
     std::size_t offset = 0;
     for (std::size_t i = 0; i < e.properties.size(); ++i) {
         const PlyProperty& p = e.properties[i];
@@ -440,12 +444,15 @@ VertexLayout makeVertexLayout(const PlyElement& e, const Context& ctx)
             std::string fieldName = p.name;
             if (name.rfind("scalar_", 0) == 0 && fieldName.size() > 7)
                 fieldName.erase(0, 7);
-            // Two properties may map to one name ("scalar_a" and "a"): keep both.
+            // Two properties may map to one name ("scalar_a" and "a"): keep
+            // both. In constant time per property: a hostile header repeating
+            // one name thousands of times took 44 s with a search per suffix.
             const std::string base = fieldName;
-            for (int k = 2; std::find(layout.fieldNames.begin(), layout.fieldNames.end(), fieldName) !=
-                            layout.fieldNames.end();
-                 ++k)
-                fieldName = base + "_" + std::to_string(k);
+            int& next = nextSuffix[base];
+            next = std::max(next, 2);
+            while (usedNames.count(fieldName) != 0)
+                fieldName = base + "_" + std::to_string(next++);
+            usedNames.insert(fieldName);
             slot.role = Role::Field;
             slot.field = static_cast<std::uint32_t>(layout.fieldNames.size());
             layout.fieldNames.push_back(fieldName);

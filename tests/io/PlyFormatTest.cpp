@@ -276,6 +276,25 @@ TEST(PlyFormat, FieldNamesSurviveTheRoundTrip)
     EXPECT_EQ(read.field("Red")->values()[1], 6.0f);
 }
 
+TEST(PlyFormat, RepeatedPropertyNamesAreKeptApartInLinearTime)
+{
+    // One name four thousand times (a hostile header took 44 s): a, a_2 ... a_4000.
+    std::string text = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n";
+    for (int i = 0; i < 4000; ++i)
+        text += "property float a\n";
+    text += "end_header\n0 0 0";
+    for (int i = 0; i < 4000; ++i)
+        text += " " + std::to_string(i);
+    text += "\n";
+    const fs::path path = tempDir() / "repeated.ply";
+    writeText(path, text);
+    const PointCloud read = io::readPointCloud(plyRegistry(), path);
+    ASSERT_EQ(read.fields().size(), 4000u);
+    EXPECT_EQ(read.field("a")->value(0), 0.0);
+    EXPECT_EQ(read.field("a_2")->value(0), 1.0);
+    EXPECT_EQ(read.field("a_4000")->value(0), 3999.0);
+}
+
 TEST(PlyFormat, ForcedOriginIsUsed)
 {
     const auto registry = plyRegistry();
