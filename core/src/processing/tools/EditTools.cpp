@@ -19,8 +19,6 @@ namespace scandiff::detail {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 //! Numbers separated by commas, semicolons, spaces, tabs or line breaks.
 std::vector<double> numbersIn(const std::string& text, const std::string& what)
 {
