@@ -549,8 +549,9 @@ TEST(LasFormat, RoundTripKeepsTheScaleOffsetAndIntegers)
         for (std::size_t a = 0; a < 3; ++a) {
             const std::int32_t original = number(in, records(in) + i * length(in) + 4 * a, std::int32_t{});
             EXPECT_EQ(number(out, records(out) + i * length(out) + 4 * a, std::int32_t{}), original) << "point " << i << " axis " << a;
-            if (i == 1)
+            if (i == 1) {
                 EXPECT_EQ(number(subset, records(subset) + 4 * a, std::int32_t{}), original) << "subset axis " << a;
+            }
         }
     EXPECT_FALSE(transformCloud(cloud, Eigen::Matrix4d::Identity(), "test").sourceGrid());
 }

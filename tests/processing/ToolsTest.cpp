@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 using namespace scandiff;
 
 namespace {
@@ -176,4 +178,71 @@ TEST_F(ProcessingTools, SampleMeshNeedsAMesh)
     mesh.vertices.positions() = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     mesh.triangles = {{0, 1, 2}};
     EXPECT_EQ(sample.execute(ToolInputs().add("input", mesh), sample.resolve({{"count", "5"}}), nullptr).cloud().size(), 5u);
+}
+
+namespace {
+
+//! Counts every poll of cancelRequested(), whatever the stage, from any
+//! thread; asks to stop from the `cancelAt`-th poll on (0: never).
+class PollCounter : public ProgressObserver
+{
+public:
+    explicit PollCounter(std::size_t cancelAt = 0) : cancelAt_(cancelAt) {}
+    void beginStage(const std::string&) override {}
+    void report(double) override {}
+    bool cancelRequested() const override
+    {
+        const std::size_t poll = ++polls_;
+        return cancelAt_ > 0 && poll >= cancelAt_;
+    }
+    std::size_t polls() const { return polls_; }
+
+private:
+    std::size_t cancelAt_;
+    mutable std::atomic<std::size_t> polls_{0};
+};
+
+} // namespace
+
+TEST_F(ProcessingTools, EveryLongToolStopsAtAnyPollAndLeavesItsInputAsItWas)
+{
+    // Each tool runs once to count its polls, then again with Cancel pressed
+    // at the first poll, a third of the way, two thirds and the last one: it
+    // must stop with Error(Cancelled) every time, and its input (a const
+    // reference, but a tool could cast or share buffers) is unchanged.
+    PointCloud cloud = test::sphereCloud(30000, 2.0);
+    cloud.enableNormals() = run("normals", cloud, {{"orient", "centroid"}}).cloud().normals();
+    ScalarField& field = cloud.addField("height");
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        field.setValue(i, cloud.positions()[i].z());
+    const PointCloud before = cloud.clone();
+    const std::vector<std::pair<std::string, std::map<std::string, std::string>>> runs = {
+        {"normals", {}},
+        {"orient-normals", {}},
+        {"features", {{"radius", "0.2"}}},
+        {"subsample", {{"spatial", "0.05"}}},
+        {"sor-filter", {}},
+        {"field-smooth", {{"field", "height"}, {"sigma", "0.1"}}},
+        {"field-gradient", {{"field", "height"}, {"radius", "0.2"}}},
+        {"mesh", {}},
+        {"primitives", {}},
+    };
+    for (const auto& [name, text] : runs) {
+        const ToolSpec& spec = tool(name);
+        const ParameterValues values = spec.resolve(text);
+        PollCounter counting;
+        ASSERT_NO_THROW(spec.execute(ToolInputs().add("input", cloud), values, &counting)) << name;
+        const std::size_t polls = counting.polls();
+        ASSERT_GE(polls, 3u) << name << " is polled " << polls << " times";
+        for (const std::size_t at : {std::size_t(1), polls / 3, 2 * polls / 3, polls}) {
+            PollCounter cancel(std::max<std::size_t>(at, 1));
+            EXPECT_EQ(test::errorCodeOf([&] { spec.execute(ToolInputs().add("input", cloud), values, &cancel); }),
+                      ErrorCode::Cancelled)
+                << name << ", Cancel at poll " << at << " of " << polls;
+        }
+        ASSERT_EQ(cloud.positions(), before.positions()) << name;
+        ASSERT_EQ(cloud.normals(), before.normals()) << name;
+        ASSERT_EQ(cloud.fields().size(), before.fields().size()) << name;
+        ASSERT_EQ(cloud.field("height")->values(), before.field("height")->values()) << name;
+    }
 }
