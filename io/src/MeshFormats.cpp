@@ -27,6 +27,32 @@ void appendNumber(std::string& out, double v)
     out.append(buffer, result.ptr);
 }
 
+//! "X Y Z" of vertex i in global coordinates, every digit, then its colour
+//! when the mesh has colours: " R G B" in 0..1 (OBJ's common extension) or
+//! " R G B 255" in 0..255 (COFF).
+void appendVertex(std::string& line, const Mesh& mesh, std::size_t i, bool unitColours)
+{
+    const Eigen::Vector3d p = mesh.vertices.globalPosition(i);
+    appendNumber(line, p.x());
+    line += ' ';
+    appendNumber(line, p.y());
+    line += ' ';
+    appendNumber(line, p.z());
+    if (mesh.vertices.hasColors()) {
+        const Rgb8 c = mesh.vertices.colors()[i];
+        for (const std::uint8_t channel : {c.r, c.g, c.b}) {
+            line += ' ';
+            if (unitColours)
+                appendNumber(line, channel / 255.0);
+            else
+                line += std::to_string(channel);
+        }
+        if (!unitColours)
+            line += " 255";
+    }
+    line += '\n';
+}
+
 void writeObj(const Mesh& mesh, const fs::path& path, const WriteOptions& options)
 {
     AtomicFile file(path);
@@ -35,14 +61,8 @@ void writeObj(const Mesh& mesh, const fs::path& path, const WriteOptions& option
     std::string line;
     out << "# written by scandiff\n";
     for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-        const Eigen::Vector3d p = mesh.vertices.globalPosition(i);
         line = "v ";
-        appendNumber(line, p.x());
-        line += ' ';
-        appendNumber(line, p.y());
-        line += ' ';
-        appendNumber(line, p.z());
-        line += '\n';
+        appendVertex(line, mesh, i, true);
         out << line;
         ticker.step();
     }
@@ -68,17 +88,11 @@ void writeOff(const Mesh& mesh, const fs::path& path, const WriteOptions& option
     AtomicFile file(path);
     auto& out = file.stream();
     ProgressTicker ticker(options.progress, "Writing " + path.filename().string(), mesh.vertices.size() + mesh.triangles.size());
-    out << "OFF\n" << mesh.vertices.size() << ' ' << mesh.triangles.size() << " 0\n";
+    out << (mesh.vertices.hasColors() ? "COFF\n" : "OFF\n") << mesh.vertices.size() << ' ' << mesh.triangles.size() << " 0\n";
     std::string line;
     for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-        const Eigen::Vector3d p = mesh.vertices.globalPosition(i);
         line.clear();
-        appendNumber(line, p.x());
-        line += ' ';
-        appendNumber(line, p.y());
-        line += ' ';
-        appendNumber(line, p.z());
-        line += '\n';
+        appendVertex(line, mesh, i, false);
         out << line;
         ticker.step();
     }

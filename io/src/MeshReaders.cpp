@@ -329,7 +329,8 @@ MeshParts readOff(Reader& reader)
                 allColoured = false;
                 continue;
             }
-            const bool integers = x[first] > 1 || x[first + 1] > 1 || x[first + 2] > 1;
+            // Integers when any channel, alpha included (ours writes 255), exceeds 1.
+            const bool integers = x[first] > 1 || x[first + 1] > 1 || x[first + 2] > 1 || (channels > 3 && x[first + 3] > 1);
             Rgb8 c;
             std::uint8_t* out[3] = {&c.r, &c.g, &c.b};
             for (int k = 0; k < 3; ++k) {

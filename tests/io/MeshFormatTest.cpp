@@ -229,3 +229,17 @@ TEST(MeshFormats, StlBinaryStartingWithSolidAndMergedCorners)
     test::writeText(dir / "short.stl", bytes.substr(0, bytes.size() - 1));
     EXPECT_EQ(test::errorCodeOf([&] { io::readMesh(registry, dir / "short.stl"); }), ErrorCode::InvalidData);
 }
+
+TEST(MeshFormats, ColoursSurviveObjAndOffRoundTrips)
+{
+    const auto registry = meshFormats();
+    Mesh m = pyramid();
+    m.vertices.enableColors() = {{0, 0, 0}, {1, 0, 1}, {255, 128, 7}, {2, 254, 1}, {100, 200, 50}};
+    for (const char* name : {"c.obj", "c.off"}) {
+        const auto path = test::tempDir() / name;
+        io::writeMesh(registry, m, path);
+        const Mesh back = io::readMesh(registry, path);
+        ASSERT_TRUE(back.vertices.hasColors()) << name;
+        EXPECT_EQ(back.vertices.colors(), m.vertices.colors()) << name;
+    }
+}
