@@ -103,7 +103,40 @@ void writeOff(const Mesh& mesh, const fs::path& path, const WriteOptions& option
     file.commit();
 }
 
-//! Binary STL (the compact, universal variant): float32 by definition.
+//! A triangle as STL stores it: its unit normal, then its three corners (global).
+struct Facet
+{
+    Eigen::Vector3d corners[4];
+};
+
+Facet facetOf(const Mesh& mesh, const Triangle& t)
+{
+    Facet f;
+    for (int k = 0; k < 3; ++k)
+        f.corners[k + 1] = mesh.vertices.globalPosition(t[static_cast<std::size_t>(k)]);
+    Eigen::Vector3d n = (f.corners[2] - f.corners[1]).cross(f.corners[3] - f.corners[1]);
+    if (n.norm() > 0)
+        n.normalize();
+    f.corners[0] = n;
+    return f;
+}
+
+//! "X Y Z" as float32 (STL's precision, even in ASCII), each written as the
+//! float's exact value (512345.6875, not the float-shortest 512345.7 that a
+//! double reader takes 1 cm away): the stream's default six digits lost half a
+//! metre at UTM magnitudes.
+void appendFloats(std::string& line, const Eigen::Vector3d& v)
+{
+    for (int axis = 0; axis < 3; ++axis) {
+        if (axis)
+            line += ' ';
+        char buffer[32];
+        const auto result = std::to_chars(buffer, buffer + sizeof buffer, static_cast<double>(static_cast<float>(v[axis])));
+        line.append(buffer, result.ptr);
+    }
+}
+
+//! STL, binary (the compact, universal variant) unless ASCII is asked for: float32 by definition.
 void writeStl(const Mesh& mesh, const fs::path& path, const WriteOptions& options)
 {
     AtomicFile file(path);
@@ -111,16 +144,19 @@ void writeStl(const Mesh& mesh, const fs::path& path, const WriteOptions& option
     ProgressTicker ticker(options.progress, "Writing " + path.filename().string(), mesh.triangles.size());
     if (options.encoding == Encoding::Ascii) {
         out << "solid scandiff\n";
+        std::string line;
         for (const auto& t : mesh.triangles) {
-            const Eigen::Vector3d a = mesh.vertices.globalPosition(t[0]), b = mesh.vertices.globalPosition(t[1]),
-                                  c = mesh.vertices.globalPosition(t[2]);
-            Eigen::Vector3d n = (b - a).cross(c - a);
-            if (n.norm() > 0)
-                n.normalize();
-            out << " facet normal " << n.x() << ' ' << n.y() << ' ' << n.z() << "\n  outer loop\n";
-            for (const auto* p : {&a, &b, &c})
-                out << "   vertex " << p->x() << ' ' << p->y() << ' ' << p->z() << '\n';
-            out << "  endloop\n endfacet\n";
+            const Facet f = facetOf(mesh, t);
+            line = " facet normal ";
+            appendFloats(line, f.corners[0]);
+            line += "\n  outer loop\n";
+            for (int k = 1; k < 4; ++k) {
+                line += "   vertex ";
+                appendFloats(line, f.corners[k]);
+                line += '\n';
+            }
+            line += "  endloop\n endfacet\n";
+            out << line;
             ticker.step();
         }
         out << "endsolid scandiff\n";
@@ -131,16 +167,11 @@ void writeStl(const Mesh& mesh, const fs::path& path, const WriteOptions& option
         const auto count = static_cast<std::uint32_t>(mesh.triangles.size());
         out.write(reinterpret_cast<const char*>(&count), 4);
         for (const auto& t : mesh.triangles) {
-            const Eigen::Vector3d a = mesh.vertices.globalPosition(t[0]), b = mesh.vertices.globalPosition(t[1]),
-                                  c = mesh.vertices.globalPosition(t[2]);
-            Eigen::Vector3d n = (b - a).cross(c - a);
-            if (n.norm() > 0)
-                n.normalize();
+            const Facet f = facetOf(mesh, t);
             float record[12];
-            const Eigen::Vector3d* vectors[4] = {&n, &a, &b, &c};
             for (int v = 0; v < 4; ++v)
-                for (int a2 = 0; a2 < 3; ++a2)
-                    record[v * 3 + a2] = static_cast<float>((*vectors[v])[a2]);
+                for (int axis = 0; axis < 3; ++axis)
+                    record[v * 3 + axis] = static_cast<float>(f.corners[v][axis]);
             out.write(reinterpret_cast<const char*>(record), sizeof record);
             const std::uint16_t attributes = 0;
             out.write(reinterpret_cast<const char*>(&attributes), 2);

@@ -243,3 +243,25 @@ TEST(MeshFormats, ColoursSurviveObjAndOffRoundTrips)
         EXPECT_EQ(back.vertices.colors(), m.vertices.colors()) << name;
     }
 }
+
+TEST(MeshFormats, AsciiStlKeepsFloatPrecisionAtUtmMagnitudes)
+{
+    // STL is float32; its ASCII form printed six digits (half a metre off at
+    // 512 km). Each coordinate now reads back as its float, exactly.
+    const auto registry = meshFormats();
+    const Mesh original = pyramid({512345.678, 5423456.789, 100.0});
+    io::WriteOptions ascii;
+    ascii.encoding = io::Encoding::Ascii;
+    const auto path = test::tempDir() / "utm.stl";
+    io::writeMesh(registry, original, path, ascii);
+    const Mesh back = io::readMesh(registry, path);
+    ASSERT_EQ(back.vertices.size(), 5u);
+    for (std::size_t i = 0; i < 5; ++i) {
+        const Eigen::Vector3d p = original.vertices.globalPosition(i);
+        const Eigen::Vector3d asFloat(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+        bool found = false;
+        for (std::size_t j = 0; j < 5 && !found; ++j)
+            found = back.vertices.globalPosition(j) == asFloat;
+        EXPECT_TRUE(found) << "vertex " << i;
+    }
+}
