@@ -39,7 +39,11 @@ public:
 
 private:
     bool centreInside(std::int64_t cx, std::int64_t cy) const;
-    static std::int64_t key(std::int64_t cx, std::int64_t cy) { return (cy << 32) ^ (cx & 0xffffffff); }
+    //! Shifted as unsigned: a left shift of a negative signed value is undefined.
+    static std::int64_t key(std::int64_t cx, std::int64_t cy)
+    {
+        return static_cast<std::int64_t>((static_cast<std::uint64_t>(cy) << 32) ^ (static_cast<std::uint64_t>(cx) & 0xffffffffu));
+    }
 
     const std::vector<Polygon2d>& rings_;
     Eigen::Vector2d low_;
