@@ -290,8 +290,10 @@ TEST(FieldOperations, ExpressionsOverFieldsCoordinatesAndColours)
 TEST(FieldOperations, GaussianSmoothingKeepsAConstantAndReducesNoise)
 {
     PointCloud cloud = test::randomPlaneCloud(20000, 5.0, 8);
-    ScalarField& constant = cloud.addField("constant");
-    ScalarField& noise = cloud.addField("noise");
+    cloud.addField("constant");
+    cloud.addField("noise"); // both added before either is held: adding one may move the other
+    ScalarField& constant = *cloud.field("constant");
+    ScalarField& noise = *cloud.field("noise");
     std::mt19937 rng(1);
     std::normal_distribution<double> g(0.0, 1.0);
     for (std::size_t i = 0; i < cloud.size(); ++i) {

@@ -116,15 +116,19 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
 
         ToolResult result;
         PointCloud labelled = input.clone();
-        ScalarField& id = labelled.addField("primitive_id");
-        ScalarField& type = labelled.addField("primitive_type");
-        ScalarField& distance = labelled.addField("primitive_distance");
+        // The three fields are added before any is held: adding a field may
+        // move the others (a reference kept across addField dangles).
+        for (const char* name : {"primitive_id", "primitive_type", "primitive_distance"})
+            labelled.addField(name);
+        std::vector<float>& id = labelled.field("primitive_id")->values();
+        std::vector<float>& type = labelled.field("primitive_type")->values();
+        std::vector<float>& distance = labelled.field("primitive_distance")->values();
         for (std::size_t i = 0; i < input.size(); ++i) {
-            id.values()[i] = static_cast<float>(detected.primitiveId[i]);
-            type.values()[i] = detected.primitiveId[i] < 0
-                                   ? -1.0f
-                                   : static_cast<float>(detected.primitives[static_cast<std::size_t>(detected.primitiveId[i])].primitive.kind);
-            distance.values()[i] = detected.distance[i];
+            id[i] = static_cast<float>(detected.primitiveId[i]);
+            type[i] = detected.primitiveId[i] < 0
+                          ? -1.0f
+                          : static_cast<float>(detected.primitives[static_cast<std::size_t>(detected.primitiveId[i])].primitive.kind);
+            distance[i] = detected.distance[i];
         }
         result.add("primitives", std::move(labelled));
         for (const DetectedPrimitive& shape : detected.primitives) {
