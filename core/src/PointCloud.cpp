@@ -38,7 +38,7 @@ void PointCloud::resize(std::size_t n)
     if (!normals_.empty())
         normals_.resize(n, Eigen::Vector3f::Zero());
     for (auto& f : fields_)
-        f.values().resize(n, std::numeric_limits<float>::quiet_NaN());
+        f.resize(n);
 }
 
 void PointCloud::reserve(std::size_t n)
@@ -157,6 +157,11 @@ PointCloud PointCloud::subset(const std::vector<std::size_t>& indices) const
         g.values().reserve(indices.size());
         for (std::size_t i : indices)
             g.values().push_back(f.values()[i]);
+        if (f.isDouble()) {
+            g.keepDoubles();
+            for (std::size_t k = 0; k < indices.size(); ++k)
+                g.doubles()[k] = f.value(indices[k]);
+        }
         out.fields_.push_back(std::move(g));
     }
     return out;
@@ -175,8 +180,11 @@ std::size_t PointCloud::removeNonFinitePoints()
                 colors_[kept] = colors_[i];
             if (!normals_.empty())
                 normals_[kept] = normals_[i];
-            for (auto& f : fields_)
+            for (auto& f : fields_) {
+                if (f.isDouble())
+                    f.doubles()[kept] = f.doubles()[i];
                 f.values()[kept] = f.values()[i];
+            }
         }
         ++kept;
     }
@@ -187,7 +195,7 @@ std::size_t PointCloud::removeNonFinitePoints()
         if (!normals_.empty())
             normals_.resize(kept);
         for (auto& f : fields_)
-            f.values().resize(kept);
+            f.resize(kept);
     }
     return n - kept;
 }

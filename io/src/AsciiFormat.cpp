@@ -351,6 +351,36 @@ double chooseFieldOffset(double firstValue)
     return std::floor(firstValue);
 }
 
+//! Whether a field stored as a float around `offset` writes `text` back with
+//! the same value. Without an offset the writer prints the float's shortest
+//! form, which gives back any number of at most 6 significant digits (FLT_DIG);
+//! longer ones are checked by printing. With an offset the value is printed as
+//! a double, so the float must hold it exactly.
+bool floatKeeps(std::string_view text, double v, double offset)
+{
+    if (offset != 0.0)
+        return offset + static_cast<double>(static_cast<float>(v - offset)) == v;
+    int digits = 0;
+    bool leading = true;
+    for (char ch : text) {
+        if (ch == 'e' || ch == 'E')
+            break;
+        if (ch < '0' || ch > '9')
+            continue;
+        if (leading && ch == '0')
+            continue;
+        leading = false;
+        ++digits;
+    }
+    if (digits <= 6)
+        return true;
+    char buffer[32];
+    const auto printed = std::to_chars(buffer, buffer + sizeof buffer, static_cast<float>(v));
+    double back = 0.0;
+    std::from_chars(buffer, printed.ptr, back);
+    return back == v;
+}
+
 std::uint8_t colorByte(double v, double scale)
 {
     v *= scale;
@@ -583,6 +613,8 @@ private:
         for (auto& f : fields_)
             f.reserve(estimate);
         offsets_.assign(mapping_.fieldNames.size(), std::numeric_limits<double>::quiet_NaN());
+        exact_.assign(mapping_.fieldNames.size(), {});
+        exactSince_.assign(mapping_.fieldNames.size(), false);
 
         std::vector<std::string_view> tokens;
         std::string_view line = firstRow_;
@@ -646,7 +678,21 @@ private:
                 double& offset = offsets_[column.field];
                 if (std::isnan(offset) && !std::isnan(v))
                     offset = chooseFieldOffset(v);
-                fields_[column.field].push_back(static_cast<float>(std::isnan(offset) ? v : v - offset));
+                const double base = std::isnan(offset) ? 0.0 : offset;
+                std::vector<float>& floats = fields_[column.field];
+                std::vector<double>& exact = exact_[column.field];
+                const bool keeping = exactSince_[column.field];
+                if (!keeping && !std::isnan(v) && !floatKeeps(tokens[c], v, base)) {
+                    // The first value a float cannot give back: from here on the
+                    // field keeps doubles, the earlier values being exact in float.
+                    exactSince_[column.field] = true;
+                    exact.reserve(floats.capacity());
+                    for (float earlier : floats)
+                        exact.push_back(base + static_cast<double>(earlier));
+                }
+                floats.push_back(static_cast<float>(v - base));
+                if (exactSince_[column.field])
+                    exact.push_back(v);
                 break;
             }
             case Role::Skip: break;
@@ -697,6 +743,11 @@ private:
             ScalarField field(mapping_.fieldNames[f]);
             field.values() = std::move(fields_[f]);
             field.setOffset(std::isnan(offsets_[f]) ? 0.0 : offsets_[f]);
+            if (exactSince_[f]) {
+                field.keepDoubles();
+                field.doubles().swap(exact_[f]);
+                exact_[f] = {};
+            }
             cloud.addField(std::move(field));
         }
         if (const std::size_t dropped = cloud.removeNonFinitePoints(); dropped > 0)
@@ -724,6 +775,9 @@ private:
     std::vector<Eigen::Vector3f> normals_;
     std::vector<std::vector<float>> fields_;
     std::vector<double> offsets_; //!< NaN until the field's first value is seen
+    //! Per field, empty until a value that a float cannot give back is read.
+    std::vector<std::vector<double>> exact_;
+    std::vector<bool> exactSince_; //!< per field: a value needed its double
 };
 
 // ---------------------------------------------------------------- writing
@@ -830,7 +884,7 @@ void writeAsciiCloud(const PointCloud& cloud, const fs::path& path, const WriteO
             text += sep;
             // A float field prints exactly in its shortest float form; with an
             // offset the sum needs double digits.
-            if (field.offset() == 0.0)
+            if (field.offset() == 0.0 && !field.isDouble())
                 number.shortest(text, field.values()[i]);
             else
                 number.shortest(text, field.value(i));

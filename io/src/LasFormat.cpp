@@ -392,6 +392,7 @@ struct PointOutputs
     float* userData = nullptr;
     float* pointSourceId = nullptr;
     float* gpsTime = nullptr;
+    double* gpsTimeExact = nullptr; //!< the same times as doubles
     double gpsTimeOffset = 0.0;
     float* nir = nullptr;
     //! Bitwise OR of every colour channel: tells whether any exceeds 255.
@@ -458,8 +459,11 @@ unsigned decodeRange(const char* records, std::size_t recordLength, std::size_t 
             out.userData[i] = static_cast<unsigned char>(p[17]);
             out.pointSourceId[i] = load<std::uint16_t>(p + 18);
         }
-        if constexpr (HasGpsTime)
-            out.gpsTime[i] = static_cast<float>(load<double>(p + gpsOffset) - out.gpsTimeOffset);
+        if constexpr (HasGpsTime) {
+            const double time = load<double>(p + gpsOffset);
+            out.gpsTime[i] = static_cast<float>(time - out.gpsTimeOffset);
+            out.gpsTimeExact[i] = time;
+        }
         if constexpr (HasRgb) {
             const unsigned r = load<std::uint16_t>(p + rgbOffset);
             const unsigned g = load<std::uint16_t>(p + rgbOffset + 2);
@@ -531,13 +535,24 @@ void decodeExtraTyped(const char* records, std::size_t recordLength, std::size_t
     const double fieldOffset = exactInFloat ? 0.0 : offsetForValues(first);
     field.setOffset(fieldOffset);
     float* values = field.values().data();
+    // Anything a float around the offset may not hold is also kept in double;
+    // the doubles go again when, for this file, the floats hold every value.
+    double* exact = nullptr;
+    if (!exactInFloat) {
+        field.keepDoubles();
+        exact = field.doubles().data();
+    }
     for (std::size_t i = 0; i < count; ++i, p += recordLength) {
         const auto raw = load<T>(p);
-        if (dim.hasNoData && static_cast<Upcast>(raw) == noData)
-            values[i] = kNaN;
-        else
-            values[i] = static_cast<float>(static_cast<double>(raw) * dim.scale + dim.offset - fieldOffset);
+        const double v = dim.hasNoData && static_cast<Upcast>(raw) == noData
+                             ? std::numeric_limits<double>::quiet_NaN()
+                             : static_cast<double>(raw) * dim.scale + dim.offset;
+        values[i] = static_cast<float>(v - fieldOffset);
+        if (exact)
+            exact[i] = v;
     }
+    if (exact && !std::is_same_v<T, double>)
+        field.dropDoublesIfExactInFloat();
 }
 
 void decodeExtra(const char* records, std::size_t recordLength, std::size_t count, const ExtraDimension& dim,
@@ -632,8 +647,11 @@ Entity readLas(const fs::path& path, const ReadOptions& options)
             cloud.addField(ScalarField(name, count));
         if (format >= 6)
             cloud.addField(ScalarField("scanner_channel", count));
-        if (formatHasGpsTime(format))
-            cloud.addField(ScalarField("gps_time", count)).setOffset(gpsTimeOffset);
+        if (formatHasGpsTime(format)) {
+            ScalarField& time = cloud.addField(ScalarField("gps_time", count));
+            time.setOffset(gpsTimeOffset);
+            time.keepDoubles(); // GPS time is a double in the file: kept to the bit
+        }
         if (formatHasNir(format))
             cloud.addField(ScalarField("nir", count));
         for (const ExtraDimension& dim : extras) {
@@ -668,6 +686,8 @@ Entity readLas(const fs::path& path, const ReadOptions& options)
     out.userData = values("user_data");
     out.pointSourceId = values("point_source_id");
     out.gpsTime = values("gps_time");
+    if (ScalarField* time = cloud.field("gps_time"))
+        out.gpsTimeExact = time->doubles().data();
     out.gpsTimeOffset = gpsTimeOffset;
     out.nir = values("nir");
 
@@ -751,16 +771,14 @@ constexpr std::array<const char*, static_cast<std::size_t>(Slot::Count)> kSlotNa
 
 struct SlotSource
 {
-    const float* values = nullptr;
-    double offset = 0.0;
+    const ScalarField* field = nullptr;
 
     // The field value of point i, or `fallback` when there is no field; NaN -> 0.
     double get(std::size_t i, double fallback) const
     {
-        if (!values)
+        if (!field)
             return fallback;
-        const float v = values[i];
-        return std::isnan(v) ? 0.0 : offset + static_cast<double>(v);
+        return field->hasValue(i) ? field->value(i) : 0.0;
     }
 };
 
@@ -844,26 +862,26 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
             others.push_back(&f);
             continue;
         }
-        slots[static_cast<std::size_t>(it - kSlotNames.begin())] = SlotSource{f.values().data(), f.offset()};
+        slots[static_cast<std::size_t>(it - kSlotNames.begin())] = SlotSource{&f};
     }
     const SlotSource& nirSlot = slots[static_cast<std::size_t>(Slot::Nir)];
     // Format 8 adds near infrared to the colours of format 7; without colours a
     // "nir" field goes to the extra bytes rather than forcing black colours.
-    const int format = cloud.hasColors() ? (nirSlot.values ? 8 : 7) : 6;
-    if (format != 8 && nirSlot.values) {
+    const int format = cloud.hasColors() ? (nirSlot.field ? 8 : 7) : 6;
+    if (format != 8 && nirSlot.field) {
         others.push_back(cloud.field("nir"));
         slots[static_cast<std::size_t>(Slot::Nir)] = SlotSource{};
     }
     const std::size_t baseSize = kBaseRecordSize[static_cast<std::size_t>(format)];
 
     // Extra bytes: float (type 9) keeps a field exactly; a field with an offset
-    // (times, large values) needs double (type 10) to keep its precision.
+    // (times, large values) or kept in double needs double (type 10).
     std::vector<ExtraOutput> extras;
     std::size_t recordLength = baseSize;
     for (const ScalarField* f : others) {
         ExtraOutput e;
         e.field = f;
-        e.asDouble = f->offset() != 0.0;
+        e.asDouble = f->offset() != 0.0 || f->isDouble();
         e.recordOffset = recordLength;
         // The descriptor's name is char[32]: longer names are cut to 32 bytes,
         // and a cut name that repeats an earlier one ends with "~2", "~3"...
@@ -994,11 +1012,10 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
             if (format == 8)
                 store<std::uint16_t>(p + 36, clampRound<std::uint16_t>(slot(Slot::Nir).get(i, 0.0)));
             for (const ExtraOutput& e : extras) {
-                const float v = e.field->values()[i];
                 if (e.asDouble)
-                    store<double>(p + e.recordOffset, e.field->offset() + static_cast<double>(v));
+                    store<double>(p + e.recordOffset, e.field->value(i));
                 else
-                    store<float>(p + e.recordOffset, v);
+                    store<float>(p + e.recordOffset, e.field->values()[i]);
             }
             if (returnNumber >= 1)
                 ++pointsByReturn[returnNumber - 1];

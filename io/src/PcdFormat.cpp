@@ -521,9 +521,13 @@ Entity readPcd(const fs::path& path, const ReadOptions& options)
         cloud.enableColors();
     std::vector<Eigen::Vector3d> global(n, Eigen::Vector3d::Zero());
     std::vector<std::vector<double>> staged(cloud.fields().size());
+    std::vector<bool> stagedFromDouble(cloud.fields().size(), false);
     for (const Slot& slot : slots)
-        if (slot.target == Target::Field && slot.wide)
+        if (slot.target == Target::Field && slot.wide) {
             staged[slot.scalar].assign(n, std::numeric_limits<double>::quiet_NaN());
+            const PcdField& source = header.fields[slot.field];
+            stagedFromDouble[slot.scalar] = source.type == 'F' && source.size == 8;
+        }
     const PointSink sink(cloud, global, staged);
     const auto* bytes = reinterpret_cast<const unsigned char*>(file.data()) + header.dataStart;
     if (header.data == DataKind::Ascii) {
@@ -550,8 +554,13 @@ Entity readPcd(const fs::path& path, const ReadOptions& options)
             }
         ScalarField& field = *cloud.field(cloud.fields()[f].name());
         field.setOffset(chooseFieldOffset(lo, hi));
+        // A double stays a double to the bit; a 32/64-bit integer keeps its
+        // doubles only where the float around the offset cannot hold it.
+        field.keepDoubles();
         for (std::size_t i = 0; i < n; ++i)
             field.setValue(i, staged[f][i]);
+        if (!stagedFromDouble[f])
+            field.dropDoublesIfExactInFloat();
         staged[f] = {};
     }
     ticker.step();
@@ -637,7 +646,7 @@ void writePcd(const PointCloud& cloud, const fs::path& path, const WriteOptions&
     if (cloud.hasColors())
         fields.push_back({"rgb", 'F', 4}); // PCL's convention: the packed bytes declared as a float
     for (const ScalarField& f : cloud.fields())
-        fields.push_back({uniqueName(f.name(), taken), 'F', f.offset() != 0.0 ? 8u : 4u});
+        fields.push_back({uniqueName(f.name(), taken), 'F', f.offset() != 0.0 || f.isDouble() ? 8u : 4u});
     std::size_t pointStep = 0;
     for (const OutField& f : fields)
         pointStep += f.size;
@@ -657,7 +666,7 @@ void writePcd(const PointCloud& cloud, const fs::path& path, const WriteOptions&
             values.push_back(0); // placeholder: the colour is written from `packed`
         }
         for (const ScalarField& f : cloud.fields())
-            values.push_back(f.offset() != 0.0 ? f.value(i) : static_cast<double>(f.values()[i]));
+            values.push_back(f.offset() != 0.0 || f.isDouble() ? f.value(i) : static_cast<double>(f.values()[i]));
     };
     auto putValue = [](unsigned char* at, double value, unsigned size) {
         if (size == 8) {

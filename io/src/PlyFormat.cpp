@@ -477,6 +477,7 @@ struct VertexSink
     Rgb8* colors = nullptr;
     Eigen::Vector3f* normals = nullptr;
     std::vector<float*> fieldValues;
+    std::vector<double*> fieldDoubles; //!< per field, null unless the field keeps doubles
     std::vector<double> fieldOffsets;
     std::vector<double*> stagedFields; //!< per field, null when written directly
     double* stagedXyz = nullptr;
@@ -541,8 +542,9 @@ struct VertexSink
                     t.kind = Target::Staged;
                     t.doubles = stagedFields[s.field];
                 } else {
-                    t.kind = Target::Float;
+                    t.kind = fieldDoubles[s.field] ? Target::FloatAndDouble : Target::Float;
                     t.floats = fieldValues[s.field];
+                    t.doubles = fieldDoubles[s.field];
                     t.offset = fieldOffsets[s.field];
                 }
                 break;
@@ -559,6 +561,10 @@ struct VertexSink
         case Target::Float: t.floats[i * t.stride] = static_cast<float>(v - t.offset); break;
         case Target::Color: t.bytes[i * t.stride] = colorByte(v, t.colorScale); break;
         case Target::Staged: t.doubles[i * t.stride] = v; break;
+        case Target::FloatAndDouble:
+            t.floats[i] = static_cast<float>(v - t.offset);
+            t.doubles[i] = v;
+            break;
         case Target::None: break;
         }
     }
@@ -566,7 +572,7 @@ struct VertexSink
 private:
     struct Target
     {
-        enum Kind : std::uint8_t { None, Float, Color, Staged } kind = None;
+        enum Kind : std::uint8_t { None, Float, Color, Staged, FloatAndDouble } kind = None;
         std::size_t stride = 1;
         float* floats = nullptr;
         std::uint8_t* bytes = nullptr;
@@ -1095,6 +1101,7 @@ private:
         // Pointers are taken once every field exists: addField may reallocate the field vector.
         for (const auto& name : layout_.fieldNames)
             sink.fieldValues.push_back(cloud_.field(name)->values().data());
+        sink.fieldDoubles.assign(layout_.fieldNames.size(), nullptr);
         sink.fieldOffsets.assign(layout_.fieldNames.size(), 0.0);
         sink.stagedFields.assign(layout_.fieldNames.size(), nullptr);
         return sink;
@@ -1129,12 +1136,33 @@ private:
             sink.origin = suggestOrigin(ranges.box());
         cloud_.setOrigin(sink.origin);
         for (std::size_t f = 0; f < layout_.fieldNames.size(); ++f)
-            if (layout_.fieldIsWide[f])
+            if (layout_.fieldIsWide[f]) {
                 sink.fieldOffsets[f] = chooseFieldOffset(ranges.fieldLo[f], ranges.fieldHi[f]);
+                // Wide values are kept in double as well (see keepWideFieldsExact).
+                ScalarField& field = *cloud_.field(layout_.fieldNames[f]);
+                field.keepDoubles();
+                sink.fieldDoubles[f] = field.doubles().data();
+            }
         applyFieldOffsets(sink);
         sink.compile(layout_);
-        return visitBinaryVertices<Swap>(e, layout_, ptr, end, ctx_, ticker,
-                                          [&sink](std::uint64_t i, const Slot& s, double v) { sink.put(i, s, v); });
+        const char* next = visitBinaryVertices<Swap>(
+            e, layout_, ptr, end, ctx_, ticker, [&sink](std::uint64_t i, const Slot& s, double v) { sink.put(i, s, v); });
+        keepWideFieldsExact();
+        return next;
+    }
+
+    //! A double property stays a double, to the bit. A 32-bit integer one keeps
+    //! its doubles only when the float around the field's offset cannot hold
+    //! every value (a range wider than 2^24).
+    void keepWideFieldsExact()
+    {
+        for (const Slot& s : layout_.slots) {
+            if (s.role != Role::Field || !layout_.fieldIsWide[s.field])
+                continue;
+            ScalarField& field = *cloud_.field(layout_.fieldNames[s.field]);
+            if (s.type != PlyType::Float64)
+                field.dropDoublesIfExactInFloat();
+        }
     }
 
     void readAsciiVertexElement(const PlyElement& e, AsciiLines& lines, ProgressTicker& ticker)
@@ -1193,8 +1221,12 @@ private:
             float* values = sink.fieldValues[f];
             for (std::size_t i = 0; i < n; ++i)
                 values[i] = static_cast<float>(staged[i] - sink.fieldOffsets[f]);
+            ScalarField& field = *cloud_.field(layout_.fieldNames[f]);
+            field.keepDoubles();
+            field.doubles().swap(stagedFields[f]);
         }
         applyFieldOffsets(sink);
+        keepWideFieldsExact();
     }
 
     void applyFieldOffsets(const VertexSink& sink)
@@ -1319,7 +1351,8 @@ public:
         for (std::size_t f = 0; f < cloud.fields().size(); ++f) {
             const ScalarField& field = cloud.fields()[f];
             columns_.push_back({plyPropertyName(field.name()),
-                                field.offset() != 0.0 ? PlyType::Float64 : PlyType::Float32, ColumnKind::Field,
+                                field.offset() != 0.0 || field.isDouble() ? PlyType::Float64 : PlyType::Float32,
+                                ColumnKind::Field,
                                 static_cast<int>(f)});
         }
     }

@@ -110,6 +110,66 @@ TEST(Merge, CloudsWithDifferentShiftsKeepTheirMillimetres)
     EXPECT_EQ(test::errorCodeOf([&] { mergeClouds({}); }), ErrorCode::InvalidArgument);
 }
 
+TEST(DoubleFields, SubsetMergeAndDroppedPointsKeepEveryDouble)
+{
+    // A field kept in double: GPS times 37.1234567 s apart, over half an
+    // hour, which its float view around the offset keeps to 0.1 ms only.
+    auto makeCloud = [](double start, std::size_t n) {
+        PointCloud cloud;
+        cloud.resize(n);
+        ScalarField time("gps_time", n);
+        time.setOffset(std::floor(start));
+        time.keepDoubles();
+        for (std::size_t i = 0; i < n; ++i) {
+            cloud.positions()[i] = Eigen::Vector3f(static_cast<float>(i), 0.0f, 0.0f);
+            time.setValue(i, start + static_cast<double>(i) * 37.1234567);
+        }
+        cloud.addField(std::move(time));
+        return cloud;
+    };
+    const PointCloud a = makeCloud(1.4e9 + 0.5, 50);
+    const PointCloud b = makeCloud(1.5e9 + 0.25, 30);
+    const ScalarField& ta = *a.field("gps_time");
+    ASSERT_NE(ta.offset() + static_cast<double>(ta.values()[40]), ta.value(40)); // the float view alone loses it
+    EXPECT_EQ(ta.value(40), 1.4e9 + 0.5 + 40 * 37.1234567);
+
+    const PointCloud some = a.subset({7, 3, 49});
+    EXPECT_EQ(some.field("gps_time")->value(0), ta.value(7));
+    EXPECT_EQ(some.field("gps_time")->value(2), ta.value(49));
+
+    // Merged around one offset, 1e8 s from b's times: still every bit.
+    const PointCloud merged = mergeClouds({&a, &b});
+    const ScalarField& tm = *merged.field("gps_time");
+    ASSERT_TRUE(tm.isDouble());
+    for (std::size_t i = 0; i < 50; ++i)
+        EXPECT_EQ(tm.value(i), ta.value(i)) << i;
+    for (std::size_t i = 0; i < 30; ++i)
+        EXPECT_EQ(tm.value(50 + i), b.field("gps_time")->value(i)) << i;
+
+    PointCloud holed = a.clone();
+    holed.positions()[4].y() = std::numeric_limits<float>::infinity();
+    ASSERT_EQ(holed.removeNonFinitePoints(), 1u);
+    EXPECT_EQ(holed.field("gps_time")->value(4), ta.value(5));
+    EXPECT_EQ(holed.field("gps_time")->doubles().size(), 49u);
+
+    // A value written through the float view wins over its stale double, and
+    // the range is the doubles' own.
+    ScalarField& edited = *holed.field("gps_time");
+    edited.values()[0] = 100000.0f;
+    EXPECT_EQ(edited.value(0), edited.offset() + 100000.0);
+    EXPECT_EQ(edited.value(1), ta.value(1));
+    EXPECT_EQ(edited.range().min, ta.value(1));
+    EXPECT_EQ(edited.range().max, edited.offset() + 100000.0);
+    // Doubles that a float holds exactly are given up.
+    ScalarField small("small", 3);
+    small.keepDoubles();
+    small.setValue(0, 0.5);
+    small.setValue(1, 2.0);
+    EXPECT_TRUE(small.dropDoublesIfExactInFloat());
+    EXPECT_FALSE(small.isDouble());
+    EXPECT_EQ(small.value(0), 0.5);
+}
+
 TEST(Crop, ScreenPolygonsEqualBruteForceInTopAndPerspectiveViews)
 {
     PointCloud cloud = test::randomPlaneCloud(3000, 10.0, 9);

@@ -56,17 +56,23 @@ PointCloud mergeClouds(const std::vector<const PointCloud*>& clouds, ProgressObs
     bool colours = false, normals = false;
     std::vector<std::string> fieldNames;
     std::vector<double> fieldOffsets;
+    std::vector<bool> fieldIsDouble;
     for (const PointCloud* c : clouds) {
         sameOrigin = sameOrigin && c->origin() == clouds.front()->origin();
         bounds = unionOf(bounds, c->bounds());
         total += c->size();
         colours = colours || c->hasColors();
         normals = normals || c->hasNormals();
-        for (const auto& f : c->fields())
-            if (std::find(fieldNames.begin(), fieldNames.end(), f.name()) == fieldNames.end()) {
+        for (const auto& f : c->fields()) {
+            const auto known = std::find(fieldNames.begin(), fieldNames.end(), f.name());
+            if (known == fieldNames.end()) {
                 fieldNames.push_back(f.name());
                 fieldOffsets.push_back(f.offset());
+                fieldIsDouble.push_back(f.isDouble());
+            } else if (f.isDouble()) {
+                fieldIsDouble[static_cast<std::size_t>(known - fieldNames.begin())] = true;
             }
+        }
     }
     PointCloud merged;
     merged.name = "merged";
@@ -82,8 +88,12 @@ PointCloud mergeClouds(const std::vector<const PointCloud*>& clouds, ProgressObs
         merged.enableColors();
     if (normals)
         merged.enableNormals();
-    for (std::size_t f = 0; f < fieldNames.size(); ++f)
-        merged.addField(fieldNames[f]).setOffset(fieldOffsets[f]);
+    for (std::size_t f = 0; f < fieldNames.size(); ++f) {
+        ScalarField& field = merged.addField(fieldNames[f]);
+        field.setOffset(fieldOffsets[f]);
+        if (fieldIsDouble[f])
+            field.keepDoubles();
+    }
     ScalarField& source = merged.addField(fields::kSourceIndex);
     ProgressTicker ticker(progress, "Merging", total);
     std::size_t at = 0;
@@ -107,9 +117,12 @@ PointCloud mergeClouds(const std::vector<const PointCloud*>& clouds, ProgressObs
             ScalarField& target = *merged.field(f.name());
             // Re-expressed around the merged field's offset, in double.
             const double delta = f.offset() - target.offset();
-            forEachPoint(n, [&](std::size_t i) {
-                target.values()[at + i] = static_cast<float>(static_cast<double>(f.values()[i]) + delta);
-            });
+            if (target.isDouble())
+                forEachPoint(n, [&](std::size_t i) { target.setValue(at + i, f.value(i)); });
+            else
+                forEachPoint(n, [&](std::size_t i) {
+                    target.values()[at + i] = static_cast<float>(static_cast<double>(f.values()[i]) + delta);
+                });
         }
         for (const auto& pose : c.sensors())
             merged.sensors().push_back(pose);
