@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <random>
 #include <sstream>
 
 namespace scandiff::io {
@@ -124,6 +125,44 @@ void writeRegionsCsv(const std::vector<RegionStatistics>& regions, const std::fi
     file.commit();
 }
 
+namespace {
+
+//! A folder beside the export's files where they are written first, removed
+//! with whatever it holds when the export stops early.
+class StagingFolder
+{
+public:
+    explicit StagingFolder(const std::filesystem::path& dir)
+    {
+        std::random_device random;
+        for (int attempt = 0; attempt < 100; ++attempt) {
+            char name[64];
+            std::snprintf(name, sizeof name, ".scandiff-export-%08x", static_cast<unsigned>(random()));
+            std::error_code ec;
+            if (std::filesystem::create_directory(dir / name, ec)) {
+                path_ = dir / name;
+                return;
+            }
+            if (ec)
+                throw Error(ErrorCode::Io, "cannot create a working folder in '" + dir.string() + "': " + ec.message());
+        }
+        throw Error(ErrorCode::Io, "cannot create a working folder in '" + dir.string() + "'");
+    }
+    StagingFolder(const StagingFolder&) = delete;
+    StagingFolder& operator=(const StagingFolder&) = delete;
+    ~StagingFolder()
+    {
+        std::error_code ec;
+        std::filesystem::remove_all(path_, ec);
+    }
+    const std::filesystem::path& path() const { return path_; }
+
+private:
+    std::filesystem::path path_;
+};
+
+} // namespace
+
 RegionExportFiles exportRegions(const FormatRegistry& registry, const PointCloud& cloud, const std::vector<RegionStatistics>& regions,
                                 const std::filesystem::path& dir, const RegionExportOptions& options)
 {
@@ -143,24 +182,39 @@ RegionExportFiles exportRegions(const FormatRegistry& registry, const PointCloud
         if (ids->hasValue(i))
             all.push_back(i);
 
-    RegionExportFiles files;
-    files.allRegions = dir / ("regions." + options.cloudExtension);
+    // Every file is written in a staging folder first and moved into `dir` once
+    // all are complete: a cancelled or failed export leaves `dir` as it was
+    // (no new file, and a previous export's files untouched).
+    const StagingFolder staging(dir);
+    std::vector<std::string> names;
+    names.push_back("regions." + options.cloudExtension);
     PointCloud allCloud = cloud.subset(all);
     allCloud.name = cloud.name.empty() ? "regions" : cloud.name + " regions";
-    writePointCloud(registry, allCloud, files.allRegions, options.write);
+    writePointCloud(registry, allCloud, staging.path() / names.back(), options.write);
     for (const RegionStatistics& r : regions) {
         char name[64];
         std::snprintf(name, sizeof name, "region_%04d.", r.id);
-        const auto path = dir / (name + options.cloudExtension);
+        names.push_back(name + options.cloudExtension);
         PointCloud part = cloud.subset(members[r.id]);
         part.name = regionLayerName(r.id);
-        writePointCloud(registry, part, path, options.write);
-        files.regionClouds.push_back(path);
+        writePointCloud(registry, part, staging.path() / names.back(), options.write);
     }
+    names.push_back("regions.dxf");
+    writeRegionsDxf(cloud, regions, staging.path() / names.back(), options.dxf, options.regionField);
+    names.push_back("regions.csv");
+    writeRegionsCsv(regions, staging.path() / names.back());
+
+    for (const std::string& name : names) {
+        std::filesystem::rename(staging.path() / name, dir / name, ec);
+        if (ec)
+            throw Error(ErrorCode::Io, "cannot move '" + name + "' into '" + dir.string() + "': " + ec.message());
+    }
+    RegionExportFiles files;
+    files.allRegions = dir / names.front();
+    for (std::size_t k = 0; k < regions.size(); ++k)
+        files.regionClouds.push_back(dir / names[1 + k]);
     files.dxf = dir / "regions.dxf";
-    writeRegionsDxf(cloud, regions, files.dxf, options.dxf, options.regionField);
     files.csv = dir / "regions.csv";
-    writeRegionsCsv(regions, files.csv);
     return files;
 }
 

@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <random>
 
 using namespace scandiff;
@@ -365,6 +366,40 @@ TEST(PointPairs, BadPairs)
     const std::vector<PointPair> parsed = parsePointPairs("1 2 3 4 5 6\n7,8,9,10,11,12;");
     ASSERT_EQ(parsed.size(), 2u);
     EXPECT_EQ(parsed[1].reference, Eigen::Vector3d(10, 11, 12));
+}
+
+TEST(Icp, EveryRegistrationToolStopsAtAnyPollAndLeavesBothCloudsAsTheyWere)
+{
+    // Each registration tool runs once to count its polls, then with Cancel
+    // pressed at the first, a third, two thirds and the last: Error(Cancelled)
+    // every time, and neither cloud changed.
+    const Eigen::Vector3d origin(500000, 5400000, 120);
+    const Scene scene = makeScene(test::rigidMotionAbout(20, 3, -2, Eigen::Vector3d(1, -0.5, 0.2), origin), 40000, true, origin);
+    const PointCloud referenceBefore = scene.reference.clone();
+    const PointCloud movingBefore = scene.moving.clone();
+    const PluginRegistry registry = makePluginRegistry();
+    const std::vector<std::pair<std::string, std::map<std::string, std::string>>> runs = {
+        {"register", {{"global", "true"}, {"exclude-changes", "true"}}},
+        {"register-global", {}},
+    };
+    for (const auto& [name, text] : runs) {
+        const ToolSpec& spec = *registry.tools.find(name);
+        const ParameterValues values = spec.resolve(text);
+        const ToolInputs inputs = ToolInputs().add("moving", scene.moving).add("reference", scene.reference);
+        test::PollCounter counting;
+        ASSERT_NO_THROW(spec.execute(inputs, values, &counting)) << name;
+        const std::size_t polls = counting.polls();
+        ASSERT_GE(polls, 3u) << name;
+        for (const std::size_t at : {std::size_t(1), polls / 3, 2 * polls / 3, polls}) {
+            test::PollCounter cancel(std::max<std::size_t>(at, 1));
+            EXPECT_EQ(test::errorCodeOf([&] { spec.execute(inputs, values, &cancel); }), ErrorCode::Cancelled)
+                << name << ", Cancel at poll " << at << " of " << polls;
+        }
+        ASSERT_EQ(scene.moving.positions(), movingBefore.positions()) << name;
+        ASSERT_EQ(scene.reference.positions(), referenceBefore.positions()) << name;
+        ASSERT_EQ(scene.moving.fields().size(), movingBefore.fields().size()) << name;
+        ASSERT_EQ(scene.moving.transformHistory().size(), movingBefore.transformHistory().size()) << name;
+    }
 }
 
 TEST(GlobalAlignment, Recovers140DegreesFromAnyStartThenIcpFinishes)

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The processing tools as every front end runs them: declarations, parameter
 // text, inputs by role, outputs by role.
+#include "StageWatcher.h"
 #include "SyntheticClouds.h"
 #include "TestSupport.h"
 
@@ -180,29 +181,6 @@ TEST_F(ProcessingTools, SampleMeshNeedsAMesh)
     EXPECT_EQ(sample.execute(ToolInputs().add("input", mesh), sample.resolve({{"count", "5"}}), nullptr).cloud().size(), 5u);
 }
 
-namespace {
-
-//! Counts every poll of cancelRequested(), whatever the stage, from any
-//! thread; asks to stop from the `cancelAt`-th poll on (0: never).
-class PollCounter : public ProgressObserver
-{
-public:
-    explicit PollCounter(std::size_t cancelAt = 0) : cancelAt_(cancelAt) {}
-    void beginStage(const std::string&) override {}
-    void report(double) override {}
-    bool cancelRequested() const override
-    {
-        const std::size_t poll = ++polls_;
-        return cancelAt_ > 0 && poll >= cancelAt_;
-    }
-    std::size_t polls() const { return polls_; }
-
-private:
-    std::size_t cancelAt_;
-    mutable std::atomic<std::size_t> polls_{0};
-};
-
-} // namespace
 
 TEST_F(ProcessingTools, EveryLongToolStopsAtAnyPollAndLeavesItsInputAsItWas)
 {
@@ -230,12 +208,12 @@ TEST_F(ProcessingTools, EveryLongToolStopsAtAnyPollAndLeavesItsInputAsItWas)
     for (const auto& [name, text] : runs) {
         const ToolSpec& spec = tool(name);
         const ParameterValues values = spec.resolve(text);
-        PollCounter counting;
+        test::PollCounter counting;
         ASSERT_NO_THROW(spec.execute(ToolInputs().add("input", cloud), values, &counting)) << name;
         const std::size_t polls = counting.polls();
         ASSERT_GE(polls, 3u) << name << " is polled " << polls << " times";
         for (const std::size_t at : {std::size_t(1), polls / 3, 2 * polls / 3, polls}) {
-            PollCounter cancel(std::max<std::size_t>(at, 1));
+            test::PollCounter cancel(std::max<std::size_t>(at, 1));
             EXPECT_EQ(test::errorCodeOf([&] { spec.execute(ToolInputs().add("input", cloud), values, &cancel); }),
                       ErrorCode::Cancelled)
                 << name << ", Cancel at poll " << at << " of " << polls;

@@ -9,11 +9,13 @@
 #include <scandiff/core/segmentation/ConnectedComponents.h>
 #include <scandiff/core/segmentation/FastMarching.h>
 #include <scandiff/core/segmentation/RegionReport.h>
+#include <scandiff/core/segmentation/SegmentationParameters.h>
 #include <scandiff/core/segmentation/StatisticalTest.h>
 #include <scandiff/io/FileIO.h>
 #include <scandiff/io/RegionExport.h>
 
 #include "DxfCheck.h"
+#include "StageWatcher.h"
 #include "SyntheticScene.h"
 #include "TestSupport.h"
 
@@ -246,4 +248,92 @@ TEST(EndToEnd, ExportWithNoRegionAndBadInput)
     io::RegionExportOptions options;
     options.cloudExtension = "nope";
     EXPECT_EQ(test::errorCodeOf([&] { io::exportRegions(formats, cloud, {}, dir / "x", options); }), ErrorCode::Unsupported);
+}
+
+namespace {
+
+//! Every file under `dir` with its content.
+std::map<std::string, std::string> folderContents(const std::filesystem::path& dir)
+{
+    std::map<std::string, std::string> contents;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
+        std::ifstream in(entry.path(), std::ios::binary);
+        contents[std::filesystem::relative(entry.path(), dir).string()] =
+            entry.is_regular_file() ? std::string(std::istreambuf_iterator<char>(in), {}) : std::string("<folder>");
+    }
+    return contents;
+}
+
+//! Runs `task` once to count its polls, then with Cancel pressed at the first,
+//! a third, two thirds and the last: each must end in Error(Cancelled), and
+//! `unchanged()` must hold after each.
+template <class Task, class Check>
+void cancelAtEveryStage(const std::string& what, Task task, Check unchanged)
+{
+    test::PollCounter counting;
+    ASSERT_NO_THROW(task(&counting)) << what;
+    const std::size_t polls = counting.polls();
+    ASSERT_GE(polls, 3u) << what << " is polled " << polls << " times";
+    for (const std::size_t at : {std::size_t(1), polls / 3, 2 * polls / 3, polls}) {
+        test::PollCounter cancel(std::max<std::size_t>(at, 1));
+        EXPECT_EQ(test::errorCodeOf([&] { task(&cancel); }), ErrorCode::Cancelled)
+            << what << ", Cancel at poll " << at << " of " << polls;
+        unchanged();
+    }
+}
+
+} // namespace
+
+TEST(EndToEnd, CancelAtAnyStageLeavesTheCloudAndTheExportFolderAsTheyWere)
+{
+    // Segmentation, region report and export on the 3-change scene, each
+    // cancelled at several polls: the cloud is unchanged and the export
+    // folder holds exactly the previous export's files, byte for byte.
+    PointCloud cloud = comparedWithDistances().clone();
+    const PointCloud before = cloud.clone();
+    auto cloudUnchanged = [&] {
+        ASSERT_EQ(cloud.positions(), before.positions());
+        ASSERT_EQ(cloud.fields().size(), before.fields().size());
+        for (std::size_t f = 0; f < cloud.fields().size(); ++f)
+            ASSERT_EQ(cloud.fields()[f].values(), before.fields()[f].values()) << cloud.fields()[f].name();
+    };
+    for (const std::map<std::string, std::string>& text :
+         {std::map<std::string, std::string>{{"field", "c2c_distance"}, {"above", "0.1"}, {"components", "true"}},
+          std::map<std::string, std::string>{{"field", "c2c_distance"}, {"stat-test", "gaussian"}, {"components", "true"}},
+          std::map<std::string, std::string>{{"field", "c2c_distance"}, {"propagate", "true"}, {"min-seed", "0.15"}}}) {
+        const ParameterValues values = resolveParameters(segmentationParameters(), text, "segment");
+        cancelAtEveryStage(
+            "segmentation " + text.rbegin()->first, [&](ProgressObserver* p) { runSegmentation(cloud, values, p); },
+            cloudUnchanged);
+    }
+
+    const ParameterValues values =
+        resolveParameters(segmentationParameters(), {{"field", "c2c_distance"}, {"above", "0.1"}, {"components", "true"}}, "segment");
+    PointCloud segmented = cloud.clone();
+    attachFields(segmented, runSegmentation(segmented, values));
+    const PointCloud reference = test::referenceEpoch();
+    RegionReportParams params = regionReportSettings(values, &reference);
+    cancelAtEveryStage(
+        "region report", [&](ProgressObserver* p) { regionReport(segmented, params, p); }, [] {});
+    const std::vector<RegionStatistics> report = regionReport(segmented, params);
+    ASSERT_EQ(report.size(), 3u);
+
+    io::FormatRegistry formats;
+    io::registerBuiltinFormats(formats);
+    const auto dir = test::tempDir() / "export";
+    // A previous export of the first region only, then one of all three,
+    // cancelled: the first stays, whole.
+    io::exportRegions(formats, segmented, {report.front()}, dir);
+    const std::map<std::string, std::string> previous = folderContents(dir);
+    ASSERT_EQ(previous.size(), 4u);
+    io::RegionExportOptions options;
+    bool counting = true; // the counting run goes elsewhere: it completes
+    cancelAtEveryStage(
+        "region export",
+        [&](ProgressObserver* p) {
+            options.write.progress = p;
+            io::exportRegions(formats, segmented, report, counting ? dir.parent_path() / "counting" : dir, options);
+            counting = false;
+        },
+        [&] { EXPECT_EQ(folderContents(dir), previous); });
 }

@@ -54,6 +54,27 @@ private:
     mutable std::size_t polls_ = 0;
 };
 
+//! Counts every poll of cancelRequested(), whatever the stage, from any
+//! thread; asks to stop from the `cancelAt`-th poll on (0: never). A first run
+//! counts a task's polls; later runs cancel it at chosen ones.
+class PollCounter : public ProgressObserver
+{
+public:
+    explicit PollCounter(std::size_t cancelAt = 0) : cancelAt_(cancelAt) {}
+    void beginStage(const std::string&) override {}
+    void report(double) override {}
+    bool cancelRequested() const override
+    {
+        const std::size_t poll = ++polls_;
+        return cancelAt_ > 0 && poll >= cancelAt_;
+    }
+    std::size_t polls() const { return polls_; }
+
+private:
+    std::size_t cancelAt_;
+    mutable std::atomic<std::size_t> polls_{0};
+};
+
 //! Asks to stop at the first poll, whatever the stage.
 struct CancelAtOnce : ProgressObserver
 {
