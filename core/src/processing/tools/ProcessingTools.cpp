@@ -12,6 +12,7 @@ void registerProcessingTools(ToolRegistry& registry)
     detail::registerEditTools(registry);
     detail::registerFieldTools(registry);
     detail::registerSurfaceTools(registry);
+    detail::registerDistanceTools(registry);
 }
 
 } // namespace scandiff

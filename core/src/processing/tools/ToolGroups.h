@@ -14,6 +14,7 @@ void registerSubsamplingTools(ToolRegistry& registry);
 void registerEditTools(ToolRegistry& registry);
 void registerFieldTools(ToolRegistry& registry);
 void registerSurfaceTools(ToolRegistry& registry);
+void registerDistanceTools(ToolRegistry& registry);
 
 //! The declaration of a tool taking one cloud, with its first output.
 inline ToolSpec oneCloudTool(std::string name, std::string title, std::string category, std::string description,

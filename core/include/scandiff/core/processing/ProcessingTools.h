@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 //! The everyday processing tools of core (normals, features, subsampling,
-//! editing, scalar fields, primitives and unrolling, mesh sampling), declared
+//! editing, scalar fields, primitives and unrolling, mesh sampling, M3C2), declared
 //! once as ToolSpecs: scandiff-cli makes a subcommand of each, the workbench a
 //! dialog and a menu entry.
 

@@ -1,0 +1,310 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/core/distance/M3C2.h>
+
+#include "processing/LocalPlane.h"
+
+#include <scandiff/core/CloudOctree.h>
+#include <scandiff/core/Error.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace scandiff {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+//! Queries per withinRadiusBatch call: bounds the lists held at once and the
+//! time between two checks for Cancel.
+constexpr std::size_t kQueriesPerBatch = 1 << 16;
+
+void checkParams(const M3c2Params& p)
+{
+    auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+    if (p.normalScales.empty())
+        throw Error(ErrorCode::InvalidArgument, "m3c2: at least one normal scale is needed");
+    for (double d : p.normalScales)
+        if (!positive(d))
+            throw Error(ErrorCode::InvalidArgument, "m3c2: a normal scale must be a positive diameter (m), not " + std::to_string(d));
+    if (!positive(p.projectionScale))
+        throw Error(ErrorCode::InvalidArgument, "m3c2: the projection scale must be a positive diameter (m)");
+    if (!positive(p.maxDepth))
+        throw Error(ErrorCode::InvalidArgument, "m3c2: the maximum depth must be positive (m)");
+    if (!std::isfinite(p.registrationError) || p.registrationError < 0.0)
+        throw Error(ErrorCode::InvalidArgument, "m3c2: the registration error must be zero or positive (m)");
+    if (p.minPoints < 1)
+        throw Error(ErrorCode::InvalidArgument, "m3c2: the minimum number of points must be at least 1");
+}
+
+void checkCloud(const PointCloud& cloud, const char* role)
+{
+    if (cloud.empty())
+        throw Error(ErrorCode::InvalidData, std::string("m3c2: the ") + role + " cloud '" + cloud.name + "' is empty");
+}
+
+//! The positions of `cloud` in the frame of `origin`, through double.
+std::vector<Eigen::Vector3f> inFrame(const PointCloud& cloud, const Eigen::Vector3d& origin)
+{
+    std::vector<Eigen::Vector3f> out(cloud.size());
+    const Eigen::Vector3d shift = cloud.origin() - origin;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cloud.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i < r.end(); ++i)
+            out[i] = (cloud.positions()[i].cast<double>() + shift).cast<float>();
+    });
+    return out;
+}
+
+//! The normal of every core point: the most planar of the scales.
+void fitNormals(const octree::Octree& reference, const std::vector<Eigen::Vector3f>& cores, const M3c2Params& params,
+                std::vector<Eigen::Vector3d>& normals, std::vector<double>& scales, ProgressObserver* progress)
+{
+    const std::size_t n = cores.size();
+    normals.assign(n, Eigen::Vector3d::Zero());
+    scales.assign(n, kNaN);
+    std::vector<double> variation(n, std::numeric_limits<double>::infinity());
+    ProgressTicker ticker(progress, "M3C2: normals", n * params.normalScales.size());
+    for (double scale : params.normalScales) {
+        for (std::size_t begin = 0; begin < n; begin += kQueriesPerBatch) {
+            const std::size_t count = std::min(kQueriesPerBatch, n - begin);
+            reference.radiusMomentsBatch(cores.data() + begin, count, static_cast<float>(scale / 2),
+                                         [&](std::uint32_t q, const octree::NeighbourhoodMoments& m) {
+                                             detail::LocalPlane plane;
+                                             if (!detail::fitLocalPlane(m, false, plane))
+                                                 return;
+                                             const double sum = plane.values.sum();
+                                             const double v = plane.values[0] / sum;
+                                             const std::size_t i = begin + q;
+                                             if (v < variation[i]) {
+                                                 variation[i] = v;
+                                                 normals[i] = plane.normal;
+                                                 scales[i] = scale;
+                                             }
+                                         });
+            ticker.step(count);
+        }
+    }
+}
+
+//! Turns each normal to the side the orientation rule gives.
+void orient(const PointCloud& reference, const std::vector<Eigen::Vector3f>& cores, const M3c2Params& params,
+            std::vector<Eigen::Vector3d>& normals, ProgressObserver* progress)
+{
+    PointCloud frame;
+    frame.setOrigin(reference.origin());
+    frame.positions() = cores;
+    frame.sensors() = reference.sensors();
+    std::vector<Eigen::Vector3f> sides(normals.size());
+    for (std::size_t i = 0; i < normals.size(); ++i)
+        sides[i] = normals[i].cast<float>();
+    if (params.orientation.kind == NormalOrientation::Kind::MinimumSpanningTree ||
+        params.orientation.kind == NormalOrientation::Kind::None)
+        throw Error(ErrorCode::InvalidArgument, "m3c2: orient the normals by a direction, the sensor or the centroid");
+    orientNormals(frame, sides, params.orientation, progress);
+    for (std::size_t i = 0; i < normals.size(); ++i)
+        if (sides[i].cast<double>().dot(normals[i]) < 0.0)
+            normals[i] = -normals[i];
+}
+
+//! One epoch's summary inside one cylinder.
+struct CylinderStats
+{
+    std::size_t count = 0;
+    double centre = kNaN; //!< mean or median of t
+    double spread = kNaN; //!< σ, or IQR / 1.349
+};
+
+//! Quantile of sorted values by linear interpolation between order
+//! statistics (Hyndman and Fan type 7, as numpy's default).
+double quantile(const std::vector<double>& sorted, double q)
+{
+    const double at = q * static_cast<double>(sorted.size() - 1);
+    const auto below = static_cast<std::size_t>(std::floor(at));
+    const std::size_t above = std::min(below + 1, sorted.size() - 1);
+    return sorted[below] + (at - static_cast<double>(below)) * (sorted[above] - sorted[below]);
+}
+
+CylinderStats summarise(std::vector<double>& t, const M3c2Params& params)
+{
+    CylinderStats s;
+    s.count = t.size();
+    if (t.empty())
+        return s;
+    if (params.robust) {
+        std::sort(t.begin(), t.end());
+        s.centre = quantile(t, 0.5);
+        // 1.349 = IQR of the standard normal: the spread is then a σ estimate.
+        s.spread = (quantile(t, 0.75) - quantile(t, 0.25)) / 1.349;
+        return s;
+    }
+    double sum = 0.0;
+    for (double v : t)
+        sum += v;
+    const double n = static_cast<double>(t.size());
+    s.centre = sum / n;
+    double squares = 0.0;
+    for (double v : t)
+        squares += (v - s.centre) * (v - s.centre);
+    s.spread = params.sampleStd ? (t.size() > 1 ? std::sqrt(squares / (n - 1)) : kNaN) : std::sqrt(squares / n);
+    return s;
+}
+
+//! The cylinder of every core point in one epoch. The cylinder (radius r,
+//! half-length H) is cut along its axis into m slices of length s <= 2r; each
+//! slice lies in a sphere of radius sqrt(r² + (s/2)²) <= r·√2 around its
+//! centre, so the octree's sphere queries gather few points beyond it even
+//! when H is many times r, and a point is kept by the slice its t falls in
+//! (half-open intervals: never twice).
+std::vector<CylinderStats> cylinderStats(const octree::Octree& epoch, const std::vector<Eigen::Vector3f>& cores,
+                                         const std::vector<Eigen::Vector3d>& normals, const M3c2Params& params,
+                                         const std::string& stage, ProgressObserver* progress)
+{
+    const std::size_t n = cores.size();
+    const double r = params.projectionScale / 2;
+    const double h = params.maxDepth;
+    const auto slices = static_cast<std::size_t>(std::max(1.0, std::ceil(h / r)));
+    const double length = 2 * h / static_cast<double>(slices);
+    double reach = 0.0;
+    for (const Eigen::Vector3f& c : cores)
+        reach = std::max(reach, static_cast<double>(c.cwiseAbs().maxCoeff()));
+    // The slice centres are rounded to float and the octree compares float
+    // squared distances: a margin above both roundings keeps every point of the
+    // slice inside its sphere; the exact test below is in double.
+    const double exactRadius = std::sqrt(r * r + length * length / 4);
+    const auto sphere = static_cast<float>(exactRadius * (1 + 1e-4) + 16 * FLT_EPSILON * (reach + h));
+
+    std::vector<CylinderStats> stats(n);
+    const std::size_t coresPerBatch = std::max<std::size_t>(1, kQueriesPerBatch / slices);
+    std::vector<std::vector<double>> lists(coresPerBatch * slices);
+    std::vector<Eigen::Vector3f> centres(coresPerBatch * slices);
+    const Eigen::Vector3f* points = epoch.points();
+    ProgressTicker ticker(progress, stage, n);
+    for (std::size_t begin = 0; begin < n; begin += coresPerBatch) {
+        const std::size_t count = std::min(coresPerBatch, n - begin);
+        for (std::size_t j = 0; j < count; ++j)
+            for (std::size_t k = 0; k < slices; ++k) {
+                const double t = -h + (static_cast<double>(k) + 0.5) * length;
+                const Eigen::Vector3d& axis = normals[begin + j];
+                // A core point without a normal gets no query (a NaN centre).
+                centres[j * slices + k] = axis.isZero() ? Eigen::Vector3f(Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()))
+                                                        : Eigen::Vector3f((cores[begin + j].cast<double>() + t * axis).cast<float>());
+                lists[j * slices + k].clear();
+            }
+        epoch.withinRadiusBatch(centres.data(), count * slices, sphere,
+                                [&](std::uint32_t q, const octree::Neighbour* found, std::size_t size) {
+                                    const std::size_t j = q / slices, k = q % slices;
+                                    const Eigen::Vector3d c = cores[begin + j].cast<double>();
+                                    const Eigen::Vector3d& axis = normals[begin + j];
+                                    const double lo = -h + static_cast<double>(k) * length;
+                                    const double hi = k + 1 == slices ? h : lo + length;
+                                    const bool last = k + 1 == slices;
+                                    std::vector<double>& list = lists[q];
+                                    for (std::size_t f = 0; f < size; ++f) {
+                                        const Eigen::Vector3d v = points[found[f].index].cast<double>() - c;
+                                        const double t = v.dot(axis);
+                                        if (t < lo || t > hi || (t == hi && !last))
+                                            continue;
+                                        if (v.squaredNorm() - t * t <= r * r)
+                                            list.push_back(t);
+                                    }
+                                });
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 64), [&](const tbb::blocked_range<std::size_t>& range) {
+            std::vector<double> t;
+            for (std::size_t j = range.begin(); j < range.end(); ++j) {
+                t.clear();
+                for (std::size_t k = 0; k < slices; ++k)
+                    t.insert(t.end(), lists[j * slices + k].begin(), lists[j * slices + k].end());
+                stats[begin + j] = summarise(t, params);
+            }
+        });
+        ticker.step(count);
+    }
+    return stats;
+}
+
+} // namespace
+
+M3c2Result m3c2(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints, const M3c2Params& params,
+                ProgressObserver* progress)
+{
+    checkParams(params);
+    checkCloud(reference, "reference");
+    checkCloud(compared, "compared");
+    const Eigen::Vector3d origin = reference.origin();
+    const std::vector<Eigen::Vector3f> cores = inFrame(corePoints, origin);
+    for (const Eigen::Vector3f& c : cores)
+        if (!c.allFinite())
+            throw Error(ErrorCode::InvalidData, "m3c2: the core points of '" + corePoints.name + "' include a non-finite one");
+    // One epoch's octree at a time: the reference's is gone before the
+    // compared one is built (the peak holds one).
+    std::vector<Eigen::Vector3d> normals;
+    std::vector<double> scales;
+    std::vector<CylinderStats> first;
+    {
+        const octree::Octree referenceTree = buildOctree(reference, std::nullopt, progress);
+        fitNormals(referenceTree, cores, params, normals, scales, progress);
+        orient(reference, cores, params, normals, progress);
+        first = cylinderStats(referenceTree, cores, normals, params, "M3C2: reference cylinders", progress);
+    }
+    std::vector<CylinderStats> second;
+    {
+        PointCloud shifted;
+        shifted.name = compared.name;
+        shifted.positions() = inFrame(compared, origin);
+        const octree::Octree comparedTree = buildOctree(shifted, std::nullopt, progress);
+        second = cylinderStats(comparedTree, cores, normals, params, "M3C2: compared cylinders", progress);
+    }
+
+    M3c2Result result;
+    result.corePoints = corePoints.clone();
+    PointCloud& out = result.corePoints;
+    const std::size_t n = cores.size();
+    std::vector<Eigen::Vector3f>& outNormals = out.enableNormals();
+    const char* names[] = {fields::kM3c2Distance, fields::kM3c2Uncertainty, fields::kM3c2Significant,
+                           fields::kM3c2N1,       fields::kM3c2N2,          fields::kM3c2Std1,
+                           fields::kM3c2Std2,     fields::kM3c2NormalScale};
+    for (const char* name : names)
+        out.addField(ScalarField(name, n));
+    // Pointers once every field exists: adding one may move the others.
+    ScalarField* f[8];
+    for (int k = 0; k < 8; ++k)
+        f[k] = out.field(names[k]);
+    for (std::size_t i = 0; i < n; ++i) {
+        outNormals[i] = normals[i].cast<float>();
+        if (normals[i].isZero()) {
+            ++result.withoutNormal;
+            continue;
+        }
+        const CylinderStats& a = first[i];
+        const CylinderStats& b = second[i];
+        f[3]->setValue(i, static_cast<double>(a.count));
+        f[4]->setValue(i, static_cast<double>(b.count));
+        f[5]->setValue(i, a.spread);
+        f[6]->setValue(i, b.spread);
+        f[7]->setValue(i, scales[i]);
+        if (a.count == 0 || b.count == 0)
+            continue;
+        const double distance = b.centre - a.centre;
+        f[0]->setValue(i, distance);
+        ++result.measuredCount;
+        if (a.count < params.minPoints || b.count < params.minPoints)
+            continue;
+        const double lod = 1.96 * (std::sqrt(a.spread * a.spread / static_cast<double>(a.count) +
+                                             b.spread * b.spread / static_cast<double>(b.count)) +
+                                   params.registrationError);
+        f[1]->setValue(i, lod);
+        if (std::isnan(lod))
+            continue;
+        const bool significant = std::abs(distance) > lod;
+        f[2]->setValue(i, significant ? 1.0 : 0.0);
+        result.significantCount += significant ? 1 : 0;
+    }
+    return result;
+}
+
+} // namespace scandiff
