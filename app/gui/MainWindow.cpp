@@ -423,6 +423,12 @@ void MainWindow::buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu)
     // go straight into the Edit menu.
     const std::set<std::string> underEdit{"Edit", "Normals", "Subsample", "Scalar fields"};
     std::map<std::string, QMenu*> categories;
+    // A category named like a submenu already there (Distances: C2C and C2M)
+    // joins it rather than making a second one of the same name.
+    for (QMenu* parent : {editMenu, toolsMenu})
+        for (QAction* existing : parent->actions())
+            if (existing->menu())
+                categories[existing->text().remove('&').toStdString()] = existing->menu();
     editMenu->addSeparator();
     for (const ToolSpec& tool : registry_.tools.tools()) {
         QMenu*& menu = categories[tool.category];

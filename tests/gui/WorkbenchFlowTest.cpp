@@ -35,6 +35,8 @@
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QPushButton>
+#include <QMenu>
+#include <QMenuBar>
 #include <QSignalSpy>
 #include <QStandardPaths>
 #include <QTableWidget>
@@ -103,6 +105,33 @@ private slots:
         QVERIFY(!dialog.values().count("max-dist"));
         dialog.form()->enabler("max-dist")->setChecked(true);
         QCOMPARE(dialog.values().at("max-dist"), std::string("1"));
+    }
+
+    void everyMenuIsThereOnceWithItsTools()
+    {
+        // A tool category named like a built-in submenu (Distances: C2C, C2M)
+        // joins it: one Tools > Distances holding C2C, C2M and M3C2.
+        Workbench workbench;
+        QMenu* tools = nullptr;
+        for (QAction* a : workbench.window.menuBar()->actions())
+            if (a->text().remove('&') == "Tools")
+                tools = a->menu();
+        QVERIFY(tools);
+        QStringList submenus;
+        QMenu* distances = nullptr;
+        for (QAction* a : tools->actions())
+            if (a->menu()) {
+                submenus << a->text().remove('&');
+                if (submenus.back() == "Distances")
+                    distances = a->menu();
+            }
+        QCOMPARE(submenus.count("Distances"), 1);
+        QCOMPARE(submenus.removeDuplicates(), 0);
+        QVERIFY(distances);
+        QStringList entries;
+        for (QAction* a : distances->actions())
+            entries << a->text().remove('&');
+        QVERIFY2(entries.size() == 3 && entries.last() == "M3C2...", qPrintable(entries.join(", ")));
     }
 
     void openComputeThresholdSplitExportRestore()
