@@ -2,6 +2,7 @@
 #include <scandiff/core/distance/M3C2.h>
 
 #include "processing/LocalPlane.h"
+#include "processing/PointNeighbourhoods.h"
 
 #include <scandiff/core/CloudOctree.h>
 #include <scandiff/core/Error.h>
@@ -20,8 +21,7 @@ namespace scandiff {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-//! Queries per withinRadiusBatch call: bounds the lists held at once and the
-//! time between two checks for Cancel.
+//! Queries per withinRadiusBatch call: bounds the lists held at once.
 constexpr std::size_t kQueriesPerBatch = 1 << 16;
 
 void checkParams(const M3c2Params& p)
@@ -74,6 +74,9 @@ void fitNormals(const octree::Octree& reference, const std::vector<Eigen::Vector
             const std::size_t count = std::min(kQueriesPerBatch, n - begin);
             reference.radiusMomentsBatch(cores.data() + begin, count, static_cast<float>(scale / 2),
                                          [&](std::uint32_t q, const octree::NeighbourhoodMoments& m) {
+                                             // Per query: Cancel is heard inside a batch, even
+                                             // when a large scale makes each query long.
+                                             detail::stepSparingly(ticker);
                                              detail::LocalPlane plane;
                                              if (!detail::fitLocalPlane(m, false, plane))
                                                  return;
@@ -86,7 +89,7 @@ void fitNormals(const octree::Octree& reference, const std::vector<Eigen::Vector
                                                  scales[i] = scale;
                                              }
                                          });
-            ticker.step(count);
+            ticker.checkCancel();
         }
     }
 }
@@ -183,7 +186,7 @@ std::vector<CylinderStats> cylinderStats(const octree::Octree& epoch, const std:
     std::vector<std::vector<double>> lists(coresPerBatch * slices);
     std::vector<Eigen::Vector3f> centres(coresPerBatch * slices);
     const Eigen::Vector3f* points = epoch.points();
-    ProgressTicker ticker(progress, stage, n);
+    ProgressTicker ticker(progress, stage, n * slices);
     for (std::size_t begin = 0; begin < n; begin += coresPerBatch) {
         const std::size_t count = std::min(coresPerBatch, n - begin);
         for (std::size_t j = 0; j < count; ++j)
@@ -197,6 +200,7 @@ std::vector<CylinderStats> cylinderStats(const octree::Octree& epoch, const std:
             }
         epoch.withinRadiusBatch(centres.data(), count * slices, sphere,
                                 [&](std::uint32_t q, const octree::Neighbour* found, std::size_t size) {
+                                    detail::stepSparingly(ticker);
                                     const std::size_t j = q / slices, k = q % slices;
                                     const Eigen::Vector3d c = cores[begin + j].cast<double>();
                                     const Eigen::Vector3d& axis = normals[begin + j];
@@ -222,7 +226,7 @@ std::vector<CylinderStats> cylinderStats(const octree::Octree& epoch, const std:
                 stats[begin + j] = summarise(t, params);
             }
         });
-        ticker.step(count);
+        ticker.checkCancel();
     }
     return stats;
 }
