@@ -151,19 +151,8 @@ PointCloud PointCloud::subset(const std::vector<std::size_t>& indices) const
         for (std::size_t i : indices)
             out.normals_.push_back(normals_[i]);
     }
-    for (const auto& f : fields_) {
-        ScalarField g(f.name(), 0);
-        g.setOffset(f.offset());
-        g.values().reserve(indices.size());
-        for (std::size_t i : indices)
-            g.values().push_back(f.values()[i]);
-        if (f.isDouble()) {
-            g.keepDoubles();
-            for (std::size_t k = 0; k < indices.size(); ++k)
-                g.doubles()[k] = f.value(indices[k]);
-        }
-        out.fields_.push_back(std::move(g));
-    }
+    for (const auto& f : fields_)
+        out.fields_.push_back(f.subset(indices));
     return out;
 }
 
@@ -180,11 +169,8 @@ std::size_t PointCloud::removeNonFinitePoints()
                 colors_[kept] = colors_[i];
             if (!normals_.empty())
                 normals_[kept] = normals_[i];
-            for (auto& f : fields_) {
-                if (f.isDouble())
-                    f.doubles()[kept] = f.doubles()[i];
-                f.values()[kept] = f.values()[i];
-            }
+            for (auto& f : fields_)
+                f.moveValue(i, kept);
         }
         ++kept;
     }

@@ -747,6 +747,7 @@ private:
                 field.keepDoubles();
                 field.doubles().swap(exact_[f]);
                 exact_[f] = {};
+                field.compact();
             }
             cloud.addField(std::move(field));
         }

@@ -392,7 +392,10 @@ struct PointOutputs
     float* userData = nullptr;
     float* pointSourceId = nullptr;
     float* gpsTime = nullptr;
-    double* gpsTimeExact = nullptr; //!< the same times as doubles
+    //! The times' exact form: float residuals, and a flag raised by a time
+    //! they cannot give back (the reader then reads the times as doubles).
+    float* gpsTimeResidual = nullptr;
+    bool* gpsTimeResidualFailed = nullptr;
     double gpsTimeOffset = 0.0;
     float* nir = nullptr;
     //! Bitwise OR of every colour channel: tells whether any exceeds 255.
@@ -461,8 +464,11 @@ unsigned decodeRange(const char* records, std::size_t recordLength, std::size_t 
         }
         if constexpr (HasGpsTime) {
             const double time = load<double>(p + gpsOffset);
-            out.gpsTime[i] = static_cast<float>(time - out.gpsTimeOffset);
-            out.gpsTimeExact[i] = time;
+            const auto f = static_cast<float>(time - out.gpsTimeOffset);
+            out.gpsTime[i] = f;
+            out.gpsTimeResidual[i] = ScalarField::residualOf(time, out.gpsTimeOffset, f);
+            if (!ScalarField::residualHolds(time, out.gpsTimeOffset))
+                *out.gpsTimeResidualFailed = true;
         }
         if constexpr (HasRgb) {
             const unsigned r = load<std::uint16_t>(p + rgbOffset);
@@ -551,8 +557,8 @@ void decodeExtraTyped(const char* records, std::size_t recordLength, std::size_t
         if (exact)
             exact[i] = v;
     }
-    if (exact && !std::is_same_v<T, double>)
-        field.dropDoublesIfExactInFloat();
+    if (exact)
+        field.compact(std::is_same_v<T, double>);
 }
 
 void decodeExtra(const char* records, std::size_t recordLength, std::size_t count, const ExtraDimension& dim,
@@ -650,7 +656,10 @@ Entity readLas(const fs::path& path, const ReadOptions& options)
         if (formatHasGpsTime(format)) {
             ScalarField& time = cloud.addField(ScalarField("gps_time", count));
             time.setOffset(gpsTimeOffset);
-            time.keepDoubles(); // GPS time is a double in the file: kept to the bit
+            // A double in the file, given back to the bit: float residuals
+            // beside the float view (4 bytes a point) hold real GPS times
+            // (hours from the offset, in microseconds); doubles otherwise.
+            time.keepResiduals();
         }
         if (formatHasNir(format))
             cloud.addField(ScalarField("nir", count));
@@ -686,8 +695,10 @@ Entity readLas(const fs::path& path, const ReadOptions& options)
     out.userData = values("user_data");
     out.pointSourceId = values("point_source_id");
     out.gpsTime = values("gps_time");
+    bool gpsResidualsFailed = false;
     if (ScalarField* time = cloud.field("gps_time"))
-        out.gpsTimeExact = time->doubles().data();
+        out.gpsTimeResidual = time->residuals().data();
+    out.gpsTimeResidualFailed = &gpsResidualsFailed;
     out.gpsTimeOffset = gpsTimeOffset;
     out.nir = values("nir");
 
@@ -701,6 +712,15 @@ Entity readLas(const fs::path& path, const ReadOptions& options)
         colorBits |= decode(records, h.recordLength, begin, end, transform, out);
         MappedFile::releaseConsumed(records + begin * h.recordLength, records + end * h.recordLength);
         ticker.step(end - begin);
+    }
+    if (gpsResidualsFailed) {
+        // Times the residuals cannot hold (far from the offset, or not times at
+        // all): read again as doubles.
+        ScalarField& time = *cloud.field("gps_time");
+        time.keepDoubles();
+        const char* p = records + (format >= 6 ? 22 : 20);
+        for (std::size_t i = 0; i < count; ++i, p += h.recordLength)
+            time.doubles()[i] = load<double>(p);
     }
 
     // LAS 1.4 R15 says colours are normalised to 16 bits, but several tools write

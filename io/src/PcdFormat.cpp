@@ -554,13 +554,12 @@ Entity readPcd(const fs::path& path, const ReadOptions& options)
             }
         ScalarField& field = *cloud.field(cloud.fields()[f].name());
         field.setOffset(chooseFieldOffset(lo, hi));
-        // A double stays a double to the bit; a 32/64-bit integer keeps its
-        // doubles only where the float around the offset cannot hold it.
+        // A double stays a double to the bit; a 32/64-bit integer keeps an
+        // exact form only where the float around the offset cannot hold it.
         field.keepDoubles();
         for (std::size_t i = 0; i < n; ++i)
             field.setValue(i, staged[f][i]);
-        if (!stagedFromDouble[f])
-            field.dropDoublesIfExactInFloat();
+        field.compact(stagedFromDouble[f]);
         staged[f] = {};
     }
     ticker.step();

@@ -26,7 +26,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
+#include <memory>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -477,7 +479,10 @@ struct VertexSink
     Rgb8* colors = nullptr;
     Eigen::Vector3f* normals = nullptr;
     std::vector<float*> fieldValues;
-    std::vector<double*> fieldDoubles; //!< per field, null unless the field keeps doubles
+    //! Per field, null unless the field keeps float residuals (its exact form),
+    //! with a flag raised by a value they cannot give back.
+    std::vector<float*> fieldResiduals;
+    std::vector<std::atomic<bool>*> fieldResidualsFailed;
     std::vector<double> fieldOffsets;
     std::vector<double*> stagedFields; //!< per field, null when written directly
     double* stagedXyz = nullptr;
@@ -542,9 +547,10 @@ struct VertexSink
                     t.kind = Target::Staged;
                     t.doubles = stagedFields[s.field];
                 } else {
-                    t.kind = fieldDoubles[s.field] ? Target::FloatAndDouble : Target::Float;
+                    t.kind = fieldResiduals[s.field] ? Target::FloatAndResidual : Target::Float;
                     t.floats = fieldValues[s.field];
-                    t.doubles = fieldDoubles[s.field];
+                    t.residuals = fieldResiduals[s.field];
+                    t.failed = fieldResidualsFailed[s.field];
                     t.offset = fieldOffsets[s.field];
                 }
                 break;
@@ -561,10 +567,14 @@ struct VertexSink
         case Target::Float: t.floats[i * t.stride] = static_cast<float>(v - t.offset); break;
         case Target::Color: t.bytes[i * t.stride] = colorByte(v, t.colorScale); break;
         case Target::Staged: t.doubles[i * t.stride] = v; break;
-        case Target::FloatAndDouble:
-            t.floats[i] = static_cast<float>(v - t.offset);
-            t.doubles[i] = v;
+        case Target::FloatAndResidual: {
+            const auto f = static_cast<float>(v - t.offset);
+            t.floats[i] = f;
+            t.residuals[i] = std::isnan(v) ? 0.0f : ScalarField::residualOf(v, t.offset, f);
+            if (!ScalarField::residualHolds(v, t.offset))
+                t.failed->store(true, std::memory_order_relaxed);
             break;
+        }
         case Target::None: break;
         }
     }
@@ -572,11 +582,13 @@ struct VertexSink
 private:
     struct Target
     {
-        enum Kind : std::uint8_t { None, Float, Color, Staged, FloatAndDouble } kind = None;
+        enum Kind : std::uint8_t { None, Float, Color, Staged, FloatAndResidual } kind = None;
         std::size_t stride = 1;
         float* floats = nullptr;
         std::uint8_t* bytes = nullptr;
         double* doubles = nullptr;
+        float* residuals = nullptr;
+        std::atomic<bool>* failed = nullptr;
         double offset = 0.0;
         double colorScale = 1.0;
     };
@@ -1101,7 +1113,8 @@ private:
         // Pointers are taken once every field exists: addField may reallocate the field vector.
         for (const auto& name : layout_.fieldNames)
             sink.fieldValues.push_back(cloud_.field(name)->values().data());
-        sink.fieldDoubles.assign(layout_.fieldNames.size(), nullptr);
+        sink.fieldResiduals.assign(layout_.fieldNames.size(), nullptr);
+        sink.fieldResidualsFailed.assign(layout_.fieldNames.size(), nullptr);
         sink.fieldOffsets.assign(layout_.fieldNames.size(), 0.0);
         sink.stagedFields.assign(layout_.fieldNames.size(), nullptr);
         return sink;
@@ -1135,33 +1148,50 @@ private:
         else if (layout_.coordinatesAreDouble)
             sink.origin = suggestOrigin(ranges.box());
         cloud_.setOrigin(sink.origin);
-        for (std::size_t f = 0; f < layout_.fieldNames.size(); ++f)
+        // Wide values keep an exact form: float residuals as they are decoded
+        // (4 bytes a value), doubles for a field they fail on (a second pass).
+        const auto failed = std::make_unique<std::atomic<bool>[]>(layout_.fieldNames.size());
+        for (std::size_t f = 0; f < layout_.fieldNames.size(); ++f) {
+            failed[f].store(false);
             if (layout_.fieldIsWide[f]) {
                 sink.fieldOffsets[f] = chooseFieldOffset(ranges.fieldLo[f], ranges.fieldHi[f]);
-                // Wide values are kept in double as well (see keepWideFieldsExact).
                 ScalarField& field = *cloud_.field(layout_.fieldNames[f]);
-                field.keepDoubles();
-                sink.fieldDoubles[f] = field.doubles().data();
+                field.keepResiduals();
+                sink.fieldResiduals[f] = field.residuals().data();
+                sink.fieldResidualsFailed[f] = &failed[f];
             }
+        }
         applyFieldOffsets(sink);
         sink.compile(layout_);
         const char* next = visitBinaryVertices<Swap>(
             e, layout_, ptr, end, ctx_, ticker, [&sink](std::uint64_t i, const Slot& s, double v) { sink.put(i, s, v); });
+        for (std::size_t f = 0; f < layout_.fieldNames.size(); ++f) {
+            if (!failed[f].load())
+                continue;
+            ScalarField& field = *cloud_.field(layout_.fieldNames[f]);
+            field.keepDoubles();
+            double* doubles = field.doubles().data();
+            visitBinaryVertices<Swap>(e, layout_, ptr, end, ctx_, ticker, [doubles, f](std::uint64_t i, const Slot& s, double v) {
+                if (s.role == Role::Field && s.field == f)
+                    doubles[i] = v;
+            });
+        }
         keepWideFieldsExact();
         return next;
     }
 
-    //! A double property stays a double, to the bit. A 32-bit integer one keeps
-    //! its doubles only when the float around the field's offset cannot hold
-    //! every value (a range wider than 2^24).
+    //! A double property stays exact, to the bit, and a double when written
+    //! back. A 32-bit integer one keeps an exact form only when the float around
+    //! the field's offset cannot hold every value (a range wider than 2^24).
     void keepWideFieldsExact()
     {
         for (const Slot& s : layout_.slots) {
             if (s.role != Role::Field || !layout_.fieldIsWide[s.field])
                 continue;
             ScalarField& field = *cloud_.field(layout_.fieldNames[s.field]);
-            if (s.type != PlyType::Float64)
-                field.dropDoublesIfExactInFloat();
+            // Residuals that held need no second look for a double property.
+            if (s.type != PlyType::Float64 || !field.doubles().empty())
+                field.compact(s.type == PlyType::Float64);
         }
     }
 

@@ -308,7 +308,9 @@ TEST(M3C2, ToolRunsFromTheRegistryAndCancelStopsItAtAnyPoll)
     EXPECT_NE(result.summary.find("significant"), std::string::npos);
     const std::size_t polls = counting.polls();
     ASSERT_GE(polls, 3u);
-    for (const std::size_t at : {std::size_t(1), polls / 3, 2 * polls / 3, polls}) {
+    // The count moves by a few polls from run to run (how the queries fall on
+    // the threads): the last Cancel is pressed in the last twentieth.
+    for (const std::size_t at : {std::size_t(1), polls / 3, 2 * polls / 3, polls - polls / 20}) {
         test::PollCounter cancel(std::max<std::size_t>(at, 1));
         EXPECT_EQ(test::errorCodeOf([&] { tool.execute(inputs, values, &cancel); }), ErrorCode::Cancelled) << at;
     }

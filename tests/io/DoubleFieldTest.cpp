@@ -177,3 +177,35 @@ TEST(DoubleFields, TextKeepsDoublesOnlyForColumnsAFloatCannotGiveBack)
     EXPECT_EQ(cloud.field("late")->value(1), 6.0);
     EXPECT_EQ(cloud.field("late")->value(2), 6.00000000001);
 }
+
+TEST(DoubleFields, ResidualsHoldGpsTimesAndDoublesTakeOverWhereTheyCannot)
+{
+    // Real GPS times (hours from the offset, microseconds) fit a float and its
+    // float residual: 4 bytes more a point. Times spread over years from the
+    // first one do not (over 50 bits): the reader then keeps doubles. Both come back
+    // to the bit.
+    const io::FormatRegistry formats = builtinFormats();
+    const auto dir = test::tempDir();
+    for (const double spacing : {37.123457, 1e8 + 0.123457}) {
+        PointCloud cloud;
+        cloud.resize(100);
+        ScalarField time("gps_time", 100);
+        time.setOffset(1.4e9);
+        time.keepDoubles();
+        for (std::size_t i = 0; i < 100; ++i) {
+            cloud.positions()[i] = Eigen::Vector3f(static_cast<float>(i), 0.0f, 0.0f);
+            time.setValue(i, 1.4e9 + static_cast<double>(i) * spacing);
+        }
+        cloud.addField(std::move(time));
+        for (const char* file : {"t.las", "t.ply"}) {
+            io::writePointCloud(formats, cloud, dir / file);
+            const PointCloud back = io::readPointCloud(formats, dir / file);
+            const ScalarField& read = *back.field("gps_time");
+            const bool residuals = spacing < 100;
+            EXPECT_EQ(read.residuals().empty(), !residuals) << file << " " << spacing;
+            EXPECT_EQ(read.doubles().empty(), residuals) << file << " " << spacing;
+            for (std::size_t i = 0; i < 100; ++i)
+                ASSERT_EQ(read.value(i), cloud.field("gps_time")->value(i)) << file << " " << spacing << " " << i;
+        }
+    }
+}

@@ -150,7 +150,7 @@ TEST(DoubleFields, SubsetMergeAndDroppedPointsKeepEveryDouble)
     holed.positions()[4].y() = std::numeric_limits<float>::infinity();
     ASSERT_EQ(holed.removeNonFinitePoints(), 1u);
     EXPECT_EQ(holed.field("gps_time")->value(4), ta.value(5));
-    EXPECT_EQ(holed.field("gps_time")->doubles().size(), 49u);
+    EXPECT_EQ(holed.field("gps_time")->size(), 49u);
 
     // A value written through the float view wins over its stale double, and
     // the range is the doubles' own.
@@ -160,14 +160,32 @@ TEST(DoubleFields, SubsetMergeAndDroppedPointsKeepEveryDouble)
     EXPECT_EQ(edited.value(1), ta.value(1));
     EXPECT_EQ(edited.range().min, ta.value(1));
     EXPECT_EQ(edited.range().max, edited.offset() + 100000.0);
-    // Doubles that a float holds exactly are given up.
+    // The smallest exact form: none when the float holds every value, float
+    // residuals when they do (GPS times), else doubles.
     ScalarField small("small", 3);
     small.keepDoubles();
     small.setValue(0, 0.5);
     small.setValue(1, 2.0);
-    EXPECT_TRUE(small.dropDoublesIfExactInFloat());
+    EXPECT_FALSE(small.compact());
     EXPECT_FALSE(small.isDouble());
     EXPECT_EQ(small.value(0), 0.5);
+    ScalarField times = ta.subset({0, 40, 49});
+    times.keepDoubles();
+    EXPECT_TRUE(times.compact());
+    EXPECT_TRUE(times.doubles().empty());
+    EXPECT_EQ(times.residuals().size(), 3u);
+    EXPECT_EQ(times.value(1), ta.value(40));
+    ScalarField tenths("tenths", 2);
+    tenths.keepDoubles();
+    tenths.setValue(0, 0.1 + 1e-12); // 53 bits: no float pair holds it
+    EXPECT_TRUE(tenths.compact());
+    EXPECT_FALSE(tenths.doubles().empty());
+    EXPECT_EQ(tenths.value(0), 0.1 + 1e-12);
+    // A residual field given a value its residual cannot hold turns to doubles.
+    times.setValue(2, 0.1 + 1e-12);
+    EXPECT_FALSE(times.doubles().empty());
+    EXPECT_EQ(times.value(2), 0.1 + 1e-12);
+    EXPECT_EQ(times.value(1), ta.value(40));
 }
 
 TEST(Crop, ScreenPolygonsEqualBruteForceInTopAndPerspectiveViews)

@@ -129,6 +129,10 @@ PointCloud mergeClouds(const std::vector<const PointCloud*>& clouds, ProgressObs
         at += n;
         ticker.step(n);
     }
+    // Exact forms were gathered as doubles: the smallest that holds them all.
+    for (std::size_t f = 0; f < fieldNames.size(); ++f)
+        if (fieldIsDouble[f])
+            merged.field(fieldNames[f])->compact(true);
     return merged;
 }
 

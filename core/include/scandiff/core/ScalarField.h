@@ -6,11 +6,19 @@
 //!
 //! A field read from a double-valued source (LAS GPS time, a PLY or PCD double
 //! property, text with more digits than a float holds) also keeps every value
-//! as a double, so that writing it back gives the same bits. The float view
-//! stays the working copy that display and algorithms read. Code that writes
-//! through the float view (values()) does not need to know about the doubles:
-//! value(i) returns the double only while the float view still holds that
-//! double's rounding, so a value changed through the float view wins.
+//! exactly, so that writing it back gives the same bits. The float view stays
+//! the working copy that display and algorithms read. The exact values are
+//! kept in the smallest form that gives every one back:
+//! - residuals: per value, the float r that the float view f misses,
+//!   value = offset + (f + r), 4 bytes more per value. Exact whenever the
+//!   value's bits below the float's fit in another float: GPS times (a span of
+//!   hours from the offset and microseconds need ~40 bits) and any 32-bit
+//!   integer;
+//! - doubles, 8 bytes more per value, for anything else.
+//! Code that writes through the float view (values()) does not need to know
+//! about them: value(i) uses the exact form only while the float view still
+//! holds that value's rounding (a residual only while it is below half the
+//! float's last digit), so a value changed through the float view wins.
 
 #include <cmath>
 #include <cstddef>
@@ -50,37 +58,55 @@ public:
 
     double value(std::size_t i) const
     {
-        if (i < doubles_.size()) {
+        if (exact_ == Exact::Doubles && i < doubles_.size()) {
             const double exact = doubles_[i];
             if (static_cast<float>(exact - offset_) == values_[i])
                 return exact;
+        } else if (exact_ == Exact::Residuals && i < residuals_.size()) {
+            const float f = values_[i], r = residuals_[i];
+            if (f + r == f)
+                return offset_ + (static_cast<double>(f) + static_cast<double>(r));
         }
         return offset_ + static_cast<double>(values_[i]);
     }
-    void setValue(std::size_t i, double v)
-    {
-        values_[i] = static_cast<float>(v - offset_);
-        if (i < doubles_.size())
-            doubles_[i] = v;
-    }
+    //! Sets value i (its exact form too, for a field that keeps one).
+    void setValue(std::size_t i, double v);
     bool hasValue(std::size_t i) const { return !std::isnan(values_[i]); }
 
-    //! Resizes the float view and, for a double field, the doubles; new values are NaN.
+    //! Resizes the float view and the exact form; new values are NaN.
     void resize(std::size_t n);
+    //! Value `from` copied onto value `to`, exact form included.
+    void moveValue(std::size_t from, std::size_t to);
+    //! The values at `indices`, in that order, exact form included.
+    ScalarField subset(const std::vector<std::size_t>& indices) const;
 
-    //! True when the field keeps its values as doubles too.
-    bool isDouble() const { return keepsDoubles_; }
-    //! Starts keeping doubles: every current value becomes its double.
+    //! True when the field keeps its values exactly (residuals or doubles).
+    bool isDouble() const { return exact_ != Exact::None; }
+    //! Keeps every value as a double from now on (the current values, exactly).
     void keepDoubles();
-    //! Back to float only (frees the doubles).
-    void dropDoubles();
-    //! Drops the doubles when the float view around the offset already gives
-    //! every one of them back exactly; returns whether it did.
-    bool dropDoublesIfExactInFloat();
-    //! The doubles (empty unless isDouble()). Writing one does not update the
+    //! Keeps float residuals (all 0: the current float view is taken as exact).
+    //! For readers that fill them with setValue() or through residuals().
+    void keepResiduals();
+    //! Back to the float view only.
+    void dropExact();
+    //! The smallest exact form that gives every current value back: none when
+    //! the float view does (residuals of 0 with `stayExact`, for a field whose
+    //! type is double in its file and must be written back as one), residuals
+    //! when they do, else doubles. Returns whether an exact form is kept.
+    bool compact(bool stayExact = false);
+    //! Whether offset + (f + r) gives v back, f and r floats (see residualOf).
+    static bool residualHolds(double v, double offset);
+    //! The float residual of v around `offset` beside its float f = float(v - offset).
+    static float residualOf(double v, double offset, float f)
+    {
+        return static_cast<float>((v - offset) - static_cast<double>(f));
+    }
+    //! The exact forms (empty unless kept). Writing one does not update the
     //! float view: use setValue() for that.
     const std::vector<double>& doubles() const { return doubles_; }
     std::vector<double>& doubles() { return doubles_; }
+    const std::vector<float>& residuals() const { return residuals_; }
+    std::vector<float>& residuals() { return residuals_; }
 
     //! Min/max of the valid values (NaN when there is none).
     ValueRange range() const;
@@ -89,8 +115,10 @@ private:
     std::string name_;
     double offset_ = 0.0;
     std::vector<float> values_;
-    bool keepsDoubles_ = false;
-    std::vector<double> doubles_; //!< empty, or one per value when keepsDoubles_
+    enum class Exact : unsigned char { None, Residuals, Doubles };
+    Exact exact_ = Exact::None;
+    std::vector<float> residuals_; //!< one per value with Exact::Residuals
+    std::vector<double> doubles_;  //!< one per value with Exact::Doubles
 };
 
 } // namespace scandiff
