@@ -11,6 +11,7 @@ void registerBuiltinFormats(FormatRegistry& registry)
     registry.add(detail::pcdFormat());
     registry.add(detail::meshFormat());
     registry.add(detail::dxfFormat());
+    registry.add(detail::geoTiffFormat());
 }
 
 } // namespace scandiff::io

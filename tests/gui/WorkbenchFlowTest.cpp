@@ -110,7 +110,8 @@ private slots:
     void everyMenuIsThereOnceWithItsTools()
     {
         // A tool category named like a built-in submenu (Distances: C2C, C2M)
-        // joins it: one Tools > Distances holding C2C, C2M and M3C2.
+        // joins it: one Tools > Distances holding C2C, C2M, M3C2, the DEM of
+        // difference and the 2.5D volume.
         Workbench workbench;
         QMenu* tools = nullptr;
         for (QAction* a : workbench.window.menuBar()->actions())
@@ -131,7 +132,8 @@ private slots:
         QStringList entries;
         for (QAction* a : distances->actions())
             entries << a->text().remove('&');
-        QVERIFY2(entries.size() == 3 && entries.last() == "M3C2...", qPrintable(entries.join(", ")));
+        QVERIFY2(entries.size() == 5 && entries.count("M3C2...") == 1 && entries.count("DEM of difference...") == 1,
+                 qPrintable(entries.join(", ")));
     }
 
     void openComputeThresholdSplitExportRestore()

@@ -12,5 +12,6 @@ FormatHandler lasFormat();        // LasFormat.cpp
 FormatHandler pcdFormat();        // PcdFormat.cpp
 FormatHandler meshFormat();       // MeshFormats.cpp (readers in MeshReaders.cpp)
 FormatHandler dxfFormat();        // DxfWriter.cpp (export only)
+FormatHandler geoTiffFormat();    // GeoTiffFormat.cpp (export of gridded clouds, GDAL)
 
 } // namespace scandiff::io::detail

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Tool: m3c2.
+// Tools: m3c2, dod, volume.
 #include "processing/tools/ToolGroups.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/TextLists.h>
+#include <scandiff/core/distance/DemOfDifference.h>
 #include <scandiff/core/distance/M3C2.h>
 #include <scandiff/core/processing/Subsampling.h>
 
@@ -38,10 +39,110 @@ ParameterSpec m3c2Orientation()
         .withSuggestions({"+z", "-z", "+x", "+y", "sensor", "centroid", "-centroid"});
 }
 
+std::vector<ParameterSpec> rasterParameters()
+{
+    return {
+        ParameterSpec::real("cell", "Cell size", "Side of the square cells both epochs are rasterised on", 1.0, 1e-6, 1e6, "m").asRequired(),
+        ParameterSpec::choice("statistic", "Cell height", "The height of a cell from its points' heights",
+                              {"min", "mean", "max", "median"}, "mean"),
+        ParameterSpec::integer("fill", "Fill passes",
+                               "Passes filling empty cells with the mean of their filled neighbours (0: leave them empty)", 0, 0, 1000),
+        ParameterSpec::real("reference-height", "Reference height",
+                            "Without a reference cloud: compare with this constant height (a floor, a design level)", 0.0, -1e9, 1e9, "m")
+            .asOptional(),
+    };
+}
+
+std::vector<InputSpec> epochInputs()
+{
+    return {InputSpec{"reference", "Reference", "The first epoch (or give a reference height)", DataKind::Cloud, false, true},
+            InputSpec{"compared", "Compared", "The second epoch", DataKind::Cloud, false, false}};
+}
+
+DemOfDifferenceParams rasterFrom(const ParameterValues& values)
+{
+    DemOfDifferenceParams params;
+    params.cell = values.real("cell");
+    params.statistic = parseCellStatistic(values.text("statistic"));
+    params.fillPasses = static_cast<int>(values.integer("fill"));
+    if (values.has("reference-height"))
+        params.referenceHeight = values.real("reference-height");
+    return params;
+}
+
+ToolResult rasterResult(const ToolInputs& inputs, const DemOfDifferenceParams& params, ProgressObserver* progress, bool dod)
+{
+    const PointCloud* reference = inputs.has("reference") ? &inputs.cloud("reference") : nullptr;
+    DemOfDifferenceResult r = demOfDifference(reference, inputs.cloud("compared"), params, progress);
+    ToolResult result;
+    result.summary = dod ? describe(r.columns, " x ", r.rows, " cells of ", params.cell, " m: ", r.significantCells, " significant of ",
+                                    r.matchingCells, "; deposition ", r.deposition, " +/- ", r.depositionError, " m3, erosion ",
+                                    r.erosion, " +/- ", r.erosionError, " m3")
+                         : describe("added ", r.added, " m3, removed ", r.removed, " m3 over ", r.matchingCells * r.cellArea,
+                                    " m2 (", r.matchingCells, " cells with both heights)");
+    result.add("report", r.report());
+    result.add("output", std::move(r.cells));
+    return result;
+}
+
 } // namespace
+
+void registerRasterTools(ToolRegistry& registry)
+{
+    ToolSpec dod;
+    dod.name = "dod";
+    dod.title = "DEM of difference";
+    dod.category = "Distances";
+    dod.description =
+        "Both epochs rasterised on one grid of square cells (min, mean, max or median height per cell; empty cells left "
+        "empty or filled from their neighbours), the compared heights minus the reference's, thresholded by a minimum "
+        "level of detection or by the propagated error 1.96 sqrt(dz1^2 + dz2^2) (dz: each cell's roughness, or a given "
+        "height error); deposition and erosion volumes of the significant cells with their uncertainty. The grid is a "
+        "cloud of cell centres (dod_difference, dod_lod, dod_significant, z_reference, z_compared): write it as .tif for "
+        "a GeoTIFF with one band per field.";
+    dod.inputs = epochInputs();
+    dod.outputs = {OutputSpec{"output", "DEM of difference (cells)", DataKind::Cloud, false},
+                   OutputSpec{"report", "Volumes", DataKind::Table, false}};
+    dod.parameters = rasterParameters();
+    dod.parameters.push_back(
+        ParameterSpec::real("lod", "Level of detection", "Changes smaller than this are not significant", 0.1, 0.0, 1e6, "m").asOptional());
+    dod.parameters.push_back(ParameterSpec::boolean(
+        "propagated", "Propagated error", "Threshold each cell at 1.96 sqrt(dz1^2 + dz2^2) instead of one level of detection", false));
+    dod.parameters.push_back(ParameterSpec::real("height-error", "Height error",
+                                                 "The height error of every cell instead of its roughness", 0.01, 0.0, 1e6, "m")
+                                 .asOptional());
+    dod.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        DemOfDifferenceParams params = rasterFrom(values);
+        if (values.has("lod"))
+            params.lod = values.real("lod");
+        params.propagated = values.boolean("propagated");
+        if (values.has("height-error"))
+            params.heightError = values.real("height-error");
+        return rasterResult(inputs, params, progress, true);
+    };
+    registry.add(std::move(dod));
+
+    ToolSpec volume;
+    volume.name = "volume";
+    volume.title = "2.5D volume";
+    volume.category = "Distances";
+    volume.description =
+        "The volume between two epochs (or an epoch and a constant height) on a grid of square cells, as CloudCompare's "
+        "\"Compute 2.5D volume\": added and removed volume over the cells where both have a height, their surface and "
+        "their share of the cells; no threshold. The grid is a cloud of cell centres, as for the DEM of difference.";
+    volume.inputs = epochInputs();
+    volume.outputs = {OutputSpec{"output", "Volume grid (cells)", DataKind::Cloud, false},
+                      OutputSpec{"report", "Volume report", DataKind::Table, false}};
+    volume.parameters = rasterParameters();
+    volume.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        return rasterResult(inputs, rasterFrom(values), progress, false);
+    };
+    registry.add(std::move(volume));
+}
 
 void registerDistanceTools(ToolRegistry& registry)
 {
+
     ToolSpec tool;
     tool.name = "m3c2";
     tool.title = "M3C2";
@@ -117,6 +218,7 @@ void registerDistanceTools(ToolRegistry& registry)
         return result;
     };
     registry.add(std::move(tool));
+    registerRasterTools(registry);
 }
 
 } // namespace scandiff::detail

@@ -14,7 +14,8 @@ void registerSubsamplingTools(ToolRegistry& registry);
 void registerEditTools(ToolRegistry& registry);
 void registerFieldTools(ToolRegistry& registry);
 void registerSurfaceTools(ToolRegistry& registry);
-void registerDistanceTools(ToolRegistry& registry);
+void registerDistanceTools(ToolRegistry& registry); // M3C2, then the raster tools
+void registerRasterTools(ToolRegistry& registry);
 
 //! The declaration of a tool taking one cloud, with its first output.
 inline ToolSpec oneCloudTool(std::string name, std::string title, std::string category, std::string description,

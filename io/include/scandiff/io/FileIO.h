@@ -85,7 +85,7 @@ private:
     std::vector<FormatHandler> handlers_;
 };
 
-//! Registers PLY, ASCII, LAS, PCD, OBJ/STL/OFF and DXF.
+//! Registers PLY, ASCII, LAS, PCD, OBJ/STL/OFF, DXF and GeoTIFF (gridded clouds).
 void registerBuiltinFormats(FormatRegistry& registry);
 
 //! Reads any supported file. Throws Error naming the file on failure.

@@ -1,0 +1,294 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/core/distance/DemOfDifference.h>
+
+#include <scandiff/core/Error.h>
+
+#include <tbb/parallel_sort.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
+
+namespace scandiff {
+
+CellStatistic parseCellStatistic(const std::string& name)
+{
+    if (name == "min")
+        return CellStatistic::Min;
+    if (name == "mean")
+        return CellStatistic::Mean;
+    if (name == "max")
+        return CellStatistic::Max;
+    if (name == "median")
+        return CellStatistic::Median;
+    throw Error(ErrorCode::InvalidArgument, "cell statistic '" + name + "': expected min, mean, max or median");
+}
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kMaxCells = 268435456.0; // 2^28: 2 GB of doubles per layer
+
+struct Grid
+{
+    double x0 = 0, y0 = 0, cell = 1;
+    std::size_t cols = 0, rows = 0;
+    std::size_t size() const { return cols * rows; }
+};
+
+//! One epoch's heights per cell; NaN where it has none.
+struct EpochRaster
+{
+    std::vector<double> z, roughness;
+    std::vector<std::uint32_t> count;
+};
+
+void addBounds(const PointCloud& cloud, double& xmin, double& ymin, double& xmax, double& ymax)
+{
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Eigen::Vector3d p = cloud.globalPosition(i);
+        if (!p.allFinite())
+            continue;
+        xmin = std::min(xmin, p.x());
+        ymin = std::min(ymin, p.y());
+        xmax = std::max(xmax, p.x());
+        ymax = std::max(ymax, p.y());
+    }
+}
+
+EpochRaster rasterise(const PointCloud& cloud, const Grid& grid, CellStatistic statistic, ProgressTicker& ticker)
+{
+    // (cell, height) pairs sorted: each cell's heights in one increasing run,
+    // which gives the median as directly as the mean.
+    std::vector<std::pair<std::uint32_t, double>> keyed;
+    keyed.reserve(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Eigen::Vector3d p = cloud.globalPosition(i);
+        if (!p.allFinite())
+            continue;
+        const auto col = static_cast<std::size_t>(std::floor((p.x() - grid.x0) / grid.cell));
+        const auto row = static_cast<std::size_t>(std::floor((p.y() - grid.y0) / grid.cell));
+        keyed.emplace_back(static_cast<std::uint32_t>(std::min(row, grid.rows - 1) * grid.cols + std::min(col, grid.cols - 1)), p.z());
+    }
+    ticker.step(cloud.size());
+    tbb::parallel_sort(keyed.begin(), keyed.end());
+    ticker.step(cloud.size());
+    EpochRaster r;
+    r.z.assign(grid.size(), kNaN);
+    r.roughness.assign(grid.size(), kNaN);
+    r.count.assign(grid.size(), 0);
+    for (std::size_t begin = 0; begin < keyed.size();) {
+        std::size_t end = begin;
+        double sum = 0;
+        while (end < keyed.size() && keyed[end].first == keyed[begin].first)
+            sum += keyed[end++].second;
+        const std::size_t n = end - begin;
+        const double mean = sum / static_cast<double>(n);
+        double squares = 0;
+        for (std::size_t k = begin; k < end; ++k)
+            squares += (keyed[k].second - mean) * (keyed[k].second - mean);
+        const std::uint32_t cell = keyed[begin].first;
+        r.count[cell] = static_cast<std::uint32_t>(n);
+        r.roughness[cell] = std::sqrt(squares / static_cast<double>(n));
+        switch (statistic) {
+        case CellStatistic::Min: r.z[cell] = keyed[begin].second; break;
+        case CellStatistic::Max: r.z[cell] = keyed[end - 1].second; break;
+        case CellStatistic::Mean: r.z[cell] = mean; break;
+        case CellStatistic::Median:
+            r.z[cell] = n % 2 ? keyed[begin + n / 2].second : 0.5 * (keyed[begin + n / 2 - 1].second + keyed[begin + n / 2].second);
+            break;
+        }
+        begin = end;
+    }
+    return r;
+}
+
+//! Each pass gives every empty cell with a filled neighbour the mean height
+//! (and roughness) of its filled neighbours among the 8 around it.
+void fill(EpochRaster& r, const Grid& grid, int passes)
+{
+    for (int pass = 0; pass < passes; ++pass) {
+        std::vector<double> z = r.z, roughness = r.roughness;
+        bool changed = false;
+        for (std::size_t row = 0; row < grid.rows; ++row)
+            for (std::size_t col = 0; col < grid.cols; ++col) {
+                const std::size_t c = row * grid.cols + col;
+                if (!std::isnan(r.z[c]))
+                    continue;
+                double sum = 0, rough = 0;
+                int n = 0;
+                for (int dr = -1; dr <= 1; ++dr)
+                    for (int dc = -1; dc <= 1; ++dc) {
+                        const auto nr = static_cast<std::ptrdiff_t>(row) + dr, nc = static_cast<std::ptrdiff_t>(col) + dc;
+                        if ((dr == 0 && dc == 0) || nr < 0 || nc < 0 || nr >= static_cast<std::ptrdiff_t>(grid.rows) ||
+                            nc >= static_cast<std::ptrdiff_t>(grid.cols))
+                            continue;
+                        const std::size_t k = static_cast<std::size_t>(nr) * grid.cols + static_cast<std::size_t>(nc);
+                        if (std::isnan(r.z[k]))
+                            continue;
+                        sum += r.z[k];
+                        rough += std::isnan(r.roughness[k]) ? 0.0 : r.roughness[k];
+                        ++n;
+                    }
+                if (n > 0) {
+                    z[c] = sum / n;
+                    roughness[c] = rough / n;
+                    changed = true;
+                }
+            }
+        r.z = std::move(z);
+        r.roughness = std::move(roughness);
+        if (!changed)
+            break;
+    }
+}
+
+} // namespace
+
+Table DemOfDifferenceResult::report() const
+{
+    Table t;
+    t.columns = {"quantity", "value", "unit"};
+    auto row = [&](const char* name, double value, const char* unit) { t.rows.push_back({std::string(name), value, std::string(unit)}); };
+    row("cell_size", std::sqrt(cellArea), "m");
+    row("columns", static_cast<double>(columns), "cells");
+    row("rows", static_cast<double>(rows), "cells");
+    row("matching_cells", static_cast<double>(matchingCells), "cells");
+    row("matching_surface", static_cast<double>(matchingCells) * cellArea, "m2");
+    row("significant_cells", static_cast<double>(significantCells), "cells");
+    row("deposition", deposition, "m3");
+    row("deposition_uncertainty", depositionError, "m3");
+    row("erosion", erosion, "m3");
+    row("erosion_uncertainty", erosionError, "m3");
+    row("net_change", deposition - erosion, "m3");
+    row("added_volume_2_5d", added, "m3");
+    row("removed_volume_2_5d", removed, "m3");
+    return t;
+}
+
+DemOfDifferenceResult demOfDifference(const PointCloud* reference, const PointCloud& compared, const DemOfDifferenceParams& params,
+                                      ProgressObserver* progress)
+{
+    if (!std::isfinite(params.cell) || params.cell <= 0)
+        throw Error(ErrorCode::InvalidArgument, "DEM of difference: the cell size must be positive (m)");
+    if (params.lod && params.propagated)
+        throw Error(ErrorCode::InvalidArgument, "DEM of difference: give a level of detection or the propagated error, not both");
+    if (params.lod && !(*params.lod >= 0))
+        throw Error(ErrorCode::InvalidArgument, "DEM of difference: the level of detection must be zero or positive (m)");
+    if (params.heightError && !(*params.heightError >= 0))
+        throw Error(ErrorCode::InvalidArgument, "DEM of difference: the height error must be zero or positive (m)");
+    if (!reference && !params.referenceHeight)
+        throw Error(ErrorCode::InvalidArgument, "DEM of difference: give a reference cloud or a reference height");
+    if (reference && params.referenceHeight)
+        throw Error(ErrorCode::InvalidArgument, "DEM of difference: give a reference cloud or a reference height, not both");
+    if (compared.empty() || (reference && reference->empty()))
+        throw Error(ErrorCode::InvalidData, "DEM of difference: an epoch has no point");
+
+    double xmin = std::numeric_limits<double>::infinity(), ymin = xmin, xmax = -xmin, ymax = -xmin;
+    addBounds(compared, xmin, ymin, xmax, ymax);
+    if (reference)
+        addBounds(*reference, xmin, ymin, xmax, ymax);
+    if (!(xmin <= xmax))
+        throw Error(ErrorCode::InvalidData, "DEM of difference: no finite point");
+    Grid grid;
+    grid.cell = params.cell;
+    grid.x0 = std::floor(xmin / params.cell) * params.cell;
+    grid.y0 = std::floor(ymin / params.cell) * params.cell;
+    const double cols = std::floor((xmax - grid.x0) / params.cell) + 1, rows = std::floor((ymax - grid.y0) / params.cell) + 1;
+    if (cols * rows > kMaxCells)
+        throw Error(ErrorCode::InvalidArgument, "DEM of difference: a " + std::to_string(params.cell) + " m cell makes " +
+                                                    std::to_string(cols) + " x " + std::to_string(rows) + " cells (at most 2^28)");
+    grid.cols = static_cast<std::size_t>(cols);
+    grid.rows = static_cast<std::size_t>(rows);
+
+    ProgressTicker ticker(progress, "DEM of difference", 2 * (compared.size() + (reference ? reference->size() : 0)) + 1);
+    EpochRaster second = rasterise(compared, grid, params.statistic, ticker);
+    EpochRaster first;
+    if (reference) {
+        first = rasterise(*reference, grid, params.statistic, ticker);
+    } else {
+        first.z.assign(grid.size(), *params.referenceHeight);
+        first.roughness.assign(grid.size(), 0.0);
+        first.count.assign(grid.size(), 0);
+    }
+    fill(first, grid, params.fillPasses);
+    fill(second, grid, params.fillPasses);
+    ticker.checkCancel();
+
+    DemOfDifferenceResult result;
+    result.cellArea = params.cell * params.cell;
+    result.columns = grid.cols;
+    result.rows = grid.rows;
+    std::vector<std::size_t> kept;
+    for (std::size_t c = 0; c < grid.size(); ++c)
+        if (!std::isnan(second.z[c]) || (reference && !std::isnan(first.z[c])))
+            kept.push_back(c);
+    PointCloud& cells = result.cells;
+    cells.name = compared.name + "_dod";
+    cells.setOrigin(Eigen::Vector3d(std::round(grid.x0), std::round(grid.y0), 0.0));
+    cells.resize(kept.size());
+    const char* names[] = {fields::kRasterCol,    fields::kRasterRow, fields::kZReference,     fields::kZCompared,
+                           fields::kDodDifference, fields::kDodLod,   fields::kDodSignificant};
+    for (const char* name : names)
+        cells.addField(ScalarField(name, kept.size()));
+    ScalarField* f[7];
+    for (int k = 0; k < 7; ++k)
+        f[k] = cells.field(names[k]);
+    // Heights far from zero keep their millimetres around an offset.
+    for (int k : {2, 3}) {
+        for (std::size_t c : kept) {
+            const double z = k == 2 ? first.z[c] : second.z[c];
+            if (!std::isnan(z)) {
+                f[k]->setOffset(std::floor(z));
+                break;
+            }
+        }
+    }
+    double depositionVariance = 0, erosionVariance = 0;
+    const double area = result.cellArea;
+    for (std::size_t k = 0; k < kept.size(); ++k) {
+        const std::size_t c = kept[k];
+        const std::size_t col = c % grid.cols, row = c / grid.cols;
+        const double z1 = first.z[c], z2 = second.z[c];
+        const double shown = std::isnan(z2) ? z1 : z2;
+        cells.positions()[k] = (Eigen::Vector3d(grid.x0 + (static_cast<double>(col) + 0.5) * grid.cell,
+                                                grid.y0 + (static_cast<double>(row) + 0.5) * grid.cell, shown) -
+                                cells.origin())
+                                   .cast<float>();
+        f[0]->setValue(k, static_cast<double>(col));
+        f[1]->setValue(k, static_cast<double>(row));
+        f[2]->setValue(k, z1);
+        f[3]->setValue(k, z2);
+        if (std::isnan(z1) || std::isnan(z2))
+            continue;
+        ++result.matchingCells;
+        const double dz = z2 - z1;
+        (dz > 0 ? result.added : result.removed) += std::abs(dz) * area;
+        const double e1 = params.heightError ? *params.heightError : first.roughness[c];
+        const double e2 = params.heightError ? *params.heightError : second.roughness[c];
+        const double sigma = std::sqrt(e1 * e1 + e2 * e2);
+        const double lod = params.lod ? *params.lod : params.propagated ? 1.96 * sigma : 0.0;
+        f[4]->setValue(k, dz);
+        f[5]->setValue(k, lod);
+        const bool significant = std::abs(dz) > lod;
+        f[6]->setValue(k, significant ? 1.0 : 0.0);
+        if (!significant)
+            continue;
+        ++result.significantCells;
+        if (dz > 0) {
+            result.deposition += dz * area;
+            depositionVariance += (area * sigma) * (area * sigma);
+        } else {
+            result.erosion -= dz * area;
+            erosionVariance += (area * sigma) * (area * sigma);
+        }
+    }
+    result.depositionError = std::sqrt(depositionVariance);
+    result.erosionError = std::sqrt(erosionVariance);
+    ticker.step();
+    return result;
+}
+
+} // namespace scandiff
