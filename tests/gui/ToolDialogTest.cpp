@@ -170,6 +170,19 @@ private slots:
         // A mesh input only accepts meshes, whatever is selected.
         QCOMPARE(gui::proposeInputs(document, *registry.tools.find("sample-mesh"), {idA}).at("input"),
                  (std::vector<gui::EntityId>{idMesh}));
+        // Two epochs: the selected one is compared (or moved), the reference
+        // the first opened of the others, as in the C2C dialog, whatever the
+        // order of the roles.
+        const gui::ToolInputChoice m3c2 = gui::proposeInputs(document, *registry.tools.find("m3c2"), {idB});
+        QCOMPARE(m3c2.at("compared"), (std::vector<gui::EntityId>{idB}));
+        QCOMPARE(m3c2.at("reference"), (std::vector<gui::EntityId>{idA}));
+        QVERIFY(m3c2.at("core-points").empty());
+        const gui::ToolInputChoice dod = gui::proposeInputs(document, *registry.tools.find("dod"), {idA});
+        QCOMPARE(dod.at("compared"), (std::vector<gui::EntityId>{idA}));
+        QCOMPARE(dod.at("reference"), (std::vector<gui::EntityId>{idB}));
+        const gui::ToolInputChoice icp = gui::proposeInputs(document, *registry.tools.find("register"), {idB});
+        QCOMPARE(icp.at("moving"), (std::vector<gui::EntityId>{idB}));
+        QCOMPARE(icp.at("reference"), (std::vector<gui::EntityId>{idA}));
 
         // The dialog lists them: a checkable list for merge, a combo box for a single input.
         gui::ToolDialog mergeDialog(*registry.tools.find("merge"), document, merge);

@@ -31,7 +31,18 @@ ToolInputChoice proposeInputs(const Document& document, const ToolSpec& tool, co
     ToolInputChoice choice;
     std::vector<EntityId> used;
     const auto isUsed = [&](EntityId id) { return std::find(used.begin(), used.end(), id) != used.end(); };
-    for (const InputSpec& input : tool.inputs) {
+    // As in CloudCompare and the C2C dialog: the selected cloud is the one
+    // compared or moved, the reference the first opened of the others (the
+    // older epoch). So the "reference" role chooses last.
+    std::vector<const InputSpec*> order;
+    for (const InputSpec& input : tool.inputs)
+        if (input.role != "reference")
+            order.push_back(&input);
+    for (const InputSpec& input : tool.inputs)
+        if (input.role == "reference")
+            order.push_back(&input);
+    for (const InputSpec* inputPointer : order) {
+        const InputSpec& input = *inputPointer;
         const std::vector<EntityId> accepted = acceptedEntities(document, input);
         const auto accepts = [&](EntityId id) { return std::find(accepted.begin(), accepted.end(), id) != accepted.end(); };
         std::vector<EntityId>& picked = choice[input.role];
@@ -51,13 +62,21 @@ ToolInputChoice proposeInputs(const Document& document, const ToolSpec& tool, co
                     used.push_back(id);
                 }
         }
-        if (picked.empty() && !input.optional)
+        if (picked.empty() && input.role == "reference") {
+            for (EntityId id : accepted)
+                if (!isUsed(id)) {
+                    picked.push_back(id);
+                    used.push_back(id);
+                    break;
+                }
+        } else if (picked.empty() && !input.optional) {
             for (auto it = accepted.rbegin(); it != accepted.rend(); ++it)
                 if (!isUsed(*it)) {
                     picked.push_back(*it);
                     used.push_back(*it);
                     break;
                 }
+        }
     }
     return choice;
 }
