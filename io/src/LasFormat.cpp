@@ -38,8 +38,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-
 // Points decoded between two progress steps: large enough that the ticker costs
 // nothing, small enough for a responsive Cancel.
 constexpr std::size_t kChunkPoints = 1u << 16;
