@@ -4,6 +4,7 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/distance/M3C2.h>
 #include <scandiff/core/processing/ProcessingTools.h>
+#include <scandiff/core/segmentation/SegmentationParameters.h>
 
 #include "StageWatcher.h"
 #include "TestSupport.h"
@@ -323,4 +324,35 @@ TEST(M3C2, ToolRunsFromTheRegistryAndCancelStopsItAtAnyPoll)
     params.orientation = parseNormalOrientation("mst");
     EXPECT_EQ(test::errorCodeOf([&] { m3c2(reference, compared, reference, params); }), ErrorCode::InvalidArgument);
     EXPECT_EQ(test::errorCodeOf([&] { m3c2(reference, PointCloud(), reference, M3c2Params()); }), ErrorCode::InvalidData);
+}
+
+TEST(M3C2, SignificantChangeBecomesRegionsWithTheirMeanDistance)
+{
+    // A 2 x 2 m patch raised 0.3 m in the compared epoch: M3C2 flags it, the
+    // segmentation groups the flagged core points into one region, and the
+    // region report gives the M3C2 distance, not the flag.
+    const PointCloud reference = grid(30, 0.1, 0.0);
+    PointCloud compared = grid(30, 0.1, 0.0);
+    for (Eigen::Vector3f& p : compared.positions())
+        if (p.x() > 0.0f && p.x() < 2.0f && p.y() > 0.0f && p.y() < 2.0f)
+            p.z() = 0.3f;
+    M3c2Params params;
+    params.normalScales = {0.5};
+    params.projectionScale = 0.3;
+    params.maxDepth = 0.5;
+    params.registrationError = 0.01;
+    PointCloud cores = m3c2(reference, compared, reference, params).corePoints;
+    const ParameterValues values = resolveParameters(
+        segmentationParameters(),
+        {{"field", fields::kM3c2Significant}, {"above", "0.5"}, {"components", "true"}, {"min-points", "20"},
+         {"report-field", fields::kM3c2Distance}},
+        "segment");
+    attachFields(cores, runSegmentation(cores, values));
+    const std::vector<RegionStatistics> regions = regionReport(cores, regionReportSettings(values, nullptr));
+    ASSERT_EQ(regions.size(), 1u);
+    // The patch's inner points see 0.3; those within the cylinder's radius of
+    // its edge see part of it: the mean lies between.
+    EXPECT_GT(regions.front().meanDistance, 0.2);
+    EXPECT_LE(regions.front().meanDistance, 0.3 + 1e-6);
+    EXPECT_NEAR(regions.front().maxDistance, 0.3, 1e-6);
 }

@@ -106,6 +106,11 @@ const std::vector<ParameterSpec>& segmentationParameters()
                                 1e-9, 1e9, "m")
                 .asOptional()
                 .onlyWith("propagate"),
+            ParameterSpec::text("report-field", "Report field",
+                                "The distances the region report gives (mean, max, RMS) when they are not the segmented field: "
+                                "segment on m3c2_significant, report m3c2_distance")
+                .asOptional()
+                .asFieldOf("input"),
             ParameterSpec::real("outline-cell", "Outline cell",
                                 "Cell of the regions' concave outlines; 0 = automatic (1.5 x the 4th-neighbour spacing)", 0.0, 0.0, 1e9,
                                 "m")
@@ -308,7 +313,7 @@ void attachFields(PointCloud& cloud, SegmentationRun&& run)
 RegionReportParams regionReportSettings(const ParameterValues& values, const PointCloud* reference)
 {
     RegionReportParams p;
-    p.distanceField = values.text("field");
+    p.distanceField = values.has("report-field") ? values.text("report-field") : values.text("field");
     p.outlineCellSize = values.real("outline-cell");
     p.volumeCellSize = values.real("volume-cell");
     p.regionInLaterEpoch = values.text("region-epoch") == "later";

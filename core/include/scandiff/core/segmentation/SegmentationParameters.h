@@ -23,7 +23,7 @@ namespace scandiff {
 //! field, absolute, range, above, kmeans, stat-test, neighbours, confidence,
 //! chi2-threshold, fit-box, noise, components, level, connectivity, min-points,
 //! propagate, alpha, min-seed, stop-speed, gradient-radius, smoothing,
-//! outline-cell.
+//! report-field, outline-cell, region-epoch, column-height, volume-cell.
 const std::vector<ParameterSpec>& segmentationParameters();
 
 //! What one run produced. `fields` are ready to be added to the cloud
