@@ -215,6 +215,8 @@ TEST(PcdFormat, HostileHeadersAreRefusedBeforeAllocating)
     const std::vector<Case> cases = {
         {"count-minus-one.pcd", pcd("x y z", "4 4 4", "F F F", "1 -1 1", 1, "ascii", "1 2 3\n"), "COUNT"},
         {"count-huge.pcd", pcd("x y z", "4 4 4", "F F F", "1 200000 1", 1, "ascii", "1 2 3\n"), "COUNT"},
+        // Found by the fuzzer: a z of COUNT 5,000 made 5,000 fields, named in quadratic time.
+        {"many-fields.pcd", pcd("x y z", "4 4 4", "F F F", "1 1 5000", 0, "ascii", ""), "scalar values"},
         {"ascii-half-billion.pcd", pcd("x y z", "4 4 4", "F F F", "1 1 1", 500000000, "ascii", "1 2 3\n"), "cannot fit"},
         {"binary-half-billion.pcd", pcd("x y z", "4 4 4", "F F F", "1 1 1", 500000000, "binary", std::string(12, '\0')), "truncated"},
         {"compressed-4gb.pcd", hugeCompressed, "cannot hold"},
