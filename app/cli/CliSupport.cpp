@@ -2,6 +2,7 @@
 #include "CliSupport.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/io/CoordinateSystem.h>
 
 #include <tbb/global_control.h>
 
@@ -168,6 +169,9 @@ void ReadFlags::addTo(CLI::App& command)
     command.add_option("--separator", separator, "ASCII files: column separator: , ; tab space");
     command.add_option("--skip-lines", skipLines, "ASCII files: number of leading lines to skip");
     command.add_option("--origin", origin, "Global shift to use, as X,Y,Z (default: chosen from the data)");
+    command.add_option("--crs", crs,
+                       "Coordinate reference system of inputs whose files give none (EPSG:2154, EPSG:2056+5728, a WKT): "
+                       "carried to the outputs and into GeoTIFFs");
 }
 
 io::ReadOptions ReadFlags::toOptions(ProgressObserver* progress) const
@@ -195,6 +199,8 @@ io::ReadOptions ReadFlags::toOptions(ProgressObserver* progress) const
         const Eigen::Vector3d o(v[0], v[1], v[2]);
         options.origin = o;
     }
+    if (!crs.empty())
+        options.crsWkt = io::crsFromUserInput(crs);
     return options;
 }
 

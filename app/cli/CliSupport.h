@@ -43,6 +43,7 @@ struct ReadFlags
     std::string separator; //!< "," ";" "tab" "space"
     int skipLines = -1;
     std::string origin;    //!< "X,Y,Z"
+    std::string crs;       //!< "EPSG:2154", a WKT...
     void addTo(CLI::App& command);
     //! Throws Error(InvalidArgument) for malformed values.
     io::ReadOptions toOptions(ProgressObserver* progress) const;

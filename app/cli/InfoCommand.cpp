@@ -2,6 +2,8 @@
 #include "CliSupport.h"
 #include "Commands.h"
 
+#include <scandiff/io/CoordinateSystem.h>
+
 #include <nlohmann/json.hpp>
 
 #include <iomanip>
@@ -34,6 +36,8 @@ nlohmann::json describe(const io::Entity& entity, const std::string& file)
         j["degenerate_triangles"] = mesh->countDegenerateTriangles();
     }
     j["global_shift"] = vectorJson(cloud.origin());
+    j["crs"] = cloud.crsWkt().empty() ? nlohmann::json(nullptr) : nlohmann::json(io::crsName(cloud.crsWkt()));
+    j["crs_wkt"] = cloud.crsWkt().empty() ? nlohmann::json(nullptr) : nlohmann::json(cloud.crsWkt());
     const BoundingBox box = cloud.bounds();
     if (box.empty)
         j["bounds"] = nullptr;
@@ -68,6 +72,7 @@ void printText(const nlohmann::json& j, std::ostream& out)
         return s.str();
     };
     out << "global shift:  " << vec(j["global_shift"]) << '\n';
+    out << "crs:           " << (j["crs"].is_null() ? std::string("(none)") : j["crs"].get<std::string>()) << '\n';
     if (j["bounds"].is_null())
         out << "bounds:        (empty)\n";
     else

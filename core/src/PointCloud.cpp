@@ -19,6 +19,7 @@ PointCloud PointCloud::clone() const
     copy.sensors_ = sensors_;
     copy.history_ = history_;
     copy.grid_ = grid_;
+    copy.crs_ = crs_;
     return copy;
 }
 
@@ -134,6 +135,7 @@ PointCloud PointCloud::subset(const std::vector<std::size_t>& indices) const
     out.sensors_ = sensors_;
     out.history_ = history_;
     out.grid_ = grid_;
+    out.crs_ = crs_;
     out.positions_.reserve(indices.size());
     for (std::size_t i : indices) {
         if (i >= positions_.size())

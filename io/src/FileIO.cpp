@@ -2,6 +2,8 @@
 #include <scandiff/io/FileIO.h>
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/Log.h>
+#include <scandiff/io/CoordinateSystem.h>
 
 #include <algorithm>
 #include <cctype>
@@ -48,6 +50,14 @@ Entity readFile(const FormatRegistry& registry, const fs::path& path, const Read
     if (!fs::exists(path, ec))
         throw Error(ErrorCode::Io, path.string() + ": no such file");
     Entity entity = handler.read(path, options);
+    if (!options.crsWkt.empty()) {
+        PointCloud& points = std::holds_alternative<Mesh>(entity) ? std::get<Mesh>(entity).vertices : std::get<PointCloud>(entity);
+        if (points.crsWkt().empty())
+            points.setCrsWkt(options.crsWkt);
+        else if (points.crsWkt() != options.crsWkt)
+            logWarning(path.string() + ": the file declares its own coordinate reference system (" + crsName(points.crsWkt()) +
+                       "), which is kept rather than the one given (" + crsName(options.crsWkt) + ")");
+    }
     const std::string stem = path.stem().string();
     std::visit([&](auto& e) {
         if (e.name.empty())

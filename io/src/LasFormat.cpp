@@ -12,15 +12,18 @@
 #include <scandiff/core/Log.h>
 #include <scandiff/core/Progress.h>
 #include <scandiff/io/AtomicFile.h>
+#include <scandiff/io/CoordinateSystem.h>
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <ctime>
 #include <limits>
 #include <new>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -322,33 +325,28 @@ std::vector<ExtraDimension> parseExtraBytes(const fs::path& path, const char* pa
     return dims;
 }
 
-// Finds the Extra Bytes record among the VLRs (and, in 1.4, the EVLRs).
-std::vector<ExtraDimension> findExtraDimensions(const MappedFile& file, const LasHeader& h)
+// Visits the variable length records, then (1.4) the extended ones, in file
+// order: visit(userId, recordId, payload, length) returns true to stop. A
+// record running out of its section ends the walk (with a warning when
+// `warn`: the first walk of a file says it, not every walk).
+template <class Visit>
+void forEachRecord(const MappedFile& file, const LasHeader& h, bool warn, Visit visit)
 {
     const fs::path& path = file.path();
     const char* data = file.data();
-    const std::size_t baseSize = kBaseRecordSize[static_cast<std::size_t>(h.pointFormat)];
-    if (h.recordLength == baseSize)
-        return {};
-    auto isExtraBytes = [](const char* recordHeader) {
-        return fixedString(recordHeader + 2, 16) == "LASF_Spec" && load<std::uint16_t>(recordHeader + 18) == 4;
-    };
-
     std::size_t position = h.headerSize;
     for (std::uint32_t v = 0; v < h.vlrCount; ++v) {
-        if (position + kVlrHeaderSize > h.offsetToPoints) {
-            logWarning(path.string() + ": variable length record " + std::to_string(v) + " at byte " +
-                       std::to_string(position) + " runs into the point data; the remaining records are ignored");
+        const bool headerFits = position + kVlrHeaderSize <= h.offsetToPoints;
+        const std::size_t length = headerFits ? load<std::uint16_t>(data + position + 20) : 0;
+        if (!headerFits || position + kVlrHeaderSize + length > h.offsetToPoints) {
+            if (warn)
+                logWarning(path.string() + ": variable length record " + std::to_string(v) + " at byte " +
+                           std::to_string(position) + " runs into the point data; the remaining records are ignored");
             break;
         }
-        const std::size_t length = load<std::uint16_t>(data + position + 20);
-        if (position + kVlrHeaderSize + length > h.offsetToPoints) {
-            logWarning(path.string() + ": variable length record " + std::to_string(v) + " at byte " +
-                       std::to_string(position) + " runs into the point data; the remaining records are ignored");
-            break;
-        }
-        if (isExtraBytes(data + position))
-            return parseExtraBytes(path, data + position + kVlrHeaderSize, length, baseSize, h.recordLength);
+        if (visit(fixedString(data + position + 2, 16), load<std::uint16_t>(data + position + 18), data + position + kVlrHeaderSize,
+                  length))
+            return;
         position += kVlrHeaderSize + length;
     }
 
@@ -359,14 +357,82 @@ std::vector<ExtraDimension> findExtraDimensions(const MappedFile& file, const La
         const std::uint64_t length = load<std::uint64_t>(data + evlr + 20);
         if (length > file.size() - evlr - kEvlrHeaderSize)
             break;
-        if (isExtraBytes(data + evlr))
-            return parseExtraBytes(path, data + evlr + kEvlrHeaderSize, static_cast<std::size_t>(length), baseSize,
-                                   h.recordLength);
+        if (visit(fixedString(data + evlr + 2, 16), load<std::uint16_t>(data + evlr + 18), data + evlr + kEvlrHeaderSize,
+                  static_cast<std::size_t>(length)))
+            return;
         evlr += kEvlrHeaderSize + length;
     }
+}
 
+// Finds the Extra Bytes record among the VLRs (and, in 1.4, the EVLRs).
+std::vector<ExtraDimension> findExtraDimensions(const MappedFile& file, const LasHeader& h)
+{
+    const fs::path& path = file.path();
+    const std::size_t baseSize = kBaseRecordSize[static_cast<std::size_t>(h.pointFormat)];
+    if (h.recordLength == baseSize)
+        return {};
+    std::optional<std::vector<ExtraDimension>> dims;
+    forEachRecord(file, h, false, [&](const std::string& user, std::uint16_t id, const char* payload, std::size_t length) {
+        if (user != "LASF_Spec" || id != 4)
+            return false;
+        dims = parseExtraBytes(path, payload, length, baseSize, h.recordLength);
+        return true;
+    });
+    if (dims)
+        return std::move(*dims);
     logInfo(path.string() + ": " + std::to_string(h.recordLength - baseSize) +
             " undescribed extra bytes per point were ignored");
+    return {};
+}
+
+// The coordinate reference system (LAS 1.4 R15, "Coordinate Reference System
+// Representation"): the OGC WKT record (user "LASF_Projection", id 2112) when
+// there is one, else the EPSG codes of the GeoTIFF GeoKeyDirectoryTag record
+// (id 34735: a header of four uint16, the last the key count, then per key
+// id, location, count, value; location 0 means the value is the key's own).
+// Systems the keys define piece by piece (code 32767, "user-defined") are not
+// rebuilt: the cloud gets none, with a warning.
+std::string findCrs(const MappedFile& file, const LasHeader& h)
+{
+    const std::string where = file.path().string();
+    std::string wkt;
+    int horizontal = -1, geographic = -1, vertical = -1; // -1: key absent
+    forEachRecord(file, h, true, [&](const std::string& user, std::uint16_t id, const char* payload, std::size_t length) {
+        if (user != "LASF_Projection")
+            return false;
+        if (id == 2112) {
+            wkt.assign(payload, std::find(payload, payload + length, '\0'));
+            while (!wkt.empty() && std::isspace(static_cast<unsigned char>(wkt.back())))
+                wkt.pop_back();
+            return !wkt.empty();
+        }
+        if (id == 34735 && length >= 8) {
+            const std::size_t keys = std::min<std::size_t>(load<std::uint16_t>(payload + 6), (length - 8) / 8);
+            for (std::size_t k = 0; k < keys; ++k) {
+                const char* key = payload + 8 + 8 * k;
+                if (load<std::uint16_t>(key + 2) != 0)
+                    continue; // a value stored elsewhere: not a code
+                const int value = load<std::uint16_t>(key + 6);
+                switch (load<std::uint16_t>(key)) {
+                case 3072: horizontal = value; break; // ProjectedCSTypeGeoKey
+                case 2048: geographic = value; break; // GeographicTypeGeoKey
+                case 4096: vertical = value; break;   // VerticalCSTypeGeoKey
+                default: break;
+                }
+            }
+        }
+        return false;
+    });
+    if (!wkt.empty())
+        return wkt;
+    auto known = [](int code) { return code > 0 && code != 32767; };
+    // A projected system's key decides alone: its geographic key is only its
+    // base, and projected metres must not be labelled as degrees.
+    const int base = horizontal >= 0 ? horizontal : geographic;
+    if (known(base))
+        return crsFromEpsg(base, known(vertical) ? vertical : 0, where);
+    if (base == 32767)
+        logWarning(where + ": the coordinate reference system is user-defined GeoTIFF keys, which are not read; the cloud gets none");
     return {};
 }
 
@@ -634,6 +700,7 @@ Entity readLas(const fs::path& path, const ReadOptions& options)
     PointCloud cloud;
     cloud.setOrigin(chooseOrigin(h, records, options));
     cloud.setSourceGrid(CoordinateGrid{h.offset, h.scale});
+    cloud.setCrsWkt(findCrs(file, h));
     double gpsTimeOffset = 0.0;
     if (formatHasGpsTime(format) && count > 0) {
         // Relative to the first time, float32 keeps 1 µs over ±8 s and 61 µs over
@@ -948,6 +1015,30 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
         }
     }
 
+    std::uint32_t vlrCount = extras.empty() ? 0u : 1u;
+    // The coordinate reference system as an OGC WKT record, NUL-terminated;
+    // one too long for a VLR's 16-bit length goes into an EVLR after the points.
+    std::string crsRecord;
+    if (!cloud.crsWkt().empty()) {
+        const std::size_t length = cloud.crsWkt().size() + 1;
+        const bool extended = length > std::numeric_limits<std::uint16_t>::max();
+        crsRecord.assign((extended ? kEvlrHeaderSize : kVlrHeaderSize) + length, '\0');
+        std::memcpy(&crsRecord[2], "LASF_Projection", 15);
+        store<std::uint16_t>(&crsRecord[18], 2112);
+        if (extended)
+            store<std::uint64_t>(&crsRecord[20], length);
+        else
+            store<std::uint16_t>(&crsRecord[20], static_cast<std::uint16_t>(length));
+        const char description[] = "OGC coordinate system WKT";
+        std::memcpy(&crsRecord[extended ? 28 : 22], description, sizeof description - 1);
+        std::memcpy(&crsRecord[extended ? kEvlrHeaderSize : kVlrHeaderSize], cloud.crsWkt().data(), cloud.crsWkt().size());
+        if (!extended) {
+            vlr += crsRecord;
+            crsRecord.clear();
+            ++vlrCount;
+        }
+    }
+
     const BoundingBox bounds = cloud.bounds();
     Eigen::Vector3d lasOffset, lasScale;
     for (int a = 0; a < 3; ++a)
@@ -1043,6 +1134,9 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
         ticker.step(end - begin);
     }
 
+    const auto evlrStart = static_cast<std::uint64_t>(stream.tellp());
+    stream.write(crsRecord.data(), static_cast<std::streamsize>(crsRecord.size()));
+
     // Public header block, LAS 1.4.
     char* h = header.data();
     std::memcpy(h, "LASF", 4);
@@ -1068,7 +1162,11 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
     }
     store<std::uint16_t>(h + hdr::headerSize, static_cast<std::uint16_t>(kHeaderSize14));
     store<std::uint32_t>(h + hdr::offsetToPoints, static_cast<std::uint32_t>(offsetToPoints));
-    store<std::uint32_t>(h + hdr::vlrCount, extras.empty() ? 0u : 1u);
+    store<std::uint32_t>(h + hdr::vlrCount, vlrCount);
+    if (!crsRecord.empty()) {
+        store<std::uint64_t>(h + hdr::evlrStart, evlrStart);
+        store<std::uint32_t>(h + hdr::evlrCount, 1u);
+    }
     h[hdr::pointFormat] = static_cast<char>(format);
     store<std::uint16_t>(h + hdr::recordLength, static_cast<std::uint16_t>(recordLength));
     // Legacy point counts stay 0: LAS 1.4 R15 requires it for point formats 6 and above.

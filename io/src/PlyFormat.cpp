@@ -135,7 +135,12 @@ struct PlyHeader
     std::vector<PlyElement> elements;
     std::size_t dataOffset = 0; //!< first byte after end_header's line
     std::size_t lineCount = 0;  //!< lines in the header, for ASCII line numbers
+    std::string crsWkt;         //!< from a "comment crs_wkt WKT" line (scandiff's own)
 };
+
+// PLY has no place for a coordinate reference system: scandiff writes it as a
+// comment line of its own, "comment crs_wkt " + the WKT on one line.
+constexpr std::string_view kCrsComment = "comment crs_wkt ";
 
 std::string lower(std::string_view s)
 {
@@ -262,6 +267,8 @@ PlyHeader parseHeader(const MappedFile& file, const Context& ctx)
         if (keyword == "end_header") {
             break;
         } else if (keyword == "comment" || keyword == "obj_info") {
+            if (line.substr(0, kCrsComment.size()) == kCrsComment)
+                header.crsWkt = std::string(line.substr(kCrsComment.size()));
             continue;
         } else if (keyword == "format") {
             if (tokens.size() != 3)
@@ -1027,6 +1034,7 @@ public:
         if (!vertexElement)
             ctx_.fail("no vertex element in the PLY header");
         layout_ = makeVertexLayout(*vertexElement, ctx_);
+        cloud_.setCrsWkt(header_.crsWkt);
 
         const bool binary = header_.encoding != PlyEncoding::Ascii;
         const bool needsRanges =
@@ -1412,6 +1420,12 @@ private:
              : encoding_ == PlyEncoding::BinaryLittleEndian ? "binary_little_endian"
                                                             : "binary_big_endian";
         h += " 1.0\ncomment Written by scandiff\n";
+        if (!cloud_.crsWkt().empty()) {
+            // WKT ignores whitespace between its tokens: one line holds it.
+            std::string wkt = cloud_.crsWkt();
+            std::replace_if(wkt.begin(), wkt.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+            h += std::string(kCrsComment) + wkt + "\n";
+        }
         h += "element vertex " + std::to_string(cloud_.size()) + "\n";
         for (const Column& c : columns_)
             h += std::string("property ") + plyTypeName(c.type) + " " + c.name + "\n";

@@ -8,6 +8,7 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/processing/CloudEditing.h>
 #include <scandiff/core/Log.h>
+#include <scandiff/io/CoordinateSystem.h>
 #include <scandiff/io/FileIO.h>
 
 #include "../support/TestSupport.h"
@@ -778,6 +779,125 @@ TEST_F(LasBadInput, MissingFile)
 {
     const fs::path file = dir_ / "missing.las";
     expectError([&] { io::readPointCloud(lasRegistry(), file); }, ErrorCode::Io, file, "no such file");
+}
+
+// ---------------------------------------------------------------------------
+// Coordinate reference systems.
+
+//! A LAS 1.2 file of one point whose only VLR is a GeoKeyDirectoryTag
+//! (LASF_Projection 34735) holding the given (key, value) pairs, each stored
+//! in place (location 0).
+Bytes makeLasWithGeoKeys(const std::vector<std::pair<std::uint16_t, std::uint16_t>>& keys)
+{
+    const std::size_t payload = 8 + 8 * keys.size();
+    HeaderSpec s;
+    s.count = 1;
+    s.vlrCount = 1;
+    s.offsetToPoints = static_cast<std::uint32_t>(227 + 54 + payload);
+    Bytes b = makeHeader(s);
+    b.putText(227 + 2, "LASF_Projection");
+    b.put<std::uint16_t>(227 + 18, 34735);
+    b.put<std::uint16_t>(227 + 20, static_cast<std::uint16_t>(payload));
+    const std::size_t p = 227 + 54;
+    b.put<std::uint16_t>(p + 0, 1); // KeyDirectoryVersion
+    b.put<std::uint16_t>(p + 2, 1); // KeyRevision
+    b.put<std::uint16_t>(p + 4, 0); // MinorRevision
+    b.put<std::uint16_t>(p + 6, static_cast<std::uint16_t>(keys.size()));
+    for (std::size_t k = 0; k < keys.size(); ++k) {
+        b.put<std::uint16_t>(p + 8 + 8 * k, keys[k].first);
+        b.put<std::uint16_t>(p + 8 + 8 * k + 2, 0);
+        b.put<std::uint16_t>(p + 8 + 8 * k + 4, 1);
+        b.put<std::uint16_t>(p + 8 + 8 * k + 6, keys[k].second);
+    }
+    b.put<std::int32_t>(s.offsetToPoints + 27, 0); // one all-zero point of 28 bytes
+    return b;
+}
+
+TEST(LasCrs, GeoTiffKeysBecomeTheWktOfTheirEpsgCodes)
+{
+    const fs::path file = test::tempDir() / "geokeys.las";
+    // GTModelType projected, Lambert-93 (EPSG 2154), NGF-IGN69 height (EPSG 5720).
+    test::writeText(file, makeLasWithGeoKeys({{1024, 1}, {3072, 2154}, {4096, 5720}}).str());
+    const PointCloud cloud = io::readPointCloud(lasRegistry(), file);
+    ASSERT_EQ(cloud.size(), 1u);
+    EXPECT_EQ(cloud.crsWkt(), io::crsFromUserInput("EPSG:2154+5720"));
+    EXPECT_NE(io::crsName(cloud.crsWkt()).find("Lambert-93"), std::string::npos) << io::crsName(cloud.crsWkt());
+
+    // Geographic only.
+    test::writeText(file, makeLasWithGeoKeys({{1024, 2}, {2048, 4326}}).str());
+    EXPECT_EQ(io::readPointCloud(lasRegistry(), file).crsWkt(), io::crsFromUserInput("EPSG:4326"));
+}
+
+TEST(LasCrs, UserDefinedOrUnknownKeysLeaveNoSystemAndAWarning)
+{
+    const fs::path file = test::tempDir() / "userkeys.las";
+    for (std::uint16_t code : {std::uint16_t{32767}, std::uint16_t{65000}}) {
+        CapturedLog log;
+        test::writeText(file, makeLasWithGeoKeys({{3072, code}}).str());
+        const PointCloud cloud = io::readPointCloud(lasRegistry(), file);
+        EXPECT_EQ(cloud.size(), 1u);
+        EXPECT_TRUE(cloud.crsWkt().empty()) << code;
+        ASSERT_EQ(log.warnings.size(), 1u) << code;
+        EXPECT_NE(log.warnings[0].find("coordinate reference system"), std::string::npos) << log.warnings[0];
+    }
+    {
+        // A user-defined projection over a known geographic base is not
+        // labelled with the base: its coordinates are metres, not degrees.
+        CapturedLog log;
+        test::writeText(file, makeLasWithGeoKeys({{1024, 1}, {3072, 32767}, {2048, 4269}}).str());
+        EXPECT_TRUE(io::readPointCloud(lasRegistry(), file).crsWkt().empty());
+        EXPECT_EQ(log.warnings.size(), 1u);
+    }
+    {
+        // An unknown vertical system leaves the horizontal one, with a warning.
+        CapturedLog log;
+        test::writeText(file, makeLasWithGeoKeys({{3072, 2154}, {4096, 65000}}).str());
+        EXPECT_EQ(io::readPointCloud(lasRegistry(), file).crsWkt(), io::crsFromUserInput("EPSG:2154"));
+        ASSERT_EQ(log.warnings.size(), 1u);
+        EXPECT_NE(log.warnings[0].find("vertical"), std::string::npos) << log.warnings[0];
+    }
+    // A key count beyond the record reads only the keys that are there.
+    Bytes b = makeLasWithGeoKeys({{3072, 2154}});
+    b.put<std::uint16_t>(227 + 54 + 6, 60000);
+    test::writeText(file, b.str());
+    EXPECT_EQ(io::readPointCloud(lasRegistry(), file).crsWkt(), io::crsFromUserInput("EPSG:2154"));
+}
+
+TEST(LasCrs, TheWktRecordRoundTripsExactlyEvenBeyondAVariableLengthRecord)
+{
+    PointCloud cloud;
+    cloud.setOrigin({651000, 6862000, 0});
+    cloud.positions() = {{1.5f, 2.25f, 30.0f}, {2.5f, 3.0f, 31.0f}};
+    cloud.setCrsWkt(io::crsFromUserInput("EPSG:2154+5720"));
+    const fs::path file = test::tempDir() / "crs.las";
+    io::writePointCloud(lasRegistry(), cloud, file);
+    EXPECT_EQ(io::readPointCloud(lasRegistry(), file).crsWkt(), cloud.crsWkt());
+
+    // A WKT longer than a VLR's 65535 bytes goes into an extended record after
+    // the points (the header then counts one EVLR).
+    const std::string longWkt = "LOCAL_CS[\"" + std::string(70000, 'x') + "\",UNIT[\"metre\",1]]";
+    cloud.setCrsWkt(longWkt);
+    io::writePointCloud(lasRegistry(), cloud, file);
+    const std::string bytes = test::readBytes(file);
+    std::uint32_t evlrCount = 0;
+    std::memcpy(&evlrCount, bytes.data() + 243, 4);
+    EXPECT_EQ(evlrCount, 1u);
+    const PointCloud back = io::readPointCloud(lasRegistry(), file);
+    EXPECT_EQ(back.crsWkt(), longWkt);
+    EXPECT_EQ(back.size(), 2u);
+}
+
+TEST(Crs, UnknownUserInputIsAClearError)
+{
+    try {
+        io::crsFromUserInput("EPSG:99999999");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::InvalidArgument);
+        EXPECT_NE(std::string(e.what()).find("EPSG:99999999"), std::string::npos);
+    }
+    EXPECT_EQ(io::crsName(""), "");
+    EXPECT_EQ(io::crsName("not a wkt"), "not a wkt");
 }
 
 } // namespace

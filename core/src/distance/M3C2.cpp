@@ -267,6 +267,8 @@ M3c2Result m3c2(const PointCloud& reference, const PointCloud& compared, const P
     M3c2Result result;
     result.corePoints = corePoints.clone();
     PointCloud& out = result.corePoints;
+    if (out.crsWkt().empty())
+        out.setCrsWkt(reference.crsWkt());
     const std::size_t n = cores.size();
     std::vector<Eigen::Vector3f>& outNormals = out.enableNormals();
     const char* names[] = {fields::kM3c2Distance, fields::kM3c2Uncertainty, fields::kM3c2Significant,

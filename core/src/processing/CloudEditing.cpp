@@ -2,6 +2,7 @@
 #include <scandiff/core/processing/CloudEditing.h>
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/Log.h>
 #include <scandiff/core/TextLists.h>
 
 #include <Eigen/Geometry>
@@ -83,6 +84,15 @@ PointCloud mergeClouds(const std::vector<const PointCloud*>& clouds, ProgressObs
         sameGrid = sameGrid && c->sourceGrid() == clouds.front()->sourceGrid();
     if (sameGrid)
         merged.setSourceGrid(clouds.front()->sourceGrid());
+    // One system for all, or none: merging clouds of different systems gives
+    // coordinates in no system at all (with a warning).
+    bool sameCrs = true;
+    for (const PointCloud* c : clouds)
+        sameCrs = sameCrs && c->crsWkt() == clouds.front()->crsWkt();
+    if (sameCrs)
+        merged.setCrsWkt(clouds.front()->crsWkt());
+    else
+        logWarning("merge: the clouds are in different coordinate reference systems; the merged cloud has none");
     merged.resize(total);
     if (colours)
         merged.enableColors();

@@ -120,6 +120,14 @@ public:
     const std::optional<CoordinateGrid>& sourceGrid() const { return grid_; }
     void setSourceGrid(std::optional<CoordinateGrid> grid) { grid_ = std::move(grid); }
 
+    //! The coordinate reference system of the global coordinates, as OGC WKT
+    //! (empty: unknown). Readers set it from the file (LAS), writers that can
+    //! hold it write it back, and a GeoTIFF made from the cloud is
+    //! georeferenced with it. clone(), subset() and a rigid transformation
+    //! keep it: the coordinates stay in the same system.
+    const std::string& crsWkt() const { return crs_; }
+    void setCrsWkt(std::string wkt) { crs_ = std::move(wkt); }
+
     //! Bounding box of the global coordinates, ignoring non-finite positions.
     BoundingBox bounds() const;
 
@@ -143,6 +151,7 @@ private:
     std::vector<SensorPose> sensors_;
     std::vector<AppliedTransform> history_;
     std::optional<CoordinateGrid> grid_;
+    std::string crs_;
 };
 
 //! Chooses an origin for global coordinates spanning `bounds`: zero when float32

@@ -41,6 +41,10 @@ struct ReadOptions
     std::optional<char> asciiSeparator;
     //! ASCII only: number of leading lines to skip (overrides header detection).
     std::optional<std::size_t> asciiSkipLines;
+    //! The coordinate reference system (OGC WKT) of files that give none (PLY
+    //! without scandiff's comment, text, PCD...). A file's own system wins,
+    //! with a warning when it differs.
+    std::string crsWkt;
 };
 
 enum class Encoding

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/io/CoordinateSystem.h>
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/Log.h>
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <ogr_srs_api.h>
+
+#include <memory>
+#include <string>
+
+namespace scandiff::io {
+
+namespace {
+
+struct SpatialReference
+{
+    OGRSpatialReferenceH handle = OSRNewSpatialReference(nullptr);
+    ~SpatialReference() { OSRDestroySpatialReference(handle); }
+};
+
+//! GDAL reports failures through its error handler (stderr by default): they
+//! become our messages instead.
+struct QuietGdalErrors
+{
+    QuietGdalErrors() { CPLPushErrorHandler(CPLQuietErrorHandler); }
+    ~QuietGdalErrors() { CPLPopErrorHandler(); }
+};
+
+std::string exportWkt(OGRSpatialReferenceH srs)
+{
+    char* text = nullptr;
+    // WKT1 (OGC 01-009) is what LAS 1.4 R15 asks for in its WKT record.
+    if (OSRExportToWkt(srs, &text) != OGRERR_NONE || !text) {
+        CPLFree(text);
+        return {};
+    }
+    std::string wkt(text);
+    CPLFree(text);
+    return wkt;
+}
+
+} // namespace
+
+std::string crsFromUserInput(const std::string& definition)
+{
+    const QuietGdalErrors quiet;
+    SpatialReference srs;
+    if (definition.empty() || OSRSetFromUserInput(srs.handle, definition.c_str()) != OGRERR_NONE)
+        throw Error(ErrorCode::InvalidArgument, "unknown coordinate reference system '" + definition +
+                                                    "' (give EPSG:CODE, EPSG:CODE+VERTICALCODE, a WKT or a PROJ string)");
+    std::string wkt = exportWkt(srs.handle);
+    if (wkt.empty())
+        throw Error(ErrorCode::InvalidArgument, "coordinate reference system '" + definition + "' has no WKT form");
+    return wkt;
+}
+
+std::string crsFromEpsg(int horizontalEpsg, int verticalEpsg, const std::string& where)
+{
+    const std::string code = "EPSG:" + std::to_string(horizontalEpsg) + (verticalEpsg > 0 ? "+" + std::to_string(verticalEpsg) : "");
+    try {
+        return crsFromUserInput(code);
+    } catch (const Error&) {
+    }
+    if (verticalEpsg > 0) { // keep the horizontal system when only the vertical one is unknown
+        try {
+            std::string wkt = crsFromUserInput("EPSG:" + std::to_string(horizontalEpsg));
+            logWarning(where + ": the vertical system EPSG:" + std::to_string(verticalEpsg) +
+                       " is unknown to PROJ; the cloud keeps the horizontal one only");
+            return wkt;
+        } catch (const Error&) {
+        }
+    }
+    logWarning(where + ": the coordinate reference system " + code + " is unknown to PROJ; the cloud gets none");
+    return {};
+}
+
+std::string crsName(const std::string& wkt)
+{
+    if (wkt.empty())
+        return {};
+    const QuietGdalErrors quiet;
+    SpatialReference srs;
+    // Imported as WKT only: text from a file must not make GDAL open a path or a URL.
+    char* text = const_cast<char*>(wkt.c_str());
+    if (OSRImportFromWkt(srs.handle, &text) == OGRERR_NONE) {
+        if (const char* name = OSRGetName(srs.handle))
+            return name;
+    }
+    return wkt.substr(0, 60) + (wkt.size() > 60 ? "..." : "");
+}
+
+} // namespace scandiff::io
