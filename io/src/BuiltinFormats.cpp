@@ -12,6 +12,7 @@ void registerBuiltinFormats(FormatRegistry& registry)
     registry.add(detail::meshFormat());
     registry.add(detail::dxfFormat());
     registry.add(detail::geoTiffFormat());
+    registry.add(detail::pngPreviewFormat());
 }
 
 } // namespace scandiff::io

@@ -7,11 +7,14 @@
 //!
 //! The grid is rebuilt from the points: the cell size from two points of
 //! different columns (or rows), the origin from any point. North up: the
-//! first row of the image is the northernmost.
+//! first row of the image is the northernmost. The cloud's coordinate
+//! reference system, when it has one, is the GeoTIFF's.
 
 #include "internal/Formats.h"
+#include "internal/GriddedCloud.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/Log.h>
 #include <scandiff/core/distance/DemOfDifference.h>
 #include <scandiff/io/AtomicFile.h>
 
@@ -30,55 +33,6 @@ namespace {
 [[noreturn]] void fail(const std::filesystem::path& path, const std::string& what)
 {
     throw Error(ErrorCode::InvalidArgument, path.string() + ": " + what);
-}
-
-struct GridOfCloud
-{
-    double x0 = 0, y0 = 0, cell = 0; //!< lower-left corner of cell (0, 0), cell size
-    std::size_t cols = 0, rows = 0;
-};
-
-GridOfCloud gridOf(const PointCloud& cloud, const ScalarField& col, const ScalarField& row, const std::filesystem::path& path)
-{
-    GridOfCloud g;
-    double maxCol = 0, maxRow = 0;
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        if (!col.hasValue(i) || !row.hasValue(i) || col.value(i) < 0 || row.value(i) < 0 || col.value(i) != std::floor(col.value(i)) ||
-            row.value(i) != std::floor(row.value(i)))
-            fail(path, "point " + std::to_string(i) + " has no whole raster_col / raster_row");
-        maxCol = std::max(maxCol, col.value(i));
-        maxRow = std::max(maxRow, row.value(i));
-    }
-    g.cols = static_cast<std::size_t>(maxCol) + 1;
-    g.rows = static_cast<std::size_t>(maxRow) + 1;
-    if (static_cast<double>(g.cols) * static_cast<double>(g.rows) > 268435456.0)
-        fail(path, "the grid has more than 2^28 cells");
-    // The cell size from the two points farthest apart in column (or row).
-    std::size_t lo = 0, hi = 0;
-    for (std::size_t i = 1; i < cloud.size(); ++i) {
-        if (col.value(i) < col.value(lo))
-            lo = i;
-        if (col.value(i) > col.value(hi))
-            hi = i;
-    }
-    if (col.value(hi) > col.value(lo)) {
-        g.cell = (cloud.globalPosition(hi).x() - cloud.globalPosition(lo).x()) / (col.value(hi) - col.value(lo));
-    } else {
-        for (std::size_t i = 1; i < cloud.size(); ++i) {
-            if (row.value(i) < row.value(lo))
-                lo = i;
-            if (row.value(i) > row.value(hi))
-                hi = i;
-        }
-        if (row.value(hi) > row.value(lo))
-            g.cell = (cloud.globalPosition(hi).y() - cloud.globalPosition(lo).y()) / (row.value(hi) - row.value(lo));
-    }
-    if (!(g.cell > 0))
-        fail(path, "a GeoTIFF needs at least two cells in a row or a column to know the cell size");
-    const Eigen::Vector3d p = cloud.globalPosition(0);
-    g.x0 = p.x() - (col.value(0) + 0.5) * g.cell;
-    g.y0 = p.y() - (row.value(0) + 0.5) * g.cell;
-    return g;
 }
 
 void writeGeoTiff(const PointCloud& cloud, const std::filesystem::path& path, const WriteOptions& options)
@@ -123,6 +77,8 @@ void writeGeoTiff(const PointCloud& cloud, const std::filesystem::path& path, co
     // North up: row 0 of the image is the top (the largest y).
     double transform[6] = {g.x0, g.cell, 0.0, g.y0 + static_cast<double>(g.rows) * g.cell, 0.0, -g.cell};
     GDALSetGeoTransform(dataset, transform);
+    if (!cloud.crsWkt().empty() && GDALSetProjection(dataset, cloud.crsWkt().c_str()) != CE_None)
+        logWarning(path.string() + ": GDAL did not take the cloud's coordinate reference system; the GeoTIFF has none");
     ProgressTicker ticker(options.progress, "Writing " + path.filename().string(), bands.size());
     std::vector<double> image(g.cols * g.rows);
     CPLErr status = CE_None;
@@ -149,10 +105,35 @@ void writeGeoTiff(const PointCloud& cloud, const std::filesystem::path& path, co
 
 } // namespace
 
+GridOfCloud gridOf(const PointCloud& cloud, const ScalarField& col, const ScalarField& row, const std::filesystem::path& path)
+{
+    GridOfCloud g;
+    double maxCol = 0, maxRow = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        if (!col.hasValue(i) || !row.hasValue(i) || col.value(i) < 0 || row.value(i) < 0 || col.value(i) != std::floor(col.value(i)) ||
+            row.value(i) != std::floor(row.value(i)))
+            fail(path, "point " + std::to_string(i) + " has no whole raster_col / raster_row");
+        maxCol = std::max(maxCol, col.value(i));
+        maxRow = std::max(maxRow, row.value(i));
+    }
+    g.cols = static_cast<std::size_t>(maxCol) + 1;
+    g.rows = static_cast<std::size_t>(maxRow) + 1;
+    if (static_cast<double>(g.cols) * static_cast<double>(g.rows) > 268435456.0)
+        fail(path, "the grid has more than 2^28 cells");
+    // The cell size from the two points farthest apart in column (or row).
+    g.cell = gridCellSize(cloud).value_or(0.0);
+    if (!(g.cell > 0))
+        fail(path, "a raster needs at least two cells in a row or a column to know the cell size");
+    const Eigen::Vector3d p = cloud.globalPosition(0);
+    g.x0 = p.x() - (col.value(0) + 0.5) * g.cell;
+    g.y0 = p.y() - (row.value(0) + 0.5) * g.cell;
+    return g;
+}
+
 FormatHandler geoTiffFormat()
 {
     FormatHandler h;
-    h.name = "GeoTIFF (gridded clouds: DEM of difference)";
+    h.name = "GeoTIFF (gridded clouds: DEM of difference, rasters)";
     h.extensions = {"tif", "tiff"};
     h.writeCloud = writeGeoTiff;
     return h;

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 
 using namespace scandiff;
 
@@ -160,4 +161,57 @@ TEST(DemOfDifference, BadParametersAreClearErrors)
     params.lod.reset();
     EXPECT_EQ(test::errorCodeOf([&] { demOfDifference(&ground, PointCloud(), params); }), ErrorCode::InvalidData);
     EXPECT_EQ(test::errorCodeOf([&] { parseCellStatistic("mode"); }), ErrorCode::InvalidArgument);
+}
+
+TEST(Rasterise, EachCellGetsItsHeightStatisticCountAndFieldMeans)
+{
+    // Five points in two 1 m cells of a UTM-like area, one with a NaN value.
+    PointCloud cloud;
+    cloud.setOrigin({512000, 5400000, 200});
+    cloud.positions() = {{0.2f, 0.2f, 1.0f}, {0.7f, 0.4f, 2.0f}, {0.5f, 0.9f, 6.0f}, {1.5f, 0.5f, 3.0f}, {1.6f, 0.6f, 5.0f}};
+    ScalarField& distance = cloud.addField("m3c2_distance");
+    for (std::size_t i = 0; i < 5; ++i)
+        distance.setValue(i, 0.1 * static_cast<double>(i + 1));
+    distance.setValue(2, std::numeric_limits<double>::quiet_NaN());
+    ScalarField& flag = cloud.addField("m3c2_significant");
+    for (std::size_t i = 0; i < 5; ++i)
+        flag.setValue(i, i == 0 || i == 3 ? 1.0 : 0.0);
+    cloud.setCrsWkt("LOCAL_CS[\"site\"]");
+
+    RasteriseParams params;
+    params.cell = 1.0;
+    for (CellStatistic statistic : {CellStatistic::Min, CellStatistic::Mean, CellStatistic::Max, CellStatistic::Median}) {
+        params.statistic = statistic;
+        const PointCloud cells = rasteriseCloud(cloud, params);
+        ASSERT_EQ(cells.size(), 2u);
+        EXPECT_EQ(cells.crsWkt(), cloud.crsWkt());
+        const double expectedFirst[] = {201.0, 203.0, 206.0, 202.0}, expectedSecond[] = {203.0, 204.0, 205.0, 204.0};
+        const auto s = static_cast<std::size_t>(statistic);
+        for (std::size_t c = 0; c < 2; ++c) {
+            const Eigen::Vector3d p = cells.globalPosition(c);
+            EXPECT_DOUBLE_EQ(p.x(), 512000.5 + static_cast<double>(c));
+            EXPECT_DOUBLE_EQ(p.y(), 5400000.5);
+            EXPECT_NEAR(p.z(), c == 0 ? expectedFirst[s] : expectedSecond[s], 1e-4);
+            EXPECT_DOUBLE_EQ(cells.field(fields::kCellHeight)->value(c), c == 0 ? expectedFirst[s] : expectedSecond[s]);
+            EXPECT_EQ(cells.field(fields::kRasterCol)->value(c), static_cast<double>(c));
+            EXPECT_EQ(cells.field(fields::kRasterRow)->value(c), 0.0);
+        }
+        EXPECT_EQ(cells.field(fields::kPointCount)->value(0), 3.0);
+        EXPECT_EQ(cells.field(fields::kPointCount)->value(1), 2.0);
+        // The NaN of point 2 is left out of the first cell's mean.
+        EXPECT_NEAR(cells.field("m3c2_distance")->value(0), 0.15, 1e-7);
+        EXPECT_NEAR(cells.field("m3c2_distance")->value(1), 0.45, 1e-7);
+        EXPECT_NEAR(cells.field("m3c2_significant")->value(0), 1.0 / 3.0, 1e-7);
+        EXPECT_NEAR(cells.field("m3c2_significant")->value(1), 0.5, 1e-7);
+    }
+    // Chosen fields only; bad input.
+    params.fields = {"m3c2_significant"};
+    EXPECT_EQ(rasteriseCloud(cloud, params).field("m3c2_distance"), nullptr);
+    params.fields = {"nothing"};
+    EXPECT_EQ(test::errorCodeOf([&] { rasteriseCloud(cloud, params); }), ErrorCode::InvalidArgument);
+    params.fields.clear();
+    params.cell = 0;
+    EXPECT_EQ(test::errorCodeOf([&] { rasteriseCloud(cloud, params); }), ErrorCode::InvalidArgument);
+    params.cell = 1;
+    EXPECT_EQ(test::errorCodeOf([&] { rasteriseCloud(PointCloud(), params); }), ErrorCode::InvalidData);
 }

@@ -2,9 +2,11 @@
 #include <scandiff/core/distance/DemOfDifference.h>
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/Log.h>
 
 #include <tbb/parallel_sort.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -45,6 +47,31 @@ struct EpochRaster
     std::vector<std::uint32_t> count;
 };
 
+//! The grid of square cells covering [xmin, xmax] x [ymin, ymax], its corner
+//! a whole number of cells from (0, 0) so that runs with one cell size share
+//! their cells.
+Grid alignedGrid(double cell, double xmin, double ymin, double xmax, double ymax, const char* what)
+{
+    Grid grid;
+    grid.cell = cell;
+    grid.x0 = std::floor(xmin / cell) * cell;
+    grid.y0 = std::floor(ymin / cell) * cell;
+    const double cols = std::floor((xmax - grid.x0) / cell) + 1, rows = std::floor((ymax - grid.y0) / cell) + 1;
+    if (cols * rows > kMaxCells)
+        throw Error(ErrorCode::InvalidArgument, std::string(what) + ": a " + std::to_string(cell) + " m cell makes " +
+                                                    std::to_string(cols) + " x " + std::to_string(rows) + " cells (at most 2^28)");
+    grid.cols = static_cast<std::size_t>(cols);
+    grid.rows = static_cast<std::size_t>(rows);
+    return grid;
+}
+
+std::uint32_t cellOf(const Grid& grid, const Eigen::Vector3d& p)
+{
+    const auto col = static_cast<std::size_t>(std::floor((p.x() - grid.x0) / grid.cell));
+    const auto row = static_cast<std::size_t>(std::floor((p.y() - grid.y0) / grid.cell));
+    return static_cast<std::uint32_t>(std::min(row, grid.rows - 1) * grid.cols + std::min(col, grid.cols - 1));
+}
+
 void addBounds(const PointCloud& cloud, double& xmin, double& ymin, double& xmax, double& ymax)
 {
     for (std::size_t i = 0; i < cloud.size(); ++i) {
@@ -68,9 +95,7 @@ EpochRaster rasterise(const PointCloud& cloud, const Grid& grid, CellStatistic s
         const Eigen::Vector3d p = cloud.globalPosition(i);
         if (!p.allFinite())
             continue;
-        const auto col = static_cast<std::size_t>(std::floor((p.x() - grid.x0) / grid.cell));
-        const auto row = static_cast<std::size_t>(std::floor((p.y() - grid.y0) / grid.cell));
-        keyed.emplace_back(static_cast<std::uint32_t>(std::min(row, grid.rows - 1) * grid.cols + std::min(col, grid.cols - 1)), p.z());
+        keyed.emplace_back(cellOf(grid, p), p.z());
     }
     ticker.step(cloud.size());
     tbb::parallel_sort(keyed.begin(), keyed.end());
@@ -192,16 +217,7 @@ DemOfDifferenceResult demOfDifference(const PointCloud* reference, const PointCl
         addBounds(*reference, xmin, ymin, xmax, ymax);
     if (!(xmin <= xmax))
         throw Error(ErrorCode::InvalidData, "DEM of difference: no finite point");
-    Grid grid;
-    grid.cell = params.cell;
-    grid.x0 = std::floor(xmin / params.cell) * params.cell;
-    grid.y0 = std::floor(ymin / params.cell) * params.cell;
-    const double cols = std::floor((xmax - grid.x0) / params.cell) + 1, rows = std::floor((ymax - grid.y0) / params.cell) + 1;
-    if (cols * rows > kMaxCells)
-        throw Error(ErrorCode::InvalidArgument, "DEM of difference: a " + std::to_string(params.cell) + " m cell makes " +
-                                                    std::to_string(cols) + " x " + std::to_string(rows) + " cells (at most 2^28)");
-    grid.cols = static_cast<std::size_t>(cols);
-    grid.rows = static_cast<std::size_t>(rows);
+    const Grid grid = alignedGrid(params.cell, xmin, ymin, xmax, ymax, "DEM of difference");
 
     ProgressTicker ticker(progress, "DEM of difference", 2 * (compared.size() + (reference ? reference->size() : 0)) + 1);
     EpochRaster second = rasterise(compared, grid, params.statistic, ticker);
@@ -227,6 +243,10 @@ DemOfDifferenceResult demOfDifference(const PointCloud* reference, const PointCl
             kept.push_back(c);
     PointCloud& cells = result.cells;
     cells.name = compared.name + "_dod";
+    // The grid is in the epochs' system (a GeoTIFF of it is georeferenced with it).
+    cells.setCrsWkt(!compared.crsWkt().empty() ? compared.crsWkt() : reference ? reference->crsWkt() : std::string());
+    if (reference && !reference->crsWkt().empty() && !compared.crsWkt().empty() && reference->crsWkt() != compared.crsWkt())
+        logWarning("DEM of difference: the epochs declare different coordinate reference systems; the grid takes the compared one's");
     cells.setOrigin(Eigen::Vector3d(std::round(grid.x0), std::round(grid.y0), 0.0));
     cells.resize(kept.size());
     const char* names[] = {fields::kRasterCol,    fields::kRasterRow, fields::kZReference,     fields::kZCompared,
@@ -289,6 +309,160 @@ DemOfDifferenceResult demOfDifference(const PointCloud* reference, const PointCl
     result.erosionError = std::sqrt(erosionVariance);
     ticker.step();
     return result;
+}
+
+std::optional<double> gridCellSize(const PointCloud& cloud)
+{
+    const ScalarField* col = cloud.field(fields::kRasterCol);
+    const ScalarField* row = cloud.field(fields::kRasterRow);
+    if (!col || !row || cloud.empty())
+        return std::nullopt;
+    for (const auto& [index, axis] : {std::pair{col, 0}, std::pair{row, 1}}) {
+        std::size_t lo = 0, hi = 0;
+        for (std::size_t i = 1; i < cloud.size(); ++i) {
+            if (index->value(i) < index->value(lo))
+                lo = i;
+            if (index->value(i) > index->value(hi))
+                hi = i;
+        }
+        const double steps = index->value(hi) - index->value(lo);
+        if (steps > 0) {
+            const double cell = (cloud.globalPosition(hi)[axis] - cloud.globalPosition(lo)[axis]) / steps;
+            if (std::isfinite(cell) && cell > 0)
+                return cell;
+            return std::nullopt;
+        }
+    }
+    return std::nullopt;
+}
+
+PointCloud rasteriseCloud(const PointCloud& cloud, const RasteriseParams& params, ProgressObserver* progress)
+{
+    if (!std::isfinite(params.cell) || params.cell <= 0)
+        throw Error(ErrorCode::InvalidArgument, "rasterise: the cell size must be positive (m)");
+    std::vector<const ScalarField*> carried;
+    if (params.fields.empty()) {
+        for (const ScalarField& f : cloud.fields())
+            if (f.name() != fields::kRasterCol && f.name() != fields::kRasterRow && f.name() != fields::kPointCount &&
+                f.name() != fields::kCellHeight)
+                carried.push_back(&f);
+    } else {
+        for (const std::string& name : params.fields) {
+            if (name == fields::kRasterCol || name == fields::kRasterRow || name == fields::kPointCount)
+                throw Error(ErrorCode::InvalidArgument, "rasterise: '" + name + "' is a field of the grid itself; it cannot be carried");
+            const ScalarField* f = cloud.field(name);
+            if (!f)
+                throw Error(ErrorCode::InvalidArgument, "rasterise: the cloud has no scalar field '" + name + "'");
+            carried.push_back(f);
+        }
+    }
+    double xmin = std::numeric_limits<double>::infinity(), ymin = xmin, xmax = -xmin, ymax = -xmin;
+    addBounds(cloud, xmin, ymin, xmax, ymax);
+    if (!(xmin <= xmax))
+        throw Error(ErrorCode::InvalidData, "rasterise: no finite point");
+    const Grid grid = alignedGrid(params.cell, xmin, ymin, xmax, ymax, "rasterise");
+
+    ProgressTicker ticker(progress, "Rasterising " + cloud.name, 3 * cloud.size() + 1);
+    // (cell, height, point) sorted: each cell's points in one run, by height.
+    struct Keyed
+    {
+        std::uint32_t cell;
+        double z;
+        std::size_t point;
+        bool operator<(const Keyed& o) const { return cell != o.cell ? cell < o.cell : z != o.z ? z < o.z : point < o.point; }
+    };
+    std::vector<Keyed> keyed;
+    keyed.reserve(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Eigen::Vector3d p = cloud.globalPosition(i);
+        if (p.allFinite())
+            keyed.push_back({cellOf(grid, p), p.z(), i});
+    }
+    ticker.step(cloud.size());
+    tbb::parallel_sort(keyed.begin(), keyed.end());
+    ticker.step(cloud.size());
+
+    std::vector<std::pair<std::size_t, std::size_t>> runs; // [begin, end) of each occupied cell
+    for (std::size_t begin = 0; begin < keyed.size();) {
+        std::size_t end = begin;
+        while (end < keyed.size() && keyed[end].cell == keyed[begin].cell)
+            ++end;
+        runs.emplace_back(begin, end);
+        begin = end;
+    }
+    PointCloud out;
+    out.name = cloud.name + "_raster";
+    out.setCrsWkt(cloud.crsWkt());
+    out.setOrigin(Eigen::Vector3d(std::round(grid.x0), std::round(grid.y0), std::floor(keyed.front().z)));
+    out.resize(runs.size());
+    out.addField(ScalarField(fields::kRasterCol, runs.size()));
+    out.addField(ScalarField(fields::kRasterRow, runs.size()));
+    out.addField(ScalarField(fields::kPointCount, runs.size()));
+    // The height as a band too (a GeoTIFF holds fields only), unless a carried field has the name.
+    const bool heightTaken =
+        std::any_of(carried.begin(), carried.end(), [](const ScalarField* f) { return f->name() == fields::kCellHeight; });
+    if (!heightTaken) {
+        ScalarField heights(fields::kCellHeight, runs.size());
+        heights.setOffset(std::floor(keyed.front().z));
+        out.addField(std::move(heights));
+    }
+    for (const ScalarField* f : carried) {
+        ScalarField means(f->name(), runs.size());
+        means.setOffset(f->offset()); // large values (GPS times) keep their digits
+        out.addField(std::move(means));
+    }
+    // Looked up after every addField: it may move the fields.
+    ScalarField* col = out.field(fields::kRasterCol);
+    ScalarField* row = out.field(fields::kRasterRow);
+    ScalarField* count = out.field(fields::kPointCount);
+    ScalarField* heightField = heightTaken ? nullptr : out.field(fields::kCellHeight);
+    std::vector<ScalarField*> targets;
+    for (const ScalarField* f : carried)
+        targets.push_back(out.field(f->name()));
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+        const auto [begin, end] = runs[r];
+        const std::size_t n = end - begin;
+        double height = 0;
+        switch (params.statistic) {
+        case CellStatistic::Min: height = keyed[begin].z; break;
+        case CellStatistic::Max: height = keyed[end - 1].z; break;
+        case CellStatistic::Mean:
+            for (std::size_t k = begin; k < end; ++k)
+                height += keyed[k].z;
+            height /= static_cast<double>(n);
+            break;
+        case CellStatistic::Median:
+            height = n % 2 ? keyed[begin + n / 2].z : 0.5 * (keyed[begin + n / 2 - 1].z + keyed[begin + n / 2].z);
+            break;
+        }
+        const std::size_t cell = keyed[begin].cell;
+        const std::size_t c = cell % grid.cols, rr = cell / grid.cols;
+        out.positions()[r] = (Eigen::Vector3d(grid.x0 + (static_cast<double>(c) + 0.5) * grid.cell,
+                                              grid.y0 + (static_cast<double>(rr) + 0.5) * grid.cell, height) -
+                              out.origin())
+                                 .cast<float>();
+        col->setValue(r, static_cast<double>(c));
+        row->setValue(r, static_cast<double>(rr));
+        count->setValue(r, static_cast<double>(n));
+        if (heightField)
+            heightField->setValue(r, height);
+        for (std::size_t f = 0; f < carried.size(); ++f) {
+            double sum = 0;
+            std::size_t valid = 0;
+            for (std::size_t k = begin; k < end; ++k) {
+                const double v = carried[f]->value(keyed[k].point);
+                if (std::isfinite(v)) {
+                    sum += v;
+                    ++valid;
+                }
+            }
+            targets[f]->setValue(r, valid ? sum / static_cast<double>(valid) : kNaN);
+        }
+        if (r % 4096 == 0)
+            ticker.checkCancel();
+    }
+    ticker.step(cloud.size() + 1);
+    return out;
 }
 
 } // namespace scandiff

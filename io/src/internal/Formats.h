@@ -13,5 +13,6 @@ FormatHandler pcdFormat();        // PcdFormat.cpp
 FormatHandler meshFormat();       // MeshFormats.cpp (readers in MeshReaders.cpp)
 FormatHandler dxfFormat();        // DxfWriter.cpp (export only)
 FormatHandler geoTiffFormat();    // GeoTiffFormat.cpp (export of gridded clouds, GDAL)
+FormatHandler pngPreviewFormat();  // RasterPreview.cpp (picture of a gridded cloud, GDAL)
 
 } // namespace scandiff::io::detail

@@ -9,6 +9,7 @@
 #include <scandiff/core/processing/Subsampling.h>
 
 #include <limits>
+#include <optional>
 
 namespace scandiff::detail {
 
@@ -138,6 +139,37 @@ void registerRasterTools(ToolRegistry& registry)
         return rasterResult(inputs, rasterFrom(values), progress, false);
     };
     registry.add(std::move(volume));
+
+    ToolSpec rasterize;
+    rasterize.name = "rasterize";
+    rasterize.title = "Rasterize";
+    rasterize.category = "Projection";
+    rasterize.description =
+        "A cloud on a grid of square cells in the horizontal plane, as CloudCompare's Rasterize: each cell holding points "
+        "becomes one point at its centre, at the min, mean, max or median height of its points, with point_count and the "
+        "mean of each scalar field (a 0/1 flag gives the share of 1s). Write it as .tif for a GeoTIFF with one band per "
+        "field, georeferenced with the cloud's coordinate reference system.";
+    rasterize.inputs = {InputSpec{"input", "Cloud", "The cloud to rasterise", DataKind::Cloud, false, false}};
+    rasterize.outputs = {OutputSpec{"output", "Raster (cells)", DataKind::Cloud, false}};
+    rasterize.parameters = {
+        ParameterSpec::real("cell", "Cell size", "Side of the square cells", 1.0, 1e-6, 1e6, "m").asRequired(),
+        ParameterSpec::choice("statistic", "Cell height", "The height of a cell from its points' heights",
+                              {"min", "mean", "max", "median"}, "mean"),
+        ParameterSpec::text("fields", "Fields", "Scalar fields to carry, separated by commas (default: every field)").asOptional(),
+    };
+    rasterize.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        RasteriseParams params;
+        params.cell = values.real("cell");
+        params.statistic = parseCellStatistic(values.text("statistic"));
+        if (values.has("fields"))
+            params.fields = splitList(values.text("fields"), ',');
+        PointCloud cells = rasteriseCloud(inputs.cloud("input"), params, progress);
+        ToolResult result;
+        result.summary = describe(cells.size(), " cells of ", params.cell, " m holding points");
+        result.add("output", std::move(cells));
+        return result;
+    };
+    registry.add(std::move(rasterize));
 }
 
 void registerDistanceTools(ToolRegistry& registry)
@@ -161,7 +193,8 @@ void registerDistanceTools(ToolRegistry& registry)
                                                  "--core-spacing)",
                   DataKind::Cloud, false, true},
     };
-    tool.outputs = {OutputSpec{"output", "M3C2 core points", DataKind::Cloud, false}};
+    tool.outputs = {OutputSpec{"output", "M3C2 core points", DataKind::Cloud, false},
+                    OutputSpec{"raster", "M3C2 raster (cells)", DataKind::Cloud, false}};
     tool.parameters = {
         ParameterSpec::real("normal-scale", "Normal scale D", "Diameter of the reference neighbourhood the normal is fitted on",
                             1.0, 1e-6, 1e6, "m")
@@ -184,6 +217,11 @@ void registerDistanceTools(ToolRegistry& registry)
         ParameterSpec::boolean("robust", "Median and IQR", "Median and IQR / 1.349 instead of mean and standard deviation", false),
         ParameterSpec::boolean("sample-std", "Sample standard deviation",
                                "Divide by n - 1 (as py4dgeo) rather than n (as CloudCompare)", false),
+        ParameterSpec::real("raster-cell", "Raster cell",
+                            "Also rasterise the results on square cells of this size (the raster output: mean distance, "
+                            "uncertainty and share of significant core points per cell; write it as .tif for a GeoTIFF)",
+                            1.0, 1e-6, 1e6, "m")
+            .asOptional(),
     };
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
         const PointCloud& reference = inputs.cloud("reference");
@@ -214,7 +252,17 @@ void registerDistanceTools(ToolRegistry& registry)
         result.summary = describe("M3C2 at ", m.corePoints.size(), " core points: ", m.measuredCount, " measured, ",
                                   m.significantCount, " significant changes",
                                   m.withoutNormal ? describe(", ", m.withoutNormal, " without a normal") : std::string());
+        std::optional<PointCloud> cells;
+        if (values.has("raster-cell")) {
+            RasteriseParams raster;
+            raster.cell = values.real("raster-cell");
+            raster.fields = {fields::kM3c2Distance, fields::kM3c2Uncertainty, fields::kM3c2Significant};
+            cells = rasteriseCloud(m.corePoints, raster, progress);
+            cells->name = reference.name + "_m3c2_raster";
+        }
         result.add("output", std::move(m.corePoints));
+        if (cells)
+            result.add("raster", std::move(*cells));
         return result;
     };
     registry.add(std::move(tool));

@@ -29,6 +29,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace scandiff {
 
@@ -45,6 +46,8 @@ inline constexpr const char* kZCompared = "z_compared";
 inline constexpr const char* kDodDifference = "dod_difference";
 inline constexpr const char* kDodLod = "dod_lod";
 inline constexpr const char* kDodSignificant = "dod_significant";
+inline constexpr const char* kPointCount = "point_count";
+inline constexpr const char* kCellHeight = "height";
 } // namespace fields
 
 struct DemOfDifferenceParams
@@ -86,5 +89,29 @@ struct DemOfDifferenceResult
 //! cloud; Error(Cancelled).
 DemOfDifferenceResult demOfDifference(const PointCloud* reference, const PointCloud& compared,
                                       const DemOfDifferenceParams& params, ProgressObserver* progress = nullptr);
+
+//! The cell size of a gridded cloud (the points of demOfDifference() or
+//! rasteriseCloud(): whole raster_col and raster_row fields) from its two
+//! points farthest apart in column, else in row; empty for a cloud without
+//! those fields, or with a single cell.
+std::optional<double> gridCellSize(const PointCloud& cloud);
+
+struct RasteriseParams
+{
+    double cell = 1.0; //!< m, > 0
+    CellStatistic statistic = CellStatistic::Mean; //!< of the heights in a cell
+    //! The scalar fields to carry (each cell: the mean of the finite values of
+    //! its points, so a 0/1 flag gives the share of 1s); empty: every field.
+    std::vector<std::string> fields;
+};
+
+//! One cloud on a grid of square cells (the grid of demOfDifference() for the
+//! same cell size): one point per cell holding a point, at the cell's centre
+//! and the statistic of its heights, with raster_col, raster_row, point_count,
+//! height (that statistic again, as a field) and the fields. A GeoTIFF of it
+//! has one band per field. Throws
+//! Error(InvalidArgument) for a bad cell, an unknown field or a grid over
+//! 2^28 cells; Error(InvalidData) without a finite point; Error(Cancelled).
+PointCloud rasteriseCloud(const PointCloud& cloud, const RasteriseParams& params, ProgressObserver* progress = nullptr);
 
 } // namespace scandiff
