@@ -45,6 +45,8 @@
 
 #include <Eigen/Geometry>
 
+#include <cmath>
+
 using namespace scandiff;
 using gui::EntityId;
 
@@ -332,6 +334,44 @@ private slots:
         QVERIFY(!window.properties()->value("Picked point").isEmpty());
         const QString xyz = window.properties()->value("X, Y, Z");
         QVERIFY(xyz.startsWith(QString::number(window.document().item(id).points().globalPosition(index).x(), 'f', 3)));
+    }
+
+    void aGridIsDrawnAsItsCellsAndAClickPicksACell()
+    {
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
+        QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
+        const EntityId reference = window.document().ids()[0], compared = window.document().ids()[1];
+        QVERIFY(window.toolController("dod")->run(gui::ToolInputChoice{{"reference", {reference}}, {"compared", {compared}}},
+                                                  {{"cell", "2"}}));
+        const EntityId grid = window.document().ids().back();
+        const PointCloud& cells = window.document().item(grid).points();
+        QVERIFY(cells.field("raster_col") && cells.size() > 10);
+        // Drawn as quads: the mean of the first cell's four corners is its centre.
+        Eigen::Vector3d offset;
+        Eigen::Vector3f first;
+        QVERIFY(window.view()->shownFrame(grid, offset, first));
+        QVERIFY((first - cells.positions().front()).norm() < 1e-4f);
+        // With the epochs hidden, a click on the middle of a top view is on a
+        // cell, and picks that cell (not one of its corners).
+        window.document().setVisible(reference, false);
+        window.document().setVisible(compared, false);
+        window.view()->zoomToEntity(grid);
+        window.view()->setStandardView(gui::StandardView::Top);
+        QSignalSpy picked(window.view(), &gui::CloudView::pointPicked);
+        QVERIFY(window.view()->pickAt(window.view()->width() / 2, window.view()->height() / 2));
+        QCOMPARE(picked.count(), 1);
+        QCOMPARE(picked.at(0).at(0).toInt(), grid);
+        const std::size_t cell = picked.at(0).at(1).value<std::size_t>();
+        QVERIFY(cell < cells.size());
+        // The picked cell is the one under the middle of the view (or its neighbour: the picker has a tolerance).
+        const gui::CameraState camera = window.view()->camera();
+        const Eigen::Vector3d centre = cells.globalPosition(cell);
+        QVERIFY(std::hypot(centre.x() - camera.focalPoint[0], centre.y() - camera.focalPoint[1]) < 2 * 2 * std::sqrt(2.0));
+        for (QWidget* w : QApplication::topLevelWidgets())
+            if (auto* t = qobject_cast<gui::TableDialog*>(w))
+                t->close();
     }
 
     void segmentTheChangesAndExportTheRegions()

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "view/CloudView.h"
+#include "view/ChunkGeometry.h"
 
 #include <scandiff/core/Log.h>
+#include <scandiff/core/distance/DemOfDifference.h>
 
 #include <QElapsedTimer>
 #include <QTimer>
@@ -33,6 +35,7 @@
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkPointData.h>
+#include <vtkCellPicker.h>
 #include <vtkPointPicker.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -50,6 +53,7 @@
 #include <vtkVariant.h>
 #include <vtkWindowToImageFilter.h>
 
+#include <algorithm>
 #include <map>
 #include <optional>
 #include <vector>
@@ -58,36 +62,6 @@ namespace scandiff::gui {
 
 namespace {
 
-
-//! VTK points reading `count` xyz triples at `xyz` in place (no copy; VTK does not free them).
-vtkSmartPointer<vtkPoints> pointsOver(const float* xyz, std::size_t count)
-{
-    auto points = vtkSmartPointer<vtkPoints>::New();
-    points->SetDataTypeToFloat();
-    vtkFloatArray::SafeDownCast(points->GetData())
-        ->SetArray(const_cast<float*>(xyz), static_cast<vtkIdType>(3 * count), /*save: VTK does not free*/ 1);
-    return points;
-}
-
-//! Vertex cells for every stride-th point, as two flat 32-bit arrays (half the
-//! memory of VTK's default 64-bit ids; a cloud above 2^31 points is refused by
-//! the view before this).
-vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride)
-{
-    const auto n = static_cast<vtkIdType>((count + stride - 1) / stride);
-    vtkNew<vtkTypeInt32Array> offsets;
-    vtkNew<vtkTypeInt32Array> connectivity;
-    offsets->SetNumberOfValues(n + 1);
-    connectivity->SetNumberOfValues(n);
-    for (vtkIdType i = 0; i < n; ++i) {
-        offsets->SetValue(i, static_cast<std::int32_t>(i));
-        connectivity->SetValue(i, static_cast<std::int32_t>(i * static_cast<vtkIdType>(stride)));
-    }
-    offsets->SetValue(n, static_cast<std::int32_t>(n));
-    auto cells = vtkSmartPointer<vtkCellArray>::New();
-    cells->SetData(offsets, connectivity);
-    return cells;
-}
 
 // Hidden points carry alpha 0; dropping their fragments hides them without
 // touching the geometry (the actor is forced opaque so VTK keeps one pass).
@@ -111,6 +85,9 @@ struct CloudView::Shown
         vtkSmartPointer<vtkUnsignedCharArray> colours;
         vtkSmartPointer<vtkActor> actor;
         std::size_t decimatedStride = 0;
+        //! A gridded cloud's chunk: four corners per point (its cell), colours
+        //! copied from the entity's RGBA at each refresh, never decimated.
+        bool raster = false;
     };
     bool isCloud = true;
     std::size_t pointCount = 0;
@@ -131,6 +108,8 @@ struct CloudView::Scene
     vtkNew<vtkScalarBarActor> scalarBar;
     vtkNew<vtkLookupTable> scalarBarTable;
     vtkNew<vtkPointPicker> picker;
+    //! For gridded clouds: a click inside a cell picks the cell, whatever its size on screen.
+    vtkNew<vtkCellPicker> cellPicker;
     std::map<EntityId, Shown> shown;
     std::optional<Eigen::Vector3d> sceneOrigin;
     float pointSize = 2.0f;
@@ -230,6 +209,7 @@ CloudView::CloudView(QWidget* parent) : QWidget(parent), scene_(std::make_unique
     scene_->scalarBar->VisibilityOff();
     scene_->overlay->AddViewProp(scene_->scalarBar);
     scene_->picker->SetTolerance(0.005);
+    scene_->cellPicker->SetTolerance(0.0);
 
     // CloudCompare-like navigation: trackball rotation, pan, zoom.
     vtkRenderWindowInteractor* interactor = scene_->window->GetInteractor();
@@ -329,19 +309,27 @@ void CloudView::addEntity(const Document::Item& item)
         s.chunks.push_back(c);
     } else {
         s.rgba.assign(4 * points.size(), 255);
+        // A grid (DEM of difference, raster) is drawn as its cells, an image on the ground.
+        const std::optional<double> rasterCell = gridCellSize(points);
         for (std::size_t begin = 0; begin < points.size(); begin += kChunkPoints) {
             Shown::Chunk c;
             c.begin = begin;
             c.count = std::min(kChunkPoints, points.size() - begin);
             c.full = vtkSmartPointer<vtkPolyData>::New();
-            c.full->SetPoints(pointsOver(xyz + 3 * begin, c.count));
-            c.full->SetVerts(vertexCells(c.count, 1));
             c.colours = vtkSmartPointer<vtkUnsignedCharArray>::New();
             c.colours->SetNumberOfComponents(4);
             c.colours->SetName("display colours");
-            c.colours->SetArray(s.rgba.data() + 4 * begin, static_cast<vtkIdType>(4 * c.count), /*save*/ 1);
+            c.raster = rasterCell.has_value();
+            if (c.raster) {
+                makeRasterGeometry(*c.full, points, begin, c.count, *rasterCell);
+                c.colours->SetNumberOfTuples(static_cast<vtkIdType>(4 * c.count));
+            } else {
+                c.full->SetPoints(pointsOver(xyz + 3 * begin, c.count));
+                c.full->SetVerts(vertexCells(c.count, 1));
+                c.colours->SetArray(s.rgba.data() + 4 * begin, static_cast<vtkIdType>(4 * c.count), /*save*/ 1);
+            }
             c.full->GetPointData()->SetScalars(c.colours);
-            if (points.hasNormals()) {
+            if (points.hasNormals() && !c.raster) {
                 // Shading by the normals, as CloudCompare lights clouds that have them:
                 // the shape reads at once. A view on the cloud's normals, no copy.
                 c.normals = vtkSmartPointer<vtkFloatArray>::New();
@@ -357,6 +345,8 @@ void CloudView::addEntity(const Document::Item& item)
             c.actor->SetPosition(offset.x(), offset.y(), offset.z());
             c.actor->SetMapper(c.fullMapper);
             c.actor->GetProperty()->SetPointSize(scene_->pointSize);
+            if (c.raster)
+                c.actor->GetProperty()->LightingOff(); // the colours of the scale, unshaded
             c.actor->ForceOpaqueOn();
             c.actor->GetShaderProperty()->AddFragmentShaderReplacement("//VTK::Light::Impl", true, kDiscardHidden, false);
             scene_->renderer->AddActor(c.actor);
@@ -389,8 +379,15 @@ void CloudView::refreshEntity(const Document::Item& item)
     if (s.isCloud) {
         // Written in place: VTK re-uploads the colours only, never the points.
         colourEntity(item.points(), item.display, s.rgba.data());
-        for (auto& c : s.chunks)
+        for (auto& c : s.chunks) {
+            if (c.raster) { // each cell's colour on its four corners
+                std::uint8_t* corners = c.colours->GetPointer(0);
+                for (std::size_t i = 0; i < c.count; ++i)
+                    for (int k = 0; k < 4; ++k)
+                        std::copy_n(&s.rgba[4 * (c.begin + i)], 4, corners + 16 * i + 4 * k);
+            }
             c.colours->Modified();
+        }
     }
     renderInteractively();
 }
@@ -856,9 +853,14 @@ bool CloudView::shownFrame(EntityId id, Eigen::Vector3d& offset, Eigen::Vector3f
     double position[3];
     c.actor->GetPosition(position);
     offset = {position[0], position[1], position[2]};
-    double p[3];
-    c.full->GetPoints()->GetPoint(0, p);
-    firstPosition = Eigen::Vector3d(p[0], p[1], p[2]).cast<float>();
+    Eigen::Vector3d first = Eigen::Vector3d::Zero();
+    const int corners = c.raster ? 4 : 1; // a cell's centre is the mean of its corners
+    for (int k = 0; k < corners; ++k) {
+        double p[3];
+        c.full->GetPoints()->GetPoint(k, p);
+        first += Eigen::Vector3d(p[0], p[1], p[2]) / corners;
+    }
+    firstPosition = first.cast<float>();
     return true;
 }
 
@@ -935,6 +937,8 @@ void CloudView::setDecimated(Shown& s, bool moving)
         return;
     const bool decimate = moving && scene_->stride > 1;
     for (auto& c : s.chunks) {
+        if (c.raster)
+            continue; // one quad per cell: already light
         if (decimate && c.decimatedStride != scene_->stride) {
             c.decimated = vtkSmartPointer<vtkPolyData>::New();
             c.decimated->SetPoints(c.full->GetPoints());
@@ -1051,21 +1055,41 @@ bool CloudView::pickAt(int x, int y)
 
 bool CloudView::pickAtDevicePixel(int x, int y)
 {
-    if (!scene_->picker->Pick(x, y, 0.0, scene_->renderer))
+    // Points by the point picker; a grid's cells (drawn as quads, whose
+    // vertices are corners shared by four cells) by the cell picker, when the
+    // point picker finds nothing else.
+    const Shown* pickedEntity = nullptr;
+    EntityId pickedId = kNoEntity;
+    std::size_t index = 0;
+    auto chunkOf = [&](vtkActor* actor, bool& raster, std::size_t& begin) {
+        for (const auto& [id, s] : scene_->shown)
+            for (const auto& c : s.chunks)
+                if (c.actor.Get() == actor) {
+                    pickedEntity = &s;
+                    pickedId = id;
+                    raster = c.raster;
+                    begin = c.begin;
+                    return true;
+                }
         return false;
-    vtkActor* actor = scene_->picker->GetActor();
-    const vtkIdType point = scene_->picker->GetPointId();
-    for (const auto& [id, s] : scene_->shown)
-        for (const auto& c : s.chunks)
-            if (c.actor.Get() == actor && point >= 0) {
-                const std::size_t index = c.begin + static_cast<std::size_t>(point);
-                // The picker sees every point; one hidden by the thresholds is not an answer.
-                if (s.isCloud && s.rgba[4 * index + 3] == 0)
-                    return false;
-                emit pointPicked(id, index);
-                return true;
-            }
-    return false;
+    };
+    bool raster = false;
+    std::size_t begin = 0;
+    const bool pointHit = scene_->picker->Pick(x, y, 0.0, scene_->renderer) && scene_->picker->GetPointId() >= 0 &&
+                          chunkOf(scene_->picker->GetActor(), raster, begin) && !raster;
+    if (pointHit) {
+        index = begin + static_cast<std::size_t>(scene_->picker->GetPointId());
+    } else {
+        if (!scene_->cellPicker->Pick(x, y, 0.0, scene_->renderer) || scene_->cellPicker->GetCellId() < 0 ||
+            !chunkOf(scene_->cellPicker->GetActor(), raster, begin) || !raster)
+            return false;
+        index = begin + static_cast<std::size_t>(scene_->cellPicker->GetCellId());
+    }
+    // The picker sees every point; one hidden by the thresholds is not an answer.
+    if (pickedEntity->isCloud && pickedEntity->rgba[4 * index + 3] == 0)
+        return false;
+    emit pointPicked(pickedId, index);
+    return true;
 }
 
 void CloudView::render()

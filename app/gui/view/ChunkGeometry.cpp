@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "view/ChunkGeometry.h"
+
+#include <vtkCellArray.h>
+#include <vtkFloatArray.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkTypeInt32Array.h>
+
+namespace scandiff::gui {
+
+//! VTK points reading `count` xyz triples at `xyz` in place (no copy; VTK does not free them).
+vtkSmartPointer<vtkPoints> pointsOver(const float* xyz, std::size_t count)
+{
+    auto points = vtkSmartPointer<vtkPoints>::New();
+    points->SetDataTypeToFloat();
+    vtkFloatArray::SafeDownCast(points->GetData())
+        ->SetArray(const_cast<float*>(xyz), static_cast<vtkIdType>(3 * count), /*save: VTK does not free*/ 1);
+    return points;
+}
+
+//! Vertex cells for every stride-th point, as two flat 32-bit arrays (half the
+//! memory of VTK's default 64-bit ids; a cloud above 2^31 points is refused by
+//! the view before this).
+vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride)
+{
+    const auto n = static_cast<vtkIdType>((count + stride - 1) / stride);
+    vtkNew<vtkTypeInt32Array> offsets;
+    vtkNew<vtkTypeInt32Array> connectivity;
+    offsets->SetNumberOfValues(n + 1);
+    connectivity->SetNumberOfValues(n);
+    for (vtkIdType i = 0; i < n; ++i) {
+        offsets->SetValue(i, static_cast<std::int32_t>(i));
+        connectivity->SetValue(i, static_cast<std::int32_t>(i * static_cast<vtkIdType>(stride)));
+    }
+    offsets->SetValue(n, static_cast<std::int32_t>(n));
+    auto cells = vtkSmartPointer<vtkCellArray>::New();
+    cells->SetData(offsets, connectivity);
+    return cells;
+}
+
+//! A gridded cloud's cells (DEM of difference, raster) as flat squares on
+//! the ground plane at each cell's height: four corners per cell (float, about
+//! the cloud's origin like its points), and a quad per cell.
+void makeRasterGeometry(vtkPolyData& polyData, const PointCloud& cloud, std::size_t begin, std::size_t count, double cell)
+{
+    vtkNew<vtkPoints> corners;
+    corners->SetDataTypeToFloat();
+    corners->SetNumberOfPoints(static_cast<vtkIdType>(4 * count));
+    const double half = 0.5 * cell;
+    const double dx[4] = {-half, half, half, -half}, dy[4] = {-half, -half, half, half};
+    for (std::size_t i = 0; i < count; ++i) {
+        const Eigen::Vector3f& p = cloud.positions()[begin + i];
+        for (int k = 0; k < 4; ++k)
+            corners->SetPoint(static_cast<vtkIdType>(4 * i + k), p.x() + dx[k], p.y() + dy[k], p.z());
+    }
+    vtkNew<vtkCellArray> quads;
+    quads->AllocateExact(static_cast<vtkIdType>(count), static_cast<vtkIdType>(4 * count));
+    for (std::size_t i = 0; i < count; ++i) {
+        const vtkIdType ids[4] = {static_cast<vtkIdType>(4 * i), static_cast<vtkIdType>(4 * i + 1), static_cast<vtkIdType>(4 * i + 2),
+                                  static_cast<vtkIdType>(4 * i + 3)};
+        quads->InsertNextCell(4, ids);
+    }
+    polyData.SetPoints(corners);
+    polyData.SetPolys(quads);
+}
+
+} // namespace scandiff::gui

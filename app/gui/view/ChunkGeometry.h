@@ -1,0 +1,31 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! The VTK geometry of the view's chunks: views on a cloud's positions, vertex
+//! cells, and a gridded cloud's cells as quads.
+
+#include <scandiff/core/PointCloud.h>
+
+#include <vtkSmartPointer.h>
+
+#include <cstddef>
+
+class vtkCellArray;
+class vtkPoints;
+class vtkPolyData;
+
+namespace scandiff::gui {
+
+//! VTK points reading `count` xyz triples at `xyz` in place (no copy; VTK does not free them).
+vtkSmartPointer<vtkPoints> pointsOver(const float* xyz, std::size_t count);
+
+//! Vertex cells for every stride-th point, as two flat 32-bit arrays (half the
+//! memory of VTK's default 64-bit ids; a cloud above 2^31 points is refused by
+//! the view before this).
+vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride);
+
+//! A gridded cloud's cells (DEM of difference, raster) as flat squares on
+//! the ground plane at each cell's height: four corners per cell (float, about
+//! the cloud's origin like its points), and a quad per cell.
+void makeRasterGeometry(vtkPolyData& polyData, const PointCloud& cloud, std::size_t begin, std::size_t count, double cell);
+
+} // namespace scandiff::gui
