@@ -7,6 +7,7 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/distance/CloudToCloud.h>
 #include <scandiff/core/distance/DistanceParameters.h>
+#include <scandiff/core/distance/M3C2.h>
 #include <scandiff/core/segmentation/RegionReport.h>
 #include <scandiff/core/segmentation/SegmentationParameters.h>
 #include <scandiff/io/RegionExport.h>
@@ -116,12 +117,61 @@ void addSegmentCommand(CLI::App& app, const PluginRegistry& registry, Streams st
     });
 }
 
+namespace {
+
+//! compare --method m3c2: the m3c2 tool (its declaration, as `scandiff-cli
+//! m3c2` and the workbench run it), then the significant core points
+//! segmented and exported; DIR/core_points.EXT holds every M3C2 field and the
+//! regions, DIR/m3c2_raster.tif the raster when --raster-cell is given.
+void compareByM3c2(const ToolSpec& tool, const std::map<std::string, std::string>& m3c2Text, const std::string& corePointsFile,
+                   std::map<std::string, std::string> segmentText, const PointCloud& reference, const PointCloud& compared,
+                   const ExportFlags& flags, const PluginRegistry& registry, const io::ReadOptions& readOptions,
+                   const io::WriteOptions& write, TerminalProgress& progress, Streams streams)
+{
+    // By default the regions are the significant changes, reported with their distances.
+    segmentText.emplace("field", fields::kM3c2Significant);
+    if (!segmentText.count("range") && !segmentText.count("kmeans") && !segmentText.count("stat-test") &&
+        !segmentText.count("propagate") && segmentText["field"] == fields::kM3c2Significant)
+        segmentText.emplace("above", "0.5");
+    segmentText.emplace("components", "true");
+    segmentText.emplace("report-field", fields::kM3c2Distance);
+    const ParameterValues segmentValues = resolveParameters(segmentationParameters(), segmentText, "compare");
+    const ParameterValues m3c2Values = tool.resolve(m3c2Text);
+
+    std::optional<PointCloud> corePoints;
+    if (!corePointsFile.empty())
+        corePoints = io::readPointCloud(registry.formats, corePointsFile, readOptions);
+    ToolInputs inputs;
+    inputs.add("reference", reference);
+    inputs.add("compared", compared);
+    if (corePoints)
+        inputs.add("core-points", *corePoints);
+    ToolResult result = tool.execute(inputs, m3c2Values, &progress);
+    streams.out << "m3c2: " << result.summary << '\n';
+    PointCloud& cores = std::get<PointCloud>(result.find("output")->data);
+    segmentAndExport(cores, segmentValues, nullptr, flags, registry.formats, write, &progress, streams);
+
+    const std::filesystem::path dir(flags.outDir);
+    const std::filesystem::path coreFile = dir / ("core_points." + flags.cloudFormat);
+    io::writePointCloud(registry.formats, cores, coreFile, write);
+    streams.out << "wrote " << coreFile.string() << '\n';
+    if (ToolOutput* raster = result.find("raster")) {
+        const std::filesystem::path rasterFile = dir / "m3c2_raster.tif";
+        io::writePointCloud(registry.formats, std::get<PointCloud>(raster->data), rasterFile, write);
+        streams.out << "wrote " << rasterFile.string() << '\n';
+    }
+}
+
+} // namespace
+
 void addCompareCommand(CLI::App& app, const PluginRegistry& registry, Streams streams)
 {
     struct Args
     {
-        std::string reference, compared;
+        std::string reference, compared, method = "c2c", corePoints;
         std::shared_ptr<std::map<std::string, std::string>> distanceValues = std::make_shared<std::map<std::string, std::string>>();
+        std::shared_ptr<std::map<std::string, std::string>> m3c2Values = std::make_shared<std::map<std::string, std::string>>();
+        std::map<std::string, std::string> m3c2Renamed; // option name -> the m3c2 parameter it stands for
         std::shared_ptr<std::map<std::string, std::string>> segmentValues;
         ExportFlags exportFlags;
         int threads = 0;
@@ -130,23 +180,64 @@ void addCompareCommand(CLI::App& app, const PluginRegistry& registry, Streams st
     };
     auto args = std::make_shared<Args>();
     CLI::App* c = app.add_subcommand("compare",
-                                     "The whole change detection in one command: c2c distances, then segment, then export "
-                                     "(DIR/compared.ply with every field, and the region files of segment)");
+                                     "The whole change detection in one command: c2c or M3C2 distances, then segment, then "
+                                     "export (DIR/compared.ply, or DIR/core_points.ply for M3C2, with every field, and the "
+                                     "region files of segment)");
     c->add_option("--reference", args->reference, "Reference cloud (the earlier epoch)")->required();
     c->add_option("--compared", args->compared, "Compared cloud (the later epoch)")->required();
+    c->add_option("--method", args->method,
+                  "c2c (default): nearest-neighbour distances, segmented as you choose; m3c2: M3C2 at core points, its "
+                  "significant changes segmented into regions (default --field m3c2_significant --above 0.5 --components "
+                  "--report-field m3c2_distance), each with its volume +/- uncertainty")
+        ->check(CLI::IsMember({"c2c", "m3c2"}));
     const auto distanceOptions = addParameterOptions(*c, cloudToCloudParameters(), args->distanceValues);
     distanceOptions.at("knn")->excludes(distanceOptions.at("radius"));
     args->segmentValues = addSegmentationOptions(*c);
+    // The m3c2 tool's own parameters; a name c2c or segment already uses
+    // (min-points) gets the prefix m3c2-. Required only with --method m3c2.
+    const ToolSpec* m3c2Tool = registry.tools.find("m3c2");
+    if (m3c2Tool) {
+        std::vector<ParameterSpec> m3c2Parameters = m3c2Tool->parameters;
+        for (ParameterSpec& p : m3c2Parameters) {
+            const std::string original = p.name;
+            if (c->get_option_no_throw("--" + p.name))
+                p.name = "m3c2-" + p.name;
+            p.required = false;
+            args->m3c2Renamed[p.name] = original;
+        }
+        addParameterOptions(*c, m3c2Parameters, args->m3c2Values);
+        c->add_option("--core-points", args->corePoints, "m3c2: where to measure (default: every reference point, or --core-spacing)");
+    }
     args->exportFlags.addTo(*c);
     ThreadLimit::addOption(*c, args->threads);
     args->read.addTo(*c);
     args->write.addTo(*c);
-    c->callback([args, &registry, streams] {
+    c->callback([args, &registry, streams, m3c2Tool] {
         const ThreadLimit threadLimit(args->threads);
-        const ParameterValues distanceValues = resolveParameters(cloudToCloudParameters(), *args->distanceValues, "compare");
-        const ParameterValues segmentValues = resolveParameters(segmentationParameters(), *args->segmentValues, "compare");
+        const bool m3c2 = args->method == "m3c2";
+        if (m3c2 && !args->distanceValues->empty())
+            throw Error(ErrorCode::InvalidArgument, "compare: --" + args->distanceValues->begin()->first + " is a c2c option; drop it with --method m3c2");
+        if (!m3c2 && (!args->m3c2Values->empty() || !args->corePoints.empty()))
+            throw Error(ErrorCode::InvalidArgument, "compare: --" + (args->corePoints.empty() ? args->m3c2Values->begin()->first : std::string("core-points")) +
+                                                        " is an M3C2 option; add --method m3c2");
+        if (m3c2 && !m3c2Tool)
+            throw Error(ErrorCode::Unsupported, "compare: this build has no m3c2 tool");
         TerminalProgress progress;
         const io::ReadOptions readOptions = args->read.toOptions(&progress);
+        const io::WriteOptions write = args->write.toOptions(&progress);
+        if (m3c2) {
+            std::map<std::string, std::string> m3c2Text;
+            for (const auto& [name, text] : *args->m3c2Values)
+                m3c2Text[args->m3c2Renamed.at(name)] = text;
+            m3c2Tool->resolve(m3c2Text); // bad parameters are reported before the reads
+            const PointCloud reference = io::readPointCloud(registry.formats, args->reference, readOptions);
+            const PointCloud compared = io::readPointCloud(registry.formats, args->compared, readOptions);
+            compareByM3c2(*m3c2Tool, m3c2Text, args->corePoints, *args->segmentValues, reference, compared, args->exportFlags, registry,
+                          readOptions, write, progress, streams);
+            return;
+        }
+        const ParameterValues distanceValues = resolveParameters(cloudToCloudParameters(), *args->distanceValues, "compare");
+        const ParameterValues segmentValues = resolveParameters(segmentationParameters(), *args->segmentValues, "compare");
         PointCloud reference = io::readPointCloud(registry.formats, args->reference, readOptions);
         PointCloud compared = io::readPointCloud(registry.formats, args->compared, readOptions);
         CloudToCloudRun run = runCloudToCloud(compared, reference, distanceValues, &progress);
@@ -154,7 +245,6 @@ void addCompareCommand(CLI::App& app, const PluginRegistry& registry, Streams st
                         run.forward.statistics);
         std::optional<PointCloud> closest = std::move(run.forward.closest);
         attachFields(compared, std::move(run.forward));
-        const io::WriteOptions write = args->write.toOptions(&progress);
         segmentAndExport(compared, segmentValues, &reference, args->exportFlags, registry.formats, write, &progress, streams);
 
         const std::filesystem::path dir(args->exportFlags.outDir);

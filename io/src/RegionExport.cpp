@@ -64,6 +64,9 @@ std::string regionLabel(const RegionStatistics& r)
         if (r.volumeCoverage < 0.999)
             s << " over " << shortNumber(100.0 * r.volumeCoverage) << " % of it";
     }
+    if (r.distanceVolume)
+        s << ", volume along the distances " << shortNumber(*r.distanceVolume) << " +/- " << shortNumber(*r.distanceVolumeUncertainty)
+          << " m3";
     return s.str();
 }
 
@@ -108,7 +111,7 @@ void writeRegionsCsv(const std::vector<RegionStatistics>& regions, const std::fi
     std::ofstream& out = file.stream();
     out << "id,points,min_x,min_y,min_z,max_x,max_y,max_z,centroid_x,centroid_y,centroid_z,normal_x,normal_y,normal_z,"
            "footprint_area,outline_area,distance_count,mean_distance,max_distance,rms_distance,volume,volume_added,volume_removed,"
-           "volume_coverage\n";
+           "volume_coverage,distance_volume,distance_volume_uncertainty\n";
     for (const RegionStatistics& r : regions) {
         out << r.id << ',' << r.pointCount;
         for (const Eigen::Vector3d* v : {&r.bounds.min, &r.bounds.max, &r.centroid})
@@ -120,6 +123,8 @@ void writeRegionsCsv(const std::vector<RegionStatistics>& regions, const std::fi
             << csvNumber(r.meanDistance) << ',' << csvNumber(r.maxDistance) << ',' << csvNumber(r.rmsDistance);
         for (double value : {r.volume.value_or(0.0), r.volumeAdded, r.volumeRemoved, r.volumeCoverage})
             out << ',' << (r.volume ? csvNumber(value) : std::string());
+        for (const std::optional<double>& value : {r.distanceVolume, r.distanceVolumeUncertainty})
+            out << ',' << (value ? csvNumber(*value) : std::string());
         out << '\n';
     }
     file.commit();

@@ -7,6 +7,7 @@
 #include "../segmentation/SyntheticScene.h"
 #include "TestSupport.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -32,6 +33,30 @@ int dxfAudit(const std::filesystem::path& file)
                                 file.string() + "' > /dev/null";
     const int status = std::system(command.c_str());
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+//! The cells of a CSV file without quoted commas (what regions.csv holds).
+std::vector<std::vector<std::string>> csvRows(const std::filesystem::path& file)
+{
+    std::ifstream in(file);
+    std::vector<std::vector<std::string>> rows;
+    for (std::string line; std::getline(in, line);) {
+        std::vector<std::string> cells(1);
+        for (char c : line)
+            if (c == ',')
+                cells.emplace_back();
+            else
+                cells.back() += c;
+        rows.push_back(std::move(cells));
+    }
+    return rows;
+}
+
+std::size_t columnOf(const std::vector<std::string>& header, const std::string& name)
+{
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name;
+    return static_cast<std::size_t>(it - header.begin());
 }
 
 //! The two epochs written as PLY files in `dir`.
@@ -67,11 +92,60 @@ TEST(SegmentCli, CompareRunsTheWholeChainAndFindsTheThreeChanges)
     ASSERT_NE(all.field("changed"), nullptr);
     EXPECT_EQ(all.field("region_id")->range().max, 3.0);
     // The volume column is filled: compare knows the reference.
-    std::ifstream csv(out / "regions.csv");
-    std::string header, first;
-    std::getline(csv, header);
-    std::getline(csv, first);
-    EXPECT_NE(first.back(), ',') << first;
+    const auto rows = csvRows(out / "regions.csv");
+    ASSERT_GE(rows.size(), 2u);
+    EXPECT_FALSE(rows[1].at(columnOf(rows[0], "volume")).empty());
+    EXPECT_TRUE(rows[1].at(columnOf(rows[0], "distance_volume")).empty()); // c2c has no level of detection
+}
+
+TEST(SegmentCli, CompareByM3c2WritesRegionsCorePointsAndRaster)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    const auto [reference, compared] = writeEpochs(registry, dir);
+    const auto out = dir / "out";
+    const test::CliRun run = test::runCliInProcess(
+        registry, {"compare", "--method", "m3c2", "--reference", reference, "--compared", compared, "--normal-scale", "1",
+                   "--projection-scale", "0.5", "--max-depth", "1.5", "--registration-error", "0.005", "--core-spacing", "0.25",
+                   "--min-points", "20", "--m3c2-min-points", "5", "--raster-cell", "1", "--out-dir", out.string()});
+    ASSERT_EQ(run.status, 0) << run.err;
+    for (const char* name : {"regions.ply", "region_0001.ply", "regions.dxf", "regions.csv", "core_points.ply", "m3c2_raster.tif"})
+        EXPECT_TRUE(std::filesystem::exists(out / name)) << name;
+    EXPECT_FALSE(std::filesystem::exists(out / "compared.ply"));
+    const PointCloud cores = io::readPointCloud(registry.formats, out / "core_points.ply");
+    for (const char* field : {"m3c2_distance", "m3c2_uncertainty", "m3c2_significant", "region_id"})
+        EXPECT_NE(cores.field(field), nullptr) << field;
+    EXPECT_NE(run.out.find("volume along the distances"), std::string::npos) << run.out;
+
+    // The raised block (3 x 3 m, +0.5 m: 4.5 m3) and the pit (3 x 3 m, -0.4 m:
+    // -3.6 m3) are regions whose volume along the distances is near theirs.
+    const auto rows = csvRows(out / "regions.csv");
+    const std::size_t volume = columnOf(rows[0], "distance_volume"), uncertainty = columnOf(rows[0], "distance_volume_uncertainty");
+    bool block = false, pit = false;
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+        const double v = std::stod(rows[r].at(volume)), u = std::stod(rows[r].at(uncertainty));
+        EXPECT_GT(u, 0.0);
+        block = block || (v > 3.5 && v < 6.0);
+        pit = pit || (v < -2.6 && v > -4.8);
+    }
+    EXPECT_TRUE(block) << run.out;
+    EXPECT_TRUE(pit) << run.out;
+
+    // Options of the other method are refused, naming them.
+    test::CliRun bad = test::runCliInProcess(registry, {"compare", "--method", "m3c2", "--reference", reference, "--compared", compared,
+                                                         "--normal-scale", "1", "--projection-scale", "0.5", "--max-depth", "1",
+                                                         "--model", "plane", "--out-dir", out.string()});
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE(bad.err.find("--model"), std::string::npos) << bad.err;
+    bad = test::runCliInProcess(registry, {"compare", "--reference", reference, "--compared", compared, "--normal-scale", "1", "--above",
+                                           "0.1", "--out-dir", out.string()});
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE(bad.err.find("--method m3c2"), std::string::npos) << bad.err;
+    // M3C2's required scales are still required with --method m3c2.
+    bad = test::runCliInProcess(registry, {"compare", "--method", "m3c2", "--reference", reference, "--compared", compared,
+                                           "--out-dir", out.string()});
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE(bad.err.find("normal-scale"), std::string::npos) << bad.err;
 }
 
 TEST(SegmentCli, SegmentWithEachMethodOnTheDistances)

@@ -355,4 +355,33 @@ TEST(M3C2, SignificantChangeBecomesRegionsWithTheirMeanDistance)
     EXPECT_GT(regions.front().meanDistance, 0.2);
     EXPECT_LE(regions.front().meanDistance, 0.3 + 1e-6);
     EXPECT_NEAR(regions.front().maxDistance, 0.3, 1e-6);
+
+    // The volume along the distances: the region's area in its plane times its
+    // mean distance, ± that area times its mean LoD95 (m3c2_uncertainty, taken
+    // by default with m3c2_distance), both recomputed here from the points.
+    const RegionStatistics& region = regions.front();
+    ASSERT_TRUE(region.distanceVolume && region.distanceVolumeUncertainty);
+    const ScalarField& ids = *cores.field("region_id");
+    const ScalarField& lod = *cores.field(fields::kM3c2Uncertainty);
+    double lodSum = 0;
+    std::size_t members = 0;
+    for (std::size_t i = 0; i < cores.size(); ++i)
+        if (ids.hasValue(i) && ids.value(i) == region.id) {
+            lodSum += lod.value(i);
+            ++members;
+        }
+    ASSERT_EQ(members, region.pointCount);
+    EXPECT_DOUBLE_EQ(*region.distanceVolume, region.outlineArea * region.meanDistance);
+    EXPECT_NEAR(*region.distanceVolumeUncertainty, region.outlineArea * lodSum / static_cast<double>(members), 1e-12);
+    // Below the true raised volume, 2 x 2 x 0.3 = 1.2 m3, and not far: the
+    // outline runs through the outermost flagged core points (inside the
+    // patch's edge), and core points near the edge see only part of the rise.
+    EXPECT_GT(*region.distanceVolume, 0.6);
+    EXPECT_LT(*region.distanceVolume, 1.2);
+    EXPECT_GT(*region.distanceVolumeUncertainty, 0.0);
+
+    // An explicit uncertainty field must exist.
+    RegionReportParams explicitField = regionReportSettings(values, nullptr);
+    explicitField.uncertaintyField = "nothing";
+    EXPECT_EQ(test::errorCodeOf([&] { regionReport(cores, explicitField); }), ErrorCode::InvalidArgument);
 }

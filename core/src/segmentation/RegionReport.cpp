@@ -3,6 +3,7 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
+#include <scandiff/core/distance/M3C2.h>
 #include <scandiff/core/segmentation/RegionReport.h>
 #include <scandiff/octree/Octree.h>
 
@@ -143,6 +144,16 @@ std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const Region
         if (!distance)
             throw Error(ErrorCode::InvalidArgument, "region report: cloud '" + cloud.name + "' has no field '" + params.distanceField + "'");
     }
+    const ScalarField* uncertainty = nullptr;
+    if (!params.uncertaintyField.empty()) {
+        uncertainty = cloud.field(params.uncertaintyField);
+        if (!uncertainty)
+            throw Error(ErrorCode::InvalidArgument, "region report: cloud '" + cloud.name + "' has no field '" + params.uncertaintyField + "'");
+        if (!distance)
+            throw Error(ErrorCode::InvalidArgument, "region report: an uncertainty field needs the distances it belongs to");
+    } else if (params.distanceField == fields::kM3c2Distance) {
+        uncertainty = cloud.field(fields::kM3c2Uncertainty);
+    }
     if (!(params.outlineCellSize >= 0.0 && std::isfinite(params.outlineCellSize)) ||
         !(params.volumeCellSize >= 0.0 && std::isfinite(params.volumeCellSize)))
         throw Error(ErrorCode::InvalidArgument, "region report: cell sizes must be finite and >= 0 (0: automatic)");
@@ -236,6 +247,19 @@ std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const Region
                 r.meanDistance = sum / n;
                 r.rmsDistance = std::sqrt(squares / n);
                 r.maxDistance = extreme;
+            }
+        }
+        if (uncertainty && r.distanceCount > 0) {
+            double lodSum = 0.0;
+            std::size_t lodCount = 0;
+            for (std::size_t i : indices)
+                if (distance->hasValue(i) && uncertainty->hasValue(i)) {
+                    lodSum += uncertainty->value(i);
+                    ++lodCount;
+                }
+            if (lodCount > 0) {
+                r.distanceVolume = r.outlineArea * r.meanDistance;
+                r.distanceVolumeUncertainty = r.outlineArea * lodSum / static_cast<double>(lodCount);
             }
         }
 

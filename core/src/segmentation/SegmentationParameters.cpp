@@ -111,6 +111,11 @@ const std::vector<ParameterSpec>& segmentationParameters()
                                 "segment on m3c2_significant, report m3c2_distance")
                 .asOptional()
                 .asFieldOf("input"),
+            ParameterSpec::text("uncertainty-field", "Uncertainty field",
+                                "Each point's level of detection of the reported distances: gives each region's volume along "
+                                "the distances with its uncertainty (default: m3c2_uncertainty when reporting m3c2_distance)")
+                .asOptional()
+                .asFieldOf("input"),
             ParameterSpec::real("outline-cell", "Outline cell",
                                 "Cell of the regions' concave outlines; 0 = automatic (1.5 x the 4th-neighbour spacing)", 0.0, 0.0, 1e9,
                                 "m")
@@ -314,6 +319,8 @@ RegionReportParams regionReportSettings(const ParameterValues& values, const Poi
 {
     RegionReportParams p;
     p.distanceField = values.has("report-field") ? values.text("report-field") : values.text("field");
+    if (values.has("uncertainty-field"))
+        p.uncertaintyField = values.text("uncertainty-field");
     p.outlineCellSize = values.real("outline-cell");
     p.volumeCellSize = values.real("volume-cell");
     p.regionInLaterEpoch = values.text("region-epoch") == "later";

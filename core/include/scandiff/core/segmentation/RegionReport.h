@@ -53,6 +53,11 @@ struct RegionReportParams
     std::string regionField = "region_id";
     //! Field whose statistics are reported (the distances); empty: none.
     std::string distanceField;
+    //! Each point's level of detection of those distances (m, a 95 % bound:
+    //! M3C2's LoD95), for the volume along the distances and its uncertainty.
+    //! Empty: m3c2_uncertainty when the distances are m3c2_distance and the
+    //! cloud has it, else none.
+    std::string uncertaintyField;
     //! Cell size of the outline grid (m), >= 0; 0 = automatic per region: 1.5
     //! times the median distance of its points to their 4th nearest neighbour
     //! (one cell per point spacing and a half, so the sampling leaves few holes).
@@ -102,6 +107,15 @@ struct RegionStatistics
     double volumeRemoved = 0.0; //!< the sum over the columns that sank (m^3, >= 0); volume = added - removed
     //! Fraction of the footprint's area where the other epoch had points.
     double volumeCoverage = 0.0;
+    //! With an uncertainty field: the volume the distances sweep, the area
+    //! inside the outline in the region's plane times the mean distance (m^3,
+    //! signed: on a cliff, the rock fallen along the normals), and its
+    //! uncertainty, that area times the mean level of detection. The levels of
+    //! detection are added, not combined in quadrature: their largest part, the
+    //! registration error, is the same for every point of the region, so the
+    //! bound stays a 95 % one.
+    std::optional<double> distanceVolume;
+    std::optional<double> distanceVolumeUncertainty;
 };
 
 //! The point indices of each region, by region id (values rounded to the
