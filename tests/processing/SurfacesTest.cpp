@@ -13,6 +13,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
+
 using namespace scandiff;
 using scandiff::test::kPi;
 
@@ -91,6 +94,50 @@ TEST(Primitives, FitsRecoverExactSurfaces)
     for (std::size_t i = 0; i < 10; ++i)
         line.positions()[i] = Eigen::Vector3f(float(i), 0, 0);
     EXPECT_EQ(test::errorCodeOf([&] { fitPrimitive(line, PrimitiveKind::Cylinder); }), ErrorCode::InvalidData);
+}
+
+TEST(Primitives, ReportedUncertaintiesMatchTheNoiseWhateverTheOrientation)
+{
+    // A 1.2 m square plate of 800 points with 5 mm of noise, facing each of
+    // the six axis directions: the offset's standard uncertainty is
+    // sigma / sqrt(n), the normal's (two tilts) sqrt(2) sigma / sqrt(n E[u^2])
+    // with E[u^2] = 1.2^2 / 12 for a uniform spread. Numerical derivatives
+    // with a step proportional to the parameter once gave 0 for parameters
+    // that converged near 0 (the sides facing some axes).
+    const double sigma = 0.005, side = 1.2;
+    const std::size_t n = 800;
+    const double offsetExpected = sigma / std::sqrt(static_cast<double>(n));
+    const double tiltExpected = std::sqrt(2.0) * sigma / std::sqrt(static_cast<double>(n) * side * side / 12.0) * 180.0 / kPi;
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> uniform(-0.5, 0.5);
+    std::normal_distribution<double> noise(0.0, sigma);
+    const Eigen::Vector3d centre(6, 6, 2);
+    for (int axis = 0; axis < 3; ++axis)
+        for (double sign : {1.0, -1.0}) {
+            Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+            normal[axis] = sign;
+            const Eigen::Vector3d e1 = normal.unitOrthogonal(), e2 = normal.cross(e1);
+            std::vector<Eigen::Vector3d> points; // relative to `centre`, as refinePrimitive takes them
+            Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+            for (std::size_t i = 0; i < n; ++i) {
+                points.push_back(Eigen::Vector3d(2, 2, -1) + uniform(rng) * side * e1 + uniform(rng) * side * e2 + noise(rng) * normal);
+                mean += points.back() / static_cast<double>(n);
+            }
+            Primitive initial;
+            initial.kind = PrimitiveKind::Plane;
+            initial.direction = normal;
+            initial.point = centre + mean;
+            const PrimitiveRefinement fit = refinePrimitive(points, centre, initial);
+            double tilt = 0, offset = 0;
+            for (const auto& [name, value] : fit.uncertainty) {
+                if (name == "direction_deg")
+                    tilt = value;
+                if (name == "offset")
+                    offset = value;
+            }
+            EXPECT_NEAR(offset, offsetExpected, 0.15 * offsetExpected) << axis << " " << sign;
+            EXPECT_NEAR(tilt, tiltExpected, 0.15 * tiltExpected) << axis << " " << sign;
+        }
 }
 
 TEST(Primitives, SignedDistancesAndText)

@@ -7,8 +7,8 @@
 
 #include <Eigen/Dense>
 #include <unsupported/Eigen/LevenbergMarquardt>
-#include <unsupported/Eigen/NumericalDiff>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 
@@ -47,6 +47,26 @@ struct Residuals : Eigen::DenseFunctor<double>
             residuals[static_cast<Eigen::Index>(i)] = f_(x, points_[i]);
         return 0;
     }
+    //! Central differences with a step of 1e-6 (radians for the direction
+    //! terms, metres for lengths) or 1e-6 of the parameter when larger.
+    //! Eigen's NumericalDiff steps by 1.5e-8 |x|: a parameter that converged
+    //! to 1e-17 (a direction term at its start, an offset of nothing) got a
+    //! step lost in rounding, a zero column, and a variance of 0 from the
+    //! pseudo-inverse (box sides reported 0.002 degrees for 0.04).
+    int df(const Eigen::VectorXd& x, Eigen::MatrixXd& jacobian) const
+    {
+        Eigen::VectorXd shifted = x, plus(values()), minus(values());
+        for (Eigen::Index j = 0; j < x.size(); ++j) {
+            const double h = 1e-6 * std::max(1.0, std::abs(x[j]));
+            shifted[j] = x[j] + h;
+            (*this)(shifted, plus);
+            shifted[j] = x[j] - h;
+            (*this)(shifted, minus);
+            shifted[j] = x[j];
+            jacobian.col(j) = (plus - minus) / (2 * h);
+        }
+        return 0;
+    }
     const std::vector<Eigen::Vector3d>& points_;
     std::function<double(const Eigen::VectorXd&, const Eigen::Vector3d&)> f_;
 };
@@ -60,8 +80,7 @@ Eigen::MatrixXd refineWithCovariance(const std::vector<Eigen::Vector3d>& points,
     if (points.size() < static_cast<std::size_t>(x.size()))
         cannotFit(kind, "too few points");
     Residuals functor(points, static_cast<int>(x.size()), residual);
-    Eigen::NumericalDiff<Residuals, Eigen::Central> numeric(functor);
-    Eigen::LevenbergMarquardt<Eigen::NumericalDiff<Residuals, Eigen::Central>> lm(numeric);
+    Eigen::LevenbergMarquardt<Residuals> lm(functor);
     lm.setFtol(1e-15);
     lm.setXtol(1e-15);
     lm.setMaxfev(400 * static_cast<Eigen::Index>(x.size() + 1));
@@ -71,7 +90,7 @@ Eigen::MatrixXd refineWithCovariance(const std::vector<Eigen::Vector3d>& points,
     Eigen::VectorXd r(static_cast<Eigen::Index>(points.size()));
     functor(x, r);
     Eigen::MatrixXd jacobian(static_cast<Eigen::Index>(points.size()), x.size());
-    numeric.df(x, jacobian);
+    functor.df(x, jacobian);
     // With as many points as parameters the residuals say nothing of the noise (0 here).
     const double variance = r.squaredNorm() / static_cast<double>(std::max<std::size_t>(1, points.size() - static_cast<std::size_t>(x.size())));
     const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
