@@ -3,6 +3,7 @@
 #include <scandiff/plugins/primitives/PrimitiveDetection.h>
 
 #include "PrimitiveScene.h"
+#include "StageWatcher.h"
 #include "TestSupport.h"
 
 #include <gtest/gtest.h>
@@ -202,4 +203,59 @@ TEST(Primitives, UtmCoordinatesGiveTheSameShapes)
         EXPECT_LT((a.direction - b.direction).norm(), 1e-6) << k;
         EXPECT_NEAR(a.radius, b.radius, 1e-6) << k;
     }
+}
+
+TEST(Primitives, RegionGrowingFindsEveryPlaneOnceAndKeepsThePanelApart)
+{
+    // Planes grown from the flattest points: every true plane of the scene is
+    // one region, a plane, within 0.05 degrees and 1 mm (or three standard
+    // uncertainties on the small box sides); the panel 10 cm in front of the
+    // wall and the two coplanar plates 1 m apart stay separate shapes.
+    PrimitiveDetectionParams params;
+    params.method = PrimitiveMethod::RegionGrowing;
+    const PrimitiveDetectionResult result = detectPrimitives(scene().cloud, params);
+    const test::PrimitiveScene& s = scene();
+    std::set<int> used;
+    for (std::size_t k = 0; k < s.shapes.size(); ++k) {
+        const Primitive& truth = s.shapes[k].truth;
+        if (truth.kind != PrimitiveKind::Plane)
+            continue;
+        std::size_t shared = 0, total = 0;
+        for (int t : s.truth)
+            total += t == static_cast<int>(k);
+        const DetectedPrimitive* match = bestMatch(result, s, static_cast<int>(k), shared);
+        ASSERT_NE(match, nullptr) << s.shapes[k].label << " not found";
+        EXPECT_EQ(match->primitive.kind, PrimitiveKind::Plane);
+        EXPECT_GT(static_cast<double>(shared), 0.8 * static_cast<double>(total)) << s.shapes[k].label;
+        EXPECT_TRUE(used.insert(match->id).second) << s.shapes[k].label << " shares its shape with another";
+        EXPECT_LT(angleBetweenLines(match->primitive.direction, truth.direction), std::max(0.05, 3 * uncertainty(*match, "direction_deg")))
+            << s.shapes[k].label;
+        EXPECT_LT(std::abs((match->primitive.point - truth.point).dot(truth.direction)), std::max(0.001, 3 * uncertainty(*match, "offset")))
+            << s.shapes[k].label;
+    }
+    for (const DetectedPrimitive& shape : result.primitives)
+        EXPECT_EQ(shape.primitive.kind, PrimitiveKind::Plane);
+
+    // No random draw: the same regions on one thread.
+    {
+        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        const PrimitiveDetectionResult again = detectPrimitives(scene().cloud, params);
+        EXPECT_EQ(again.primitiveId, result.primitiveId);
+    }
+    // Planes only; Cancel stops it.
+    params.kinds = {PrimitiveKind::Sphere};
+    EXPECT_EQ(test::errorCodeOf([&] { detectPrimitives(scene().cloud, params); }), ErrorCode::InvalidArgument);
+    params.kinds = {PrimitiveKind::Plane};
+    // Cancel at the first poll, a third, two thirds and the last: CGAL's
+    // region growing has none of its own, the neighbour queries ask.
+    test::PollCounter counting;
+    detectPrimitives(scene().cloud, params, &counting);
+    const std::size_t polls = counting.polls();
+    ASSERT_GT(polls, 20u);
+    for (std::size_t at : {std::size_t{1}, polls / 3, 2 * polls / 3, polls - polls / 20}) {
+        test::PollCounter cancel(std::max<std::size_t>(at, 1));
+        EXPECT_EQ(test::errorCodeOf([&] { detectPrimitives(scene().cloud, params, &cancel); }), ErrorCode::Cancelled) << at;
+    }
+    EXPECT_EQ(parsePrimitiveMethod("region-growing"), PrimitiveMethod::RegionGrowing);
+    EXPECT_EQ(test::errorCodeOf([] { parsePrimitiveMethod("hough"); }), ErrorCode::InvalidArgument);
 }

@@ -2,6 +2,7 @@
 #include <scandiff/plugins/primitives/PrimitiveDetection.h>
 
 #include "EfficientRansac.h"
+#include "RegionGrowing.h"
 
 #include <scandiff/core/CloudOctree.h>
 #include <scandiff/core/Error.h>
@@ -219,11 +220,35 @@ bool touching(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Ve
     return false;
 }
 
+//! The shapes efficient RANSAC finds (in the frame of `points`).
+std::vector<detail::RansacShape> findByRansac(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& unitNormals,
+                                              const PrimitiveDetectionParams& params, const PrimitiveDetectionResult& result,
+                                              ProgressObserver* progress, bool& cancelled)
+{
+    detail::RansacSettings settings;
+    settings.kinds = params.kinds;
+    settings.epsilon = result.epsilon;
+    settings.clusterEpsilon = result.clusterEpsilon;
+    settings.normalCosine = std::cos(params.normalDeviationDegrees * kPi / 180.0);
+    settings.minPoints = params.minPoints;
+    settings.probability = params.probability;
+    settings.seed = params.seed;
+    return detail::efficientRansac(points, unitNormals, settings, [&](double) {
+        if (progress && progress->cancelRequested()) {
+            cancelled = true;
+            return false;
+        }
+        return true;
+    });
+}
+
 void checkParameters(const PrimitiveDetectionParams& params)
 {
     auto bad = [](const std::string& why) { throw Error(ErrorCode::InvalidArgument, "primitives: " + why); };
     if (params.kinds.empty())
         bad("no shape type asked for");
+    if (params.method == PrimitiveMethod::RegionGrowing && !params.kinds.count(PrimitiveKind::Plane))
+        bad("region growing grows planes: ask for planes, or use efficient RANSAC for curved shapes");
     if (params.epsilon && !(*params.epsilon > 0))
         bad("epsilon must be > 0");
     if (params.clusterEpsilon && !(*params.clusterEpsilon > 0))
@@ -239,6 +264,15 @@ void checkParameters(const PrimitiveDetectionParams& params)
 }
 
 } // namespace
+
+PrimitiveMethod parsePrimitiveMethod(const std::string& name)
+{
+    if (name == "efficient-ransac")
+        return PrimitiveMethod::EfficientRansac;
+    if (name == "region-growing")
+        return PrimitiveMethod::RegionGrowing;
+    throw Error(ErrorCode::InvalidArgument, "primitives: method '" + name + "': expected efficient-ransac or region-growing");
+}
 
 PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const PrimitiveDetectionParams& params, ProgressObserver* progress)
 {
@@ -288,26 +322,35 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
         unitNormals[i] = n.norm() > 0 ? n.normalized() : Eigen::Vector3d::UnitZ();
     }
 
-    detail::RansacSettings settings;
-    settings.kinds = params.kinds;
-    settings.epsilon = result.epsilon;
-    settings.clusterEpsilon = result.clusterEpsilon;
-    settings.normalCosine = std::cos(params.normalDeviationDegrees * kPi / 180.0);
-    settings.minPoints = params.minPoints;
-    settings.probability = params.probability;
-    settings.seed = params.seed;
+    std::vector<detail::RansacShape> found;
     bool cancelled = false;
-    const std::vector<detail::RansacShape> found = detail::efficientRansac(points, unitNormals, settings, [&](double fraction) {
-        (void)fraction;
-        if (progress && progress->cancelRequested()) {
-            cancelled = true;
-            return false;
-        }
-        return true;
-    });
+    // A stage of its own: what the progress dialog shows (and the cancel-latency bench counts) after the normals.
+    const ProgressTicker findingStage(progress, params.method == PrimitiveMethod::RegionGrowing ? "Primitives: region growing"
+                                                                                                 : "Primitives: efficient RANSAC",
+                                      1);
+    if (params.method == PrimitiveMethod::RegionGrowing) {
+        detail::RegionGrowingSettings growing;
+        growing.epsilon = result.epsilon;
+        growing.normalDegrees = params.normalDeviationDegrees;
+        growing.neighbourRadius = result.clusterEpsilon;
+        growing.minPoints = params.minPoints;
+        found = detail::growPlanarRegions(points, unitNormals, tree, growing, [&] {
+            cancelled = cancelled || (progress && progress->cancelRequested());
+            return !cancelled;
+        });
+    } else {
+        found = findByRansac(points, unitNormals, params, result, progress, cancelled);
+    }
     if (cancelled)
         ticker.checkCancel();
     ticker.step(60);
+    // Region growing grows planes: the type check does not turn them into curved shapes.
+    PrimitiveDetectionParams typeParams = params;
+    if (params.method == PrimitiveMethod::RegionGrowing) {
+        typeParams.kinds = {PrimitiveKind::Plane};
+        if (params.kinds.size() > 1)
+            result.notes.push_back("region growing grows planes: the other shape types asked for are left to efficient RANSAC");
+    }
 
     // Each shape refitted, its type checked; a curved shape that does not fit
     // clearly better than a plane becomes a plane when a plane holds its
@@ -322,7 +365,7 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
             continue;
         Primitive initial = shape.primitive;
         initial.point += centre; // CGAL's frame -> global
-        std::optional<PrimitiveRefinement> chosen = chooseType(members, centre, initial, params, result.epsilon, result.notes);
+        std::optional<PrimitiveRefinement> chosen = chooseType(members, centre, initial, typeParams, result.epsilon, result.notes);
         if (!chosen)
             continue;
         const PrimitiveRefinement& refined = *chosen;

@@ -64,19 +64,24 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
     using namespace scandiff;
     using namespace scandiff::plugins;
     const PrimitiveDetectionParams defaults;
-    registry.plugins.push_back({"primitives", "Planes, spheres, cylinders, cones and tori by efficient RANSAC", "CGAL"});
+    registry.plugins.push_back({"primitives", "Planes, spheres, cylinders, cones and tori by efficient RANSAC; planes by region growing", "CGAL"});
 
     ToolSpec tool;
     tool.name = "primitives";
-    tool.title = "Primitives (efficient RANSAC)";
+    tool.title = "Primitives";
     tool.category = "Primitives";
     tool.description =
-        "Finds planes, spheres, cylinders, cones and tori (efficient RANSAC, Schnabel et al. 2007, through CGAL), splits each "
-        "shape into connected parts, keeps a curved shape only where it fits its points clearly better than a plane, and "
+        "Finds planes, spheres, cylinders, cones and tori (efficient RANSAC, Schnabel et al. 2007, through CGAL), or planes by "
+        "region growing (CGAL's), splits each shape into connected parts, merges touching parts of one surface, keeps a curved shape only where it fits its points clearly better than a plane, and "
         "refits every shape by least squares with the uncertainty of its parameters. Adds primitive_id (-1: none), "
         "primitive_type (0 plane, 1 sphere, 2 cylinder, 3 cone, 4 torus) and primitive_distance to the cloud; gives one cloud "
         "per shape and a table of their parameters. Normals are fitted when the cloud has none (within 10 x the noise).";
     tool.parameters = {
+        ParameterSpec::choice("method", "Method",
+                              "efficient-ransac: every shape type, from random samples (seeded); region-growing: planes grown from "
+                              "the flattest points, each point joining a neighbour's region within the distance threshold and the "
+                              "normal deviation (no random draw), as thesis 004 compares with RANSAC",
+                              {"efficient-ransac", "region-growing"}, "efficient-ransac"),
         ParameterSpec::text("shapes", "Shape types", "Comma-separated: plane, sphere, cylinder, cone, torus",
                             "plane,sphere,cylinder,cone,torus")
             .withSuggestions({"plane,sphere,cylinder,cone,torus", "plane", "plane,cylinder", "plane,sphere,cylinder"}),
@@ -103,6 +108,7 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
         const PointCloud& input = inputs.cloud();
         PrimitiveDetectionParams params;
+        params.method = parsePrimitiveMethod(values.text("method"));
         params.kinds = kindsFrom(values.text("shapes"));
         if (values.has("epsilon"))
             params.epsilon = values.real("epsilon");

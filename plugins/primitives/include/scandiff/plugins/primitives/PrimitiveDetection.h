@@ -2,7 +2,8 @@
 #pragma once
 //! Primitive extraction: planes, spheres, cylinders, cones and tori found in a
 //! cloud by efficient RANSAC (Schnabel, Wahl and Klein 2007, through CGAL's
-//! Shape_detection), then made what a user can trust:
+//! Shape_detection), or planes by region growing (CGAL's, on point sets),
+//! then made what a user can trust:
 //! - each shape's inliers one connected part (cluster epsilon): disjoint
 //!   coplanar plates are separate shapes;
 //! - the right type: the simplest type that fits the shape's points about as
@@ -25,8 +26,16 @@
 
 namespace scandiff::plugins {
 
+//! How shapes are found: efficient RANSAC (every type), or planar regions
+//! grown from the flattest points (planes only; no random draw).
+enum class PrimitiveMethod { EfficientRansac, RegionGrowing };
+
+//! "efficient-ransac", "region-growing"; throws Error(InvalidArgument) otherwise.
+PrimitiveMethod parsePrimitiveMethod(const std::string& name);
+
 struct PrimitiveDetectionParams
 {
+    PrimitiveMethod method = PrimitiveMethod::EfficientRansac;
     std::set<PrimitiveKind> kinds = {PrimitiveKind::Plane, PrimitiveKind::Sphere, PrimitiveKind::Cylinder, PrimitiveKind::Cone,
                                      PrimitiveKind::Torus};
     //! Largest distance of an inlier to its shape (m); absent: 3 x the noise
