@@ -44,7 +44,7 @@ struct Glyph
 constexpr Glyph kGlyphs[] = {
     {'0', {7, 5, 5, 5, 7}}, {'1', {2, 6, 2, 2, 7}}, {'2', {7, 1, 7, 4, 7}}, {'3', {7, 1, 7, 1, 7}}, {'4', {5, 5, 7, 1, 1}},
     {'5', {7, 4, 7, 1, 7}}, {'6', {7, 4, 7, 5, 7}}, {'7', {7, 1, 1, 1, 1}}, {'8', {7, 5, 7, 5, 7}}, {'9', {7, 5, 7, 1, 7}},
-    {'-', {0, 0, 7, 0, 0}}, {'+', {0, 2, 7, 2, 0}}, {'.', {0, 0, 0, 0, 2}}, {'e', {7, 4, 7, 4, 7}}, {'m', {0, 6, 7, 5, 5}},
+    {'-', {0, 0, 7, 0, 0}}, {'+', {0, 2, 7, 2, 0}}, {'.', {0, 0, 0, 0, 2}}, {'e', {7, 4, 7, 4, 7}}, {'m', {5, 7, 7, 5, 5}},
     {' ', {0, 0, 0, 0, 0}},
 };
 constexpr int kFontScale = 2; // each font pixel is 2 x 2 image pixels
@@ -78,17 +78,6 @@ void drawText(Rgba& image, int x, int y, const std::string& text)
     }
 }
 
-const ScalarField* previewField(const PointCloud& cloud)
-{
-    for (const char* name : {fields::kDodDifference, fields::kM3c2Distance, fields::kCellHeight})
-        if (const ScalarField* f = cloud.field(name))
-            return f;
-    for (const ScalarField& f : cloud.fields())
-        if (f.name() != fields::kRasterCol && f.name() != fields::kRasterRow && f.name() != fields::kPointCount)
-            return &f;
-    return nullptr;
-}
-
 std::string label(double value)
 {
     char text[32];
@@ -103,7 +92,7 @@ void writePngPreview(const PointCloud& cloud, const std::filesystem::path& path,
     if (!col || !row || cloud.empty())
         throw Error(ErrorCode::InvalidArgument,
                     path.string() + ": only a gridded cloud (a DEM of difference, an M3C2 raster, a rasterised cloud) has a PNG preview");
-    const ScalarField* field = previewField(cloud);
+    const ScalarField* field = mainGridField(cloud);
     if (!field)
         throw Error(ErrorCode::InvalidArgument, path.string() + ": the grid has no field to draw");
     const GridOfCloud g = gridOf(cloud, *col, *row, path);

@@ -204,9 +204,17 @@ TEST(Rasterise, EachCellGetsItsHeightStatisticCountAndFieldMeans)
         EXPECT_NEAR(cells.field("m3c2_significant")->value(0), 1.0 / 3.0, 1e-7);
         EXPECT_NEAR(cells.field("m3c2_significant")->value(1), 0.5, 1e-7);
     }
+    // A grid is shown by its change, else its height; a plain cloud is no grid.
+    params.statistic = CellStatistic::Mean;
+    EXPECT_EQ(mainGridField(rasteriseCloud(cloud, params))->name(), "m3c2_distance");
+    EXPECT_EQ(mainGridField(cloud), nullptr);
+    EXPECT_FALSE(gridCellSize(cloud).has_value());
+    EXPECT_DOUBLE_EQ(gridCellSize(rasteriseCloud(cloud, params)).value(), 1.0);
+
     // Chosen fields only; bad input.
     params.fields = {"m3c2_significant"};
     EXPECT_EQ(rasteriseCloud(cloud, params).field("m3c2_distance"), nullptr);
+    EXPECT_EQ(mainGridField(rasteriseCloud(cloud, params))->name(), fields::kCellHeight);
     params.fields = {"nothing"};
     EXPECT_EQ(test::errorCodeOf([&] { rasteriseCloud(cloud, params); }), ErrorCode::InvalidArgument);
     params.fields.clear();

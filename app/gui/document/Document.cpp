@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "document/Document.h"
 
+#include <scandiff/core/distance/DemOfDifference.h>
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -22,8 +24,11 @@ EntityId Document::add(QString name, io::Entity entity, EntityId parent, QString
     item->parent = contains(parent) ? parent : kNoEntity;
     item->sourcePath = std::move(sourcePath);
     item->unsaved = item->sourcePath.isEmpty();
-    if (const PointCloud* cloud = item->cloud(); cloud && !cloud->fields().empty())
-        item->display.activeField = cloud->fields().front().name();
+    // A grid (DEM of difference, raster) shows its difference or height, not its column numbers.
+    if (const PointCloud* cloud = item->cloud(); cloud && !cloud->fields().empty()) {
+        const ScalarField* main = mainGridField(*cloud);
+        item->display.activeField = main ? main->name() : cloud->fields().front().name();
+    }
     const EntityId id = item->id;
     items_.push_back(std::move(item));
     emit added(id);

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "panels/PropertiesPanel.h"
 
+#include <scandiff/io/CoordinateSystem.h>
+
 #include <QHeaderView>
 
 #include <cmath>
@@ -94,6 +96,8 @@ void PropertiesPanel::rebuild()
         if (const Mesh* mesh = item->mesh())
             add(nullptr, tr("Triangles"), QString::number(mesh->triangles.size()));
         add(nullptr, tr("Global shift"), triple(points.origin()));
+        add(nullptr, tr("Coordinate system"),
+            points.crsWkt().empty() ? tr("none") : QString::fromStdString(io::crsName(points.crsWkt())));
         const BoundingBox box = points.bounds();
         if (!box.empty) {
             add(nullptr, tr("Bounds min"), triple(box.min));

@@ -311,6 +311,19 @@ DemOfDifferenceResult demOfDifference(const PointCloud* reference, const PointCl
     return result;
 }
 
+const ScalarField* mainGridField(const PointCloud& cloud)
+{
+    if (!cloud.field(fields::kRasterCol) || !cloud.field(fields::kRasterRow))
+        return nullptr;
+    for (const char* name : {fields::kDodDifference, "m3c2_distance", fields::kCellHeight})
+        if (const ScalarField* f = cloud.field(name))
+            return f;
+    for (const ScalarField& f : cloud.fields())
+        if (f.name() != fields::kRasterCol && f.name() != fields::kRasterRow && f.name() != fields::kPointCount)
+            return &f;
+    return nullptr;
+}
+
 std::optional<double> gridCellSize(const PointCloud& cloud)
 {
     const ScalarField* col = cloud.field(fields::kRasterCol);

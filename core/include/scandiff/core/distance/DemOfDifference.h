@@ -96,6 +96,12 @@ DemOfDifferenceResult demOfDifference(const PointCloud* reference, const PointCl
 //! those fields, or with a single cell.
 std::optional<double> gridCellSize(const PointCloud& cloud);
 
+//! The field a gridded cloud is best shown by: the first present of
+//! dod_difference, m3c2_distance and height, else the first field that is not
+//! raster_col, raster_row or point_count; null for a cloud that is not a grid
+//! or has no such field.
+const ScalarField* mainGridField(const PointCloud& cloud);
+
 struct RasteriseParams
 {
     double cell = 1.0; //!< m, > 0
