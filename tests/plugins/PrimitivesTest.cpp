@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include <scandiff/core/Error.h>
+#include <scandiff/core/Drawing.h>
+#include <scandiff/plugins/PluginRegistry.h>
 #include <scandiff/plugins/primitives/PrimitiveDetection.h>
 
 #include "PrimitiveScene.h"
@@ -10,7 +12,10 @@
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <map>
 
 using namespace scandiff;
 using namespace scandiff::plugins;
@@ -258,4 +263,51 @@ TEST(Primitives, RegionGrowingFindsEveryPlaneOnceAndKeepsThePanelApart)
     }
     EXPECT_EQ(parsePrimitiveMethod("region-growing"), PrimitiveMethod::RegionGrowing);
     EXPECT_EQ(test::errorCodeOf([] { parsePrimitiveMethod("hough"); }), ErrorCode::InvalidArgument);
+}
+
+TEST(Primitives, ThePlanesOutlinesAreADrawingOnALayerPerShape)
+{
+    // Through the tool, as the CLI and the workbench run it: plate A (1.5 x
+    // 1.5 m, horizontal at z = 1.2 over [3, 4.5] x [9.5, 11]) gets one closed
+    // outline on its plane, around its extent, enclosing its area.
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& tool = *registry.tools.find("primitives");
+    ToolResult result = tool.execute(ToolInputs().add("input", scene().cloud), tool.resolve({{"method", "region-growing"}}), nullptr);
+    const PointCloud& labelled = std::get<PointCloud>(result.find("primitives")->data);
+    const Drawing& drawing = std::get<Drawing>(result.find("outlines")->data);
+    std::map<int, std::size_t> votes;
+    for (std::size_t i = 0; i < scene().truth.size(); ++i)
+        if (scene().shapes[static_cast<std::size_t>(std::max(scene().truth[i], 0))].label == "plate A" && scene().truth[i] >= 0)
+            ++votes[static_cast<int>(labelled.field("primitive_id")->value(i))];
+    const int plate = std::max_element(votes.begin(), votes.end(), [](auto& a, auto& b) { return a.second < b.second; })->first;
+    char layer[32];
+    std::snprintf(layer, sizeof layer, "PLANE_%04d", plate);
+    std::vector<const DrawingPolyline*> rings;
+    for (const DrawingPolyline& p : drawing.polylines)
+        if (p.layer == layer)
+            rings.push_back(&p);
+    ASSERT_EQ(rings.size(), 1u) << layer;
+    EXPECT_TRUE(rings[0]->closed);
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+    double area = 0;
+    const std::vector<Eigen::Vector3d>& ring = rings[0]->points;
+    for (std::size_t k = 0; k < ring.size(); ++k) {
+        lo = lo.cwiseMin(ring[k]);
+        hi = hi.cwiseMax(ring[k]);
+        const Eigen::Vector3d& a = ring[k];
+        const Eigen::Vector3d& b = ring[(k + 1) % ring.size()];
+        area += a.x() * b.y() - b.x() * a.y();
+    }
+    EXPECT_NEAR(lo.z(), 1.2, 0.002);
+    EXPECT_NEAR(hi.z(), 1.2, 0.002);
+    // Within one neighbour radius (3 spacings, 6.6 cm here): a clutter point
+    // near the plane and the plate's edge may join it.
+    EXPECT_NEAR(lo.x(), 3.0, 0.07);
+    EXPECT_NEAR(hi.x(), 4.5, 0.07);
+    EXPECT_NEAR(lo.y(), 9.5, 0.07);
+    EXPECT_NEAR(hi.y(), 11.0, 0.07);
+    EXPECT_NEAR(std::abs(area) / 2, 2.25, 0.2);
+    // Curved shapes have no outline layer.
+    for (const DrawingPolyline& p : drawing.polylines)
+        EXPECT_EQ(p.layer.rfind("PLANE_", 0), 0u);
 }

@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Registers primitive extraction as the tool "primitives".
 #include <scandiff/core/Error.h>
+#include <scandiff/core/Drawing.h>
 #include <scandiff/core/TextLists.h>
+#include <scandiff/core/segmentation/RegionReport.h>
 #include <scandiff/plugins/PluginRegistry.h>
 #include <scandiff/plugins/primitives/PrimitiveDetection.h>
 
+#include <cstdio>
 #include <sstream>
 
 namespace scandiff::plugins {
@@ -55,6 +58,49 @@ Table primitivesTable(const PrimitiveDetectionResult& result)
     return t;
 }
 
+//! Each plane's concave outline (and the outlines of its separate parts) in
+//! its own plane, lifted back to 3D, on a layer per shape (PLANE_0003): the
+//! drawing of a façade's or a room's planes for CAD. The outline grid is the
+//! region report's (cells of 1.5 x the 4th-neighbour spacing of the shape's points).
+Drawing planeOutlines(const PointCloud& cloud, const PrimitiveDetectionResult& detected)
+{
+    Drawing drawing;
+    for (const DetectedPrimitive& shape : detected.primitives) {
+        if (shape.primitive.kind != PrimitiveKind::Plane || shape.inliers.size() < 3)
+            continue;
+        const Eigen::Vector3d normal = shape.primitive.direction.normalized();
+        const Eigen::Vector3d e1 = normal.unitOrthogonal(), e2 = normal.cross(e1);
+        const Eigen::Vector3d foot = shape.primitive.point;
+        std::vector<Eigen::Vector2d> inPlane;
+        std::vector<Eigen::Vector3f> local;
+        inPlane.reserve(shape.inliers.size());
+        for (std::uint32_t i : shape.inliers) {
+            const Eigen::Vector3d v = cloud.globalPosition(i) - foot;
+            inPlane.emplace_back(v.dot(e1), v.dot(e2));
+            local.emplace_back(static_cast<float>(v.dot(e1)), static_cast<float>(v.dot(e2)), 0.0f);
+        }
+        BoundingBox box;
+        box.empty = false;
+        box.min = box.max = Eigen::Vector3d::Zero();
+        for (const Eigen::Vector3f& p : local) {
+            box.min = box.min.cwiseMin(p.cast<double>());
+            box.max = box.max.cwiseMax(p.cast<double>());
+        }
+        const Outline2d outline = concaveOutline(inPlane, outlineCellFor(local, box));
+        char layer[32];
+        std::snprintf(layer, sizeof layer, "PLANE_%04d", shape.id);
+        for (const Polygon2d& ring : outline.rings) {
+            std::vector<Eigen::Vector3d> lifted;
+            lifted.reserve(ring.size());
+            for (const Eigen::Vector2d& q : ring)
+                lifted.push_back(foot + q.x() * e1 + q.y() * e2);
+            if (lifted.size() >= 2)
+                drawing.polylines.push_back({layer, std::move(lifted), true});
+        }
+    }
+    return drawing;
+}
+
 } // namespace
 
 } // namespace scandiff::plugins
@@ -75,7 +121,7 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
         "region growing (CGAL's), splits each shape into connected parts, merges touching parts of one surface, keeps a curved shape only where it fits its points clearly better than a plane, and "
         "refits every shape by least squares with the uncertainty of its parameters. Adds primitive_id (-1: none), "
         "primitive_type (0 plane, 1 sphere, 2 cylinder, 3 cone, 4 torus) and primitive_distance to the cloud; gives one cloud "
-        "per shape and a table of their parameters. Normals are fitted when the cloud has none (within 10 x the noise).";
+        "per shape, a table of their parameters and the planes' outlines as a drawing (DXF, a layer per plane). Normals are fitted when the cloud has none (within 10 x the noise).";
     tool.parameters = {
         ParameterSpec::choice("method", "Method",
                               "efficient-ransac: every shape type, from random samples (seeded); region-growing: planes grown from "
@@ -104,7 +150,8 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
     };
     tool.outputs = {OutputSpec{"primitives", "Cloud with primitive fields", DataKind::Cloud, true},
                     OutputSpec{"shape", "Shape", DataKind::Cloud, false, true},
-                    OutputSpec{"table", "Primitives", DataKind::Table, false}};
+                    OutputSpec{"table", "Primitives", DataKind::Table, false},
+                    OutputSpec{"outlines", "Plane outlines", DataKind::Drawing, false}};
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
         const PointCloud& input = inputs.cloud();
         PrimitiveDetectionParams params;
@@ -144,6 +191,7 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
             result.add("shape", std::move(part));
         }
         result.add("table", primitivesTable(detected));
+        result.add("outlines", planeOutlines(input, detected));
         std::ostringstream summary;
         std::map<std::string, int> counts;
         std::size_t assigned = 0;
