@@ -65,7 +65,9 @@ struct Residuals : Eigen::DenseFunctor<double>
             shifted[j] = x[j];
             jacobian.col(j) = (plus - minus) / (2 * h);
         }
-        return 0;
+        // The evaluations it made: Eigen's LM counts them against setMaxfev,
+        // as it counted NumericalDiff's.
+        return 2 * static_cast<int>(x.size());
     }
     const std::vector<Eigen::Vector3d>& points_;
     std::function<double(const Eigen::VectorXd&, const Eigen::Vector3d&)> f_;

@@ -62,10 +62,13 @@ Table primitivesTable(const PrimitiveDetectionResult& result)
 //! its own plane, lifted back to 3D, on a layer per shape (PLANE_0003): the
 //! drawing of a façade's or a room's planes for CAD. The outline grid is the
 //! region report's (cells of 1.5 x the 4th-neighbour spacing of the shape's points).
-Drawing planeOutlines(const PointCloud& cloud, const PrimitiveDetectionResult& detected)
+Drawing planeOutlines(const PointCloud& cloud, const PrimitiveDetectionResult& detected, ProgressObserver* progress)
 {
     Drawing drawing;
+    ProgressTicker ticker(progress, "Primitives: plane outlines", detected.primitives.size());
     for (const DetectedPrimitive& shape : detected.primitives) {
+        ticker.checkCancel(); // before each outline: a large plane takes a moment
+        ticker.step();
         if (shape.primitive.kind != PrimitiveKind::Plane || shape.inliers.size() < 3)
             continue;
         const Eigen::Vector3d normal = shape.primitive.direction.normalized();
@@ -191,7 +194,7 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
             result.add("shape", std::move(part));
         }
         result.add("table", primitivesTable(detected));
-        result.add("outlines", planeOutlines(input, detected));
+        result.add("outlines", planeOutlines(input, detected, progress));
         std::ostringstream summary;
         std::map<std::string, int> counts;
         std::size_t assigned = 0;

@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <atomic>
 #include <iterator>
 #include <mutex>
@@ -31,25 +32,37 @@ struct StopTheRun
 };
 
 //! CGAL's NeighborQuery concept answered from the octree: the points within
-//! the radius of every point (itself included, as CGAL's sphere query), found
-//! once for all by the octree's parallel batch query, since the seed sorting
-//! and the growing each ask for every point. The caller is asked every 4096
-//! points whether to go on, during the batch and during CGAL's growing, which
-//! has no cancellation of its own.
+//! the radius of every point (itself included, as CGAL's sphere query), at
+//! most the kMaxNeighbours nearest, found once for all by the octree's
+//! parallel batch query, since the seed sorting and the growing each ask for
+//! every point. The cap keeps the lists to 128 bytes a point whatever radius
+//! a user gives (a wide one on a dense scan would list thousands), and is
+//! above what the default radius (3 spacings: about 28 points on a plane)
+//! holds. The caller is asked every 4096 points whether to go on, during the
+//! batch and during CGAL's growing, which has no cancellation of its own.
 class OctreeQuery
 {
 public:
-    OctreeQuery(const octree::Octree& tree, double radius, const std::function<bool()>& keepGoing) : keepGoing_(keepGoing)
+    static constexpr std::size_t kMaxNeighbours = 32;
+
+    OctreeQuery(const octree::Octree& tree, double radius, const std::function<bool()>& keepGoing)
+        : keepGoing_(keepGoing), lists_(tree.size() * kMaxNeighbours), counts_(tree.size(), 0)
     {
-        lists_.resize(tree.size());
         std::atomic<std::size_t> visited{0};
         std::mutex asking;
         tree.withinRadiusBatch(tree.points(), tree.size(), static_cast<float>(radius),
                                [&](std::uint32_t q, const octree::Neighbour* found, std::size_t count) {
-                                   std::vector<std::uint32_t>& list = lists_[q];
-                                   list.resize(count);
-                                   for (std::size_t k = 0; k < count; ++k)
-                                       list[k] = found[k].index;
+                                   std::uint32_t* list = lists_.data() + std::size_t(q) * kMaxNeighbours;
+                                   if (count <= kMaxNeighbours) {
+                                       for (std::size_t k = 0; k < count; ++k)
+                                           list[k] = found[k].index;
+                                   } else {
+                                       std::vector<octree::Neighbour> nearest(found, found + count);
+                                       std::nth_element(nearest.begin(), nearest.begin() + kMaxNeighbours - 1, nearest.end());
+                                       for (std::size_t k = 0; k < kMaxNeighbours; ++k)
+                                           list[k] = nearest[k].index;
+                                   }
+                                   counts_[q] = static_cast<std::uint8_t>(std::min(count, kMaxNeighbours));
                                    if (++visited % 4096 == 0) {
                                        const std::lock_guard<std::mutex> lock(asking);
                                        if (!keepGoing_())
@@ -61,12 +74,14 @@ public:
     {
         if (++calls_ % 4096 == 0 && !keepGoing_())
             throw StopTheRun{};
-        neighbours.assign(lists_[index].begin(), lists_[index].end());
+        const std::uint32_t* list = lists_.data() + index * kMaxNeighbours;
+        neighbours.assign(list, list + counts_[index]);
     }
 
 private:
     const std::function<bool()>& keepGoing_;
-    std::vector<std::vector<std::uint32_t>> lists_;
+    std::vector<std::uint32_t> lists_; //!< kMaxNeighbours slots a point
+    std::vector<std::uint8_t> counts_;
     std::size_t calls_ = 0;
 };
 

@@ -23,9 +23,9 @@ struct RegionGrowingSettings
 //! Least_squares_plane_fit_sorting: seeds in order of their neighbourhood's
 //! planarity), each point joining the region of a neighbour when it lies
 //! within epsilon of the region's least-squares plane and its normal within
-//! the angle. Deterministic: no random draw. The neighbours come from
-//! `tree`, the octree of the same points (its own float coordinates): exact,
-//! and already built, where CGAL's sphere query would build a kd-tree of its
+//! the angle. Deterministic: no random draw. The neighbours (the 32 nearest
+//! within the radius at most) come from `tree`, the octree of the same points
+//! (its own float coordinates): exact, and already built, where CGAL's sphere query would build a kd-tree of its
 //! own (a second of silence on a million points, Cancel unheard). `keepGoing`
 //! is asked every few thousand neighbour queries; false stops the run (the
 //! result is then empty).
