@@ -11,6 +11,7 @@
 //! reference system, when it has one, is the GeoTIFF's.
 
 #include "internal/Formats.h"
+#include "internal/GdalDataset.h"
 #include "internal/GriddedCloud.h"
 
 #include <scandiff/core/Error.h>
@@ -22,7 +23,6 @@
 
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <string>
 #include <vector>
 
@@ -51,27 +51,14 @@ void writeGeoTiff(const PointCloud& cloud, const std::filesystem::path& path, co
     if (bands.empty())
         fail(path, "the grid has no field to write as a band");
 
-    static std::once_flag registered;
-    std::call_once(registered, [] { GDALAllRegister(); });
-    GDALDriverH driver = GDALGetDriverByName("GTiff");
-    if (!driver)
-        throw Error(ErrorCode::Unsupported, path.string() + ": this GDAL has no GTiff driver");
+    GDALDriverH driver = gdalDriver("GTiff", path);
     AtomicFile file(path);
     const std::string temp = file.tempPath().string();
     char compress[] = "COMPRESS=DEFLATE";
     char* creation[] = {compress, nullptr};
-    // Closed on every way out (a cancellation too); GDAL writes it on close.
-    struct Dataset
-    {
-        GDALDatasetH handle;
-        ~Dataset()
-        {
-            if (handle)
-                GDALClose(handle);
-        }
-    } owned{GDALCreate(driver, temp.c_str(), static_cast<int>(g.cols), static_cast<int>(g.rows), static_cast<int>(bands.size()),
-                       GDT_Float64, creation)};
-    GDALDatasetH dataset = owned.handle;
+    GdalDataset owned(GDALCreate(driver, temp.c_str(), static_cast<int>(g.cols), static_cast<int>(g.rows), static_cast<int>(bands.size()),
+                                 GDT_Float64, creation));
+    GDALDatasetH dataset = owned.get();
     if (!dataset)
         throw Error(ErrorCode::Io, path.string() + ": GDAL cannot create the file: " + CPLGetLastErrorMsg());
     // North up: row 0 of the image is the top (the largest y).
@@ -96,8 +83,7 @@ void writeGeoTiff(const PointCloud& cloud, const std::filesystem::path& path, co
                               static_cast<int>(g.cols), static_cast<int>(g.rows), GDT_Float64, 0, 0);
         ticker.step();
     }
-    GDALClose(dataset);
-    owned.handle = nullptr;
+    owned.close();
     if (status != CE_None)
         throw Error(ErrorCode::Io, path.string() + ": GDAL failed to write: " + CPLGetLastErrorMsg());
     file.commit();

@@ -13,6 +13,7 @@
 //! need, written here: io has no GUI toolkit, and GDAL draws no text.
 
 #include "internal/Formats.h"
+#include "internal/GdalDataset.h"
 #include "internal/GriddedCloud.h"
 
 #include <scandiff/core/ColourScale.h>
@@ -27,7 +28,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <mutex>
 #include <string>
 #include <vector>
 
@@ -152,34 +152,21 @@ void writePngPreview(const PointCloud& cloud, const std::filesystem::path& path,
     drawText(image, barX + barWidth + 6, (barTop + barBottom) / 2 - 5, label(0.5 * (lo + hi)));
     drawText(image, barX + barWidth + 6, barBottom - 10, label(lo));
 
-    static std::once_flag registered;
-    std::call_once(registered, [] { GDALAllRegister(); });
-    GDALDriverH memory = GDALGetDriverByName("MEM");
-    GDALDriverH png = GDALGetDriverByName("PNG");
-    if (!memory || !png)
-        throw Error(ErrorCode::Unsupported, path.string() + ": this GDAL has no PNG driver");
-    struct Dataset
-    {
-        GDALDatasetH handle;
-        ~Dataset()
-        {
-            if (handle)
-                GDALClose(handle);
-        }
-    } picture{GDALCreate(memory, "", image.width, image.height, 4, GDT_Byte, nullptr)};
-    if (!picture.handle)
+    GDALDriverH memory = gdalDriver("MEM", path);
+    GDALDriverH png = gdalDriver("PNG", path);
+    const GdalDataset picture(GDALCreate(memory, "", image.width, image.height, 4, GDT_Byte, nullptr));
+    if (!picture)
         throw Error(ErrorCode::Io, path.string() + ": GDAL cannot make the picture: " + CPLGetLastErrorMsg());
     std::vector<std::uint8_t>* channels[] = {&image.r, &image.g, &image.b, &image.a};
     for (int b = 0; b < 4; ++b)
-        if (GDALRasterIO(GDALGetRasterBand(picture.handle, b + 1), GF_Write, 0, 0, image.width, image.height, channels[b]->data(),
+        if (GDALRasterIO(GDALGetRasterBand(picture.get(), b + 1), GF_Write, 0, 0, image.width, image.height, channels[b]->data(),
                          image.width, image.height, GDT_Byte, 0, 0) != CE_None)
             throw Error(ErrorCode::Io, path.string() + ": GDAL failed to draw: " + CPLGetLastErrorMsg());
     AtomicFile file(path);
-    Dataset written{GDALCreateCopy(png, file.tempPath().string().c_str(), picture.handle, FALSE, nullptr, nullptr, nullptr)};
-    if (!written.handle)
+    GdalDataset written(GDALCreateCopy(png, file.tempPath().string().c_str(), picture.get(), FALSE, nullptr, nullptr, nullptr));
+    if (!written)
         throw Error(ErrorCode::Io, path.string() + ": GDAL failed to write the PNG: " + CPLGetLastErrorMsg());
-    GDALClose(written.handle);
-    written.handle = nullptr;
+    written.close();
     // GDAL's PNG driver leaves an .aux.xml beside the file only when asked for
     // georeferencing it cannot store; none is asked here.
     file.commit();
