@@ -925,6 +925,25 @@ void chooseQuantization(const fs::path& path, double origin, double lo, double h
                                             " m, too large for LAS even at a 1 km resolution");
 }
 
+// A variable length record (54-byte header, 16-bit length) or an extended
+// one (60-byte header, 64-bit length, LAS 1.4), its payload after the header:
+// reserved u16, user id char[16] at 2, record id u16 at 18, the length at 20,
+// the description char[32] after it (LAS 1.4 R15, tables 16 and 24).
+std::string variableLengthRecord(const char* userId, std::uint16_t recordId, const char* description, const std::string& payload,
+                                 bool extended)
+{
+    std::string record((extended ? kEvlrHeaderSize : kVlrHeaderSize) + payload.size(), '\0');
+    std::memcpy(&record[2], userId, std::min<std::size_t>(16, std::strlen(userId)));
+    store<std::uint16_t>(&record[18], recordId);
+    if (extended)
+        store<std::uint64_t>(&record[20], payload.size());
+    else
+        store<std::uint16_t>(&record[20], static_cast<std::uint16_t>(payload.size()));
+    std::memcpy(&record[extended ? 28 : 22], description, std::min<std::size_t>(32, std::strlen(description)));
+    std::memcpy(&record[extended ? kEvlrHeaderSize : kVlrHeaderSize], payload.data(), payload.size());
+    return record;
+}
+
 void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions& options)
 {
     const std::size_t n = cloud.size();
@@ -996,14 +1015,11 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
 
     // Extra Bytes VLR.
     std::string vlr;
+    std::uint32_t vlrCount = 0;
     if (!extras.empty()) {
-        vlr.assign(kVlrHeaderSize + kExtraBytesDescriptorSize * extras.size(), '\0');
-        std::memcpy(&vlr[2], "LASF_Spec", 9);
-        store<std::uint16_t>(&vlr[18], 4);
-        store<std::uint16_t>(&vlr[20], static_cast<std::uint16_t>(kExtraBytesDescriptorSize * extras.size()));
-        std::memcpy(&vlr[22], "Extra Bytes Record", 18);
+        std::string descriptors(kExtraBytesDescriptorSize * extras.size(), '\0');
         for (std::size_t d = 0; d < extras.size(); ++d) {
-            char* p = &vlr[kVlrHeaderSize + kExtraBytesDescriptorSize * d];
+            char* p = &descriptors[kExtraBytesDescriptorSize * d];
             p[eb::dataType] = static_cast<char>(extras[d].asDouble ? eb::typeDouble : eb::typeFloat);
             // NaN means "no value" in scandiff; declaring it as no_data tells other
             // readers so (stored as a double, the upcast of float and double).
@@ -1013,28 +1029,19 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
             const char description[] = "scandiff scalar field";
             std::memcpy(p + eb::description, description, sizeof description - 1);
         }
+        vlr += variableLengthRecord("LASF_Spec", 4, "Extra Bytes Record", descriptors, false);
+        ++vlrCount;
     }
 
-    std::uint32_t vlrCount = extras.empty() ? 0u : 1u;
     // The coordinate reference system as an OGC WKT record, NUL-terminated;
     // one too long for a VLR's 16-bit length goes into an EVLR after the points.
     std::string crsRecord;
     if (!cloud.crsWkt().empty()) {
-        const std::size_t length = cloud.crsWkt().size() + 1;
-        const bool extended = length > std::numeric_limits<std::uint16_t>::max();
-        crsRecord.assign((extended ? kEvlrHeaderSize : kVlrHeaderSize) + length, '\0');
-        std::memcpy(&crsRecord[2], "LASF_Projection", 15);
-        store<std::uint16_t>(&crsRecord[18], 2112);
-        if (extended)
-            store<std::uint64_t>(&crsRecord[20], length);
-        else
-            store<std::uint16_t>(&crsRecord[20], static_cast<std::uint16_t>(length));
-        const char description[] = "OGC coordinate system WKT";
-        std::memcpy(&crsRecord[extended ? 28 : 22], description, sizeof description - 1);
-        std::memcpy(&crsRecord[extended ? kEvlrHeaderSize : kVlrHeaderSize], cloud.crsWkt().data(), cloud.crsWkt().size());
-        if (!extended) {
-            vlr += crsRecord;
-            crsRecord.clear();
+        const std::string wkt = cloud.crsWkt() + '\0';
+        if (wkt.size() > std::numeric_limits<std::uint16_t>::max()) {
+            crsRecord = variableLengthRecord("LASF_Projection", 2112, "OGC coordinate system WKT", wkt, true);
+        } else {
+            vlr += variableLengthRecord("LASF_Projection", 2112, "OGC coordinate system WKT", wkt, false);
             ++vlrCount;
         }
     }
