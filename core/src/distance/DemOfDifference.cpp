@@ -3,6 +3,7 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
+#include <scandiff/core/distance/M3C2.h>
 
 #include <tbb/parallel_sort.h>
 
@@ -72,6 +73,27 @@ std::uint32_t cellOf(const Grid& grid, const Eigen::Vector3d& p)
     return static_cast<std::uint32_t>(std::min(row, grid.rows - 1) * grid.cols + std::min(col, grid.cols - 1));
 }
 
+//! The statistic of a cell's n heights, given in increasing order (zAt(k):
+//! the k-th), with their mean.
+template <class HeightAt>
+double cellHeight(CellStatistic statistic, std::size_t n, double mean, HeightAt zAt)
+{
+    switch (statistic) {
+    case CellStatistic::Min: return zAt(0);
+    case CellStatistic::Max: return zAt(n - 1);
+    case CellStatistic::Mean: return mean;
+    case CellStatistic::Median: return n % 2 ? zAt(n / 2) : 0.5 * (zAt(n / 2 - 1) + zAt(n / 2));
+    }
+    return mean;
+}
+
+//! The fields that place a grid's cells and count their points, rather than
+//! measure something: not shown, not carried.
+bool isGridBookkeeping(const std::string& name)
+{
+    return name == fields::kRasterCol || name == fields::kRasterRow || name == fields::kPointCount;
+}
+
 void addBounds(const PointCloud& cloud, double& xmin, double& ymin, double& xmax, double& ymax)
 {
     for (std::size_t i = 0; i < cloud.size(); ++i) {
@@ -117,14 +139,7 @@ EpochRaster rasterise(const PointCloud& cloud, const Grid& grid, CellStatistic s
         const std::uint32_t cell = keyed[begin].first;
         r.count[cell] = static_cast<std::uint32_t>(n);
         r.roughness[cell] = std::sqrt(squares / static_cast<double>(n));
-        switch (statistic) {
-        case CellStatistic::Min: r.z[cell] = keyed[begin].second; break;
-        case CellStatistic::Max: r.z[cell] = keyed[end - 1].second; break;
-        case CellStatistic::Mean: r.z[cell] = mean; break;
-        case CellStatistic::Median:
-            r.z[cell] = n % 2 ? keyed[begin + n / 2].second : 0.5 * (keyed[begin + n / 2 - 1].second + keyed[begin + n / 2].second);
-            break;
-        }
+        r.z[cell] = cellHeight(statistic, n, mean, [&](std::size_t k) { return keyed[begin + k].second; });
         begin = end;
     }
     return r;
@@ -315,11 +330,11 @@ const ScalarField* mainGridField(const PointCloud& cloud)
 {
     if (!cloud.field(fields::kRasterCol) || !cloud.field(fields::kRasterRow))
         return nullptr;
-    for (const char* name : {fields::kDodDifference, "m3c2_distance", fields::kCellHeight})
+    for (const char* name : {fields::kDodDifference, fields::kM3c2Distance, fields::kCellHeight})
         if (const ScalarField* f = cloud.field(name))
             return f;
     for (const ScalarField& f : cloud.fields())
-        if (f.name() != fields::kRasterCol && f.name() != fields::kRasterRow && f.name() != fields::kPointCount)
+        if (!isGridBookkeeping(f.name()))
             return &f;
     return nullptr;
 }
@@ -356,12 +371,11 @@ PointCloud rasteriseCloud(const PointCloud& cloud, const RasteriseParams& params
     std::vector<const ScalarField*> carried;
     if (params.fields.empty()) {
         for (const ScalarField& f : cloud.fields())
-            if (f.name() != fields::kRasterCol && f.name() != fields::kRasterRow && f.name() != fields::kPointCount &&
-                f.name() != fields::kCellHeight)
+            if (!isGridBookkeeping(f.name()) && f.name() != fields::kCellHeight)
                 carried.push_back(&f);
     } else {
         for (const std::string& name : params.fields) {
-            if (name == fields::kRasterCol || name == fields::kRasterRow || name == fields::kPointCount)
+            if (isGridBookkeeping(name))
                 throw Error(ErrorCode::InvalidArgument, "rasterise: '" + name + "' is a field of the grid itself; it cannot be carried");
             const ScalarField* f = cloud.field(name);
             if (!f)
@@ -435,19 +449,11 @@ PointCloud rasteriseCloud(const PointCloud& cloud, const RasteriseParams& params
     for (std::size_t r = 0; r < runs.size(); ++r) {
         const auto [begin, end] = runs[r];
         const std::size_t n = end - begin;
-        double height = 0;
-        switch (params.statistic) {
-        case CellStatistic::Min: height = keyed[begin].z; break;
-        case CellStatistic::Max: height = keyed[end - 1].z; break;
-        case CellStatistic::Mean:
-            for (std::size_t k = begin; k < end; ++k)
-                height += keyed[k].z;
-            height /= static_cast<double>(n);
-            break;
-        case CellStatistic::Median:
-            height = n % 2 ? keyed[begin + n / 2].z : 0.5 * (keyed[begin + n / 2 - 1].z + keyed[begin + n / 2].z);
-            break;
-        }
+        double sum = 0;
+        for (std::size_t k = begin; k < end; ++k)
+            sum += keyed[k].z;
+        const double height =
+            cellHeight(params.statistic, n, sum / static_cast<double>(n), [&, begin = begin](std::size_t k) { return keyed[begin + k].z; });
         const std::size_t cell = keyed[begin].cell;
         const std::size_t c = cell % grid.cols, rr = cell / grid.cols;
         out.positions()[r] = (Eigen::Vector3d(grid.x0 + (static_cast<double>(c) + 0.5) * grid.cell,
