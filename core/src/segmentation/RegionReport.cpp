@@ -231,7 +231,8 @@ std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const Region
         }
 
         if (distance) {
-            double sum = 0.0, squares = 0.0, extreme = 0.0;
+            double sum = 0.0, squares = 0.0, extreme = 0.0, lodSum = 0.0;
+            std::size_t lodCount = 0;
             for (std::size_t i : indices) {
                 if (!distance->hasValue(i))
                     continue;
@@ -241,6 +242,10 @@ std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const Region
                 if (r.distanceCount == 0 || std::abs(d) > std::abs(extreme))
                     extreme = d;
                 ++r.distanceCount;
+                if (uncertainty && uncertainty->hasValue(i)) {
+                    lodSum += uncertainty->value(i);
+                    ++lodCount;
+                }
             }
             if (r.distanceCount > 0) {
                 const double n = static_cast<double>(r.distanceCount);
@@ -248,15 +253,6 @@ std::vector<RegionStatistics> regionReport(const PointCloud& cloud, const Region
                 r.rmsDistance = std::sqrt(squares / n);
                 r.maxDistance = extreme;
             }
-        }
-        if (uncertainty && r.distanceCount > 0) {
-            double lodSum = 0.0;
-            std::size_t lodCount = 0;
-            for (std::size_t i : indices)
-                if (distance->hasValue(i) && uncertainty->hasValue(i)) {
-                    lodSum += uncertainty->value(i);
-                    ++lodCount;
-                }
             if (lodCount > 0) {
                 r.distanceVolume = r.outlineArea * r.meanDistance;
                 r.distanceVolumeUncertainty = r.outlineArea * lodSum / static_cast<double>(lodCount);
