@@ -119,25 +119,28 @@ void addSegmentCommand(CLI::App& app, const PluginRegistry& registry, Streams st
 
 namespace {
 
-//! compare --method m3c2: the m3c2 tool (its declaration, as `scandiff-cli
-//! m3c2` and the workbench run it), then the significant core points
-//! segmented and exported; DIR/core_points.EXT holds every M3C2 field and the
-//! regions, DIR/m3c2_raster.tif the raster when --raster-cell is given.
-void compareByM3c2(const ToolSpec& tool, const std::map<std::string, std::string>& m3c2Text, const std::string& corePointsFile,
-                   std::map<std::string, std::string> segmentText, const PointCloud& reference, const PointCloud& compared,
-                   const ExportFlags& flags, const PluginRegistry& registry, const io::ReadOptions& readOptions,
-                   const io::WriteOptions& write, TerminalProgress& progress, Streams streams)
+//! compare --method m3c2 segments the significant changes, reported with
+//! their distances, unless told otherwise.
+std::map<std::string, std::string> withM3c2SegmentDefaults(std::map<std::string, std::string> segmentText)
 {
-    // By default the regions are the significant changes, reported with their distances.
     segmentText.emplace("field", fields::kM3c2Significant);
     if (!segmentText.count("range") && !segmentText.count("kmeans") && !segmentText.count("stat-test") &&
         !segmentText.count("propagate") && segmentText["field"] == fields::kM3c2Significant)
         segmentText.emplace("above", "0.5");
     segmentText.emplace("components", "true");
     segmentText.emplace("report-field", fields::kM3c2Distance);
-    const ParameterValues segmentValues = resolveParameters(segmentationParameters(), segmentText, "compare");
-    const ParameterValues m3c2Values = tool.resolve(m3c2Text);
+    return segmentText;
+}
 
+//! compare --method m3c2: the m3c2 tool (its declaration, as `scandiff-cli
+//! m3c2` and the workbench run it), then the significant core points
+//! segmented and exported; DIR/core_points.EXT holds every M3C2 field and the
+//! regions, DIR/m3c2_raster.tif the raster when --raster-cell is given.
+void compareByM3c2(const ToolSpec& tool, const ParameterValues& m3c2Values, const std::string& corePointsFile,
+                   const ParameterValues& segmentValues, const PointCloud& reference, const PointCloud& compared,
+                   const ExportFlags& flags, const PluginRegistry& registry, const io::ReadOptions& readOptions,
+                   const io::WriteOptions& write, TerminalProgress& progress, Streams streams)
+{
     std::optional<PointCloud> corePoints;
     if (!corePointsFile.empty())
         corePoints = io::readPointCloud(registry.formats, corePointsFile, readOptions);
@@ -229,10 +232,13 @@ void addCompareCommand(CLI::App& app, const PluginRegistry& registry, Streams st
             std::map<std::string, std::string> m3c2Text;
             for (const auto& [name, text] : *args->m3c2Values)
                 m3c2Text[args->m3c2Renamed.at(name)] = text;
-            m3c2Tool->resolve(m3c2Text); // bad parameters are reported before the reads
+            // Bad parameters are reported before the (possibly long) reads.
+            const ParameterValues m3c2Values = m3c2Tool->resolve(m3c2Text);
+            const ParameterValues segmentValues =
+                resolveParameters(segmentationParameters(), withM3c2SegmentDefaults(*args->segmentValues), "compare");
             const PointCloud reference = io::readPointCloud(registry.formats, args->reference, readOptions);
             const PointCloud compared = io::readPointCloud(registry.formats, args->compared, readOptions);
-            compareByM3c2(*m3c2Tool, m3c2Text, args->corePoints, *args->segmentValues, reference, compared, args->exportFlags, registry,
+            compareByM3c2(*m3c2Tool, m3c2Values, args->corePoints, segmentValues, reference, compared, args->exportFlags, registry,
                           readOptions, write, progress, streams);
             return;
         }
