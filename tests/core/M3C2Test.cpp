@@ -131,8 +131,8 @@ double value(const PointCloud& cloud, const char* field, std::size_t i) { return
 
 TEST(M3C2, EqualsTheDefinitionEvaluatedByBruteForceAtEveryCorePoint)
 {
-    // Two rough epochs with different global shifts; the cylinder is 5 slices
-    // long (H = 5 r) so points are gathered slice by slice.
+    // Two rough epochs with different global shifts; cylinders five times
+    // longer than wide (H = 5 r).
     const PointCloud reference = roughSurface(6000, 12.0, 0.0, 0.01, 1, {500000, 4000000, 100});
     PointCloud compared = roughSurface(5000, 12.0, 0.04, 0.015, 2, {500010, 4000003, 90});
     PointCloud cores = reference.subset([] {

@@ -509,6 +509,81 @@ TEST(Octree, BatchRadiusEqualsBruteForceForOwnAndOtherQueries)
                  std::invalid_argument);
 }
 
+//! The points of `cloud` inside the cylinder by its definition, with their
+//! positions along the axis: (index, t) in index order.
+std::vector<std::pair<std::uint32_t, double>> bruteForceCylinder(const Cloud& cloud, const Octree::CylinderQuery& q)
+{
+    std::vector<std::pair<std::uint32_t, double>> inside;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Eigen::Vector3d v = cloud[i].cast<double>() - q.centre;
+        const double t = v.dot(q.axis);
+        if (std::abs(t) <= q.halfLength && v.squaredNorm() - t * t <= q.radius * q.radius)
+            inside.emplace_back(static_cast<std::uint32_t>(i), t);
+    }
+    return inside;
+}
+
+TEST(Octree, CylinderBatchEqualsBruteForceWhateverTheCylinder)
+{
+    std::mt19937 rng(31);
+    std::normal_distribution<double> g(0.0, 1.0);
+    std::uniform_real_distribution<double> u(-6.0, 6.0);
+    for (const Shape& shape : kShapes) {
+        const Cloud cloud = shape.make(900, rng);
+        const Octree tree(cloud.data(), cloud.size());
+        std::vector<Octree::CylinderQuery> queries;
+        // Short and long (a long thin oblique one is found by descent), on the
+        // cloud's points and anywhere, along random directions and the axes.
+        for (double radius : {0.0, 0.05, 0.4, 2.5})
+            for (double halfLength : {0.0, 0.1, 1.0, 30.0})
+                for (int k = 0; k < 6; ++k) {
+                    Octree::CylinderQuery q;
+                    q.centre = k % 2 ? cloud[static_cast<std::size_t>(k) * 97].cast<double>() : Eigen::Vector3d(u(rng), u(rng), u(rng));
+                    q.axis = k < 2 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+                    q.radius = radius;
+                    q.halfLength = halfLength;
+                    queries.push_back(q);
+                }
+        // The planar cloud lies at z = 1.5: a cylinder ending exactly on it holds it (closed ends).
+        Octree::CylinderQuery onEnd;
+        onEnd.centre = {1.0, 1.0, 1.0};
+        onEnd.radius = 1.0;
+        onEnd.halfLength = 0.5;
+        queries.push_back(onEnd);
+        Octree::CylinderQuery far = onEnd;
+        far.centre = {1e7, 0, 0};
+        queries.push_back(far);
+        const std::size_t usable = queries.size();
+        Octree::CylinderQuery unusable = onEnd;
+        unusable.centre.x() = std::nan("");
+        queries.push_back(unusable);
+        unusable = onEnd;
+        unusable.axis.setZero();
+        queries.push_back(unusable);
+        unusable = onEnd;
+        unusable.radius = -1;
+        queries.push_back(unusable);
+
+        std::vector<std::vector<std::pair<std::uint32_t, double>>> got(queries.size());
+        std::vector<int> visits(queries.size(), 0);
+        tree.withinCylinderBatch(queries.data(), queries.size(),
+                                 [&](std::uint32_t q, const std::uint32_t* indices, const double* along, std::size_t count) {
+                                     for (std::size_t i = 0; i < count; ++i)
+                                         got[q].emplace_back(indices[i], along[i]);
+                                     ++visits[q];
+                                 });
+        for (std::size_t q = 0; q < queries.size(); ++q) {
+            ASSERT_EQ(visits[q], 1) << shape.name << " query " << q;
+            std::sort(got[q].begin(), got[q].end());
+            const auto expected = q < usable ? bruteForceCylinder(cloud, queries[q]) : std::vector<std::pair<std::uint32_t, double>>{};
+            ASSERT_EQ(got[q], expected) << shape.name << " query " << q << " radius " << queries[q].radius << " half-length "
+                                        << queries[q].halfLength;
+        }
+        if (std::string(shape.name) == "planar")
+            EXPECT_FALSE(got[usable - 2].empty()) << "the points on the cylinder's end";
+    }
+}
+
 TEST(Octree, BatchMomentsEqualTheBruteForceNeighbourhoods)
 {
     std::mt19937 rng(29);

@@ -8,10 +8,10 @@
 #include <scandiff/core/Error.h>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cfloat>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -157,75 +157,34 @@ CylinderStats summarise(std::vector<double>& t, const M3c2Params& params)
     return s;
 }
 
-//! The cylinder of every core point in one epoch. The cylinder (radius r,
-//! half-length H) is cut along its axis into m slices of length s <= 2r; each
-//! slice lies in a sphere of radius sqrt(r² + (s/2)²) <= r·√2 around its
-//! centre, so the octree's sphere queries gather few points beyond it even
-//! when H is many times r, and a point is kept by the slice its t falls in
-//! (half-open intervals: never twice).
+//! The cylinder of every core point in one epoch (the octree's cylinder
+//! query: the exact test in double, reading only the cells near the axis).
 std::vector<CylinderStats> cylinderStats(const octree::Octree& epoch, const std::vector<Eigen::Vector3f>& cores,
                                          const std::vector<Eigen::Vector3d>& normals, const M3c2Params& params,
                                          const std::string& stage, ProgressObserver* progress)
 {
     const std::size_t n = cores.size();
-    const double r = params.projectionScale / 2;
-    const double h = params.maxDepth;
-    const auto slices = static_cast<std::size_t>(std::max(1.0, std::ceil(h / r)));
-    const double length = 2 * h / static_cast<double>(slices);
-    double reach = 0.0;
-    for (const Eigen::Vector3f& c : cores)
-        reach = std::max(reach, static_cast<double>(c.cwiseAbs().maxCoeff()));
-    // The slice centres are rounded to float and the octree compares float
-    // squared distances: a margin above both roundings keeps every point of the
-    // slice inside its sphere; the exact test below is in double.
-    const double exactRadius = std::sqrt(r * r + length * length / 4);
-    const auto sphere = static_cast<float>(exactRadius * (1 + 1e-4) + 16 * FLT_EPSILON * (reach + h));
-
     std::vector<CylinderStats> stats(n);
-    const std::size_t coresPerBatch = std::max<std::size_t>(1, kQueriesPerBatch / slices);
-    std::vector<std::vector<double>> lists(coresPerBatch * slices);
-    std::vector<Eigen::Vector3f> centres(coresPerBatch * slices);
-    const Eigen::Vector3f* points = epoch.points();
-    ProgressTicker ticker(progress, stage, n * slices);
-    for (std::size_t begin = 0; begin < n; begin += coresPerBatch) {
-        const std::size_t count = std::min(coresPerBatch, n - begin);
-        for (std::size_t j = 0; j < count; ++j)
-            for (std::size_t k = 0; k < slices; ++k) {
-                const double t = -h + (static_cast<double>(k) + 0.5) * length;
-                const Eigen::Vector3d& axis = normals[begin + j];
-                // A core point without a normal gets no query (a NaN centre).
-                centres[j * slices + k] = axis.isZero() ? Eigen::Vector3f(Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()))
-                                                        : Eigen::Vector3f((cores[begin + j].cast<double>() + t * axis).cast<float>());
-                lists[j * slices + k].clear();
-            }
-        epoch.withinRadiusBatch(centres.data(), count * slices, sphere,
-                                [&](std::uint32_t q, const octree::Neighbour* found, std::size_t size) {
-                                    detail::stepSparingly(ticker);
-                                    const std::size_t j = q / slices, k = q % slices;
-                                    const Eigen::Vector3d c = cores[begin + j].cast<double>();
-                                    const Eigen::Vector3d& axis = normals[begin + j];
-                                    const double lo = -h + static_cast<double>(k) * length;
-                                    const double hi = k + 1 == slices ? h : lo + length;
-                                    const bool last = k + 1 == slices;
-                                    std::vector<double>& list = lists[q];
-                                    for (std::size_t f = 0; f < size; ++f) {
-                                        const Eigen::Vector3d v = points[found[f].index].cast<double>() - c;
-                                        const double t = v.dot(axis);
-                                        if (t < lo || t > hi || (t == hi && !last))
-                                            continue;
-                                        if (v.squaredNorm() - t * t <= r * r)
-                                            list.push_back(t);
-                                    }
-                                });
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 64), [&](const tbb::blocked_range<std::size_t>& range) {
-            std::vector<double> t;
-            for (std::size_t j = range.begin(); j < range.end(); ++j) {
-                t.clear();
-                for (std::size_t k = 0; k < slices; ++k)
-                    t.insert(t.end(), lists[j * slices + k].begin(), lists[j * slices + k].end());
-                stats[begin + j] = summarise(t, params);
-            }
-        });
+    std::vector<octree::Octree::CylinderQuery> cylinders(std::min(kQueriesPerBatch, n));
+    tbb::enumerable_thread_specific<std::vector<double>> positions;
+    ProgressTicker ticker(progress, stage, n);
+    for (std::size_t begin = 0; begin < n; begin += kQueriesPerBatch) {
+        const std::size_t count = std::min(kQueriesPerBatch, n - begin);
+        for (std::size_t j = 0; j < count; ++j) {
+            octree::Octree::CylinderQuery& cylinder = cylinders[j];
+            cylinder.centre = cores[begin + j].cast<double>();
+            // A core point without a normal gets no query (a zero axis).
+            cylinder.axis = normals[begin + j];
+            cylinder.radius = params.projectionScale / 2;
+            cylinder.halfLength = params.maxDepth;
+        }
+        epoch.withinCylinderBatch(cylinders.data(), count,
+                                  [&](std::uint32_t q, const std::uint32_t*, const double* along, std::size_t size) {
+                                      detail::stepSparingly(ticker);
+                                      std::vector<double>& t = positions.local();
+                                      t.assign(along, along + size);
+                                      stats[begin + q] = summarise(t, params);
+                                  });
         ticker.checkCancel();
     }
     return stats;

@@ -202,6 +202,36 @@ public:
     using MomentsVisitor = std::function<void(std::uint32_t query, const NeighbourhoodMoments& moments)>;
     void radiusMomentsBatch(const Eigen::Vector3f* queries, std::size_t count, float radius, const MomentsVisitor& visit) const;
 
+    //! A finite cylinder in the octree's frame (the points' coordinates), in
+    //! double: the points p with t = (p - centre)·axis in [-halfLength,
+    //! halfLength] and |p - centre|² - t² <= radius². `axis` must be of unit length.
+    struct CylinderQuery
+    {
+        Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+        Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+        double radius = 0.0;
+        double halfLength = 0.0;
+    };
+    //! Receives one cylinder's points in withinCylinderBatch(): their indices
+    //! and their positions t along the axis, in no particular order (the same
+    //! order for the same inputs, whatever the number of threads).
+    using CylinderVisitor =
+        std::function<void(std::uint32_t query, const std::uint32_t* indices, const double* positions, std::size_t count)>;
+
+    //! Every point inside each cylinder, by the exact test above in double on
+    //! the float points, in parallel (TBB). Only the cells the cylinder can
+    //! touch are read (those whose centre lies within the radius plus their
+    //! half-diagonal of the axis segment), at the deepest level whose cells are
+    //! at least the radius wide; a cylinder so long that its bounding box holds
+    //! too many such cells is searched by descent from the root instead. What
+    //! M3C2 needs, a cylinder per core point: a sphere around it would read
+    //! several times the cylinder's points on a surface. `visit` is called
+    //! exactly once per query, from the worker threads, concurrently; an
+    //! exception it throws (a cancellation) stops the batch and reaches the
+    //! caller. A query that is not finite, has a zero axis or a negative size
+    //! gets no point.
+    void withinCylinderBatch(const CylinderQuery* queries, std::size_t count, const CylinderVisitor& visit) const;
+
     //! The level of thesis 000 §4.5 (eq. 4.2) for k-nearest queries of the
     //! points of `queries`, an octree built on the same cube: the level that
     //! minimises the estimated cost of distances (candidates per query) plus
