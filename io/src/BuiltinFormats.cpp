@@ -8,6 +8,7 @@ void registerBuiltinFormats(FormatRegistry& registry)
     registry.add(detail::plyFormat());
     registry.add(detail::asciiFormat());
     registry.add(detail::lasFormat());
+    registry.add(detail::lazFormat());
     registry.add(detail::pcdFormat());
     registry.add(detail::meshFormat());
     registry.add(detail::dxfFormat());

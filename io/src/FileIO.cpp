@@ -36,8 +36,6 @@ const FormatHandler& FormatRegistry::forPath(const fs::path& path) const
     for (const auto& h : handlers_)
         for (const auto& e : h.extensions)
             known += (known.empty() ? "" : ", ") + e;
-    if (ext == "laz")
-        throw Error(ErrorCode::Unsupported, path.string() + ": compressed LAS (LAZ) is not supported; decompress it to .las first (e.g. with laszip or pdal translate)");
     throw Error(ErrorCode::Unsupported, path.string() + ": unknown file extension '" + ext + "' (supported: " + known + ")");
 }
 
@@ -88,6 +86,8 @@ Mesh readMesh(const FormatRegistry& registry, const fs::path& path, const ReadOp
 void writePointCloud(const FormatRegistry& registry, const PointCloud& cloud, const fs::path& path, const WriteOptions& options)
 {
     const FormatHandler& handler = registry.forPath(path);
+    if (!handler.writeCloud && !handler.writeMesh && handler.read)
+        throw Error(ErrorCode::Unsupported, path.string() + ": " + handler.name + " files can be read but not written by this build");
     if (!handler.writeCloud)
         throw Error(ErrorCode::Unsupported, path.string() + ": " + handler.name + " cannot store point clouds");
     cloud.checkConsistency();

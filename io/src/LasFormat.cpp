@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-//! LAS: reads LAS 1.0-1.4 (point data record formats 0-10, uncompressed) straight
-//! from a memory map, and writes LAS 1.4 with point format 6, 7 or 8.
+//! LAS: reads LAS 1.0-1.4 (point data record formats 0-10) straight from a
+//! memory map, or from the records LazDecoder.cpp decompresses when the points
+//! are LAZ, and writes LAS 1.4 with point format 6, 7 or 8.
 //!
 //! Layout facts quoted below come from the ASPRS LAS 1.4 specification, R15
 //! ("LAS 1.4 R15"), which also describes the older versions this reader accepts.
 
 #include "internal/Formats.h"
+#include "internal/LazDecoder.h"
 #include "internal/MappedFile.h"
 
 #include <scandiff/core/Error.h>
@@ -126,6 +128,7 @@ struct LasHeader
     Eigen::Vector3d offset = Eigen::Vector3d::Zero();
     Eigen::Vector3d min = Eigen::Vector3d::Zero();
     Eigen::Vector3d max = Eigen::Vector3d::Zero();
+    bool compressed = false; //!< LAZ: the points are LASzip's
 };
 
 [[noreturn]] void invalid(const fs::path& path, const std::string& what)
@@ -167,12 +170,9 @@ LasHeader parseHeader(const MappedFile& file)
 
     const auto formatByte = static_cast<unsigned char>(data[hdr::pointFormat]);
     // LASzip marks compressed points by setting bit 7 of the format id (bit 6 in
-    // some older writers); the points are then unreadable without LASzip.
-    if (formatByte & 0xC0)
-        throw Error(ErrorCode::Unsupported, path.string() +
-                                                ": compressed LAS (LAZ) is not supported; decompress it to .las first "
-                                                "(e.g. with laszip or pdal translate)");
-    h.pointFormat = formatByte;
+    // some older writers).
+    h.compressed = (formatByte & 0xC0) != 0;
+    h.pointFormat = formatByte & 0x3F;
     if (h.pointFormat > 10)
         invalid(path, "unknown point data record format " + std::to_string(h.pointFormat) +
                           " at byte 104 (0 to 10 are defined)");
@@ -223,7 +223,16 @@ LasHeader parseHeader(const MappedFile& file)
     }
 
     const std::uint64_t available = size - h.offsetToPoints;
-    if (h.pointCount > available / h.recordLength)
+    // LASzip's coders spend at least a few thousandths of a bit on a point
+    // (every adaptive model keeps a floor under each probability), so no LAZ
+    // file holds more than about a thousand points per byte; ten thousand
+    // bounds the allocation for a header that lies.
+    constexpr std::uint64_t kMaxLazPointsPerByte = 10000;
+    if (h.compressed && h.pointCount / kMaxLazPointsPerByte > available)
+        invalid(path, "the header claims " + std::to_string(h.pointCount) + " points, more than " +
+                          std::to_string(kMaxLazPointsPerByte) + " per byte of the " + std::to_string(available) +
+                          " bytes of compressed point data");
+    if (!h.compressed && h.pointCount > available / h.recordLength)
         invalid(path, "truncated: " + std::to_string(h.pointCount) + " points of " + std::to_string(h.recordLength) +
                           " bytes need " +
                           (h.pointCount > std::numeric_limits<std::uint64_t>::max() / h.recordLength
@@ -688,12 +697,40 @@ std::string uniqueFieldName(const PointCloud& cloud, std::string name)
     }
 }
 
+//! The uncompressed point records of a LAZ file.
+std::vector<char> decompressRecords(const MappedFile& file, const LasHeader& h, const ReadOptions& options)
+{
+    const fs::path& path = file.path();
+    std::optional<LazLayout> layout;
+    forEachRecord(file, h, false, [&](const std::string& user, std::uint16_t id, const char* payload, std::size_t length) {
+        if (user != kLaszipUserId || id != kLaszipRecordId)
+            return false;
+        layout = parseLazLayout(path, payload, length, h.recordLength);
+        return true;
+    });
+    if (!layout)
+        invalid(path, "the point format (byte 104) says the points are compressed (LAZ), but there is no LASzip record "
+                      "(user id 'laszip encoded', record 22204)");
+    std::vector<char> records;
+    try {
+        records.resize(static_cast<std::size_t>(h.pointCount) * h.recordLength);
+    } catch (const std::bad_alloc&) {
+        throw Error(ErrorCode::Io, path.string() + ": not enough memory to decompress " + std::to_string(h.pointCount) + " points");
+    }
+    ProgressTicker ticker(options.progress, "Decompressing " + path.filename().string(), h.pointCount);
+    decompressLaz(path, file.data(), file.size(), h.offsetToPoints, *layout, h.recordLength, h.pointCount, records.data(),
+                  [&](std::size_t points) { ticker.step(points); });
+    return records;
+}
+
 Entity readLas(const fs::path& path, const ReadOptions& options)
 {
     MappedFile file(path);
     const LasHeader h = parseHeader(file);
     const std::size_t count = static_cast<std::size_t>(h.pointCount);
-    const char* records = file.data() + h.offsetToPoints;
+    // LAZ: the records decompressed into memory (freed at the end of the read).
+    const std::vector<char> decompressed = h.compressed ? decompressRecords(file, h, options) : std::vector<char>();
+    const char* records = h.compressed ? decompressed.data() : file.data() + h.offsetToPoints;
     const int format = h.pointFormat;
     std::vector<ExtraDimension> extras = findExtraDimensions(file, h);
 
@@ -775,7 +812,8 @@ Entity readLas(const fs::path& path, const ReadOptions& options)
     for (std::size_t begin = 0; begin < count; begin += kChunkPoints) {
         const std::size_t end = std::min(count, begin + kChunkPoints);
         colorBits |= decode(records, h.recordLength, begin, end, transform, out);
-        MappedFile::releaseConsumed(records + begin * h.recordLength, records + end * h.recordLength);
+        if (!h.compressed) // a heap buffer's pages would come back as zeros
+            MappedFile::releaseConsumed(records + begin * h.recordLength, records + end * h.recordLength);
         ticker.step(end - begin);
     }
     if (gpsResidualsFailed) {
@@ -1205,6 +1243,15 @@ FormatHandler lasFormat()
     handler.writeCloud = [](const PointCloud& cloud, const fs::path& path, const WriteOptions& options) {
         writeLas(cloud, path, options);
     };
+    return handler;
+}
+
+FormatHandler lazFormat()
+{
+    FormatHandler handler;
+    handler.name = "LAZ";
+    handler.extensions = {"laz"};
+    handler.read = [](const fs::path& path, const ReadOptions& options) { return readLas(path, options); };
     return handler;
 }
 

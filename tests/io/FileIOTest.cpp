@@ -39,7 +39,7 @@ TEST(FileIO, ExtensionsAreCaseInsensitive)
     EXPECT_EQ(io::lowerExtension("a/b/C.LaS"), "las");
 }
 
-TEST(FileIO, UnknownExtensionAndLazAreUnsupported)
+TEST(FileIO, UnknownExtensionIsUnsupportedAndABrokenLazInvalid)
 {
     const auto registry = builtins();
     const auto dir = test::tempDir();
@@ -48,8 +48,8 @@ TEST(FileIO, UnknownExtensionAndLazAreUnsupported)
     std::string message;
     EXPECT_EQ(readError(registry, dir / "scan.e57", &message), ErrorCode::Unsupported);
     EXPECT_NE(message.find("scan.e57"), std::string::npos);
-    EXPECT_EQ(readError(registry, dir / "scan.laz", &message), ErrorCode::Unsupported);
-    EXPECT_NE(message.find("compressed LAS"), std::string::npos);
+    EXPECT_EQ(readError(registry, dir / "scan.laz", &message), ErrorCode::InvalidData);
+    EXPECT_NE(message.find("LAS header too short"), std::string::npos);
 }
 
 TEST(FileIO, MissingAndEmptyFilesNameTheFile)

@@ -732,22 +732,13 @@ TEST_F(LasBadInput, UnknownPointFormat)
     expectInvalid("format11.las", b.str(), ErrorCode::InvalidData, "unknown point data record format 11");
 }
 
-TEST_F(LasBadInput, CompressedPointFormatIsUnsupported)
+TEST_F(LasBadInput, CompressedPointsWithoutALaszipRecord)
 {
     Bytes b = makeLas12Format1();
     b.put<std::uint8_t>(104, 0x80 | 1);
-    expectInvalid("compressed.las", b.str(), ErrorCode::Unsupported, "compressed LAS (LAZ) is not supported");
+    expectInvalid("compressed.las", b.str(), ErrorCode::InvalidData, "no LASzip record");
     b.put<std::uint8_t>(104, 0x40 | 1);
-    expectInvalid("compressed_bit6.las", b.str(), ErrorCode::Unsupported, "LAZ");
-}
-
-TEST_F(LasBadInput, LazExtensionIsUnsupported)
-{
-    const fs::path file = dir_ / "scan.laz";
-    test::writeText(file, makeLas12Format1().str());
-    auto registry = lasRegistry();
-    expectError([&] { registry.forPath(file); }, ErrorCode::Unsupported, file, "LAZ");
-    expectError([&] { io::readPointCloud(registry, file); }, ErrorCode::Unsupported, file, "LAZ");
+    expectInvalid("compressed_bit6.las", b.str(), ErrorCode::InvalidData, "no LASzip record");
 }
 
 TEST_F(LasBadInput, OffsetToPointDataBeyondTheFile)

@@ -9,6 +9,7 @@ namespace scandiff::io::detail {
 FormatHandler plyFormat();        // PlyFormat.cpp
 FormatHandler asciiFormat();      // AsciiFormat.cpp
 FormatHandler lasFormat();        // LasFormat.cpp
+FormatHandler lazFormat();        // LasFormat.cpp (reading; LazDecoder.cpp decompresses)
 FormatHandler pcdFormat();        // PcdFormat.cpp
 FormatHandler meshFormat();       // MeshFormats.cpp (readers in MeshReaders.cpp)
 FormatHandler dxfFormat();        // DxfWriter.cpp (export only)

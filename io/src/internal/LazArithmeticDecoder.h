@@ -1,0 +1,309 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! The entropy decoder of LAZ (internal to io/): the adaptive arithmetic coder
+//! LASzip uses (A. Said, "Introduction to Arithmetic Coding - Theory and
+//! Practice", HP Labs HPL-2004-76, in the variant M. Isenburg published with
+//! LASzip, "LASzip: lossless compression of LiDAR data", PE&RS 79(2), 2013),
+//! its adaptive symbol and bit models, and the integer decompressor that codes
+//! a value as a correction to a prediction. Every constant and update rule
+//! must match the encoder bit for bit, or the stream decodes into garbage:
+//! they are LASzip's, from its published description and source.
+//!
+//! Written by hand because Debian 12 packages no LAZ library (no LASzip, no
+//! laz-perf, no PDAL).
+
+#include <cstdint>
+#include <vector>
+
+namespace scandiff::io::detail::laz {
+
+constexpr std::uint32_t kMinLength = 0x01000000u; //!< renormalise below this interval length
+constexpr std::uint32_t kMaxLength = 0xFFFFFFFFu;
+constexpr std::uint32_t kBitLengthShift = 13;     //!< bit models: probability precision
+constexpr std::uint32_t kBitMaxCount = 1u << kBitLengthShift;
+constexpr std::uint32_t kSymbolLengthShift = 15;  //!< symbol models: distribution precision
+constexpr std::uint32_t kSymbolMaxCount = 1u << kSymbolLengthShift;
+
+//! An adaptive model of one binary decision.
+struct BitModel
+{
+    std::uint32_t updateCycle = 4, bitsUntilUpdate = 4;
+    std::uint32_t bit0Probability = 1u << (kBitLengthShift - 1);
+    std::uint32_t bit0Count = 1, bitCount = 2;
+
+    void update()
+    {
+        // Halve the counts when they reach the maximum, then rescale.
+        if ((bitCount += updateCycle) > kBitMaxCount) {
+            bitCount = (bitCount + 1) >> 1;
+            bit0Count = (bit0Count + 1) >> 1;
+            if (bit0Count == bitCount)
+                ++bitCount;
+        }
+        const std::uint32_t scale = 0x80000000u / bitCount;
+        bit0Probability = (bit0Count * scale) >> (31 - kBitLengthShift);
+        updateCycle = (5 * updateCycle) >> 2;
+        if (updateCycle > 64)
+            updateCycle = 64;
+        bitsUntilUpdate = updateCycle;
+    }
+};
+
+//! An adaptive model of an alphabet of 2..2048 symbols, with the lookup table
+//! that speeds decoding of alphabets larger than 16.
+class SymbolModel
+{
+public:
+    explicit SymbolModel(std::uint32_t symbols) : symbols_(symbols), lastSymbol_(symbols - 1)
+    {
+        if (symbols > 16) {
+            std::uint32_t tableBits = 3;
+            while (symbols > (1u << (tableBits + 2)))
+                ++tableBits;
+            tableSize_ = 1u << tableBits;
+            tableShift_ = kSymbolLengthShift - tableBits;
+            decoderTable_.resize(tableSize_ + 2);
+        }
+        distribution_.resize(symbols);
+        counts_.assign(symbols, 1);
+        updateCycle_ = symbols;
+        update();
+        updateCycle_ = symbolsUntilUpdate_ = (symbols + 6) >> 1;
+    }
+
+    void update()
+    {
+        if ((totalCount_ += updateCycle_) > kSymbolMaxCount) {
+            totalCount_ = 0;
+            for (std::uint32_t& c : counts_)
+                totalCount_ += (c = (c + 1) >> 1);
+        }
+        std::uint32_t sum = 0, s = 0;
+        const std::uint32_t scale = 0x80000000u / totalCount_;
+        for (std::uint32_t k = 0; k < symbols_; ++k) {
+            distribution_[k] = (scale * sum) >> (31 - kSymbolLengthShift);
+            sum += counts_[k];
+            if (tableSize_ != 0) {
+                const std::uint32_t w = distribution_[k] >> tableShift_;
+                while (s < w)
+                    decoderTable_[++s] = k - 1;
+            }
+        }
+        if (tableSize_ != 0) {
+            decoderTable_[0] = 0;
+            while (s <= tableSize_)
+                decoderTable_[++s] = symbols_ - 1;
+        }
+        updateCycle_ = (5 * updateCycle_) >> 2;
+        const std::uint32_t maxCycle = (symbols_ + 6) << 3;
+        if (updateCycle_ > maxCycle)
+            updateCycle_ = maxCycle;
+        symbolsUntilUpdate_ = updateCycle_;
+    }
+
+private:
+    friend class ArithmeticDecoder;
+    std::uint32_t symbols_, lastSymbol_;
+    std::uint32_t tableSize_ = 0, tableShift_ = 0;
+    std::uint32_t totalCount_ = 0, updateCycle_ = 0, symbolsUntilUpdate_ = 0;
+    std::vector<std::uint32_t> distribution_, counts_, decoderTable_;
+};
+
+//! Decodes from the bytes [begin, end); beyond `end` it reads zeros and counts
+//! them, so a corrupt stream can be told from a whole one.
+class ArithmeticDecoder
+{
+public:
+    ArithmeticDecoder(const unsigned char* begin, const unsigned char* end) : next_(begin), end_(end)
+    {
+        for (int i = 0; i < 4; ++i)
+            value_ = (value_ << 8) | byte();
+    }
+
+    //! Where the next byte would be read (past `end` when it ran out).
+    const unsigned char* position() const { return next_; }
+    std::size_t bytesPastEnd() const { return pastEnd_; }
+
+    std::uint32_t decodeBit(BitModel& m)
+    {
+        const std::uint32_t x = m.bit0Probability * (length_ >> kBitLengthShift);
+        const std::uint32_t bit = value_ >= x;
+        if (bit == 0) {
+            length_ = x;
+            ++m.bit0Count;
+        } else {
+            value_ -= x;
+            length_ -= x;
+        }
+        if (length_ < kMinLength)
+            renormalise();
+        if (--m.bitsUntilUpdate == 0)
+            m.update();
+        return bit;
+    }
+
+    std::uint32_t decodeSymbol(SymbolModel& m)
+    {
+        std::uint32_t symbol, x, y = length_;
+        if (!m.decoderTable_.empty()) {
+            // The table narrows the search to a few symbols, bisection ends it.
+            length_ >>= kSymbolLengthShift;
+            const std::uint32_t dv = value_ / length_;
+            const std::uint32_t t = dv >> m.tableShift_;
+            symbol = m.decoderTable_[t];
+            std::uint32_t n = m.decoderTable_[t + 1] + 1;
+            while (n > symbol + 1) {
+                const std::uint32_t k = (symbol + n) >> 1;
+                if (m.distribution_[k] > dv)
+                    n = k;
+                else
+                    symbol = k;
+            }
+            x = m.distribution_[symbol] * length_;
+            if (symbol != m.lastSymbol_)
+                y = m.distribution_[symbol + 1] * length_;
+        } else {
+            x = symbol = 0;
+            length_ >>= kSymbolLengthShift;
+            std::uint32_t n = m.symbols_;
+            std::uint32_t k = n >> 1;
+            do {
+                const std::uint32_t z = length_ * m.distribution_[k];
+                if (z > value_) {
+                    n = k;
+                    y = z;
+                } else {
+                    symbol = k;
+                    x = z;
+                }
+            } while ((k = (symbol + n) >> 1) != symbol);
+        }
+        value_ -= x;
+        length_ = y - x;
+        if (length_ < kMinLength)
+            renormalise();
+        ++m.counts_[symbol];
+        if (--m.symbolsUntilUpdate_ == 0)
+            m.update();
+        return symbol;
+    }
+
+    //! `bits` raw bits (1..32), not modelled.
+    std::uint32_t readBits(std::uint32_t bits)
+    {
+        if (bits > 19) {
+            const std::uint32_t low = readShort();
+            const std::uint32_t high = readBits(bits - 16) << 16;
+            return high | low;
+        }
+        length_ >>= bits;
+        const std::uint32_t value = value_ / length_;
+        value_ -= length_ * value;
+        if (length_ < kMinLength)
+            renormalise();
+        return value;
+    }
+
+    std::uint32_t readShort() { return readBits(16); }
+    //! Low 16 bits first.
+    std::uint32_t readInt()
+    {
+        const std::uint32_t low = readShort();
+        const std::uint32_t high = readShort();
+        return (high << 16) | low;
+    }
+
+private:
+    std::uint32_t byte()
+    {
+        if (next_ < end_)
+            return *next_++;
+        ++next_;
+        ++pastEnd_;
+        return 0;
+    }
+    void renormalise()
+    {
+        do
+            value_ = (value_ << 8) | byte();
+        while ((length_ <<= 8) < kMinLength);
+    }
+
+    const unsigned char* next_;
+    const unsigned char* end_;
+    std::size_t pastEnd_ = 0;
+    std::uint32_t value_ = 0, length_ = kMaxLength;
+};
+
+//! Integers of `bits` bits (32: any int32) coded as the correction to a
+//! prediction: first the number k of significant bits of the correction (a
+//! symbol model per context), then its value among the 2^k of that size (a
+//! model per k for the high `bitsHigh` bits, raw bits below). Sums wrap
+//! modulo 2^bits, as the encoder folded them.
+class IntegerDecompressor
+{
+public:
+    explicit IntegerDecompressor(std::uint32_t bits, std::uint32_t contexts = 1, std::uint32_t bitsHigh = 8)
+        : bitsHigh_(bitsHigh)
+    {
+        if (bits > 0 && bits < 32) {
+            correctionBits_ = bits;
+            range_ = 1u << bits;
+            minCorrection_ = -static_cast<std::int32_t>(range_ / 2);
+        }
+        sizeModels_.reserve(contexts);
+        for (std::uint32_t c = 0; c < contexts; ++c)
+            sizeModels_.emplace_back(correctionBits_ + 1);
+        valueModels_.reserve(correctionBits_);
+        for (std::uint32_t k = 1; k <= correctionBits_; ++k)
+            valueModels_.emplace_back(k <= bitsHigh ? 1u << k : 1u << bitsHigh);
+    }
+
+    std::int32_t decompress(ArithmeticDecoder& decoder, std::int32_t prediction, std::uint32_t context = 0)
+    {
+        const std::int32_t correction = readCorrection(decoder, sizeModels_[context]);
+        if (range_ == 0)
+            return static_cast<std::int32_t>(static_cast<std::uint32_t>(prediction) + static_cast<std::uint32_t>(correction));
+        std::int64_t value = std::int64_t(prediction) + correction;
+        if (value < 0)
+            value += range_;
+        else if (value >= std::int64_t(range_))
+            value -= range_;
+        return static_cast<std::int32_t>(value);
+    }
+
+    //! The size k of the last correction: the point coders use it as context.
+    std::uint32_t lastSize() const { return k_; }
+
+private:
+    std::int32_t readCorrection(ArithmeticDecoder& decoder, SymbolModel& sizeModel)
+    {
+        k_ = decoder.decodeSymbol(sizeModel);
+        if (k_ == 0)
+            return static_cast<std::int32_t>(decoder.decodeBit(zeroOrOne_));
+        if (k_ >= 32)
+            return minCorrection_;
+        std::int64_t c = decoder.decodeSymbol(valueModels_[k_ - 1]);
+        if (k_ > bitsHigh_) {
+            const std::uint32_t lowBits = k_ - bitsHigh_;
+            c = (c << lowBits) | decoder.readBits(lowBits);
+        }
+        // [0, 2^(k-1)) stands for [-(2^k - 1), -2^(k-1)], [2^(k-1), 2^k) for [2^(k-1) + 1, 2^k].
+        if (c >= (std::int64_t(1) << (k_ - 1)))
+            c += 1;
+        else
+            c -= (std::int64_t(1) << k_) - 1;
+        return static_cast<std::int32_t>(static_cast<std::uint32_t>(c));
+    }
+
+    std::uint32_t bitsHigh_;
+    std::uint32_t correctionBits_ = 32;
+    std::uint32_t range_ = 0; //!< 0: 32-bit values, wrapping as uint32
+    std::int32_t minCorrection_ = INT32_MIN;
+    std::uint32_t k_ = 0;
+    std::vector<SymbolModel> sizeModels_;
+    BitModel zeroOrOne_;
+    std::vector<SymbolModel> valueModels_; //!< index k - 1
+};
+
+} // namespace scandiff::io::detail::laz
