@@ -66,7 +66,7 @@ TEST(FuzzCorpus, EveryFileIsReadOrRefusedCleanly)
             }
     }
     // Every reader has its corpus.
-    for (const char* extension : {"ply", "pcd", "las", "xyz", "obj", "stl", "off"})
+    for (const char* extension : {"ply", "pcd", "las", "laz", "xyz", "obj", "stl", "off"})
         EXPECT_TRUE(extensions.count(extension)) << "no corpus for ." << extension;
     EXPECT_GT(files, 7u);
 }

@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! The coders of the parts ("items") of a LAZ point record (internal to io/):
+//! pointwise ones (LAS 1.0-1.3 records, one arithmetic stream for the whole
+//! record) in PointwiseItems.cpp, layered ones (LAS 1.4 records, a stream per
+//! attribute so a reader may skip some) in LayeredItems.cpp. Each item coder
+//! keeps the last item it produced and writes the next straight into the
+//! output record.
+
+#include "ArithmeticDecoder.h"
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <string>
+
+namespace scandiff::io::detail::laz {
+
+//! Item types of the LASzip record (LASzip's laszip.hpp).
+enum ItemType : std::uint16_t {
+    kByte = 0,
+    kPoint10 = 6,
+    kGpsTime11 = 7,
+    kRgb12 = 8,
+    kWavePacket13 = 9,
+    kPoint14 = 10,
+    kRgb14 = 11,
+    kRgbNir14 = 12,
+    kWavePacket14 = 13,
+    kByte14 = 14,
+};
+
+std::string itemName(std::uint16_t type);
+
+template <typename T>
+T load(const void* p)
+{
+    T value;
+    std::memcpy(&value, p, sizeof(T));
+    return value;
+}
+
+template <typename T>
+void store(void* p, T value)
+{
+    std::memcpy(p, &value, sizeof(T));
+}
+
+//! A byte plus a change, modulo 256 (LASzip's U8_FOLD).
+inline std::uint8_t fold(std::int32_t v) { return static_cast<std::uint8_t>(v & 0xFF); }
+inline std::int32_t clampByte(std::int32_t v) { return std::clamp(v, 0, 255); }
+
+//! The median of the last five values (of a coordinate's differences).
+struct StreamingMedian5
+{
+    std::array<std::int32_t, 5> v{};
+    bool high = true;
+
+    std::int32_t median() const { return v[2]; }
+    void add(std::int32_t x);
+};
+
+//! The six byte models of a colour and the decoding both RGB coders share:
+//! which bytes changed, then each byte's change, green and blue predicted
+//! from red's change.
+struct RgbModels
+{
+    SymbolModel byteUsed{128};
+    std::array<SymbolModel, 6> diff{SymbolModel(256), SymbolModel(256), SymbolModel(256),
+                                    SymbolModel(256), SymbolModel(256), SymbolModel(256)};
+};
+std::array<std::uint16_t, 3> decodeRgb(ArithmeticDecoder& d, RgbModels& models, const std::array<std::uint16_t, 3>& last);
+
+//! A pointwise item: decoded from the record's single stream.
+class PointwiseItem
+{
+public:
+    virtual ~PointwiseItem() = default;
+    virtual void decode(ArithmeticDecoder& decoder, unsigned char* item) = 0;
+};
+
+//! The coder of a pointwise item (point10, gpstime11, rgb12 or bytes,
+//! version 2), starting from the chunk's first item.
+std::unique_ptr<PointwiseItem> makePointwiseItem(std::uint16_t type, std::size_t size, const unsigned char* first);
+
+//! The bytes of one layer of a chunk (possibly none: the attribute never changes in it).
+struct Layer
+{
+    const unsigned char* data = nullptr;
+    std::size_t size = 0;
+};
+
+//! A layered item: each of its attributes in a stream of its own. The
+//! point14 item chooses the context (the scanner channel, 0-3) the others
+//! follow: each context keeps its own last values and models.
+class LayeredItem
+{
+public:
+    virtual ~LayeredItem() = default;
+    virtual std::size_t layerCount() const = 0;
+    //! Gives the chunk's layers (layerCount() of them) and the context of the
+    //! first point; the point14 item sets it from that point.
+    virtual void start(const Layer* layers, std::uint32_t& context) = 0;
+    virtual void decode(unsigned char* item, std::uint32_t& context) = 0;
+    //! Whether a layer's stream was read beyond its end: a corrupt chunk.
+    virtual bool overran() const = 0;
+};
+
+//! The coder of a layered item (point14, rgb14, rgbnir14 or byte14, version
+//! 3), starting from the chunk's first item.
+std::unique_ptr<LayeredItem> makeLayeredItem(std::uint16_t type, std::size_t size, const unsigned char* first);
+
+} // namespace scandiff::io::detail::laz

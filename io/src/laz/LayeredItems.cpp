@@ -1,0 +1,505 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+//! The layered item coders of LAZ, version 3 (LAS 1.4 point formats 6-10):
+//! point14, rgb14, rgbnir14 and byte14, after LASzip's
+//! lasreaditemcompressed_v3.cpp. Each attribute has a stream ("layer") of its
+//! own in a chunk, empty when the attribute never changes there; the state is
+//! kept per scanner channel (four contexts), a new context starting from the
+//! last point of the one before it.
+
+#include "Items.h"
+
+#include <optional>
+#include <vector>
+
+namespace scandiff::io::detail::laz {
+
+namespace {
+
+// The context of a return r of n (4-bit fields): the coordinates' medians are
+// kept per class of this map (6 classes), the last heights per level.
+constexpr std::uint8_t kReturnMap6[16][16] = {
+    {0, 1, 2, 3, 4, 5, 3, 4, 4, 5, 5, 5, 5, 5, 5, 5}, {1, 0, 1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3},
+    {2, 1, 2, 4, 4, 4, 4, 4, 4, 4, 4, 3, 3, 3, 3, 3}, {3, 3, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
+    {4, 3, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
+    {3, 3, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {4, 3, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4},
+    {4, 3, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4},
+    {5, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 4, 4, 4},
+    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4},
+    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5}};
+//! |n - r|, at most 7.
+constexpr std::uint32_t returnLevel8(std::uint32_t n, std::uint32_t r) { return std::min<std::uint32_t>(n > r ? n - r : r - n, 7); }
+
+//! A layer's decoder, when the layer has bytes.
+class LayerStream
+{
+public:
+    void open(const Layer& layer)
+    {
+        decoder_.reset();
+        if (layer.size > 0)
+            decoder_.emplace(layer.data, layer.data + layer.size);
+    }
+    bool changes() const { return decoder_.has_value(); }
+    ArithmeticDecoder& operator*() { return *decoder_; }
+    bool overran() const { return decoder_ && decoder_->bytesPastEnd() > 0; }
+
+private:
+    std::optional<ArithmeticDecoder> decoder_;
+};
+
+//! The fields of a LAS 1.4 point (formats 6-10, the first 30 bytes).
+struct Point14
+{
+    std::int32_t x = 0, y = 0, z = 0;
+    std::uint16_t intensity = 0;
+    std::uint32_t returnNumber = 0, numberOfReturns = 0;
+    std::uint32_t classificationFlags = 0, scannerChannel = 0, scanDirection = 0, edgeOfFlightLine = 0;
+    std::uint32_t classification = 0, userData = 0;
+    std::int16_t scanAngle = 0;
+    std::uint16_t pointSource = 0;
+    std::int64_t gpsTime = 0; //!< the double's bit pattern
+    bool gpsTimeChanged = false; //!< of this point, a context of the next one
+
+    static Point14 parse(const unsigned char* p)
+    {
+        Point14 q;
+        q.x = load<std::int32_t>(p);
+        q.y = load<std::int32_t>(p + 4);
+        q.z = load<std::int32_t>(p + 8);
+        q.intensity = load<std::uint16_t>(p + 12);
+        q.returnNumber = p[14] & 15u;
+        q.numberOfReturns = p[14] >> 4;
+        q.classificationFlags = p[15] & 15u;
+        q.scannerChannel = (p[15] >> 4) & 3u;
+        q.scanDirection = (p[15] >> 6) & 1u;
+        q.edgeOfFlightLine = p[15] >> 7;
+        q.classification = p[16];
+        q.userData = p[17];
+        q.scanAngle = load<std::int16_t>(p + 18);
+        q.pointSource = load<std::uint16_t>(p + 20);
+        q.gpsTime = load<std::int64_t>(p + 22);
+        return q;
+    }
+
+    void write(unsigned char* p) const
+    {
+        store(p, x);
+        store(p + 4, y);
+        store(p + 8, z);
+        store(p + 12, intensity);
+        p[14] = static_cast<unsigned char>(returnNumber | (numberOfReturns << 4));
+        p[15] = static_cast<unsigned char>(classificationFlags | (scannerChannel << 4) | (scanDirection << 6) | (edgeOfFlightLine << 7));
+        p[16] = static_cast<unsigned char>(classification);
+        p[17] = static_cast<unsigned char>(userData);
+        store(p + 18, scanAngle);
+        store(p + 20, pointSource);
+        store(p + 22, gpsTime);
+    }
+};
+
+//! Models made on first use, keyed by a small value.
+template <std::size_t N>
+class LazyModels
+{
+public:
+    explicit LazyModels(std::uint32_t symbols) : symbols_(symbols) {}
+    SymbolModel& operator[](std::size_t key)
+    {
+        std::unique_ptr<SymbolModel>& m = models_[key];
+        if (!m)
+            m = std::make_unique<SymbolModel>(symbols_);
+        return *m;
+    }
+
+private:
+    std::uint32_t symbols_;
+    std::array<std::unique_ptr<SymbolModel>, N> models_;
+};
+
+//! The context switch of the items that follow point14's context (rgb14,
+//! rgbnir14, byte14): a context used for the first time starts from the last
+//! item of the one before it. Returns the last item to predict from and
+//! update. In version 3 a switch to a context already used keeps predicting
+//! from (and updating) the previous context's last item, with the new
+//! context's models: LASzip's encoder does the same, so the format is that
+//! (version 4 corrected it).
+template <typename Context>
+auto& switchContext(std::array<std::unique_ptr<Context>, 4>& contexts, std::uint32_t& current, std::uint32_t context)
+{
+    Context* holder = contexts[current].get();
+    if (context != current) {
+        current = context;
+        if (!contexts[context]) {
+            contexts[context] = std::make_unique<Context>(holder->last);
+            holder = contexts[context].get();
+        }
+    }
+    return holder->last;
+}
+
+//! The GPS time of the layered coder: as in gpstime11, with the codes
+//! renumbered (no "unchanged" code: whether the time changed is in the
+//! point's changed-values symbol).
+class GpsTime14
+{
+public:
+    explicit GpsTime14(std::int64_t first) { last_[0] = first; }
+
+    std::int64_t decode(ArithmeticDecoder& d)
+    {
+        for (;;) {
+            if (lastDiff_[current_] == 0) {
+                const auto multi = static_cast<std::int32_t>(d.decodeSymbol(zeroDiff_));
+                if (multi == 0) {
+                    lastDiff_[current_] = diff_.decompress(d, 0, 0);
+                    last_[current_] += lastDiff_[current_];
+                    extremeCount_[current_] = 0;
+                } else if (multi == 1) {
+                    fullTime(d);
+                } else {
+                    current_ = (current_ + static_cast<std::uint32_t>(multi) - 1) & 3;
+                    continue;
+                }
+                return last_[current_];
+            }
+            auto multi = static_cast<std::int32_t>(d.decodeSymbol(multiple_));
+            if (multi == 1) {
+                last_[current_] += diff_.decompress(d, lastDiff_[current_], 1);
+                extremeCount_[current_] = 0;
+            } else if (multi < kMultiCodeFull) {
+                std::int32_t diff;
+                const std::int32_t previous = lastDiff_[current_];
+                if (multi == 0) {
+                    diff = diff_.decompress(d, 0, 7);
+                    countExtreme(diff);
+                } else if (multi < kMulti) {
+                    diff = diff_.decompress(d, wrapMul(multi, previous), multi < 10 ? 2 : 3);
+                } else if (multi == kMulti) {
+                    diff = diff_.decompress(d, wrapMul(kMulti, previous), 4);
+                    countExtreme(diff);
+                } else {
+                    multi = kMulti - multi;
+                    if (multi > kMultiMinus) {
+                        diff = diff_.decompress(d, wrapMul(multi, previous), 5);
+                    } else {
+                        diff = diff_.decompress(d, wrapMul(kMultiMinus, previous), 6);
+                        countExtreme(diff);
+                    }
+                }
+                last_[current_] += diff;
+            } else if (multi == kMultiCodeFull) {
+                fullTime(d);
+            } else {
+                current_ = (current_ + static_cast<std::uint32_t>(multi - kMultiCodeFull)) & 3;
+                continue;
+            }
+            return last_[current_];
+        }
+    }
+
+private:
+    static constexpr std::int32_t kMulti = 500;
+    static constexpr std::int32_t kMultiMinus = -10;
+    static constexpr std::int32_t kMultiCodeFull = kMulti - kMultiMinus + 1;
+    static constexpr std::uint32_t kMultiTotal = kMulti - kMultiMinus + 5;
+
+    void fullTime(ArithmeticDecoder& d)
+    {
+        next_ = (next_ + 1) & 3;
+        const auto high = static_cast<std::uint32_t>(
+            diff_.decompress(d, static_cast<std::int32_t>(static_cast<std::uint64_t>(last_[current_]) >> 32), 8));
+        last_[next_] = static_cast<std::int64_t>((std::uint64_t(high) << 32) | d.readInt());
+        current_ = next_;
+        lastDiff_[current_] = 0;
+        extremeCount_[current_] = 0;
+    }
+    void countExtreme(std::int32_t diff)
+    {
+        if (++extremeCount_[current_] > 3) {
+            lastDiff_[current_] = diff;
+            extremeCount_[current_] = 0;
+        }
+    }
+    static std::int32_t wrapMul(std::int32_t a, std::int32_t b)
+    {
+        return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) * static_cast<std::uint32_t>(b));
+    }
+
+    std::array<std::int64_t, 4> last_{};
+    std::array<std::int32_t, 4> lastDiff_{}, extremeCount_{};
+    std::uint32_t current_ = 0, next_ = 0;
+    SymbolModel multiple_{kMultiTotal};
+    SymbolModel zeroDiff_{5};
+    IntegerDecompressor diff_{32, 9};
+};
+
+//! One scanner channel's state of the point14 coder.
+struct Point14Context
+{
+    explicit Point14Context(const Point14& from) : last(from), gpsTime(from.gpsTime)
+    {
+        last.gpsTimeChanged = false;
+        lastZ.fill(from.z);
+        lastIntensity.fill(from.intensity);
+    }
+
+    Point14 last;
+    std::array<SymbolModel, 8> changedValues{SymbolModel(128), SymbolModel(128), SymbolModel(128), SymbolModel(128),
+                                             SymbolModel(128), SymbolModel(128), SymbolModel(128), SymbolModel(128)};
+    SymbolModel scannerChannel{3};
+    LazyModels<16> numberOfReturns{16}, returnNumber{16};
+    SymbolModel returnNumberGpsSame{13};
+    IntegerDecompressor dx{32, 2}, dy{32, 22}, z{32, 20};
+    std::array<StreamingMedian5, 12> xMedian{}, yMedian{};
+    std::array<std::int32_t, 8> lastZ{};
+    LazyModels<64> classification{256}, flags{64}, userData{256};
+    IntegerDecompressor intensity{16, 4};
+    std::array<std::uint16_t, 8> lastIntensity{};
+    IntegerDecompressor scanAngle{16, 2};
+    IntegerDecompressor pointSource{16};
+    GpsTime14 gpsTime;
+};
+
+//! The 30 bytes of a LAS 1.4 point, in nine layers: returns and x, y; z;
+//! classification; flags; intensity; scan angle; user data; point source;
+//! GPS time.
+class Point14Decoder final : public LayeredItem
+{
+public:
+    explicit Point14Decoder(const unsigned char* first) : first_(Point14::parse(first)) {}
+
+    std::size_t layerCount() const override { return kLayers; }
+
+    void start(const Layer* layers, std::uint32_t& context) override
+    {
+        for (std::size_t i = 0; i < kLayers; ++i)
+            streams_[i].open(layers[i]);
+        current_ = first_.scannerChannel;
+        context = current_;
+        contexts_[current_] = std::make_unique<Point14Context>(first_);
+    }
+
+    bool overran() const override
+    {
+        return std::any_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.overran(); });
+    }
+
+    void decode(unsigned char* item, std::uint32_t& context) override
+    {
+        Point14Context* c = contexts_[current_].get();
+        ArithmeticDecoder& xy = *streams_[kReturnsXY];
+        // The last point's return (single, first, last or intermediate) and
+        // whether its time changed choose the model of what changed now.
+        const std::uint32_t lastPosition = (c->last.returnNumber == 1 ? 1u : 0u) +
+                                           (c->last.returnNumber >= c->last.numberOfReturns ? 2u : 0u) +
+                                           (c->last.gpsTimeChanged ? 4u : 0u);
+        const std::uint32_t changed = xy.decodeSymbol(c->changedValues[lastPosition]);
+        if (changed & (1u << 6)) {
+            const std::uint32_t channel = (current_ + xy.decodeSymbol(c->scannerChannel) + 1) % 4;
+            if (!contexts_[channel])
+                contexts_[channel] = std::make_unique<Point14Context>(c->last);
+            current_ = channel;
+            context = current_;
+            c = contexts_[current_].get();
+            c->last.scannerChannel = channel;
+        }
+        Point14& p = c->last;
+        const bool pointSourceChanged = changed & (1u << 5);
+        const bool gpsTimeChanged = changed & (1u << 4);
+        const bool scanAngleChanged = changed & (1u << 3);
+
+        const std::uint32_t lastN = p.numberOfReturns, lastR = p.returnNumber;
+        const std::uint32_t n = (changed & (1u << 2)) ? xy.decodeSymbol(c->numberOfReturns[lastN]) : lastN;
+        p.numberOfReturns = n;
+        std::uint32_t r = lastR;
+        switch (changed & 3u) {
+        case 1: r = (lastR + 1) % 16; break;
+        case 2: r = (lastR + 15) % 16; break;
+        case 3:
+            r = gpsTimeChanged ? xy.decodeSymbol(c->returnNumber[lastR])
+                               : (lastR + xy.decodeSymbol(c->returnNumberGpsSame) + 2) % 16;
+            break;
+        default: break;
+        }
+        p.returnNumber = r;
+        const std::uint32_t m = kReturnMap6[n][r], l = returnLevel8(n, r);
+        const std::uint32_t position = (r == 1 ? 1u : 0u) + (r >= n ? 2u : 0u);
+        const std::uint32_t medianSlot = (m << 1) | (gpsTimeChanged ? 1u : 0u);
+
+        const std::int32_t dx = c->dx.decompress(xy, c->xMedian[medianSlot].median(), n == 1);
+        p.x = static_cast<std::int32_t>(static_cast<std::uint32_t>(p.x) + static_cast<std::uint32_t>(dx));
+        c->xMedian[medianSlot].add(dx);
+        std::uint32_t k = c->dx.lastSize();
+        const std::int32_t dy = c->dy.decompress(xy, c->yMedian[medianSlot].median(), (n == 1) + (k < 20 ? k & ~1u : 20));
+        p.y = static_cast<std::int32_t>(static_cast<std::uint32_t>(p.y) + static_cast<std::uint32_t>(dy));
+        c->yMedian[medianSlot].add(dy);
+
+        if (streams_[kZ].changes()) {
+            k = (c->dx.lastSize() + c->dy.lastSize()) / 2;
+            p.z = c->z.decompress(*streams_[kZ], c->lastZ[l], (n == 1) + (k < 18 ? k & ~1u : 18));
+            c->lastZ[l] = p.z;
+        }
+        if (streams_[kClassification].changes()) {
+            const std::uint32_t key = ((p.classification & 0x1F) << 1) + (position == 3 ? 1 : 0);
+            p.classification = (*streams_[kClassification]).decodeSymbol(c->classification[key]);
+        }
+        if (streams_[kFlags].changes()) {
+            const std::uint32_t key = (p.edgeOfFlightLine << 5) | (p.scanDirection << 4) | p.classificationFlags;
+            const std::uint32_t f = (*streams_[kFlags]).decodeSymbol(c->flags[key]);
+            p.edgeOfFlightLine = (f >> 5) & 1;
+            p.scanDirection = (f >> 4) & 1;
+            p.classificationFlags = f & 0x0F;
+        }
+        if (streams_[kIntensity].changes()) {
+            const std::uint32_t slot = (position << 1) | (gpsTimeChanged ? 1u : 0u);
+            p.intensity = static_cast<std::uint16_t>(c->intensity.decompress(*streams_[kIntensity], c->lastIntensity[slot], position));
+            c->lastIntensity[slot] = p.intensity;
+        }
+        if (streams_[kScanAngle].changes() && scanAngleChanged)
+            p.scanAngle = static_cast<std::int16_t>(c->scanAngle.decompress(*streams_[kScanAngle], p.scanAngle, gpsTimeChanged));
+        if (streams_[kUserData].changes())
+            p.userData = (*streams_[kUserData]).decodeSymbol(c->userData[p.userData / 4]);
+        if (streams_[kPointSource].changes() && pointSourceChanged)
+            p.pointSource = static_cast<std::uint16_t>(c->pointSource.decompress(*streams_[kPointSource], p.pointSource));
+        if (streams_[kGpsTime].changes() && gpsTimeChanged)
+            p.gpsTime = c->gpsTime.decode(*streams_[kGpsTime]);
+        p.write(item);
+        p.gpsTimeChanged = gpsTimeChanged;
+    }
+
+private:
+    enum : std::size_t { kReturnsXY, kZ, kClassification, kFlags, kIntensity, kScanAngle, kUserData, kPointSource, kGpsTime, kLayers };
+
+    Point14 first_;
+    std::array<LayerStream, kLayers> streams_;
+    std::array<std::unique_ptr<Point14Context>, 4> contexts_;
+    std::uint32_t current_ = 0;
+};
+
+//! Red, green, blue (uint16 each) in one layer, and near infrared in a
+//! second one for rgbnir14.
+class Rgb14Decoder final : public LayeredItem
+{
+public:
+    Rgb14Decoder(const unsigned char* first, bool withNir) : withNir_(withNir)
+    {
+        for (std::size_t c = 0; c < first_.size(); ++c)
+            first_[c] = load<std::uint16_t>(first + 2 * c);
+    }
+
+    std::size_t layerCount() const override { return withNir_ ? 2 : 1; }
+
+    void start(const Layer* layers, std::uint32_t& context) override
+    {
+        rgb_.open(layers[0]);
+        if (withNir_)
+            nir_.open(layers[1]);
+        current_ = context;
+        contexts_[current_] = std::make_unique<Context>(first_);
+    }
+
+    bool overran() const override { return rgb_.overran() || nir_.overran(); }
+
+    void decode(unsigned char* item, std::uint32_t& context) override
+    {
+        std::array<std::uint16_t, 4>& last = switchContext(contexts_, current_, context);
+        Context& c = *contexts_[current_];
+        if (rgb_.changes()) {
+            const std::array<std::uint16_t, 3> rgb = decodeRgb(*rgb_, c.rgbModels, {last[0], last[1], last[2]});
+            std::copy(rgb.begin(), rgb.end(), last.begin());
+        }
+        if (nir_.changes()) {
+            ArithmeticDecoder& d = *nir_;
+            const std::uint32_t used = d.decodeSymbol(c.nirUsed);
+            std::uint32_t low = last[3] & 0xFFu, high = last[3] >> 8;
+            if (used & 1)
+                low = fold(static_cast<std::int32_t>(d.decodeSymbol(c.nirDiff[0]) + low));
+            if (used & 2)
+                high = fold(static_cast<std::int32_t>(d.decodeSymbol(c.nirDiff[1]) + high));
+            last[3] = static_cast<std::uint16_t>(low | (high << 8));
+        }
+        for (std::size_t k = 0; k < (withNir_ ? 4u : 3u); ++k)
+            store(item + 2 * k, last[k]);
+    }
+
+private:
+    struct Context
+    {
+        explicit Context(const std::array<std::uint16_t, 4>& from) : last(from) {}
+        std::array<std::uint16_t, 4> last;
+        RgbModels rgbModels;
+        SymbolModel nirUsed{4};
+        std::array<SymbolModel, 2> nirDiff{SymbolModel(256), SymbolModel(256)};
+    };
+
+    bool withNir_;
+    std::array<std::uint16_t, 4> first_{};
+    LayerStream rgb_, nir_;
+    std::array<std::unique_ptr<Context>, 4> contexts_;
+    std::uint32_t current_ = 0;
+};
+
+//! Extra bytes: a layer per byte.
+class Byte14Decoder final : public LayeredItem
+{
+public:
+    Byte14Decoder(const unsigned char* first, std::size_t size) : first_(first, first + size), streams_(size) {}
+
+    std::size_t layerCount() const override { return first_.size(); }
+
+    void start(const Layer* layers, std::uint32_t& context) override
+    {
+        for (std::size_t i = 0; i < streams_.size(); ++i)
+            streams_[i].open(layers[i]);
+        current_ = context;
+        contexts_[current_] = std::make_unique<Context>(first_);
+    }
+
+    bool overran() const override
+    {
+        return std::any_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.overran(); });
+    }
+
+    void decode(unsigned char* item, std::uint32_t& context) override
+    {
+        std::vector<unsigned char>& last = switchContext(contexts_, current_, context);
+        Context& c = *contexts_[current_];
+        for (std::size_t i = 0; i < streams_.size(); ++i) {
+            if (streams_[i].changes())
+                last[i] = fold(static_cast<std::int32_t>(last[i]) + static_cast<std::int32_t>((*streams_[i]).decodeSymbol(c.models[i])));
+            item[i] = last[i];
+        }
+    }
+
+private:
+    struct Context
+    {
+        explicit Context(const std::vector<unsigned char>& from) : last(from)
+        {
+            models.reserve(from.size());
+            for (std::size_t i = 0; i < from.size(); ++i)
+                models.emplace_back(256);
+        }
+        std::vector<unsigned char> last;
+        std::vector<SymbolModel> models;
+    };
+
+    std::vector<unsigned char> first_;
+    std::vector<LayerStream> streams_;
+    std::array<std::unique_ptr<Context>, 4> contexts_;
+    std::uint32_t current_ = 0;
+};
+
+} // namespace
+
+std::unique_ptr<LayeredItem> makeLayeredItem(std::uint16_t type, std::size_t size, const unsigned char* first)
+{
+    switch (type) {
+    case kPoint14: return std::make_unique<Point14Decoder>(first);
+    case kRgb14: return std::make_unique<Rgb14Decoder>(first, false);
+    case kRgbNir14: return std::make_unique<Rgb14Decoder>(first, true);
+    default: return std::make_unique<Byte14Decoder>(first, size);
+    }
+}
+
+} // namespace scandiff::io::detail::laz
