@@ -9,7 +9,7 @@
 //! that description. The item coders are in laz/.
 
 #include "internal/LazDecoder.h"
-#include "laz/ArithmeticDecoder.h"
+#include "laz/ArithmeticCoder.h"
 #include "laz/Items.h"
 
 #include <scandiff/core/Error.h>
@@ -29,7 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using laz::ArithmeticDecoder;
-using laz::IntegerDecompressor;
+using laz::IntegerCoder;
 using laz::load;
 
 [[noreturn]] void invalid(const fs::path& path, const std::string& what)
@@ -176,7 +176,7 @@ std::vector<Chunk> readChunkTable(const fs::path& path, const unsigned char* fil
     const bool variable = layout.chunkSize == UINT32_MAX;
     std::vector<Chunk> chunks(chunkCount);
     ArithmeticDecoder decoder(table + 8, file + size);
-    IntegerDecompressor sizes(32, 2);
+    IntegerCoder sizes(32, 2);
     for (std::size_t i = 0; i < chunkCount; ++i) {
         if (variable)
             chunks[i].points = static_cast<std::uint32_t>(sizes.decompress(decoder, i ? static_cast<std::int32_t>(chunks[i - 1].points) : 0, 0));

@@ -5,6 +5,7 @@
 
 #include "internal/Formats.h"
 #include "internal/LazDecoder.h"
+#include "internal/LazEncoder.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
@@ -19,6 +20,8 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <random>
+#include <sstream>
 #include <iterator>
 #include <string>
 #include <vector>
@@ -206,12 +209,135 @@ TEST(LazFormat, ExtraBytesAndALargerChunkDecodeExactly)
     }
 }
 
-TEST(LazFormat, WritingIsRefusedClearly)
+TEST(LazFormat, OurEncoderWritesLaszipsBytes)
 {
-    const PointCloud cloud = io::readPointCloud(registry(), kLazDir / "simple.laz");
-    const fs::path out = test::tempDir() / "out.laz";
-    expectError([&] { io::writePointCloud(registry(), cloud, out); }, ErrorCode::Unsupported, out, "can be read but not written");
-    EXPECT_FALSE(fs::exists(out));
+    // The records of 1_4_w_evlr.las through our layered encoder: the same
+    // chunk, byte for byte, as LASzip wrote into 1_4_w_evlr.laz.
+    const std::string las = fileBytes(kLazDir / "1_4_w_evlr.las");
+    const std::string laz = fileBytes(kLazDir / "1_4_w_evlr.laz");
+    const auto count = at<std::uint64_t>(las, 247);
+    const auto length = at<std::uint16_t>(las, kRecordLength);
+    std::ostringstream out;
+    io::detail::LazPointWriter writer(out, io::detail::lazLayoutForFormat(6, length - 30), length);
+    writer.add(las.data() + at<std::uint32_t>(las, kOffsetToPoints), count);
+    writer.finish();
+    const std::string ours = out.str();
+    const std::size_t points = at<std::uint32_t>(laz, kOffsetToPoints);
+    const auto theirTable = static_cast<std::size_t>(at<std::int64_t>(laz, points));
+    const std::string theirChunk = laz.substr(points + 8, theirTable - points - 8);
+    const auto ourTable = static_cast<std::size_t>(at<std::int64_t>(ours, 0));
+    ASSERT_EQ(ours.substr(8, ourTable - 8), theirChunk);
+    // And the chunk table after it.
+    EXPECT_EQ(ours.substr(ourTable), laz.substr(theirTable, ours.size() - ourTable));
+}
+
+namespace {
+
+//! A cloud with every LAS 1.4 attribute varying as a scanner's would:
+//! returns of pulses, four scanner channels interleaved, GPS times in
+//! sequences, colours (and NIR), extra fields; `count` points.
+PointCloud varyingCloud(std::size_t count, bool colours, bool nir, unsigned seed)
+{
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    PointCloud cloud;
+    cloud.setOrigin({652000.0, 5120000.0, 300.0});
+    cloud.resize(count);
+    const char* names[] = {"intensity", "return_number", "number_of_returns", "classification", "classification_flags",
+                           "scanner_channel", "scan_direction_flag", "edge_of_flight_line", "scan_angle", "user_data",
+                           "point_source_id", "gps_time", "height_above_ground", "amplitude"};
+    for (const char* name : names)
+        cloud.addField(ScalarField(name, count));
+    if (nir)
+        cloud.addField(ScalarField("nir", count));
+    std::vector<Rgb8>* rgb = colours ? &cloud.enableColors() : nullptr;
+    auto set = [&](const char* name, std::size_t i, double v) { cloud.field(name)->setValue(i, v); };
+    double time = 345678.0;
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t pulse = i / 3, ret = i % 3;
+        cloud.positions()[i] = Eigen::Vector3f(static_cast<float>(i % 1000) * 0.05f, static_cast<float>(i / 1000) * 0.05f,
+                                               static_cast<float>(10.0 * u(rng) - ret * 1.5));
+        set("intensity", i, std::floor(u(rng) * 4000));
+        set("return_number", i, double(ret + 1));
+        set("number_of_returns", i, 3);
+        set("classification", i, i % 97 == 0 ? 7 : (ret == 2 ? 2 : 5));
+        set("classification_flags", i, i % 501 == 0 ? 4 : 0);
+        set("scanner_channel", i, double((pulse / 5) % 4));
+        set("scan_direction_flag", i, double((pulse / 40) % 2));
+        set("edge_of_flight_line", i, pulse % 40 == 39 ? 1 : 0);
+        set("scan_angle", i, std::round((-20.0 + double(pulse % 400) * 0.1) / 0.006) * 0.006);
+        set("user_data", i, double(i % 7));
+        set("point_source_id", i, i < count / 2 ? 12 : 13);
+        if (ret == 0)
+            time += (i % 1000 == 999) ? 12.5 : 1e-5 * (1 + (pulse % 3)); // regular pulses, a gap now and then
+        set("gps_time", i, time);
+        set("height_above_ground", i, std::round(u(rng) * 1000) / 100);
+        set("amplitude", i, std::floor(u(rng) * 300));
+        if (nir)
+            set("nir", i, std::floor(u(rng) * 65535));
+        if (colours) {
+            const auto grey = static_cast<std::uint8_t>(u(rng) * 255);
+            (*rgb)[i] = i % 5 == 0 ? Rgb8{grey, grey, grey}
+                                           : Rgb8{static_cast<std::uint8_t>(i % 256), static_cast<std::uint8_t>(u(rng) * 255), 40};
+        }
+    }
+    return cloud;
+}
+
+void expectSameClouds(const PointCloud& a, const PointCloud& b, const std::string& what)
+{
+    ASSERT_EQ(a.size(), b.size()) << what;
+    EXPECT_EQ(a.origin(), b.origin()) << what;
+    EXPECT_EQ(a.positions(), b.positions()) << what;
+    EXPECT_EQ(a.hasColors(), b.hasColors()) << what;
+    if (a.hasColors()) {
+        EXPECT_EQ(a.colors(), b.colors()) << what;
+    }
+    ASSERT_EQ(a.fields().size(), b.fields().size()) << what;
+    for (const ScalarField& f : a.fields()) {
+        const ScalarField* g = b.field(f.name());
+        ASSERT_NE(g, nullptr) << what << " " << f.name();
+        for (std::size_t i = 0; i < f.size(); ++i)
+            ASSERT_EQ(g->value(i), f.value(i)) << what << " " << f.name() << " " << i;
+    }
+}
+
+} // namespace
+
+TEST(LazFormat, WrittenLazReadsBackAsTheSameCloudAsLas)
+{
+    // Formats 6, 7 and 8 with extra bytes, over several chunks (120,000
+    // points: chunks of 50,000) and four interleaved scanner channels.
+    const fs::path dir = test::tempDir();
+    struct Case
+    {
+        const char* name;
+        bool colours, nir;
+    } cases[] = {{"format6", false, false}, {"format7", true, false}, {"format8", true, true}};
+    for (const Case& c : cases) {
+        const PointCloud cloud = varyingCloud(120000, c.colours, c.nir, 5);
+        io::writePointCloud(registry(), cloud, dir / (std::string(c.name) + ".las"));
+        io::writePointCloud(registry(), cloud, dir / (std::string(c.name) + ".laz"));
+        const PointCloud las = io::readPointCloud(registry(), dir / (std::string(c.name) + ".las"));
+        const PointCloud laz = io::readPointCloud(registry(), dir / (std::string(c.name) + ".laz"));
+        expectSameClouds(las, laz, c.name);
+        // The LAZ holds the LAS file's records exactly: same header fields, same records.
+        const std::string lasBytes = fileBytes(dir / (std::string(c.name) + ".las"));
+        const std::string lazBytes = fileBytes(dir / (std::string(c.name) + ".laz"));
+        EXPECT_EQ(static_cast<unsigned char>(lazBytes[104]), static_cast<unsigned char>(lasBytes[104]) | 0x80) << c.name;
+        EXPECT_LT(lazBytes.size(), lasBytes.size() / 2) << c.name;
+    }
+    // A cloud of one point, and an empty one.
+    PointCloud one = varyingCloud(1, true, false, 6);
+    io::writePointCloud(registry(), one, dir / "one.laz");
+    expectSameClouds(io::readPointCloud(registry(), dir / "one.laz"), io::readPointCloud(registry(), [&] {
+                         io::writePointCloud(registry(), one, dir / "one.las");
+                         return dir / "one.las";
+                     }()),
+                     "one point");
+    PointCloud none;
+    io::writePointCloud(registry(), none, dir / "none.laz");
+    EXPECT_EQ(io::readPointCloud(registry(), dir / "none.laz").size(), 0u);
 }
 
 TEST(LazFormat, DamagedFilesAreClearErrors)

@@ -7,7 +7,7 @@
 //! keeps the last item it produced and writes the next straight into the
 //! output record.
 
-#include "ArithmeticDecoder.h"
+#include "ArithmeticCoder.h"
 
 #include <algorithm>
 #include <array>
@@ -15,6 +15,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace scandiff::io::detail::laz {
 
@@ -72,6 +73,9 @@ struct RgbModels
                                     SymbolModel(256), SymbolModel(256), SymbolModel(256)};
 };
 std::array<std::uint16_t, 3> decodeRgb(ArithmeticDecoder& d, RgbModels& models, const std::array<std::uint16_t, 3>& last);
+//! The mirror of decodeRgb(): codes `rgb` after `last`.
+void encodeRgb(ArithmeticEncoder& e, RgbModels& models, const std::array<std::uint16_t, 3>& last,
+               const std::array<std::uint16_t, 3>& rgb);
 
 //! A pointwise item: decoded from the record's single stream.
 class PointwiseItem
@@ -111,5 +115,22 @@ public:
 //! The coder of a layered item (point14, rgb14, rgbnir14 or byte14, version
 //! 3), starting from the chunk's first item.
 std::unique_ptr<LayeredItem> makeLayeredItem(std::uint16_t type, std::size_t size, const unsigned char* first);
+
+//! The encoder of a layered item, the mirror of LayeredItem: each item of a
+//! chunk after the first goes to encode(), then finish() gives its layers
+//! (empty for an attribute that never changed in the chunk).
+class LayeredItemEncoder
+{
+public:
+    virtual ~LayeredItemEncoder() = default;
+    virtual void encode(const unsigned char* item, std::uint32_t& context) = 0;
+    virtual void finish(std::vector<std::vector<unsigned char>>& layers) = 0;
+};
+
+//! The encoder of a layered item (point14, rgb14, rgbnir14 or byte14,
+//! version 3), starting from the chunk's first item; the point14 one sets
+//! `context` from it.
+std::unique_ptr<LayeredItemEncoder> makeLayeredItemEncoder(std::uint16_t type, std::size_t size, const unsigned char* first,
+                                                           std::uint32_t& context);
 
 } // namespace scandiff::io::detail::laz

@@ -6,7 +6,7 @@
 //! kept per scanner channel (four contexts), a new context starting from the
 //! last point of the one before it.
 
-#include "Items.h"
+#include "LayeredState.h"
 
 #include <optional>
 #include <vector>
@@ -15,19 +15,7 @@ namespace scandiff::io::detail::laz {
 
 namespace {
 
-// The context of a return r of n (4-bit fields): the coordinates' medians are
-// kept per class of this map (6 classes), the last heights per level.
-constexpr std::uint8_t kReturnMap6[16][16] = {
-    {0, 1, 2, 3, 4, 5, 3, 4, 4, 5, 5, 5, 5, 5, 5, 5}, {1, 0, 1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3},
-    {2, 1, 2, 4, 4, 4, 4, 4, 4, 4, 4, 3, 3, 3, 3, 3}, {3, 3, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
-    {4, 3, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
-    {3, 3, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {4, 3, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4},
-    {4, 3, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4},
-    {5, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 4, 4, 4},
-    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4},
-    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5}};
-//! |n - r|, at most 7.
-constexpr std::uint32_t returnLevel8(std::uint32_t n, std::uint32_t r) { return std::min<std::uint32_t>(n > r ? n - r : r - n, 7); }
+using namespace layered;
 
 //! A layer's decoder, when the layer has bytes.
 class LayerStream
@@ -45,219 +33,6 @@ public:
 
 private:
     std::optional<ArithmeticDecoder> decoder_;
-};
-
-//! The fields of a LAS 1.4 point (formats 6-10, the first 30 bytes).
-struct Point14
-{
-    std::int32_t x = 0, y = 0, z = 0;
-    std::uint16_t intensity = 0;
-    std::uint32_t returnNumber = 0, numberOfReturns = 0;
-    std::uint32_t classificationFlags = 0, scannerChannel = 0, scanDirection = 0, edgeOfFlightLine = 0;
-    std::uint32_t classification = 0, userData = 0;
-    std::int16_t scanAngle = 0;
-    std::uint16_t pointSource = 0;
-    std::int64_t gpsTime = 0; //!< the double's bit pattern
-    bool gpsTimeChanged = false; //!< of this point, a context of the next one
-
-    static Point14 parse(const unsigned char* p)
-    {
-        Point14 q;
-        q.x = load<std::int32_t>(p);
-        q.y = load<std::int32_t>(p + 4);
-        q.z = load<std::int32_t>(p + 8);
-        q.intensity = load<std::uint16_t>(p + 12);
-        q.returnNumber = p[14] & 15u;
-        q.numberOfReturns = p[14] >> 4;
-        q.classificationFlags = p[15] & 15u;
-        q.scannerChannel = (p[15] >> 4) & 3u;
-        q.scanDirection = (p[15] >> 6) & 1u;
-        q.edgeOfFlightLine = p[15] >> 7;
-        q.classification = p[16];
-        q.userData = p[17];
-        q.scanAngle = load<std::int16_t>(p + 18);
-        q.pointSource = load<std::uint16_t>(p + 20);
-        q.gpsTime = load<std::int64_t>(p + 22);
-        return q;
-    }
-
-    void write(unsigned char* p) const
-    {
-        store(p, x);
-        store(p + 4, y);
-        store(p + 8, z);
-        store(p + 12, intensity);
-        p[14] = static_cast<unsigned char>(returnNumber | (numberOfReturns << 4));
-        p[15] = static_cast<unsigned char>(classificationFlags | (scannerChannel << 4) | (scanDirection << 6) | (edgeOfFlightLine << 7));
-        p[16] = static_cast<unsigned char>(classification);
-        p[17] = static_cast<unsigned char>(userData);
-        store(p + 18, scanAngle);
-        store(p + 20, pointSource);
-        store(p + 22, gpsTime);
-    }
-};
-
-//! Models made on first use, keyed by a small value.
-template <std::size_t N>
-class LazyModels
-{
-public:
-    explicit LazyModels(std::uint32_t symbols) : symbols_(symbols) {}
-    SymbolModel& operator[](std::size_t key)
-    {
-        std::unique_ptr<SymbolModel>& m = models_[key];
-        if (!m)
-            m = std::make_unique<SymbolModel>(symbols_);
-        return *m;
-    }
-
-private:
-    std::uint32_t symbols_;
-    std::array<std::unique_ptr<SymbolModel>, N> models_;
-};
-
-//! The context switch of the items that follow point14's context (rgb14,
-//! rgbnir14, byte14): a context used for the first time starts from the last
-//! item of the one before it. Returns the last item to predict from and
-//! update. In version 3 a switch to a context already used keeps predicting
-//! from (and updating) the previous context's last item, with the new
-//! context's models: LASzip's encoder does the same, so the format is that
-//! (version 4 corrected it).
-template <typename Context>
-auto& switchContext(std::array<std::unique_ptr<Context>, 4>& contexts, std::uint32_t& current, std::uint32_t context)
-{
-    Context* holder = contexts[current].get();
-    if (context != current) {
-        current = context;
-        if (!contexts[context]) {
-            contexts[context] = std::make_unique<Context>(holder->last);
-            holder = contexts[context].get();
-        }
-    }
-    return holder->last;
-}
-
-//! The GPS time of the layered coder: as in gpstime11, with the codes
-//! renumbered (no "unchanged" code: whether the time changed is in the
-//! point's changed-values symbol).
-class GpsTime14
-{
-public:
-    explicit GpsTime14(std::int64_t first) { last_[0] = first; }
-
-    std::int64_t decode(ArithmeticDecoder& d)
-    {
-        for (;;) {
-            if (lastDiff_[current_] == 0) {
-                const auto multi = static_cast<std::int32_t>(d.decodeSymbol(zeroDiff_));
-                if (multi == 0) {
-                    lastDiff_[current_] = diff_.decompress(d, 0, 0);
-                    last_[current_] += lastDiff_[current_];
-                    extremeCount_[current_] = 0;
-                } else if (multi == 1) {
-                    fullTime(d);
-                } else {
-                    current_ = (current_ + static_cast<std::uint32_t>(multi) - 1) & 3;
-                    continue;
-                }
-                return last_[current_];
-            }
-            auto multi = static_cast<std::int32_t>(d.decodeSymbol(multiple_));
-            if (multi == 1) {
-                last_[current_] += diff_.decompress(d, lastDiff_[current_], 1);
-                extremeCount_[current_] = 0;
-            } else if (multi < kMultiCodeFull) {
-                std::int32_t diff;
-                const std::int32_t previous = lastDiff_[current_];
-                if (multi == 0) {
-                    diff = diff_.decompress(d, 0, 7);
-                    countExtreme(diff);
-                } else if (multi < kMulti) {
-                    diff = diff_.decompress(d, wrapMul(multi, previous), multi < 10 ? 2 : 3);
-                } else if (multi == kMulti) {
-                    diff = diff_.decompress(d, wrapMul(kMulti, previous), 4);
-                    countExtreme(diff);
-                } else {
-                    multi = kMulti - multi;
-                    if (multi > kMultiMinus) {
-                        diff = diff_.decompress(d, wrapMul(multi, previous), 5);
-                    } else {
-                        diff = diff_.decompress(d, wrapMul(kMultiMinus, previous), 6);
-                        countExtreme(diff);
-                    }
-                }
-                last_[current_] += diff;
-            } else if (multi == kMultiCodeFull) {
-                fullTime(d);
-            } else {
-                current_ = (current_ + static_cast<std::uint32_t>(multi - kMultiCodeFull)) & 3;
-                continue;
-            }
-            return last_[current_];
-        }
-    }
-
-private:
-    static constexpr std::int32_t kMulti = 500;
-    static constexpr std::int32_t kMultiMinus = -10;
-    static constexpr std::int32_t kMultiCodeFull = kMulti - kMultiMinus + 1;
-    static constexpr std::uint32_t kMultiTotal = kMulti - kMultiMinus + 5;
-
-    void fullTime(ArithmeticDecoder& d)
-    {
-        next_ = (next_ + 1) & 3;
-        const auto high = static_cast<std::uint32_t>(
-            diff_.decompress(d, static_cast<std::int32_t>(static_cast<std::uint64_t>(last_[current_]) >> 32), 8));
-        last_[next_] = static_cast<std::int64_t>((std::uint64_t(high) << 32) | d.readInt());
-        current_ = next_;
-        lastDiff_[current_] = 0;
-        extremeCount_[current_] = 0;
-    }
-    void countExtreme(std::int32_t diff)
-    {
-        if (++extremeCount_[current_] > 3) {
-            lastDiff_[current_] = diff;
-            extremeCount_[current_] = 0;
-        }
-    }
-    static std::int32_t wrapMul(std::int32_t a, std::int32_t b)
-    {
-        return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) * static_cast<std::uint32_t>(b));
-    }
-
-    std::array<std::int64_t, 4> last_{};
-    std::array<std::int32_t, 4> lastDiff_{}, extremeCount_{};
-    std::uint32_t current_ = 0, next_ = 0;
-    SymbolModel multiple_{kMultiTotal};
-    SymbolModel zeroDiff_{5};
-    IntegerDecompressor diff_{32, 9};
-};
-
-//! One scanner channel's state of the point14 coder.
-struct Point14Context
-{
-    explicit Point14Context(const Point14& from) : last(from), gpsTime(from.gpsTime)
-    {
-        last.gpsTimeChanged = false;
-        lastZ.fill(from.z);
-        lastIntensity.fill(from.intensity);
-    }
-
-    Point14 last;
-    std::array<SymbolModel, 8> changedValues{SymbolModel(128), SymbolModel(128), SymbolModel(128), SymbolModel(128),
-                                             SymbolModel(128), SymbolModel(128), SymbolModel(128), SymbolModel(128)};
-    SymbolModel scannerChannel{3};
-    LazyModels<16> numberOfReturns{16}, returnNumber{16};
-    SymbolModel returnNumberGpsSame{13};
-    IntegerDecompressor dx{32, 2}, dy{32, 22}, z{32, 20};
-    std::array<StreamingMedian5, 12> xMedian{}, yMedian{};
-    std::array<std::int32_t, 8> lastZ{};
-    LazyModels<64> classification{256}, flags{64}, userData{256};
-    IntegerDecompressor intensity{16, 4};
-    std::array<std::uint16_t, 8> lastIntensity{};
-    IntegerDecompressor scanAngle{16, 2};
-    IntegerDecompressor pointSource{16};
-    GpsTime14 gpsTime;
 };
 
 //! The 30 bytes of a LAS 1.4 point, in nine layers: returns and x, y; z;
@@ -423,14 +198,7 @@ public:
     }
 
 private:
-    struct Context
-    {
-        explicit Context(const std::array<std::uint16_t, 4>& from) : last(from) {}
-        std::array<std::uint16_t, 4> last;
-        RgbModels rgbModels;
-        SymbolModel nirUsed{4};
-        std::array<SymbolModel, 2> nirDiff{SymbolModel(256), SymbolModel(256)};
-    };
+    using Context = RgbContext;
 
     bool withNir_;
     std::array<std::uint16_t, 4> first_{};
@@ -472,17 +240,7 @@ public:
     }
 
 private:
-    struct Context
-    {
-        explicit Context(const std::vector<unsigned char>& from) : last(from)
-        {
-            models.reserve(from.size());
-            for (std::size_t i = 0; i < from.size(); ++i)
-                models.emplace_back(256);
-        }
-        std::vector<unsigned char> last;
-        std::vector<SymbolModel> models;
-    };
+    using Context = BytesContext;
 
     std::vector<unsigned char> first_;
     std::vector<LayerStream> streams_;

@@ -114,6 +114,41 @@ std::array<std::uint16_t, 3> decodeRgb(ArithmeticDecoder& d, RgbModels& models, 
     return rgb;
 }
 
+void encodeRgb(ArithmeticEncoder& e, RgbModels& models, const std::array<std::uint16_t, 3>& last,
+               const std::array<std::uint16_t, 3>& rgb)
+{
+    auto low = [](std::uint32_t v) { return static_cast<std::int32_t>(v & 0xFF); };
+    auto high = [](std::uint32_t v) { return static_cast<std::int32_t>(v >> 8); };
+    std::uint32_t used = 0;
+    for (std::size_t c = 0; c < 3; ++c) {
+        used |= (low(last[c]) != low(rgb[c]) ? 1u : 0u) << (2 * c);
+        used |= (high(last[c]) != high(rgb[c]) ? 1u : 0u) << (2 * c + 1);
+    }
+    if (rgb[0] != rgb[1] || rgb[0] != rgb[2])
+        used |= 64;
+    e.encodeSymbol(models.byteUsed, used);
+    if (used & 1)
+        e.encodeSymbol(models.diff[0], fold(low(rgb[0]) - low(last[0])));
+    if (used & 2)
+        e.encodeSymbol(models.diff[1], fold(high(rgb[0]) - high(last[0])));
+    if (!(used & 64))
+        return;
+    std::int32_t diff = low(rgb[0]) - low(last[0]);
+    if (used & 4)
+        e.encodeSymbol(models.diff[2], fold(low(rgb[1]) - clampByte(diff + low(last[1]))));
+    if (used & 16) {
+        diff = (diff + (low(rgb[1]) - low(last[1]))) / 2;
+        e.encodeSymbol(models.diff[4], fold(low(rgb[2]) - clampByte(diff + low(last[2]))));
+    }
+    diff = high(rgb[0]) - high(last[0]);
+    if (used & 8)
+        e.encodeSymbol(models.diff[3], fold(high(rgb[1]) - clampByte(diff + high(last[1]))));
+    if (used & 32) {
+        diff = (diff + (high(rgb[1]) - high(last[1]))) / 2;
+        e.encodeSymbol(models.diff[5], fold(high(rgb[2]) - clampByte(diff + high(last[2]))));
+    }
+}
+
 namespace {
 
 // The context of a return r of n (3-bit fields): the coordinates' medians and
@@ -188,11 +223,11 @@ private:
     std::array<StreamingMedian5, 16> xMedian_{}, yMedian_{};
     std::array<std::int32_t, 8> lastHeight_{};
     SymbolModel changedValues_{64};
-    IntegerDecompressor intensity_{16, 4};
+    IntegerCoder intensity_{16, 4};
     std::array<SymbolModel, 2> scanAngle_{SymbolModel(256), SymbolModel(256)};
-    IntegerDecompressor pointSource_{16};
+    IntegerCoder pointSource_{16};
     std::array<std::unique_ptr<SymbolModel>, 256> returnByte_, classification_, userData_;
-    IntegerDecompressor dx_{32, 2}, dy_{32, 22}, z_{32, 20};
+    IntegerCoder dx_{32, 2}, dy_{32, 22}, z_{32, 20};
 };
 
 //! The GPS time (a double), coded on its 64-bit pattern: as a multiple of
@@ -302,7 +337,7 @@ private:
     std::uint32_t current_ = 0, next_ = 0;
     SymbolModel multiple_{kMultiTotal};
     SymbolModel zeroDiff_{6};
-    IntegerDecompressor diff_{32, 9};
+    IntegerCoder diff_{32, 9};
 };
 
 //! Red, green, blue (uint16 each).

@@ -1,17 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! The entropy decoder of LAZ (internal to io/): the adaptive arithmetic coder
+//! The entropy coder of LAZ (internal to io/): the adaptive arithmetic coder
 //! LASzip uses (A. Said, "Introduction to Arithmetic Coding - Theory and
 //! Practice", HP Labs HPL-2004-76, in the variant M. Isenburg published with
 //! LASzip, "LASzip: lossless compression of LiDAR data", PE&RS 79(2), 2013),
-//! its adaptive symbol and bit models, and the integer decompressor that codes
-//! a value as a correction to a prediction. Every constant and update rule
+//! its adaptive symbol and bit models, and the integer coder that codes a value
+//! as a correction to a prediction, in both directions. Every constant and update rule
 //! must match the encoder bit for bit, or the stream decodes into garbage:
 //! they are LASzip's, from its published description and source.
 //!
 //! Written by hand because Debian 12 packages no LAZ library (no LASzip, no
 //! laz-perf, no PDAL).
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -103,6 +104,7 @@ public:
 
 private:
     friend class ArithmeticDecoder;
+    friend class ArithmeticEncoder;
     std::uint32_t symbols_, lastSymbol_;
     std::uint32_t tableSize_ = 0, tableShift_ = 0;
     std::uint32_t totalCount_ = 0, updateCycle_ = 0, symbolsUntilUpdate_ = 0;
@@ -235,21 +237,136 @@ private:
     std::uint32_t value_ = 0, length_ = kMaxLength;
 };
 
+//! Encodes into a byte vector, the mirror of ArithmeticDecoder. done() ends
+//! the stream with the bytes the decoder reads ahead, no more.
+class ArithmeticEncoder
+{
+public:
+    void encodeBit(BitModel& m, std::uint32_t bit)
+    {
+        const std::uint32_t x = m.bit0Probability * (length_ >> kBitLengthShift);
+        if (bit == 0) {
+            length_ = x;
+            ++m.bit0Count;
+        } else {
+            add(x);
+            length_ -= x;
+        }
+        if (length_ < kMinLength)
+            renormalise();
+        if (--m.bitsUntilUpdate == 0)
+            m.update();
+    }
+
+    void encodeSymbol(SymbolModel& m, std::uint32_t symbol)
+    {
+        std::uint32_t x;
+        if (symbol == m.lastSymbol_) {
+            x = m.distribution_[symbol] * (length_ >> kSymbolLengthShift);
+            add(x);
+            length_ -= x;
+        } else {
+            length_ >>= kSymbolLengthShift;
+            x = m.distribution_[symbol] * length_;
+            add(x);
+            length_ = m.distribution_[symbol + 1] * length_ - x;
+        }
+        if (length_ < kMinLength)
+            renormalise();
+        ++m.counts_[symbol];
+        if (--m.symbolsUntilUpdate_ == 0)
+            m.update();
+    }
+
+    //! `bits` raw bits (1..32) of `value`.
+    void writeBits(std::uint32_t bits, std::uint32_t value)
+    {
+        if (bits > 19) {
+            writeBits(16, value & 0xFFFF);
+            value >>= 16;
+            bits -= 16;
+        }
+        length_ >>= bits;
+        add(value * length_);
+        if (length_ < kMinLength)
+            renormalise();
+    }
+    //! Low 16 bits first.
+    void writeInt(std::uint32_t value)
+    {
+        writeBits(16, value & 0xFFFF);
+        writeBits(16, value >> 16);
+    }
+
+    //! The finished stream.
+    std::vector<unsigned char> done()
+    {
+        const std::uint32_t before = base_;
+        bool anotherByte = true;
+        if (length_ > 2 * kMinLength) {
+            base_ += kMinLength;
+            length_ = kMinLength >> 1;
+        } else {
+            base_ += kMinLength >> 1;
+            length_ = kMinLength >> 9;
+            anotherByte = false;
+        }
+        if (before > base_)
+            propagateCarry();
+        renormalise();
+        // Zeros for the decoder's read-ahead, so that it ends on the last byte.
+        out_.push_back(0);
+        out_.push_back(0);
+        if (anotherByte)
+            out_.push_back(0);
+        return std::move(out_);
+    }
+
+private:
+    void add(std::uint32_t x)
+    {
+        const std::uint32_t before = base_;
+        base_ += x;
+        if (before > base_)
+            propagateCarry();
+    }
+    void propagateCarry()
+    {
+        std::size_t i = out_.size();
+        while (i > 0 && out_[i - 1] == 0xFF)
+            out_[--i] = 0;
+        if (i > 0)
+            ++out_[i - 1];
+    }
+    void renormalise()
+    {
+        do {
+            out_.push_back(static_cast<unsigned char>(base_ >> 24));
+            base_ <<= 8;
+        } while ((length_ <<= 8) < kMinLength);
+    }
+
+    std::uint32_t base_ = 0, length_ = kMaxLength;
+    std::vector<unsigned char> out_;
+};
+
 //! Integers of `bits` bits (32: any int32) coded as the correction to a
 //! prediction: first the number k of significant bits of the correction (a
 //! symbol model per context), then its value among the 2^k of that size (a
 //! model per k for the high `bitsHigh` bits, raw bits below). Sums wrap
-//! modulo 2^bits, as the encoder folded them.
-class IntegerDecompressor
+//! modulo 2^bits, as the encoder folded them. One class for both directions:
+//! the per-scanner-channel states that hold these are shared by the decoders
+//! and the encoders.
+class IntegerCoder
 {
 public:
-    explicit IntegerDecompressor(std::uint32_t bits, std::uint32_t contexts = 1, std::uint32_t bitsHigh = 8)
-        : bitsHigh_(bitsHigh)
+    explicit IntegerCoder(std::uint32_t bits, std::uint32_t contexts = 1, std::uint32_t bitsHigh = 8) : bitsHigh_(bitsHigh)
     {
         if (bits > 0 && bits < 32) {
             correctionBits_ = bits;
             range_ = 1u << bits;
             minCorrection_ = -static_cast<std::int32_t>(range_ / 2);
+            maxCorrection_ = minCorrection_ + static_cast<std::int32_t>(range_ - 1);
         }
         sizeModels_.reserve(contexts);
         for (std::uint32_t c = 0; c < contexts; ++c)
@@ -258,6 +375,9 @@ public:
         for (std::uint32_t k = 1; k <= correctionBits_; ++k)
             valueModels_.emplace_back(k <= bitsHigh ? 1u << k : 1u << bitsHigh);
     }
+
+    //! The size k of the last correction: the point coders use it as context.
+    std::uint32_t lastSize() const { return k_; }
 
     std::int32_t decompress(ArithmeticDecoder& decoder, std::int32_t prediction, std::uint32_t context = 0)
     {
@@ -272,8 +392,21 @@ public:
         return static_cast<std::int32_t>(value);
     }
 
-    //! The size k of the last correction: the point coders use it as context.
-    std::uint32_t lastSize() const { return k_; }
+    void compress(ArithmeticEncoder& encoder, std::int32_t prediction, std::int32_t value, std::uint32_t context = 0)
+    {
+        std::int32_t correction;
+        if (range_ == 0) {
+            correction = static_cast<std::int32_t>(static_cast<std::uint32_t>(value) - static_cast<std::uint32_t>(prediction));
+        } else {
+            std::int64_t c = std::int64_t(value) - prediction;
+            if (c < minCorrection_)
+                c += range_;
+            else if (c > maxCorrection_)
+                c -= range_;
+            correction = static_cast<std::int32_t>(c);
+        }
+        writeCorrection(encoder, correction, sizeModels_[context]);
+    }
 
 private:
     std::int32_t readCorrection(ArithmeticDecoder& decoder, SymbolModel& sizeModel)
@@ -295,11 +428,38 @@ private:
             c -= (std::int64_t(1) << k_) - 1;
         return static_cast<std::int32_t>(static_cast<std::uint32_t>(c));
     }
+    void writeCorrection(ArithmeticEncoder& encoder, std::int32_t c, SymbolModel& sizeModel)
+    {
+        // k: the smallest with c in [-(2^k - 1), 2^k].
+        std::uint32_t magnitude = c <= 0 ? static_cast<std::uint32_t>(-std::int64_t(c)) : static_cast<std::uint32_t>(c) - 1;
+        k_ = 0;
+        while (magnitude) {
+            magnitude >>= 1;
+            ++k_;
+        }
+        encoder.encodeSymbol(sizeModel, k_);
+        if (k_ == 0) {
+            encoder.encodeBit(zeroOrOne_, static_cast<std::uint32_t>(c));
+            return;
+        }
+        if (k_ >= 32)
+            return; // INT32_MIN: the decoder knows it from k alone
+        std::int64_t v = c < 0 ? std::int64_t(c) + ((std::int64_t(1) << k_) - 1) : std::int64_t(c) - 1;
+        if (k_ <= bitsHigh_) {
+            encoder.encodeSymbol(valueModels_[k_ - 1], static_cast<std::uint32_t>(v));
+        } else {
+            const std::uint32_t lowBits = k_ - bitsHigh_;
+            const auto low = static_cast<std::uint32_t>(v & ((std::int64_t(1) << lowBits) - 1));
+            encoder.encodeSymbol(valueModels_[k_ - 1], static_cast<std::uint32_t>(v >> lowBits));
+            encoder.writeBits(lowBits, low);
+        }
+    }
 
     std::uint32_t bitsHigh_;
     std::uint32_t correctionBits_ = 32;
     std::uint32_t range_ = 0; //!< 0: 32-bit values, wrapping as uint32
     std::int32_t minCorrection_ = INT32_MIN;
+    std::int32_t maxCorrection_ = INT32_MAX;
     std::uint32_t k_ = 0;
     std::vector<SymbolModel> sizeModels_;
     BitModel zeroOrOne_;
