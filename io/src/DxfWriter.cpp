@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 //! DXF export (AutoCAD R12 / AC1009 ASCII): DxfDrawing, and the "dxf" format
-//! handler that writes clouds as POINT entities and meshes as 3DFACEs.
+//! handler that writes clouds as POINT entities and meshes as 3DFACEs (and
+//! reads meshes back through DxfReader.cpp).
 //!
 //! R12 rather than a newer version: it needs no handles, owner references or
 //! OBJECTS section, and it is the one version every CAD, GIS and survey program
@@ -12,6 +13,7 @@
 #include <map>
 
 #include "internal/Formats.h"
+#include "internal/MeshReaders.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
@@ -553,7 +555,8 @@ FormatHandler dxfFormat()
     FormatHandler handler;
     handler.name = "DXF";
     handler.extensions = {"dxf"};
-    // Export only: handler.read stays empty.
+    // Reading takes the meshes (DxfReader.cpp): CAD models to compare scans with.
+    handler.read = [](const fs::path& path, const ReadOptions& options) -> Entity { return readDxfMesh(path, options); };
     handler.writeCloud = [](const PointCloud& cloud, const fs::path& path, const WriteOptions& options) {
         writeCloudDxf(cloud, path, options);
     };

@@ -225,15 +225,7 @@ LasHeader parseHeader(const MappedFile& file)
     }
 
     const std::uint64_t available = size - h.offsetToPoints;
-    // LASzip's coders spend at least a few thousandths of a bit on a point
-    // (every adaptive model keeps a floor under each probability), so no LAZ
-    // file holds more than about a thousand points per byte; ten thousand
-    // bounds the allocation for a header that lies.
-    constexpr std::uint64_t kMaxLazPointsPerByte = 10000;
-    if (h.compressed && h.pointCount / kMaxLazPointsPerByte > available)
-        invalid(path, "the header claims " + std::to_string(h.pointCount) + " points, more than " +
-                          std::to_string(kMaxLazPointsPerByte) + " per byte of the " + std::to_string(available) +
-                          " bytes of compressed point data");
+    // A LAZ file's count is checked against its chunk table (LazDecoder.cpp).
     if (!h.compressed && h.pointCount > available / h.recordLength)
         invalid(path, "truncated: " + std::to_string(h.pointCount) + " points of " + std::to_string(h.recordLength) +
                           " bytes need " +
@@ -713,17 +705,9 @@ std::unique_ptr<char[]> decompressRecords(const MappedFile& file, const LasHeade
     if (!layout)
         invalid(path, "the point format (byte 104) says the points are compressed (LAZ), but there is no LASzip record "
                       "(user id 'laszip encoded', record 22204)");
-    // Not zeroed first: the decoder writes every byte (zeroing 36 bytes a point
-    // costs a quarter of the decoding time on this kind of machine).
-    std::unique_ptr<char[]> records;
-    try {
-        records.reset(new char[static_cast<std::size_t>(h.pointCount) * h.recordLength]);
-    } catch (const std::bad_alloc&) {
-        throw Error(ErrorCode::Io, path.string() + ": not enough memory to decompress " + std::to_string(h.pointCount) + " points");
-    }
     ProgressTicker ticker(options.progress, "Decompressing " + path.filename().string(), h.pointCount);
-    decompressLaz(path, file.data(), file.size(), h.offsetToPoints, *layout, h.recordLength, h.pointCount, records.get(),
-                  [&](std::size_t points) { ticker.step(points); });
+    std::unique_ptr<char[]> records = decompressLaz(path, file.data(), file.size(), h.offsetToPoints, *layout, h.recordLength,
+                                                    h.pointCount, [&](std::size_t points) { ticker.step(points); });
     return records;
 }
 

@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -45,6 +46,14 @@ struct Chunk
     std::uint64_t points = 0;
 };
 
+//! Points between two checks of a stream for damage while decoding.
+constexpr std::uint64_t kCheckEvery = 1024;
+//! LASzip's coders spend at least a few thousandths of a bit on a point
+//! (every adaptive model keeps a floor under each probability), so no chunk
+//! holds more than about a thousand points per byte; ten thousand bounds what
+//! a lying header or chunk table can make us allocate.
+constexpr std::uint64_t kMaxPointsPerByte = 10000;
+
 std::string chunkName(std::size_t index, const Chunk& chunk)
 {
     return "LAZ chunk " + std::to_string(index) + " (from byte " + std::to_string(chunk.offset) + ")";
@@ -65,16 +74,22 @@ std::uint64_t decodePointwise(const fs::path& path, const LazLayout& layout, con
         at += item.size;
     }
     ArithmeticDecoder decoder(first + recordLength, end);
+    auto refuse = [&] {
+        invalid(path, chunkName(index, chunk) + " is corrupt or truncated: its stream does not decode into " +
+                          std::to_string(chunk.points) + " points");
+    };
     for (std::uint64_t p = 1; p < chunk.points; ++p) {
         auto* record = reinterpret_cast<unsigned char*>(out + p * recordLength);
         for (std::size_t i = 0; i < items.size(); ++i)
             items[i]->decode(decoder, record + offsets[i]);
+        // A damaged stream is given up soon, not after billions of points.
+        if (p % kCheckEvery == 0 && decoder.corrupt())
+            refuse();
     }
     // The encoder flushes exactly the bytes the decoder reads ahead: a whole
     // chunk is used up to its last byte, never beyond.
-    if (decoder.bytesPastEnd() > 0)
-        invalid(path, chunkName(index, chunk) + " is corrupt or truncated: decoding its " + std::to_string(chunk.points) +
-                          " points runs past its end");
+    if (decoder.corrupt())
+        refuse();
     return static_cast<std::uint64_t>(decoder.position() - first);
 }
 
@@ -94,7 +109,7 @@ std::uint64_t decodeLayered(const fs::path& path, const LazLayout& layout, const
         layerCount += items.back()->layerCount();
     }
     const unsigned char* p = first + recordLength;
-    auto remaining = [&] { return static_cast<std::uint64_t>(end - p); };
+    auto remaining = [&] { return end > p ? static_cast<std::uint64_t>(end - p) : 0; };
     if (remaining() < 4 + 4 * layerCount)
         invalid(path, chunkName(index, chunk) + " is truncated before its layer sizes");
     const auto count = load<std::uint32_t>(p);
@@ -114,21 +129,29 @@ std::uint64_t decodeLayered(const fs::path& path, const LazLayout& layout, const
         layer.data = p;
         p += layer.size;
     }
+    // The first layer, the returns and x, y, is never empty when there is a second point.
+    if (chunk.points > 1 && layers.front().size == 0)
+        invalid(path, chunkName(index, chunk) + " is corrupt: it has no x, y layer");
     std::uint32_t context = 0;
     std::size_t nextLayer = 0;
     for (auto& item : items) {
         item->start(layers.data() + nextLayer, context);
         nextLayer += item->layerCount();
     }
+    auto corrupt = [&] { return std::any_of(items.begin(), items.end(), [](const auto& item) { return item->corrupt(); }); };
+    auto refuse = [&] {
+        invalid(path, chunkName(index, chunk) + " is corrupt: a layer does not decode into " + std::to_string(chunk.points) +
+                          " points");
+    };
     for (std::uint64_t q = 1; q < chunk.points; ++q) {
         auto* record = reinterpret_cast<unsigned char*>(out + q * recordLength);
         for (std::size_t i = 0; i < items.size(); ++i)
             items[i]->decode(record + offsets[i], context);
+        if (q % kCheckEvery == 0 && corrupt())
+            refuse();
     }
-    for (const auto& item : items)
-        if (item->overran())
-            invalid(path, chunkName(index, chunk) + " is corrupt: decoding its " + std::to_string(chunk.points) +
-                              " points runs past the end of a layer");
+    if (corrupt())
+        refuse();
     return static_cast<std::uint64_t>(p - first);
 }
 
@@ -194,6 +217,11 @@ std::vector<Chunk> readChunkTable(const fs::path& path, const unsigned char* fil
         if (c.bytes > static_cast<std::uint64_t>(tableOffset) - offset)
             invalid(path, "LAZ chunk " + std::to_string(i) + " (" + std::to_string(c.bytes) + " bytes from byte " +
                               std::to_string(offset) + ") runs past the chunk table at byte " + std::to_string(tableOffset));
+        // A chunk holds at least its first record (and, layered, its point count).
+        const std::uint64_t minimum = recordLength + (layout.compressor == 3 ? 4 : 0);
+        if (c.points > 0 && (c.bytes < minimum || c.points / kMaxPointsPerByte > c.bytes))
+            invalid(path, "LAZ chunk " + std::to_string(i) + " cannot hold " + std::to_string(c.points) + " points in " +
+                              std::to_string(c.bytes) + " bytes");
         offset += c.bytes;
         point += c.points;
     }
@@ -260,17 +288,32 @@ LazLayout parseLazLayout(const fs::path& path, const char* payload, std::size_t 
     return layout;
 }
 
-void decompressLaz(const fs::path& path, const char* data, std::size_t size, std::uint64_t pointsStart, const LazLayout& layout,
-                   std::size_t recordLength, std::uint64_t count, char* out, const std::function<void(std::size_t)>& progress)
+std::unique_ptr<char[]> decompressLaz(const fs::path& path, const char* data, std::size_t size, std::uint64_t pointsStart,
+                                      const LazLayout& layout, std::size_t recordLength, std::uint64_t count,
+                                      const std::function<void(std::size_t)>& progress)
 {
-    if (count == 0)
-        return;
     const auto* file = reinterpret_cast<const unsigned char*>(data);
     std::vector<Chunk> chunks;
-    if (layout.compressor == 1) {
+    if (count == 0) {
+        // nothing to decode
+    } else if (layout.compressor == 1) {
+        if (pointsStart > size || count / kMaxPointsPerByte > size - pointsStart)
+            invalid(path, "the header claims " + std::to_string(count) + " points, more than the " +
+                              std::to_string(pointsStart > size ? 0 : size - pointsStart) + " bytes of compressed points can hold");
         chunks.push_back(Chunk{pointsStart, 0, 0, count});
     } else {
         chunks = readChunkTable(path, file, size, pointsStart, layout, recordLength, count);
+    }
+    // Allocated once the chunk table has vouched for the count. Not zeroed:
+    // the decoder writes every byte (zeroing them first costs a quarter of
+    // the decoding time on this kind of machine).
+    std::unique_ptr<char[]> out;
+    if (count > std::numeric_limits<std::size_t>::max() / recordLength)
+        invalid(path, std::to_string(count) + " points of " + std::to_string(recordLength) + " bytes do not fit in memory");
+    try {
+        out.reset(new char[std::max<std::size_t>(1, static_cast<std::size_t>(count) * recordLength)]);
+    } catch (const std::bad_alloc&) {
+        throw Error(ErrorCode::Io, path.string() + ": not enough memory to decompress " + std::to_string(count) + " points");
     }
     // A few chunks per worker between two calls of `progress`: Cancel is heard
     // within a few chunks' time (about 10 ms each for 50,000 points).
@@ -281,7 +324,7 @@ void decompressLaz(const fs::path& path, const char* data, std::size_t size, std
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 const Chunk& chunk = chunks[i];
                 const std::uint64_t used =
-                    decodeChunk(path, layout, file, size, chunk, recordLength, i, out + chunk.firstPoint * recordLength);
+                    decodeChunk(path, layout, file, size, chunk, recordLength, i, out.get() + chunk.firstPoint * recordLength);
                 if (chunk.bytes != 0 && chunk.points > 1 && used != chunk.bytes)
                     invalid(path, chunkName(i, chunk) + " is corrupt: its " + std::to_string(chunk.points) + " points use " +
                                       std::to_string(used) + " of its " + std::to_string(chunk.bytes) + " bytes");
@@ -292,6 +335,7 @@ void decompressLaz(const fs::path& path, const char* data, std::size_t size, std
             points += chunks[i].points;
         progress(points);
     }
+    return out;
 }
 
 } // namespace scandiff::io::detail

@@ -35,14 +35,6 @@ namespace {
 
 constexpr std::uint64_t kMaxVertices = std::numeric_limits<std::uint32_t>::max();
 
-//! What a reader collects before the mesh is built: vertices in double.
-struct MeshParts
-{
-    std::vector<Eigen::Vector3d> vertices;
-    std::vector<Eigen::Vector3f> normals; //!< one per vertex, or empty
-    std::vector<Rgb8> colors;             //!< one per vertex, or empty
-    std::vector<Triangle> triangles;
-};
 
 //! Lines of a text file, with their numbers for error messages.
 class TextLines
@@ -499,17 +491,15 @@ MeshParts readStl(Reader& reader)
 
 } // namespace
 
-Mesh readMeshFile(const fs::path& path, const ReadOptions& options)
+Mesh meshFromParts(MeshParts parts, const fs::path& path, const ReadOptions& options)
 {
-    Reader reader(path, options);
-    const std::string ext = lowerExtension(path);
-    MeshParts parts = ext == "obj" ? readObj(reader) : ext == "off" ? readOff(reader) : readStl(reader);
+    auto fail = [&](const std::string& message) { throw Error(ErrorCode::InvalidData, path.string() + ": " + message); };
     if (parts.triangles.empty())
-        reader.fail("the file holds no triangle");
+        fail("the file holds no triangle");
     BoundingBox box;
     for (const auto& v : parts.vertices) {
         if (!v.allFinite())
-            reader.fail("a vertex has a non-finite coordinate");
+            fail("a vertex has a non-finite coordinate");
         box.min = box.empty ? v : box.min.cwiseMin(v);
         box.max = box.empty ? v : box.max.cwiseMax(v);
         box.empty = false;
@@ -525,8 +515,19 @@ Mesh readMeshFile(const fs::path& path, const ReadOptions& options)
         mesh.vertices.enableNormals() = std::move(parts.normals);
     if (!parts.colors.empty())
         mesh.vertices.enableColors() = std::move(parts.colors);
+    for (ScalarField& field : parts.fields)
+        mesh.vertices.addField(std::move(field));
     mesh.triangles = std::move(parts.triangles);
     mesh.checkConsistency();
+    return mesh;
+}
+
+Mesh readMeshFile(const fs::path& path, const ReadOptions& options)
+{
+    Reader reader(path, options);
+    const std::string ext = lowerExtension(path);
+    MeshParts parts = ext == "obj" ? readObj(reader) : ext == "off" ? readOff(reader) : readStl(reader);
+    Mesh mesh = meshFromParts(std::move(parts), path, options);
     reader.done();
     return mesh;
 }

@@ -66,7 +66,7 @@ TEST(FuzzCorpus, EveryFileIsReadOrRefusedCleanly)
             }
     }
     // Every reader has its corpus.
-    for (const char* extension : {"ply", "pcd", "las", "laz", "xyz", "obj", "stl", "off"})
+    for (const char* extension : {"ply", "pcd", "las", "laz", "xyz", "obj", "stl", "off", "dxf"})
         EXPECT_TRUE(extensions.count(extension)) << "no corpus for ." << extension;
     EXPECT_GT(files, 7u);
 }
@@ -81,5 +81,5 @@ TEST(FuzzCorpus, EveryReproducerIsRefusedOrReadCleanly)
             readOrRefuse(registry, entry.path(), entry.path().extension().string().substr(1), scratch);
             ++files;
         }
-    EXPECT_EQ(files, 17u);
+    EXPECT_EQ(files, 18u);
 }

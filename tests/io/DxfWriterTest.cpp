@@ -193,11 +193,12 @@ TEST(DxfFormat, MeshThroughTheRegistry)
     EXPECT_EQ(check.count("total"), 2);
 }
 
-TEST(DxfFormat, ReadingIsUnsupported)
+TEST(DxfFormat, AFileWithoutSurfacesIsAClearError)
 {
+    // Reading takes meshes (DxfReaderTest.cpp); a drawing without one says so.
     const fs::path file = test::tempDir() / "in.dxf";
     test::writeText(file, "  0\nEOF\n");
-    expectErrorCode([&] { io::readPointCloud(dxfRegistry(), file); }, ErrorCode::Unsupported);
+    expectErrorCode([&] { io::readPointCloud(dxfRegistry(), file); }, ErrorCode::InvalidData);
 }
 
 } // namespace

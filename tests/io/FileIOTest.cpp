@@ -80,7 +80,7 @@ TEST(FileIO, WritingAPointCloudToAMeshOnlyFormatIsRefused)
 TEST(FileIO, EveryBuiltinFormatIsRegistered)
 {
     const auto registry = builtins();
-    for (const char* ext : {"ply", "xyz", "txt", "csv", "pts", "asc", "las", "obj", "stl", "off", "dxf"})
+    for (const char* ext : {"ply", "xyz", "txt", "csv", "pts", "asc", "las", "laz", "obj", "stl", "off", "dxf"})
         EXPECT_NO_THROW(registry.forPath(std::string("a.") + ext)) << ext;
 }
 

@@ -6,6 +6,7 @@
 #include "internal/Formats.h"
 #include "internal/LazDecoder.h"
 #include "internal/LazEncoder.h"
+#include "laz/ArithmeticCoder.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
@@ -19,6 +20,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <algorithm>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -135,14 +137,14 @@ void expectRecordsOfTheLasTwin(const std::string& name, std::size_t expectedPoin
     const io::detail::LazLayout layout =
         io::detail::parseLazLayout(name + ".laz", laz.data() + payload, at<std::uint16_t>(laz, payload - 54 + 20), length);
     ASSERT_EQ(layout.items.size(), expectedItems);
-    std::vector<char> records(std::size_t(count) * length);
     std::size_t reported = 0;
-    io::detail::decompressLaz(name + ".laz", laz.data(), laz.size(), at<std::uint32_t>(laz, kOffsetToPoints), layout,
-                              length, count, records.data(), [&](std::size_t points) { reported += points; });
+    const std::unique_ptr<char[]> records =
+        io::detail::decompressLaz(name + ".laz", laz.data(), laz.size(), at<std::uint32_t>(laz, kOffsetToPoints), layout,
+                                  length, count, [&](std::size_t points) { reported += points; });
     EXPECT_EQ(reported, count);
     const char* twin = las.data() + at<std::uint32_t>(las, kOffsetToPoints);
     for (std::size_t i = 0; i < count; ++i)
-        ASSERT_EQ(std::memcmp(records.data() + i * length, twin + i * length, length), 0) << name << " record " << i;
+        ASSERT_EQ(std::memcmp(records.get() + i * length, twin + i * length, length), 0) << name << " record " << i;
 }
 
 } // namespace
@@ -358,6 +360,25 @@ TEST(LazFormat, DamagedFilesAreClearErrors)
     bytes = good;
     bytes[points + 8 + 34 + 500] ^= 0x5A;
     expectRefused("flipped.laz", bytes, ErrorCode::InvalidData, "LAZ chunk 0");
+    // A stream of 0xFF bytes (it leaves the coding interval): refused, not decoded into garbage.
+    bytes = good;
+    std::fill(bytes.begin() + static_cast<std::ptrdiff_t>(points + 8 + 34), bytes.begin() + static_cast<std::ptrdiff_t>(table), '\xFF');
+    expectRefused("ff.laz", bytes, ErrorCode::InvalidData, "LAZ chunk 0");
+    // A chunk table giving the chunk fewer bytes than its first record.
+    bytes = good;
+    {
+        // Re-encode the table with a chunk of 10 bytes.
+        std::ostringstream table10;
+        const std::uint32_t header[2] = {0, 1};
+        table10.write(reinterpret_cast<const char*>(header), 8);
+        io::detail::laz::ArithmeticEncoder e;
+        io::detail::laz::IntegerCoder ic(32, 2);
+        ic.compress(e, 0, 10, 1);
+        const auto coded = e.done();
+        table10.write(reinterpret_cast<const char*>(coded.data()), static_cast<std::streamsize>(coded.size()));
+        bytes.replace(table, std::string::npos, table10.str());
+    }
+    expectRefused("short.laz", bytes, ErrorCode::InvalidData, "cannot hold 1065 points in 10 bytes");
     // An unknown chunk table version.
     bytes = good;
     put<std::uint32_t>(bytes, table, 7u);
@@ -374,11 +395,16 @@ TEST(LazFormat, DamagedFilesAreClearErrors)
     bytes = good;
     put<std::uint16_t>(bytes, payload + 34 + 12, 9);
     expectRefused("wave.laz", bytes, ErrorCode::Unsupported, "wavepacket13");
-    // A header claiming far more points than the compressed bytes can hold
-    // is refused before anything is allocated.
+    // A header claiming far more points than the chunk table is refused
+    // before anything is allocated.
     bytes = good;
     put<std::uint32_t>(bytes, kPointCount, 4000000000u);
-    expectRefused("count.laz", bytes, ErrorCode::InvalidData, "per byte");
+    expectRefused("count.laz", bytes, ErrorCode::InvalidData, "the header says 4000000000");
+    // And so is a chunk size no chunk of these bytes can hold.
+    bytes = good;
+    put<std::uint32_t>(bytes, kPointCount, 4000000000u);
+    put<std::uint32_t>(bytes, payload + 12, 4000000000u);
+    expectRefused("dense.laz", bytes, ErrorCode::InvalidData, "cannot hold 4000000000 points");
     // Fewer points in the header than in the chunk: decoding them leaves
     // bytes of the chunk unused.
     bytes = good;
@@ -411,6 +437,23 @@ TEST(LazFormat, DamagedLayeredChunksAreClearErrors)
     bytes = good;
     put<std::uint16_t>(bytes, payload + 34 + 4, 4);
     expectRefused("v4.laz", bytes, ErrorCode::Unsupported, "point14 version 4");
+    // No x, y layer although the chunk has 1,000 points.
+    bytes = good;
+    put<std::uint32_t>(bytes, sizes, 0u);
+    expectRefused("noxy.laz", bytes, ErrorCode::InvalidData, "no x, y layer");
+    // Layers of 0xFF bytes: the stream leaves the coding interval at once (it
+    // read past the models' tables before), and the GPS time coder would
+    // switch sequence forever; both are refused.
+    bytes = good;
+    const std::size_t layers = sizes + 36;
+    std::fill(bytes.begin() + static_cast<std::ptrdiff_t>(layers), bytes.begin() + static_cast<std::ptrdiff_t>(layers + 3000), '\xFF');
+    expectRefused("ff.laz", bytes, ErrorCode::InvalidData, "is corrupt");
+    bytes = good;
+    std::size_t gps = layers;
+    for (int layer = 0; layer < 8; ++layer)
+        gps += at<std::uint32_t>(good, sizes + 4 * static_cast<std::size_t>(layer));
+    std::fill(bytes.begin() + static_cast<std::ptrdiff_t>(gps), bytes.begin() + static_cast<std::ptrdiff_t>(gps + 555), '\xFF');
+    expectRefused("gps.laz", bytes, ErrorCode::InvalidData, "is corrupt");
 }
 
 namespace {

@@ -390,7 +390,10 @@ TEST(Icp, EveryRegistrationToolStopsAtAnyPollAndLeavesBothCloudsAsTheyWere)
         ASSERT_NO_THROW(spec.execute(inputs, values, &counting)) << name;
         const std::size_t polls = counting.polls();
         ASSERT_GE(polls, 3u) << name;
-        for (const std::size_t at : {std::size_t(1), polls / 3, 2 * polls / 3, polls}) {
+        // "The last" is 95 % of the counted polls: the parallel stages poll per
+        // worker, so another run may poll a few times less (this test failed
+        // once under load when it waited for the exact count).
+        for (const std::size_t at : {std::size_t(1), polls / 3, 2 * polls / 3, polls - polls / 20}) {
             test::PollCounter cancel(std::max<std::size_t>(at, 1));
             EXPECT_EQ(test::errorCodeOf([&] { spec.execute(inputs, values, &cancel); }), ErrorCode::Cancelled)
                 << name << ", Cancel at poll " << at << " of " << polls;

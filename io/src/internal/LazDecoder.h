@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <vector>
 
 namespace scandiff::io::detail {
@@ -39,14 +40,16 @@ constexpr std::uint16_t kLaszipRecordId = 22204;
 //! have, each naming the file.
 LazLayout parseLazLayout(const std::filesystem::path& path, const char* payload, std::size_t length, std::size_t recordLength);
 
-//! Decompresses `count` records of `recordLength` bytes, whose compressed data
-//! starts at byte `pointsStart` of the file (`data`, `size` bytes), into `out`.
-//! Chunks are decoded in parallel; `progress(points)` is called between batches
-//! of chunks with the points decoded since the last call (it may throw to
+//! Decompresses the `count` records of `recordLength` bytes whose compressed
+//! data starts at byte `pointsStart` of the file (`data`, `size` bytes), into
+//! memory allocated once the chunk table has vouched for the count. Chunks are
+//! decoded in parallel; `progress(points)` is called between batches of
+//! chunks with the points decoded since the last call (it may throw to
 //! cancel). Throws Error(InvalidData) naming the file for a chunk table or
-//! chunk that does not fit the file or the header's count.
-void decompressLaz(const std::filesystem::path& path, const char* data, std::size_t size, std::uint64_t pointsStart,
-                   const LazLayout& layout, std::size_t recordLength, std::uint64_t count, char* out,
-                   const std::function<void(std::size_t)>& progress);
+//! chunk that does not fit the file or the header's count, or that does not
+//! decode (a damaged stream is given up within a thousand points or so).
+std::unique_ptr<char[]> decompressLaz(const std::filesystem::path& path, const char* data, std::size_t size,
+                                      std::uint64_t pointsStart, const LazLayout& layout, std::size_t recordLength,
+                                      std::uint64_t count, const std::function<void(std::size_t)>& progress);
 
 } // namespace scandiff::io::detail

@@ -125,6 +125,10 @@ public:
     //! Where the next byte would be read (past `end` when it ran out).
     const unsigned char* position() const { return next_; }
     std::size_t bytesPastEnd() const { return pastEnd_; }
+    //! Whether the stream cannot come from an encoder: it ran past its end,
+    //! left the coding interval, or a coder saw an impossible sequence.
+    bool corrupt() const { return pastEnd_ > 0 || corrupt_ || value_ >= length_; }
+    void markCorrupt() { corrupt_ = true; }
 
     std::uint32_t decodeBit(BitModel& m)
     {
@@ -151,7 +155,13 @@ public:
             // The table narrows the search to a few symbols, bisection ends it.
             length_ >>= kSymbolLengthShift;
             const std::uint32_t dv = value_ / length_;
-            const std::uint32_t t = dv >> m.tableShift_;
+            std::uint32_t t = dv >> m.tableShift_;
+            // The table has two entries beyond its size for the rounding of
+            // `length`; only a damaged stream, out of its interval, goes further.
+            if (t > m.tableSize_) {
+                corrupt_ = true;
+                t = m.tableSize_;
+            }
             symbol = m.decoderTable_[t];
             std::uint32_t n = m.decoderTable_[t + 1] + 1;
             while (n > symbol + 1) {
@@ -234,6 +244,7 @@ private:
     const unsigned char* next_;
     const unsigned char* end_;
     std::size_t pastEnd_ = 0;
+    bool corrupt_ = false;
     std::uint32_t value_ = 0, length_ = kMaxLength;
 };
 

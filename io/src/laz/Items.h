@@ -49,6 +49,13 @@ void store(void* p, T value)
     std::memcpy(p, &value, sizeof(T));
 }
 
+//! A GPS time's bit pattern plus a difference, wrapping as LASzip's integers
+//! do (a damaged stream may add anything).
+inline std::int64_t addWrapping(std::int64_t pattern, std::int32_t diff)
+{
+    return static_cast<std::int64_t>(static_cast<std::uint64_t>(pattern) + static_cast<std::uint64_t>(std::int64_t(diff)));
+}
+
 //! A byte plus a change, modulo 256 (LASzip's U8_FOLD).
 inline std::uint8_t fold(std::int32_t v) { return static_cast<std::uint8_t>(v & 0xFF); }
 inline std::int32_t clampByte(std::int32_t v) { return std::clamp(v, 0, 255); }
@@ -108,8 +115,8 @@ public:
     //! first point; the point14 item sets it from that point.
     virtual void start(const Layer* layers, std::uint32_t& context) = 0;
     virtual void decode(unsigned char* item, std::uint32_t& context) = 0;
-    //! Whether a layer's stream was read beyond its end: a corrupt chunk.
-    virtual bool overran() const = 0;
+    //! Whether a layer's stream cannot come from an encoder (see ArithmeticDecoder::corrupt).
+    virtual bool corrupt() const = 0;
 };
 
 //! The coder of a layered item (point14, rgb14, rgbnir14 or byte14, version

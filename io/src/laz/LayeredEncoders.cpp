@@ -80,7 +80,7 @@ public:
                 xy.encodeSymbol(c->returnNumberGpsSame, (r + 16 - lastR - 2) % 16);
         }
         const std::uint32_t m = kReturnMap6[n][r], l = returnLevel8(n, r);
-        const std::uint32_t position = (r == 1 ? 1u : 0u) + (r >= n ? 2u : 0u);
+        const std::uint32_t position = (r == 1 ? 2u : 0u) + (r >= n ? 1u : 0u); // as the decoder's
         const std::uint32_t medianSlot = (m << 1) | (gpsTimeChanged ? 1u : 0u);
 
         const auto dx = static_cast<std::int32_t>(static_cast<std::uint32_t>(p.x) - static_cast<std::uint32_t>(last->x));

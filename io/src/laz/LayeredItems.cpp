@@ -29,7 +29,7 @@ public:
     }
     bool changes() const { return decoder_.has_value(); }
     ArithmeticDecoder& operator*() { return *decoder_; }
-    bool overran() const { return decoder_ && decoder_->bytesPastEnd() > 0; }
+    bool corrupt() const { return decoder_ && decoder_->corrupt(); }
 
 private:
     std::optional<ArithmeticDecoder> decoder_;
@@ -54,9 +54,9 @@ public:
         contexts_[current_] = std::make_unique<Point14Context>(first_);
     }
 
-    bool overran() const override
+    bool corrupt() const override
     {
-        return std::any_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.overran(); });
+        return std::any_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.corrupt(); });
     }
 
     void decode(unsigned char* item, std::uint32_t& context) override
@@ -98,7 +98,9 @@ public:
         }
         p.returnNumber = r;
         const std::uint32_t m = kReturnMap6[n][r], l = returnLevel8(n, r);
-        const std::uint32_t position = (r == 1 ? 1u : 0u) + (r >= n ? 2u : 0u);
+        // The return of this point: single 3, first 2, last 1, intermediate 0
+        // (the last point's above counts first as 1 and last as 2).
+        const std::uint32_t position = (r == 1 ? 2u : 0u) + (r >= n ? 1u : 0u);
         const std::uint32_t medianSlot = (m << 1) | (gpsTimeChanged ? 1u : 0u);
 
         const std::int32_t dx = c->dx.decompress(xy, c->xMedian[medianSlot].median(), n == 1);
@@ -158,7 +160,7 @@ class Rgb14Decoder final : public LayeredItem
 public:
     Rgb14Decoder(const unsigned char* first, bool withNir) : withNir_(withNir)
     {
-        for (std::size_t c = 0; c < first_.size(); ++c)
+        for (std::size_t c = 0; c < (withNir ? 4u : 3u); ++c)
             first_[c] = load<std::uint16_t>(first + 2 * c);
     }
 
@@ -173,7 +175,7 @@ public:
         contexts_[current_] = std::make_unique<Context>(first_);
     }
 
-    bool overran() const override { return rgb_.overran() || nir_.overran(); }
+    bool corrupt() const override { return rgb_.corrupt() || nir_.corrupt(); }
 
     void decode(unsigned char* item, std::uint32_t& context) override
     {
@@ -223,9 +225,9 @@ public:
         contexts_[current_] = std::make_unique<Context>(first_);
     }
 
-    bool overran() const override
+    bool corrupt() const override
     {
-        return std::any_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.overran(); });
+        return std::any_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.corrupt(); });
     }
 
     void decode(unsigned char* item, std::uint32_t& context) override

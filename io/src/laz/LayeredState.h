@@ -124,12 +124,18 @@ public:
 
     std::int64_t decode(ArithmeticDecoder& d)
     {
-        for (;;) {
+        // An encoder switches sequence at most once per time (the time fits
+        // the sequence it switches to); a damaged stream could switch forever.
+        for (int switches = 0;; ++switches) {
+            if (switches > 1) {
+                d.markCorrupt();
+                return last_[current_];
+            }
             if (lastDiff_[current_] == 0) {
                 const auto multi = static_cast<std::int32_t>(d.decodeSymbol(zeroDiff_));
                 if (multi == 0) {
                     lastDiff_[current_] = diff_.decompress(d, 0, 0);
-                    last_[current_] += lastDiff_[current_];
+                    last_[current_] = addWrapping(last_[current_], lastDiff_[current_]);
                     extremeCount_[current_] = 0;
                 } else if (multi == 1) {
                     fullTime(d);
@@ -141,7 +147,7 @@ public:
             }
             auto multi = static_cast<std::int32_t>(d.decodeSymbol(multiple_));
             if (multi == 1) {
-                last_[current_] += diff_.decompress(d, lastDiff_[current_], 1);
+                last_[current_] = addWrapping(last_[current_], diff_.decompress(d, lastDiff_[current_], 1));
                 extremeCount_[current_] = 0;
             } else if (multi < kMultiCodeFull) {
                 std::int32_t diff;
@@ -163,7 +169,7 @@ public:
                         countExtreme(diff);
                     }
                 }
-                last_[current_] += diff;
+                last_[current_] = addWrapping(last_[current_], diff);
             } else if (multi == kMultiCodeFull) {
                 fullTime(d);
             } else {
@@ -213,7 +219,8 @@ public:
             }
             const std::int32_t previous = lastDiff_[current_];
             // LASzip's choice of multiplier: a float ratio rounded half away from zero.
-            const float ratio = static_cast<float>(diff) / static_cast<float>(previous);
+            // Clamped first: every multiplier beyond the coded ones is coded as the extreme one.
+            const float ratio = std::clamp(static_cast<float>(diff) / static_cast<float>(previous), float(kMultiMinus - 1), float(kMulti + 1));
             const auto multi = static_cast<std::int32_t>(ratio >= 0 ? ratio + 0.5f : ratio - 0.5f);
             if (multi == 1) {
                 e.encodeSymbol(multiple_, 1);

@@ -254,12 +254,18 @@ private:
     void read(ArithmeticDecoder& d)
     {
         // A switch to another sequence is followed by that sequence's own code.
-        for (;;) {
+        // An encoder switches sequence at most once per time (the time fits
+        // the sequence it switches to); a damaged stream could switch forever.
+        for (int switches = 0;; ++switches) {
+            if (switches > 1) {
+                d.markCorrupt();
+                return;
+            }
             if (lastDiff_[current_] == 0) {
                 const auto multi = static_cast<std::int32_t>(d.decodeSymbol(zeroDiff_));
                 if (multi == 1) {
                     lastDiff_[current_] = diff_.decompress(d, 0, 0);
-                    last_[current_] += lastDiff_[current_];
+                    last_[current_] = addWrapping(last_[current_], lastDiff_[current_]);
                     extremeCount_[current_] = 0;
                 } else if (multi == 2) {
                     fullTime(d);
@@ -271,7 +277,7 @@ private:
             }
             auto multi = static_cast<std::int32_t>(d.decodeSymbol(multiple_));
             if (multi == 1) {
-                last_[current_] += diff_.decompress(d, lastDiff_[current_], 1);
+                last_[current_] = addWrapping(last_[current_], diff_.decompress(d, lastDiff_[current_], 1));
                 extremeCount_[current_] = 0;
             } else if (multi < kMultiUnchanged) {
                 std::int32_t diff;
@@ -293,7 +299,7 @@ private:
                         countExtreme(diff);
                     }
                 }
-                last_[current_] += diff;
+                last_[current_] = addWrapping(last_[current_], diff);
             } else if (multi == kMultiCodeFull) {
                 fullTime(d);
             } else if (multi > kMultiCodeFull) {

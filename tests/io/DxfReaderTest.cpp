@@ -1,0 +1,213 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// DXF meshes read back: a file built by hand from the DXF reference, our own
+// 3DFACE export, and a file written by ezdxf (tests/data/dxf).
+
+#include <scandiff/core/Error.h>
+#include <scandiff/core/Log.h>
+#include <scandiff/io/FileIO.h>
+
+#include "../support/TestSupport.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace scandiff;
+
+io::FormatRegistry registry()
+{
+    io::FormatRegistry r;
+    io::registerBuiltinFormats(r);
+    return r;
+}
+
+//! Keeps the reader's warnings and notes for the test to check.
+class CapturedLog
+{
+public:
+    CapturedLog()
+    {
+        previous_ = setLogSink([this](LogLevel, const std::string& message) { messages.push_back(message); });
+    }
+    ~CapturedLog() { setLogSink(std::move(previous_)); }
+    bool has(const std::string& words) const
+    {
+        return std::any_of(messages.begin(), messages.end(), [&](const std::string& m) { return m.find(words) != std::string::npos; });
+    }
+    std::vector<std::string> messages;
+
+private:
+    LogSink previous_;
+};
+
+//! DXF text from (code, value) pairs.
+std::string dxf(const std::vector<std::pair<int, std::string>>& groups)
+{
+    std::string out;
+    for (const auto& [code, value] : groups)
+        out += "  " + std::to_string(code) + "\r\n" + value + "\r\n";
+    return out;
+}
+
+using Groups = std::vector<std::pair<int, std::string>>;
+
+Groups vertex(const std::string& layer, double x, double y, double z, int flags)
+{
+    return {{0, "VERTEX"}, {8, layer}, {10, std::to_string(x)}, {20, std::to_string(y)}, {30, std::to_string(z)}, {70, std::to_string(flags)}};
+}
+
+void append(Groups& to, const Groups& from) { to.insert(to.end(), from.begin(), from.end()); }
+
+//! Every triangle as its three corners in global coordinates, sorted, so two
+//! meshes compare whatever their vertex order.
+std::multiset<std::array<std::array<double, 3>, 3>> triangleSet(const Mesh& mesh)
+{
+    std::multiset<std::array<std::array<double, 3>, 3>> out;
+    for (const Triangle& t : mesh.triangles) {
+        std::array<std::array<double, 3>, 3> corners{};
+        for (int k = 0; k < 3; ++k) {
+            const Eigen::Vector3d p = mesh.vertices.globalPosition(t[static_cast<std::size_t>(k)]);
+            corners[static_cast<std::size_t>(k)] = {p.x(), p.y(), p.z()};
+        }
+        std::sort(corners.begin(), corners.end());
+        out.insert(corners);
+    }
+    return out;
+}
+
+} // namespace
+
+TEST(DxfReader, FacesPolyfacesAndPolygonMeshesOfTheEntitiesSection)
+{
+    Groups g = {{0, "SECTION"}, {2, "HEADER"}, {0, "ENDSEC"},
+                // A block's face is not a model face (its INSERT is reported, not expanded).
+                {0, "SECTION"}, {2, "BLOCKS"}, {0, "BLOCK"}, {8, "0"}, {2, "B"}, {0, "3DFACE"}, {8, "0"},
+                {10, "9"}, {20, "9"}, {30, "9"}, {11, "8"}, {21, "9"}, {31, "9"}, {12, "8"}, {22, "8"}, {32, "9"},
+                {0, "ENDBLK"}, {0, "ENDSEC"},
+                {0, "SECTION"}, {2, "ENTITIES"},
+                // A triangle (no fourth corner) and a quadrilateral sharing its edge, layer WALL.
+                {0, "3DFACE"}, {8, "WALL"}, {10, "0"}, {20, "0"}, {30, "0"}, {11, "1"}, {21, "0"}, {31, "0"},
+                {12, "1"}, {22, "1"}, {32, "0"},
+                {0, "3DFACE"}, {8, "WALL"}, {10, "1"}, {20, "0"}, {30, "0"}, {11, "2"}, {21, "0"}, {31, "0"},
+                {12, "2"}, {22, "1"}, {32, "0"}, {13, "1"}, {23, "1"}, {33, "0"},
+                {0, "LINE"}, {8, "WALL"}, {10, "0"}, {20, "0"}, {30, "0"}, {11, "5"}, {21, "5"}, {31, "5"},
+                {0, "INSERT"}, {2, "B"}, {10, "0"}, {20, "0"}, {30, "0"},
+                // A polyface tetrahedron, layer BOX: 4 vertices, 4 faces (one with an invisible edge).
+                {0, "POLYLINE"}, {8, "BOX"}, {66, "1"}, {70, "64"}, {71, "4"}, {72, "4"}};
+    append(g, vertex("BOX", 10, 0, 0, 192));
+    append(g, vertex("BOX", 11, 0, 0, 192));
+    append(g, vertex("BOX", 10, 1, 0, 192));
+    append(g, vertex("BOX", 10, 0, 1, 192));
+    for (const std::array<int, 3>& f : {std::array<int, 3>{1, 2, 3}, {1, 2, -4}, {2, 3, 4}, {3, 1, 4}}) {
+        Groups face = {{0, "VERTEX"}, {8, "BOX"}, {10, "0"}, {20, "0"}, {30, "0"}, {70, "128"},
+                       {71, std::to_string(f[0])}, {72, std::to_string(f[1])}, {73, std::to_string(f[2])}};
+        append(g, face);
+    }
+    append(g, {{0, "SEQEND"},
+               // A 2 x 3 polygon mesh closed in N, layer GROUND: 2 quads per row pair plus the closing one.
+               {0, "POLYLINE"}, {8, "GROUND"}, {66, "1"}, {70, "48"}, {71, "2"}, {72, "3"}});
+    for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 3; ++j)
+            append(g, vertex("GROUND", 20 + i, j, 0.5 * i * j, 64));
+    append(g, {{0, "SEQEND"}, {0, "ENDSEC"}, {0, "EOF"}});
+
+    const fs::path file = test::tempDir() / "model.dxf";
+    test::writeText(file, dxf(g));
+    CapturedLog log;
+    const Mesh mesh = io::readMesh(registry(), file);
+    // 1 + 2 (the quad) + 4 (tetrahedron) + 2 x 3 (three quads of the closed mesh).
+    ASSERT_EQ(mesh.triangles.size(), 13u);
+    // The two faces share two corners: 3 + 2 vertices, then 4, then 6.
+    ASSERT_EQ(mesh.vertices.size(), 15u);
+    EXPECT_TRUE(log.has("1 block references (INSERT) were not expanded"));
+    EXPECT_TRUE(log.has("0 = WALL, 1 = BOX, 2 = GROUND"));
+    const ScalarField* layer = mesh.vertices.field("dxf_layer");
+    ASSERT_NE(layer, nullptr);
+    std::vector<int> perLayer(3, 0);
+    for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+        ++perLayer[static_cast<std::size_t>(layer->value(i))];
+    EXPECT_EQ(perLayer, (std::vector<int>{5, 4, 6}));
+    // The closing quad of the polygon mesh joins column 2 to column 0.
+    const auto triangles = triangleSet(mesh);
+    EXPECT_EQ(triangles.count({{{20, 0, 0}, {20, 2, 0}, {21, 0, 0}}}) + triangles.count({{{20, 2, 0}, {21, 0, 0}, {21, 2, 1}}}), 2u);
+}
+
+TEST(DxfReader, OurExportAndEzdxfsFilesReadBack)
+{
+    // A georeferenced mesh through our 3DFACE export and back: the same
+    // triangles, every coordinate to the digit the export wrote.
+    Mesh mesh;
+    mesh.vertices.setOrigin({652000.0, 5120000.0, 300.0});
+    mesh.vertices.resize(5);
+    mesh.vertices.positions() = {{0, 0, 0}, {1.25f, 0, 0}, {1.25f, 2.5f, 0.5f}, {0, 2.5f, 0.75f}, {0.5f, 1, 3}};
+    mesh.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 1, 4}, {1, 2, 4}};
+    const fs::path ours = test::tempDir() / "ours.dxf";
+    io::writeMesh(registry(), mesh, ours);
+    const Mesh back = io::readMesh(registry(), ours);
+    EXPECT_EQ(triangleSet(back), triangleSet(mesh));
+
+    // ezdxf 0.18.1: a polyface cube (6 quads), a 3 x 4 polygon mesh (6 quads),
+    // a 3DFACE triangle and a quadrilateral.
+    const Mesh ez = io::readMesh(registry(), test::dataPath("dxf/ezdxf-meshes.dxf"));
+    EXPECT_EQ(ez.triangles.size(), 12u + 12u + 1u + 2u);
+    EXPECT_EQ(ez.vertices.size(), 8u + 12u + 3u + 4u);
+    // The top of the cube: two triangles at z = 302 over its four corners.
+    std::set<std::array<double, 3>> top;
+    std::size_t topTriangles = 0;
+    for (const auto& t : triangleSet(ez))
+        if (t[0][2] == 302 && t[1][2] == 302 && t[2][2] == 302) {
+            ++topTriangles;
+            top.insert(t.begin(), t.end());
+        }
+    EXPECT_EQ(topTriangles, 2u);
+    EXPECT_EQ(top, (std::set<std::array<double, 3>>{{652000, 5120000, 302}, {652002, 5120000, 302}, {652002, 5120002, 302},
+                                                    {652000, 5120002, 302}}));
+    // The corner of the polygon mesh at i = 2, j = 3 (z = 300 + 0.125 * 6).
+    bool corner = false;
+    for (std::size_t i = 0; i < ez.vertices.size(); ++i)
+        corner = corner || ez.vertices.globalPosition(i).isApprox(Eigen::Vector3d(652012, 5120003, 300.75), 1e-12);
+    EXPECT_TRUE(corner);
+}
+
+TEST(DxfReader, BrokenFilesAreClearErrors)
+{
+    const fs::path dir = test::tempDir();
+    auto expectError = [&](const std::string& name, const std::string& text, ErrorCode code, const std::string& words) {
+        const fs::path file = dir / name;
+        test::writeText(file, text);
+        try {
+            io::readMesh(registry(), file);
+            ADD_FAILURE() << name << ": no error";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), code) << e.what();
+            EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+        }
+    };
+    const Groups start = {{0, "SECTION"}, {2, "ENTITIES"}};
+    Groups g = start;
+    append(g, {{0, "POLYLINE"}, {70, "64"}});
+    append(g, vertex("0", 0, 0, 0, 192));
+    append(g, {{0, "VERTEX"}, {70, "128"}, {71, "1"}, {72, "2"}, {73, "3"}, {0, "SEQEND"}, {0, "ENDSEC"}, {0, "EOF"}});
+    expectError("index.dxf", dxf(g), ErrorCode::InvalidData, "uses vertex 2 of 1");
+    g = start;
+    append(g, {{0, "POLYLINE"}, {70, "16"}, {71, "3"}, {72, "3"}});
+    append(g, vertex("0", 0, 0, 0, 64));
+    append(g, {{0, "SEQEND"}, {0, "ENDSEC"}});
+    expectError("grid.dxf", dxf(g), ErrorCode::InvalidData, "3 x 3 vertices has 1");
+    g = start;
+    append(g, {{0, "3DFACE"}, {10, "1e999"}, {20, "0"}, {30, "0"}, {0, "ENDSEC"}});
+    expectError("inf.dxf", dxf(g), ErrorCode::InvalidData, "must be a finite number");
+    expectError("code.dxf", "  0\nSECTION\nxx\nENTITIES\n", ErrorCode::InvalidData, "line 3: a group code must be an integer");
+    expectError("cut.dxf", "  0\nSECTION\n  2\n", ErrorCode::InvalidData, "without its value");
+    expectError("lines.dxf", dxf({{0, "SECTION"}, {2, "ENTITIES"}, {0, "LINE"}, {0, "ENDSEC"}}), ErrorCode::InvalidData,
+                "no surface");
+    expectError("binary.dxf", std::string("AutoCAD Binary DXF\r\n\x1a\0", 22), ErrorCode::Unsupported, "binary DXF");
+}
