@@ -120,19 +120,9 @@ void Octree::withinCylinderBatch(const CylinderQuery* queries, std::size_t count
                 scan(q, node.first, node.last, s);
                 continue;
             }
-            const int childLevel = node.level + 1;
-            const int shift = 3 * (kMaxLevel - childLevel);
-            std::size_t begin = node.first;
-            for (MortonCode c = 0; c < 8 && begin < node.last; ++c) {
-                const MortonCode child = (node.cell << 3) | c;
-                const auto end = static_cast<std::size_t>(
-                    std::lower_bound(codes_.begin() + static_cast<std::ptrdiff_t>(begin),
-                                     codes_.begin() + static_cast<std::ptrdiff_t>(node.last), (child + 1) << shift) -
-                    codes_.begin());
-                if (end > begin)
-                    s.stack.push_back({child, childLevel, begin, end});
-                begin = end;
-            }
+            forEachChild(node.cell, node.level, node.first, node.last, [&](MortonCode child, std::size_t begin, std::size_t end) {
+                s.stack.push_back({child, node.level + 1, begin, end});
+            });
         }
     };
     auto collect = [&](const CylinderQuery& q, CylinderScratch& s) {

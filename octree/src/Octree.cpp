@@ -332,18 +332,9 @@ void Octree::descend(const Eigen::Vector3f& q, int leafLevel, Visit&& visitRange
             continue;
         }
         const int childLevel = node.level + 1;
-        const int shift = 3 * (kMaxLevel - childLevel);
-        std::size_t begin = node.first;
-        for (MortonCode c = 0; c < 8 && begin < node.last; ++c) {
-            const MortonCode child = (node.cell << 3) | c;
-            const auto end = static_cast<std::size_t>(
-                std::lower_bound(codes_.begin() + static_cast<std::ptrdiff_t>(begin),
-                                 codes_.begin() + static_cast<std::ptrdiff_t>(node.last), (child + 1) << shift) -
-                codes_.begin());
-            if (end > begin)
-                queue.push({squaredGap(child, childLevel, q), childLevel, child, begin, end});
-            begin = end;
-        }
+        forEachChild(node.cell, node.level, node.first, node.last, [&](MortonCode child, std::size_t begin, std::size_t end) {
+            queue.push({squaredGap(child, childLevel, q), childLevel, child, begin, end});
+        });
     }
 }
 

@@ -28,25 +28,6 @@ io::FormatRegistry registry()
     return r;
 }
 
-//! Keeps the reader's warnings and notes for the test to check.
-class CapturedLog
-{
-public:
-    CapturedLog()
-    {
-        previous_ = setLogSink([this](LogLevel, const std::string& message) { messages.push_back(message); });
-    }
-    ~CapturedLog() { setLogSink(std::move(previous_)); }
-    bool has(const std::string& words) const
-    {
-        return std::any_of(messages.begin(), messages.end(), [&](const std::string& m) { return m.find(words) != std::string::npos; });
-    }
-    std::vector<std::string> messages;
-
-private:
-    LogSink previous_;
-};
-
 //! DXF text from (code, value) pairs.
 std::string dxf(const std::vector<std::pair<int, std::string>>& groups)
 {
@@ -120,7 +101,7 @@ TEST(DxfReader, FacesPolyfacesAndPolygonMeshesOfTheEntitiesSection)
 
     const fs::path file = test::tempDir() / "model.dxf";
     test::writeText(file, dxf(g));
-    CapturedLog log;
+    test::CapturedLog log;
     const Mesh mesh = io::readMesh(registry(), file);
     // 1 + 2 (the quad) + 4 (tetrahedron) + 2 x 3 (three quads of the closed mesh).
     ASSERT_EQ(mesh.triangles.size(), 13u);

@@ -26,23 +26,6 @@ using namespace scandiff;
 using test::checkDxf;
 using test::DxfCheck;
 
-class CapturedLog
-{
-public:
-    CapturedLog()
-    {
-        previous_ = setLogSink([this](LogLevel level, const std::string& message) {
-            if (level == LogLevel::Warning)
-                warnings.push_back(message);
-        });
-    }
-    ~CapturedLog() { setLogSink(std::move(previous_)); }
-    std::vector<std::string> warnings;
-
-private:
-    LogSink previous_;
-};
-
 io::FormatRegistry dxfRegistry()
 {
     io::FormatRegistry registry;
@@ -151,7 +134,7 @@ TEST(DxfDrawing, RejectsInvalidInput)
 
 TEST(DxfFormat, CloudThroughTheRegistry)
 {
-    CapturedLog log;
+    test::CapturedLog log;
     const fs::path file = test::tempDir() / "cloud.dxf";
     PointCloud cloud;
     cloud.name = "scan 2024/05";

@@ -36,24 +36,6 @@ io::FormatRegistry lasRegistry()
     return registry;
 }
 
-//! Collects warnings while alive, so tests can check them and the output stays quiet.
-class CapturedLog
-{
-public:
-    CapturedLog()
-    {
-        previous_ = setLogSink([this](LogLevel level, const std::string& message) {
-            if (level == LogLevel::Warning)
-                warnings.push_back(message);
-        });
-    }
-    ~CapturedLog() { setLogSink(std::move(previous_)); }
-    std::vector<std::string> warnings;
-
-private:
-    LogSink previous_;
-};
-
 //! A little-endian byte buffer with writes at absolute offsets.
 class Bytes
 {
@@ -269,19 +251,6 @@ double fieldValue(const PointCloud& cloud, const std::string& name, std::size_t 
 
 //! Runs `read` and checks it throws scandiff::Error with `code` and a message
 //! naming `path` and containing `words`.
-template <class Fn>
-void expectError(Fn&& read, ErrorCode code, const fs::path& path, const std::string& words)
-{
-    try {
-        read();
-        ADD_FAILURE() << "no error for " << path << " (expected: " << words << ")";
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), code) << e.what();
-        EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
-    }
-}
-
 // ---------------------------------------------------------------------------
 
 TEST(LasFormat, RoundTripKeepsCoordinatesColoursAndFields)
@@ -396,7 +365,7 @@ TEST(LasFormat, WrittenHeaderFollowsLas14Rules)
 
 TEST(LasFormat, FieldsOutsideTheStandardSlotsBecomeExtraBytes)
 {
-    CapturedLog log;
+    test::CapturedLog log;
     const fs::path file = test::tempDir() / "extra.las";
     PointCloud cloud;
     cloud.resize(4);
@@ -456,7 +425,7 @@ TEST(LasFormat, ColoursAndNirUseFormat8AndStandardSlotsAreClamped)
 
 TEST(LasFormat, EmptyCloudAndNonFinitePoints)
 {
-    CapturedLog log;
+    test::CapturedLog log;
     const fs::path dir = test::tempDir();
     PointCloud empty;
     io::writePointCloud(lasRegistry(), empty, dir / "empty.las");
@@ -478,7 +447,7 @@ TEST(LasFormat, EmptyCloudAndNonFinitePoints)
 
 TEST(LasFormat, HandBuiltLas12Format1DecodesAsTheSpecSays)
 {
-    CapturedLog log;
+    test::CapturedLog log;
     const fs::path file = test::tempDir() / "v12.las";
     test::writeText(file, makeLas12Format1().str());
     const PointCloud cloud = io::readPointCloud(lasRegistry(), file);
@@ -559,7 +528,7 @@ TEST(LasFormat, RoundTripKeepsTheScaleOffsetAndIntegers)
 
 TEST(LasFormat, HandBuiltLas14Format10DecodesAsTheSpecSays)
 {
-    CapturedLog log;
+    test::CapturedLog log;
     const fs::path file = test::tempDir() / "v14.las";
     test::writeText(file, makeLas14Format10().str());
     const PointCloud cloud = io::readPointCloud(lasRegistry(), file);
@@ -665,13 +634,13 @@ public:
 
 TEST(LasFormat, CancellationThrowsCancelled)
 {
-    CapturedLog log;
+    test::CapturedLog log;
     const fs::path file = test::tempDir() / "cancel.las";
     test::writeText(file, makeLas12Format1().str());
     CancelAtOnce cancel;
     io::ReadOptions options;
     options.progress = &cancel;
-    expectError([&] { io::readPointCloud(lasRegistry(), file, options); }, ErrorCode::Cancelled, fs::path(),
+    test::expectError([&] { io::readPointCloud(lasRegistry(), file, options); }, ErrorCode::Cancelled, fs::path(),
                 "cancelled");
 }
 
@@ -687,7 +656,7 @@ protected:
     {
         const fs::path file = dir_ / name;
         test::writeText(file, bytes);
-        expectError([&] { io::readPointCloud(lasRegistry(), file); }, code, file, words);
+        test::expectError([&] { io::readPointCloud(lasRegistry(), file); }, code, file, words);
     }
 
     fs::path dir_;
@@ -769,7 +738,7 @@ TEST_F(LasBadInput, RecordLengthSmallerThanTheFormat)
 TEST_F(LasBadInput, MissingFile)
 {
     const fs::path file = dir_ / "missing.las";
-    expectError([&] { io::readPointCloud(lasRegistry(), file); }, ErrorCode::Io, file, "no such file");
+    test::expectError([&] { io::readPointCloud(lasRegistry(), file); }, ErrorCode::Io, file, "no such file");
 }
 
 // ---------------------------------------------------------------------------
@@ -823,7 +792,7 @@ TEST(LasCrs, UserDefinedOrUnknownKeysLeaveNoSystemAndAWarning)
 {
     const fs::path file = test::tempDir() / "userkeys.las";
     for (std::uint16_t code : {std::uint16_t{32767}, std::uint16_t{65000}}) {
-        CapturedLog log;
+        test::CapturedLog log;
         test::writeText(file, makeLasWithGeoKeys({{3072, code}}).str());
         const PointCloud cloud = io::readPointCloud(lasRegistry(), file);
         EXPECT_EQ(cloud.size(), 1u);
@@ -834,14 +803,14 @@ TEST(LasCrs, UserDefinedOrUnknownKeysLeaveNoSystemAndAWarning)
     {
         // A user-defined projection over a known geographic base is not
         // labelled with the base: its coordinates are metres, not degrees.
-        CapturedLog log;
+        test::CapturedLog log;
         test::writeText(file, makeLasWithGeoKeys({{1024, 1}, {3072, 32767}, {2048, 4269}}).str());
         EXPECT_TRUE(io::readPointCloud(lasRegistry(), file).crsWkt().empty());
         EXPECT_EQ(log.warnings.size(), 1u);
     }
     {
         // An unknown vertical system leaves the horizontal one, with a warning.
-        CapturedLog log;
+        test::CapturedLog log;
         test::writeText(file, makeLasWithGeoKeys({{3072, 2154}, {4096, 65000}}).str());
         EXPECT_EQ(io::readPointCloud(lasRegistry(), file).crsWkt(), io::crsFromUserInput("EPSG:2154"));
         ASSERT_EQ(log.warnings.size(), 1u);

@@ -71,24 +71,6 @@ std::size_t laszipPayload(const std::string& bytes)
     return 0;
 }
 
-//! Keeps the warnings of a read (extra.laz has dimensions we skip) out of the output.
-class CapturedWarnings
-{
-public:
-    CapturedWarnings()
-    {
-        previous_ = setLogSink([this](LogLevel level, const std::string& message) {
-            if (level == LogLevel::Warning)
-                warnings.push_back(message);
-        });
-    }
-    ~CapturedWarnings() { setLogSink(std::move(previous_)); }
-    std::vector<std::string> warnings;
-
-private:
-    LogSink previous_;
-};
-
 io::FormatRegistry registry()
 {
     io::FormatRegistry r;
@@ -96,25 +78,12 @@ io::FormatRegistry registry()
     return r;
 }
 
-template <typename Fn>
-void expectError(Fn&& read, ErrorCode code, const fs::path& path, const std::string& words)
-{
-    try {
-        read();
-        ADD_FAILURE() << "no error for " << path << " (expected: " << words << ")";
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), code) << e.what();
-        EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
-    }
-}
-
 //! Writes `bytes` as a .laz file and expects reading it to fail with `code` and `words`.
 void expectRefused(const std::string& name, const std::string& bytes, ErrorCode code, const std::string& words)
 {
     const fs::path file = test::tempDir() / name;
     test::writeText(file, bytes);
-    expectError([&] { io::readPointCloud(registry(), file); }, code, file, words);
+    test::expectError([&] { io::readPointCloud(registry(), file); }, code, file, words);
 }
 
 } // namespace
@@ -179,7 +148,7 @@ TEST(LazFormat, ExtraBytesAndALargerChunkDecodeExactly)
 {
     // extra.laz is simple.las with two Extra Bytes dimensions appended (a copy
     // of the intensity and the GPS time in whole seconds): the byte item.
-    CapturedWarnings quiet;
+    test::CapturedLog quiet; // extra.laz has dimensions the reader skips
     const PointCloud simple = io::readPointCloud(registry(), kLazDir / "simple.las");
     const PointCloud extra = io::readPointCloud(registry(), kLazDir / "extra.laz");
     ASSERT_EQ(extra.size(), simple.size());
@@ -473,6 +442,6 @@ TEST(LazFormat, CancelStopsTheDecompression)
     CancelAtOnce cancel;
     io::ReadOptions options;
     options.progress = &cancel;
-    expectError([&] { io::readPointCloud(registry(), kLazDir / "plane.laz", options); }, ErrorCode::Cancelled, fs::path(),
+    test::expectError([&] { io::readPointCloud(registry(), kLazDir / "plane.laz", options); }, ErrorCode::Cancelled, fs::path(),
                 "cancelled");
 }

@@ -579,8 +579,9 @@ TEST(Octree, CylinderBatchEqualsBruteForceWhateverTheCylinder)
             ASSERT_EQ(got[q], expected) << shape.name << " query " << q << " radius " << queries[q].radius << " half-length "
                                         << queries[q].halfLength;
         }
-        if (std::string(shape.name) == "planar")
+        if (std::string(shape.name) == "planar") {
             EXPECT_FALSE(got[usable - 2].empty()) << "the points on the cylinder's end";
+        }
     }
 }
 

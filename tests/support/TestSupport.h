@@ -4,12 +4,14 @@
 //! per-test temporary folder, and small file utilities.
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/Log.h>
 
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -60,6 +62,53 @@ inline ErrorCode errorCodeOf(const std::function<void()>& f)
         return e.code();
     }
     return ErrorCode::Internal;
+}
+
+//! Collects what is logged while alive, so a test can check it and the
+//! output stays quiet: the warnings, and every message.
+class CapturedLog
+{
+public:
+    CapturedLog()
+    {
+        previous_ = setLogSink([this](LogLevel level, const std::string& message) {
+            if (level == LogLevel::Warning)
+                warnings.push_back(message);
+            messages.push_back(message);
+        });
+    }
+    ~CapturedLog() { setLogSink(std::move(previous_)); }
+    CapturedLog(const CapturedLog&) = delete;
+    CapturedLog& operator=(const CapturedLog&) = delete;
+
+    //! Whether a message says `words`.
+    bool has(const std::string& words) const
+    {
+        for (const std::string& m : messages)
+            if (m.find(words) != std::string::npos)
+                return true;
+        return false;
+    }
+
+    std::vector<std::string> warnings, messages;
+
+private:
+    LogSink previous_;
+};
+
+//! Expects `read` to throw scandiff::Error with `code`, its message naming
+//! `path` and saying `words`.
+template <class Fn>
+void expectError(Fn&& read, ErrorCode code, const std::filesystem::path& path, const std::string& words)
+{
+    try {
+        read();
+        ADD_FAILURE() << "no error for " << path << " (expected: " << words << ")";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), code) << e.what();
+        EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
 }
 
 } // namespace scandiff::test

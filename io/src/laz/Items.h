@@ -84,6 +84,40 @@ std::array<std::uint16_t, 3> decodeRgb(ArithmeticDecoder& d, RgbModels& models, 
 void encodeRgb(ArithmeticEncoder& e, RgbModels& models, const std::array<std::uint16_t, 3>& last,
                const std::array<std::uint16_t, 3>& rgb);
 
+//! The GPS times of both GPS coders (gpstime11 and the layered point14's):
+//! four sequences of 64-bit patterns (returns of interleaved pulses), each
+//! with its last time and last difference. A time is coded as a multiple of
+//! the last difference plus a correction, as a new 32-bit difference, as a
+//! switch to another sequence, or in full as a new sequence; the two coders
+//! differ only in how they number those codes.
+class GpsTimeSequences
+{
+protected:
+    static constexpr std::int32_t kMulti = 500;
+    static constexpr std::int32_t kMultiMinus = -10;
+
+    explicit GpsTimeSequences(std::int64_t first) { last_[0] = first; }
+
+    //! Decodes the time of multiplier code `multi`: 0 (no relation to the
+    //! last difference), 2..kMulti (a multiple), kMulti + 1..kMulti - kMultiMinus
+    //! (a negative multiple).
+    void decodeMultiple(ArithmeticDecoder& d, std::int32_t multi);
+    //! A time too far from the last for 32 bits: its high word as a
+    //! correction, its low word raw, in a new sequence.
+    void decodeFullTime(ArithmeticDecoder& d);
+    //! After more than three extreme differences in a row the last one becomes the reference.
+    void countExtreme(std::int32_t diff);
+    static std::int32_t wrapMul(std::int32_t a, std::int32_t b)
+    {
+        return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) * static_cast<std::uint32_t>(b));
+    }
+
+    std::array<std::int64_t, 4> last_{};
+    std::array<std::int32_t, 4> lastDiff_{}, extremeCount_{};
+    std::uint32_t current_ = 0, next_ = 0;
+    IntegerCoder diff_{32, 9};
+};
+
 //! A pointwise item: decoded from the record's single stream.
 class PointwiseItem
 {

@@ -117,10 +117,10 @@ auto& switchContext(std::array<std::unique_ptr<Context>, 4>& contexts, std::uint
 //! The GPS time of the layered coder: as in gpstime11, with the codes
 //! renumbered (no "unchanged" code: whether the time changed is in the
 //! point's changed-values symbol). Decodes or encodes, not both.
-class GpsTime14
+class GpsTime14 : private GpsTimeSequences
 {
 public:
-    explicit GpsTime14(std::int64_t first) { last_[0] = first; }
+    explicit GpsTime14(std::int64_t first) : GpsTimeSequences(first) {}
 
     std::int64_t decode(ArithmeticDecoder& d)
     {
@@ -138,40 +138,21 @@ public:
                     last_[current_] = addWrapping(last_[current_], lastDiff_[current_]);
                     extremeCount_[current_] = 0;
                 } else if (multi == 1) {
-                    fullTime(d);
+                    decodeFullTime(d);
                 } else {
                     current_ = (current_ + static_cast<std::uint32_t>(multi) - 1) & 3;
                     continue;
                 }
                 return last_[current_];
             }
-            auto multi = static_cast<std::int32_t>(d.decodeSymbol(multiple_));
+            const auto multi = static_cast<std::int32_t>(d.decodeSymbol(multiple_));
             if (multi == 1) {
                 last_[current_] = addWrapping(last_[current_], diff_.decompress(d, lastDiff_[current_], 1));
                 extremeCount_[current_] = 0;
             } else if (multi < kMultiCodeFull) {
-                std::int32_t diff;
-                const std::int32_t previous = lastDiff_[current_];
-                if (multi == 0) {
-                    diff = diff_.decompress(d, 0, 7);
-                    countExtreme(diff);
-                } else if (multi < kMulti) {
-                    diff = diff_.decompress(d, wrapMul(multi, previous), multi < 10 ? 2 : 3);
-                } else if (multi == kMulti) {
-                    diff = diff_.decompress(d, wrapMul(kMulti, previous), 4);
-                    countExtreme(diff);
-                } else {
-                    multi = kMulti - multi;
-                    if (multi > kMultiMinus) {
-                        diff = diff_.decompress(d, wrapMul(multi, previous), 5);
-                    } else {
-                        diff = diff_.decompress(d, wrapMul(kMultiMinus, previous), 6);
-                        countExtreme(diff);
-                    }
-                }
-                last_[current_] = addWrapping(last_[current_], diff);
+                decodeMultiple(d, multi);
             } else if (multi == kMultiCodeFull) {
-                fullTime(d);
+                decodeFullTime(d);
             } else {
                 current_ = (current_ + static_cast<std::uint32_t>(multi - kMultiCodeFull)) & 3;
                 continue;
@@ -255,8 +236,6 @@ public:
     }
 
 private:
-    static constexpr std::int32_t kMulti = 500;
-    static constexpr std::int32_t kMultiMinus = -10;
     static constexpr std::int32_t kMultiCodeFull = kMulti - kMultiMinus + 1;
     static constexpr std::uint32_t kMultiTotal = kMulti - kMultiMinus + 5;
 
@@ -286,34 +265,8 @@ private:
         last_[current_] = time;
     }
 
-    void fullTime(ArithmeticDecoder& d)
-    {
-        next_ = (next_ + 1) & 3;
-        const auto high = static_cast<std::uint32_t>(
-            diff_.decompress(d, static_cast<std::int32_t>(static_cast<std::uint64_t>(last_[current_]) >> 32), 8));
-        last_[next_] = static_cast<std::int64_t>((std::uint64_t(high) << 32) | d.readInt());
-        current_ = next_;
-        lastDiff_[current_] = 0;
-        extremeCount_[current_] = 0;
-    }
-    void countExtreme(std::int32_t diff)
-    {
-        if (++extremeCount_[current_] > 3) {
-            lastDiff_[current_] = diff;
-            extremeCount_[current_] = 0;
-        }
-    }
-    static std::int32_t wrapMul(std::int32_t a, std::int32_t b)
-    {
-        return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) * static_cast<std::uint32_t>(b));
-    }
-
-    std::array<std::int64_t, 4> last_{};
-    std::array<std::int32_t, 4> lastDiff_{}, extremeCount_{};
-    std::uint32_t current_ = 0, next_ = 0;
     SymbolModel multiple_{kMultiTotal};
     SymbolModel zeroDiff_{5};
-    IntegerCoder diff_{32, 9};
 };
 
 //! One scanner channel's state of the point14 coder.

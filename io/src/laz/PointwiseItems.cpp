@@ -149,6 +149,49 @@ void encodeRgb(ArithmeticEncoder& e, RgbModels& models, const std::array<std::ui
     }
 }
 
+void GpsTimeSequences::decodeMultiple(ArithmeticDecoder& d, std::int32_t multi)
+{
+    std::int32_t diff;
+    const std::int32_t previous = lastDiff_[current_];
+    if (multi == 0) {
+        diff = diff_.decompress(d, 0, 7);
+        countExtreme(diff);
+    } else if (multi < kMulti) {
+        diff = diff_.decompress(d, wrapMul(multi, previous), multi < 10 ? 2 : 3);
+    } else if (multi == kMulti) {
+        diff = diff_.decompress(d, wrapMul(kMulti, previous), 4);
+        countExtreme(diff);
+    } else {
+        multi = kMulti - multi;
+        if (multi > kMultiMinus) {
+            diff = diff_.decompress(d, wrapMul(multi, previous), 5);
+        } else {
+            diff = diff_.decompress(d, wrapMul(kMultiMinus, previous), 6);
+            countExtreme(diff);
+        }
+    }
+    last_[current_] = addWrapping(last_[current_], diff);
+}
+
+void GpsTimeSequences::decodeFullTime(ArithmeticDecoder& d)
+{
+    next_ = (next_ + 1) & 3;
+    const auto high = static_cast<std::uint32_t>(
+        diff_.decompress(d, static_cast<std::int32_t>(static_cast<std::uint64_t>(last_[current_]) >> 32), 8));
+    last_[next_] = static_cast<std::int64_t>((std::uint64_t(high) << 32) | d.readInt());
+    current_ = next_;
+    lastDiff_[current_] = 0;
+    extremeCount_[current_] = 0;
+}
+
+void GpsTimeSequences::countExtreme(std::int32_t diff)
+{
+    if (++extremeCount_[current_] > 3) {
+        lastDiff_[current_] = diff;
+        extremeCount_[current_] = 0;
+    }
+}
+
 namespace {
 
 // The context of a return r of n (3-bit fields): the coordinates' medians and
@@ -233,10 +276,10 @@ private:
 //! The GPS time (a double), coded on its 64-bit pattern: as a multiple of
 //! the last difference, a new difference, or a jump to one of four sequences
 //! (returns of several pulses interleave in time).
-class GpsTime11Decoder final : public PointwiseItem
+class GpsTime11Decoder final : public PointwiseItem, private GpsTimeSequences
 {
 public:
-    explicit GpsTime11Decoder(const unsigned char* first) { last_[0] = load<std::int64_t>(first); }
+    explicit GpsTime11Decoder(const unsigned char* first) : GpsTimeSequences(load<std::int64_t>(first)) {}
 
     void decode(ArithmeticDecoder& d, unsigned char* item) override
     {
@@ -245,8 +288,6 @@ public:
     }
 
 private:
-    static constexpr std::int32_t kMulti = 500;
-    static constexpr std::int32_t kMultiMinus = -10;
     static constexpr std::int32_t kMultiUnchanged = kMulti - kMultiMinus + 1;
     static constexpr std::int32_t kMultiCodeFull = kMulti - kMultiMinus + 2;
     static constexpr std::uint32_t kMultiTotal = kMulti - kMultiMinus + 6;
@@ -268,40 +309,21 @@ private:
                     last_[current_] = addWrapping(last_[current_], lastDiff_[current_]);
                     extremeCount_[current_] = 0;
                 } else if (multi == 2) {
-                    fullTime(d);
+                    decodeFullTime(d);
                 } else if (multi > 2) {
                     current_ = (current_ + static_cast<std::uint32_t>(multi) - 2) & 3;
                     continue;
                 }
                 return;
             }
-            auto multi = static_cast<std::int32_t>(d.decodeSymbol(multiple_));
+            const auto multi = static_cast<std::int32_t>(d.decodeSymbol(multiple_));
             if (multi == 1) {
                 last_[current_] = addWrapping(last_[current_], diff_.decompress(d, lastDiff_[current_], 1));
                 extremeCount_[current_] = 0;
             } else if (multi < kMultiUnchanged) {
-                std::int32_t diff;
-                const std::int32_t previous = lastDiff_[current_];
-                if (multi == 0) {
-                    diff = diff_.decompress(d, 0, 7);
-                    countExtreme(diff);
-                } else if (multi < kMulti) {
-                    diff = diff_.decompress(d, wrapMul(multi, previous), multi < 10 ? 2 : 3);
-                } else if (multi == kMulti) {
-                    diff = diff_.decompress(d, wrapMul(kMulti, previous), 4);
-                    countExtreme(diff);
-                } else {
-                    multi = kMulti - multi;
-                    if (multi > kMultiMinus) {
-                        diff = diff_.decompress(d, wrapMul(multi, previous), 5);
-                    } else {
-                        diff = diff_.decompress(d, wrapMul(kMultiMinus, previous), 6);
-                        countExtreme(diff);
-                    }
-                }
-                last_[current_] = addWrapping(last_[current_], diff);
+                decodeMultiple(d, multi);
             } else if (multi == kMultiCodeFull) {
-                fullTime(d);
+                decodeFullTime(d);
             } else if (multi > kMultiCodeFull) {
                 current_ = (current_ + static_cast<std::uint32_t>(multi - kMultiCodeFull)) & 3;
                 continue;
@@ -311,39 +333,8 @@ private:
         }
     }
 
-    //! A time too far from the last for 32 bits: its high word as a
-    //! correction, its low word raw, in a new sequence.
-    void fullTime(ArithmeticDecoder& d)
-    {
-        next_ = (next_ + 1) & 3;
-        const auto high = static_cast<std::uint32_t>(diff_.decompress(d, static_cast<std::int32_t>(static_cast<std::uint64_t>(last_[current_]) >> 32), 8));
-        const std::uint64_t pattern = (std::uint64_t(high) << 32) | d.readInt();
-        last_[next_] = static_cast<std::int64_t>(pattern);
-        current_ = next_;
-        lastDiff_[current_] = 0;
-        extremeCount_[current_] = 0;
-    }
-
-    //! After more than three extreme differences in a row the last one becomes the reference.
-    void countExtreme(std::int32_t diff)
-    {
-        if (++extremeCount_[current_] > 3) {
-            lastDiff_[current_] = diff;
-            extremeCount_[current_] = 0;
-        }
-    }
-
-    static std::int32_t wrapMul(std::int32_t a, std::int32_t b)
-    {
-        return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) * static_cast<std::uint32_t>(b));
-    }
-
-    std::array<std::int64_t, 4> last_{};
-    std::array<std::int32_t, 4> lastDiff_{}, extremeCount_{};
-    std::uint32_t current_ = 0, next_ = 0;
     SymbolModel multiple_{kMultiTotal};
     SymbolModel zeroDiff_{6};
-    IntegerCoder diff_{32, 9};
 };
 
 //! Red, green, blue (uint16 each).

@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -254,6 +255,24 @@ private:
     //! sorted ranges, `prune(gap2)` ends the search once nothing closer remains.
     template <typename Visit, typename Prune>
     void descend(const Eigen::Vector3f& q, int leafLevel, Visit&& visitRange, Prune&& prune) const;
+    //! Calls visit(childCode, first, last) for each non-empty child of the
+    //! cell `cell` of `level` whose points are the sorted range [first, last).
+    template <typename Visit>
+    void forEachChild(MortonCode cell, int level, std::size_t first, std::size_t last, Visit&& visit) const
+    {
+        const int shift = 3 * (kMaxLevel - (level + 1));
+        std::size_t begin = first;
+        for (MortonCode c = 0; c < 8 && begin < last; ++c) {
+            const MortonCode child = (cell << 3) | c;
+            const auto end = static_cast<std::size_t>(std::lower_bound(codes_.begin() + static_cast<std::ptrdiff_t>(begin),
+                                                                       codes_.begin() + static_cast<std::ptrdiff_t>(last),
+                                                                       (child + 1) << shift) -
+                                                      codes_.begin());
+            if (end > begin)
+                visit(child, begin, end);
+            begin = end;
+        }
+    }
     //! The k nearest within sqrt(maxSquared) by best-first descent, as a max-heap.
     void descendNearest(const Eigen::Vector3f& q, std::size_t k, int leafLevel, std::vector<Neighbour>& heap,
                         float maxSquared = std::numeric_limits<float>::infinity()) const;
