@@ -28,6 +28,7 @@ const char* kindName(DataKind kind)
     case DataKind::Table: return "table (CSV)";
     case DataKind::Transform: return "4x4 matrix (text)";
     case DataKind::Drawing: return "drawing (DXF)";
+    case DataKind::Document: return "document";
     }
     return "";
 }
@@ -40,6 +41,8 @@ std::string extensionFor(const OutputSpec& spec, const OutputData& data, const s
         return ".txt";
     if (spec.kind == DataKind::Drawing)
         return ".dxf";
+    if (const auto* document = std::get_if<TextDocument>(&data))
+        return document->extension;
     return cloudExtension;
 }
 
@@ -60,7 +63,7 @@ std::filesystem::path outputPath(const ToolSpec& tool, const OutputSpec& spec, c
     if (own != places.byRole.end() && !own->second.empty())
         return own->second;
     if (!places.directory.empty()) {
-        std::string name = spec.role;
+        std::string name = spec.fileStem.empty() ? spec.role : spec.fileStem;
         if (spec.repeated) {
             const PointCloud* cloud = std::get_if<PointCloud>(&output.data);
             const Mesh* mesh = std::get_if<Mesh>(&output.data);
@@ -165,6 +168,10 @@ void emitOutput(const OutputSpec& spec, ToolOutput& output, const std::filesyste
         return;
     } else if (const auto* drawing = std::get_if<Drawing>(&output.data)) {
         io::writeDrawingDxf(*drawing, path);
+    } else if (const auto* document = std::get_if<TextDocument>(&output.data)) {
+        io::AtomicFile file(path);
+        file.stream() << document->text;
+        file.commit();
     } else if (auto* cloud = std::get_if<PointCloud>(&output.data)) {
         Entity* firstInput = nullptr;
         if (spec.updatesInput && !tool.inputs.empty() && loaded.byRole.count(tool.inputs.front().role))

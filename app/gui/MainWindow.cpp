@@ -452,8 +452,9 @@ void MainWindow::buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu)
             auto* window = new TableDialog(title, tables, this);
             window->show();
         });
-        connect(controller, &ToolController::drawingReady, this, [this](const QString& title, const Drawing& drawing) {
-            const QString path = QFileDialog::getSaveFileName(this, tr("Save %1 as DXF").arg(title), "sections.dxf", tr("DXF drawing (*.dxf)"));
+        const QString proposedName = QString::fromStdString(tool.name) + ".dxf";
+        connect(controller, &ToolController::drawingReady, this, [this, proposedName](const QString& title, const Drawing& drawing) {
+            const QString path = QFileDialog::getSaveFileName(this, tr("Save %1 as DXF").arg(title), proposedName, tr("DXF drawing (*.dxf)"));
             if (path.isEmpty())
                 return;
             try {

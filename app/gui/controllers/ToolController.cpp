@@ -154,6 +154,8 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
                 drawings.emplace_back(QString::fromStdString(spec.label), std::move(*drawing));
                 continue;
             }
+            if (std::holds_alternative<TextDocument>(output->data))
+                continue; // the same results as the tables and drawings, for scripts
             if (auto* matrix = std::get_if<Eigen::Matrix4d>(&output->data)) {
                 notes += QString("\n%1:\n%2").arg(QString::fromStdString(spec.label), QString::fromStdString(io::matrixText(*matrix)).trimmed());
                 continue;

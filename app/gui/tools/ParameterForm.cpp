@@ -121,6 +121,9 @@ ParameterForm::ParameterForm(const std::vector<ParameterSpec>& parameters, QWidg
         // A switch others depend on shows or hides them.
         if (auto* check = qobject_cast<QCheckBox*>(editor))
             connect(check, &QCheckBox::toggled, this, &ParameterForm::updateVisibility);
+        if (p.type == ParameterType::Choice) // and so does a choice ("method=alpha")
+            if (auto* combo = qobject_cast<QComboBox*>(editor))
+                connect(combo, QOverload<int>::of(&QComboBox::currentIndexChanged), this, &ParameterForm::updateVisibility);
         if (!p.optional) {
             form_->addRow(QString::fromStdString(p.label), editor);
             rows_[p.name] = editor;
@@ -208,7 +211,17 @@ bool ParameterForm::conditionHolds(const ParameterSpec& p) const
     if (p.usedWith.empty())
         return true;
     const bool negated = p.usedWith.front() == '!';
-    const bool given = isGiven(negated ? p.usedWith.substr(1) : p.usedWith);
+    const std::string condition = negated ? p.usedWith.substr(1) : p.usedWith;
+    const std::size_t equals = condition.find('=');
+    bool given = false;
+    if (equals == std::string::npos) {
+        given = isGiven(condition);
+    } else {
+        // "method=alpha": the choice is given and holds that value.
+        const std::string name = condition.substr(0, equals);
+        const auto spec = std::find_if(parameters_.begin(), parameters_.end(), [&](const ParameterSpec& s) { return s.name == name; });
+        given = spec != parameters_.end() && isGiven(name) && editorText(*spec, editors_.at(name)) == condition.substr(equals + 1);
+    }
     return negated ? !given : given;
 }
 

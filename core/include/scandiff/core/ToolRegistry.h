@@ -67,7 +67,8 @@ struct ParameterSpec
     //! The parameter matters only with this other one given (an alternative
     //! chosen, an optional value switched on, a switch turned on): "neighbours"
     //! of the statistical test, "alpha" of the propagation; "!name": only
-    //! without it. The GUI shows it only then (and gives an optional one only
+    //! without it; "name=value": only while the choice `name` is `value`
+    //! ("method=alpha"). The GUI shows it only then (and gives an optional one only
     //! then); the CLI lists it as usual.
     std::string usedWith;
     //! Integer/Real: what 0 stands for ("automatic"); the GUI writes it in
@@ -127,8 +128,16 @@ private:
 };
 
 //! What a tool takes or gives. A Cloud input also accepts a mesh (its
-//! vertices); a Mesh input needs triangles.
-enum class DataKind { Cloud, Mesh, Table, Transform, Drawing };
+//! vertices); a Mesh input needs triangles. A Document is a text file the tool
+//! composes itself (a JSON description of its results).
+enum class DataKind { Cloud, Mesh, Table, Transform, Drawing, Document };
+
+//! A Document output: its text and the extension of its file (".json").
+struct TextDocument
+{
+    std::string extension = ".json";
+    std::string text;
+};
 
 //! One input of a tool: an entity, or several, playing a role.
 struct InputSpec
@@ -161,6 +170,10 @@ struct OutputSpec
     //! Any number of outputs of this role (one per station of a multi-station
     //! registration): the CLI writes them with --out-dir, each under its name.
     bool repeated = false;
+    //! The name of its file in --out-dir, without extension (default: the
+    //! role): outputs of different kinds may share one ("stones" gives
+    //! stones.ply, stones.dxf and stones.csv).
+    std::string fileStem = {};
 };
 
 //! The entities a run gets, by role. It only refers to them: they belong to
@@ -187,7 +200,7 @@ private:
     std::map<std::string, std::vector<Ref>> entities_;
 };
 
-using OutputData = std::variant<PointCloud, Mesh, Table, Eigen::Matrix4d, Drawing>;
+using OutputData = std::variant<PointCloud, Mesh, Table, Eigen::Matrix4d, Drawing, TextDocument>;
 
 struct ToolOutput
 {

@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Stone-by-stone drawing of a wall from the intensity of its scan (thesis 003,
+//! Boucher 2015): the points are classified into stone and joint by intensity,
+//! isolated stone points removed, and each group of stone points separated by
+//! joints becomes one closed polygon in the wall's best-fit plane.
+
+#include <scandiff/core/PointCloud.h>
+#include <scandiff/core/Progress.h>
+#include <scandiff/plugins/contours/PlanarContours.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace scandiff::plugins {
+
+//! The iterative inter-means threshold of thesis 003 §II.1.3.2 (Ridler and
+//! Calvard's isodata, on a global histogram, not Otsu): S = (mean of the values
+//! <= S + mean of the values > S) / 2, repeated from S = the mean until the two
+//! classes no longer change. Computed on the values themselves, not on bins.
+struct InterMeansThreshold
+{
+    double threshold = 0.0;
+    double lowMean = 0.0, highMean = 0.0;
+    std::size_t lowCount = 0, highCount = 0;
+    int iterations = 0;
+};
+//! Non-finite values are ignored. Throws Error(InvalidData) when fewer than
+//! two distinct finite values remain (no threshold separates anything).
+InterMeansThreshold interMeansThreshold(const std::vector<float>& values, std::optional<double> initial = std::nullopt);
+
+enum class StonePolarity { Dark, Bright }; //!< stones below or above the threshold
+enum class StoneMethod { Classify, Grow };
+StonePolarity parseStonePolarity(const std::string& name); //!< "dark", "bright"
+StoneMethod parseStoneMethod(const std::string& name);     //!< "classify", "grow"
+
+struct StoneParams
+{
+    std::string field = "intensity";
+    StonePolarity polarity = StonePolarity::Dark;
+    std::optional<double> threshold; //!< absent: the inter-means threshold
+    StoneMethod method = StoneMethod::Classify;
+    //! Cleaning: a stone point with fewer than `cleaningNeighbours` other stone
+    //! points within `cleaningRadius` (0: 2 x the point spacing) is a joint
+    //! point (thesis 003 §III.1.2.1.1: "isolated points").
+    double cleaningRadius = 0.0;
+    int cleaningNeighbours = 3;
+    //! Largest circumradius of a stone's triangles (alpha-shape radius, thesis
+    //! 003 §III.1.1); 0: at the knee of the sorted circumradii.
+    double alpha = 0.0;
+    //! Smallest stone polygon (m²); 0: 100 x the squared point spacing.
+    double minStoneArea = 0.0;
+    //! Grow: neighbourhood radius R (0: 2 x the point spacing, thesis 003
+    //! §II.2.1) and intensity variance tolerance tau (0: the variance of the
+    //! stone class found by the threshold).
+    double growRadius = 0.0;
+    double growVariance = 0.0;
+};
+
+struct Stone
+{
+    std::vector<Eigen::Vector3d> outline; //!< closed, counter-clockwise seen from the front, in the wall plane, global
+    Ring2d outline2d;                     //!< the same in the plane's (u, v)
+    double area = 0.0, perimeter = 0.0;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero(); //!< of the polygon, global
+    double planeRms = 0.0; //!< of the stone's points' distances to the wall plane
+    std::size_t points = 0;
+};
+
+struct StoneWallResult
+{
+    PlaneFrame wall;
+    double threshold = 0.0;
+    int thresholdIterations = 0; //!< 0 when the threshold was given
+    double spacing = 0.0;        //!< median distance of a point to its nearest neighbour
+    double alpha = 0.0;          //!< the one used
+    std::vector<std::int32_t> stoneOfPoint; //!< -1: joint, isolated, or in a dropped contour
+    std::vector<std::uint8_t> stoneClass;   //!< 1: classified stone (before cleaning), 0: joint or no intensity
+    std::size_t isolatedRemoved = 0, smallDropped = 0, nestedDropped = 0;
+    std::vector<Stone> stones; //!< in order of their centroid: rows from the top, left to right
+};
+
+//! Throws Error(InvalidArgument) when the field is missing or a parameter is
+//! invalid, Error(InvalidData) for fewer than 3 points or a wall that is not a
+//! surface, Error(Cancelled) when the observer asks.
+StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params, ProgressObserver* progress = nullptr);
+
+} // namespace scandiff::plugins

@@ -1,0 +1,358 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Registers the tools "contours" (outlines and openings of planar segments,
+// thesis 001 ch. 4) and "stones" (stone-by-stone wall drawing, thesis 003).
+#include <scandiff/core/Error.h>
+#include <scandiff/core/segmentation/RegionReport.h>
+#include <scandiff/plugins/PluginRegistry.h>
+#include <scandiff/plugins/contours/PlanarContours.h>
+#include <scandiff/plugins/contours/StoneWall.h>
+#include <scandiff/plugins/contours/Vectorisation.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+namespace scandiff::plugins {
+
+namespace {
+
+nlohmann::json pointJson(const Eigen::Vector3d& p) { return nlohmann::json::array({p.x(), p.y(), p.z()}); }
+
+nlohmann::json ringJson(const std::vector<Eigen::Vector3d>& ring)
+{
+    nlohmann::json out = nlohmann::json::array();
+    for (const Eigen::Vector3d& p : ring)
+        out.push_back(pointJson(p));
+    return out;
+}
+
+std::vector<Eigen::Vector3d> lift(const PlaneFrame& frame, const Ring2d& ring)
+{
+    std::vector<Eigen::Vector3d> out;
+    out.reserve(ring.size());
+    for (const Eigen::Vector2d& q : ring)
+        out.push_back(frame.toWorld(q));
+    return out;
+}
+
+std::string layerName(const char* prefix, long id)
+{
+    char name[40];
+    std::snprintf(name, sizeof name, "%s_%04ld", prefix, id);
+    return name;
+}
+
+//! "auto" or a positive length.
+double thresholdFrom(const std::string& text)
+{
+    if (text == "auto" || text.empty())
+        return 0.0;
+    char* end = nullptr;
+    const double value = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0' || !(value > 0) || !std::isfinite(value))
+        throw Error(ErrorCode::InvalidArgument, "contours: --edge-threshold is 'auto' or a length > 0, not '" + text + "'");
+    return value;
+}
+
+struct Segment
+{
+    long id = -1;
+    std::vector<std::size_t> points;
+};
+
+//! The segments to outline: one per value >= 0 of the id field, or the whole
+//! cloud when it has no such field.
+std::vector<Segment> segmentsOf(const PointCloud& cloud, const std::string& fieldName, std::string& note)
+{
+    std::vector<Segment> segments;
+    const ScalarField* field = fieldName.empty() ? nullptr : cloud.field(fieldName);
+    if (!field) {
+        Segment all;
+        all.points.resize(cloud.size());
+        for (std::size_t i = 0; i < cloud.size(); ++i)
+            all.points[i] = i;
+        segments.push_back(std::move(all));
+        note = "no field '" + fieldName + "': the cloud is one segment";
+        return segments;
+    }
+    std::map<long, std::vector<std::size_t>> byId;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const double v = field->value(i);
+        if (std::isfinite(v) && v >= 0)
+            byId[std::lround(v)].push_back(i);
+    }
+    for (auto& [id, points] : byId)
+        segments.push_back({id, std::move(points)});
+    return segments;
+}
+
+ToolSpec contoursTool()
+{
+    ToolSpec tool;
+    tool.name = "contours";
+    tool.title = "Contours";
+    tool.category = "Contours";
+    tool.description =
+        "Outlines every planar segment (the primitive_id field of the primitives tool, or the whole cloud) with its openings: "
+        "the points in their best-fit plane are triangulated (Delaunay) and the triangles spanning gaps removed, by the long-edge "
+        "criterion of thesis 001 (threshold at the knee of the sorted edge lengths) or by alpha shapes; each part gives a closed "
+        "outer ring and one ring per hole. --vectorise turns the rings into straight pieces (horizontal, vertical, inclined) and "
+        "arcs with corners at the intersections of neighbouring pieces (thesis 001 §4.3). Gives the rings as a drawing (a layer per "
+        "plane), a table and a JSON document.";
+    tool.parameters = {
+        ParameterSpec::choice("method", "Method",
+                              "long-edges: drop triangles with an edge longer than the threshold (thesis 001); alpha: drop "
+                              "triangles whose circumradius exceeds alpha (alpha shapes)",
+                              {"long-edges", "alpha"}, "long-edges"),
+        ParameterSpec::text("edge-threshold", "Edge threshold",
+                            "long-edges: 'auto' (the knee of the sorted edge lengths) or the longest edge of the surface, m", "auto")
+            .withSuggestions({"auto"})
+            .onlyWith("method=long-edges"),
+        ParameterSpec::real("alpha", "Alpha", "alpha: the largest circumradius of the surface's triangles", 0.0, 0.0, 1e9, "m")
+            .withZeroMeaning("automatic (knee of the sorted circumradii)")
+            .onlyWith("method=alpha"),
+        ParameterSpec::text("segment-field", "Segment field", "The field holding each point's segment (-1: none)", "primitive_id")
+            .asFieldOf("input"),
+        ParameterSpec::real("min-area", "Smallest area",
+                            "Parts and holes smaller than this are dropped (missed points, occlusion specks)", 0.0, 0.0, 1e12, "m²")
+            .withZeroMeaning("automatic (50 x the squared point spacing)"),
+        ParameterSpec::boolean("vectorise", "Vectorise", "Straight pieces and arcs, corners by intersection", false),
+        ParameterSpec::real("tolerance", "Line tolerance", "Vectorise: largest distance of a contour point to its piece", 0.0, 0.0,
+                            1e9, "m")
+            .withZeroMeaning("automatic (1.5 x the point spacing)")
+            .onlyWith("vectorise"),
+        ParameterSpec::boolean("offset-edges", "Edges at half a spacing",
+                               "Vectorise: move the straight pieces half a point spacing away from the surface, where the true "
+                               "edge lies on average",
+                               true)
+            .onlyWith("vectorise"),
+    };
+    tool.outputs = {OutputSpec{"contours", "Contours", DataKind::Drawing},
+                    OutputSpec{"rings", "Contour rings", DataKind::Table, false, false, "contours"},
+                    OutputSpec{"document", "Contours (JSON)", DataKind::Document, false, false, "contours"}};
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        const PointCloud& cloud = inputs.cloud();
+        OutlineParams outline;
+        outline.method = parseOutlineMethod(values.text("method"));
+        outline.threshold = outline.method == OutlineMethod::LongEdges ? thresholdFrom(values.text("edge-threshold")) : values.real("alpha");
+        std::string note;
+        const std::vector<Segment> segments = segmentsOf(cloud, values.text("segment-field"), note);
+        ProgressTicker ticker(progress, "Contours", segments.size());
+
+        Drawing drawing;
+        Table table;
+        table.columns = {"plane", "part", "ring", "vertices", "area", "perimeter", "threshold", "plane_rms"};
+        nlohmann::json planes = nlohmann::json::array();
+        std::size_t rings = 0, holes = 0, skipped = 0;
+        for (const Segment& segment : segments) {
+            ticker.checkCancel();
+            ticker.step();
+            std::vector<Eigen::Vector3d> global;
+            global.reserve(segment.points.size());
+            for (std::size_t i : segment.points)
+                global.push_back(cloud.globalPosition(i));
+            PlaneFrame frame;
+            try {
+                frame = fitPlaneFrame(global);
+            } catch (const Error&) {
+                ++skipped; // fewer than 3 points, or a line
+                continue;
+            }
+            std::vector<Eigen::Vector2d> uv;
+            uv.reserve(global.size());
+            for (const Eigen::Vector3d& p : global)
+                uv.push_back(frame.toPlane(p));
+            OutlineResult parts = extractOutlines(uv, outline);
+            const double spacing = parts.spacing;
+            const double minArea = values.real("min-area") > 0 ? values.real("min-area") : 50.0 * spacing * spacing;
+            VectoriseParams vector;
+            vector.tolerance = values.real("tolerance") > 0 ? values.real("tolerance") : std::max(1.5 * spacing, 1e-6);
+            vector.edgeOffset = values.boolean("offset-edges") ? 0.5 * spacing : 0.0;
+            const bool vectorise = values.boolean("vectorise");
+
+            nlohmann::json polygons = nlohmann::json::array();
+            const std::string layer = layerName("PLANE", segment.id);
+            long partNumber = 0;
+            for (const OutlinePart& part : parts.parts) {
+                if (part.area < minArea)
+                    continue;
+                std::vector<Ring2d> ringList{part.outer};
+                for (const Ring2d& hole : part.holes)
+                    if (std::abs(ringArea(hole)) >= minArea)
+                        ringList.push_back(hole);
+                nlohmann::json polygon = {{"holes", nlohmann::json::array()}};
+                for (std::size_t r = 0; r < ringList.size(); ++r) {
+                    Ring2d ring = ringList[r];
+                    nlohmann::json pieces = nlohmann::json::array();
+                    if (vectorise) {
+                        const VectorRing vectorised = vectoriseRing(ring, vector);
+                        ring = vectorised.vertices;
+                        for (const VectorPiece& piece : vectorised.pieces) {
+                            nlohmann::json p = {{"type", pieceKindName(piece.kind)},
+                                                {"start", pointJson(frame.toWorld(piece.start))},
+                                                {"end", pointJson(frame.toWorld(piece.end))}};
+                            if (piece.kind == PieceKind::Arc) {
+                                p["centre"] = pointJson(frame.toWorld(piece.centre));
+                                p["radius"] = piece.radius;
+                                p["sagitta"] = piece.sagitta;
+                            }
+                            pieces.push_back(p);
+                        }
+                    }
+                    const std::vector<Eigen::Vector3d> lifted = lift(frame, ring);
+                    drawing.polylines.push_back({layer, lifted, true});
+                    const double area = std::abs(ringArea(ring)), perimeter = ringPerimeter(ring);
+                    table.rows.push_back({static_cast<double>(segment.id), static_cast<double>(partNumber), std::string(r == 0 ? "outer" : "hole"),
+                                          static_cast<double>(ring.size()), area, perimeter, parts.threshold, frame.rms});
+                    nlohmann::json ringDoc = {{"vertices", ringJson(lifted)}, {"area", area}, {"perimeter", perimeter}};
+                    if (vectorise)
+                        ringDoc["pieces"] = pieces;
+                    if (r == 0)
+                        polygon["outer"] = ringDoc;
+                    else
+                        polygon["holes"].push_back(ringDoc);
+                    ++rings;
+                    holes += r > 0;
+                }
+                polygons.push_back(polygon);
+                ++partNumber;
+            }
+            planes.push_back({{"id", segment.id},
+                              {"layer", layer},
+                              {"normal", pointJson(frame.normal)},
+                              {"d", -frame.normal.dot(frame.origin)},
+                              {"points", segment.points.size()},
+                              {"plane_rms", frame.rms},
+                              {"method", values.text("method")},
+                              {"threshold", parts.threshold},
+                              {"polygons", polygons}});
+        }
+        ToolResult result;
+        result.add("contours", std::move(drawing));
+        result.add("rings", std::move(table));
+        result.add("document", TextDocument{".json", nlohmann::json({{"planes", planes}}).dump(1) + "\n"});
+        std::ostringstream summary;
+        summary << segments.size() - skipped << " planes outlined: " << rings - holes << " outer rings, " << holes << " holes";
+        if (skipped)
+            summary << "; " << skipped << " segments skipped (fewer than 3 points or on a line)";
+        if (!note.empty())
+            summary << "; " << note;
+        result.summary = summary.str();
+        return result;
+    };
+    return tool;
+}
+
+ToolSpec stonesTool()
+{
+    const StoneParams defaults;
+    ToolSpec tool;
+    tool.name = "stones";
+    tool.title = "Stones";
+    tool.category = "Contours";
+    tool.description =
+        "Draws a masonry wall stone by stone from the intensity of its scan (thesis 003): the points are classified into stone "
+        "and joint by a threshold (the iterative inter-means threshold of the thesis when none is given) with the stones darker "
+        "or brighter, isolated stone points are removed, and each group of stone points separated by joints becomes one closed "
+        "polygon in the wall's best-fit plane (alpha shape); small and nested contours are dropped. Gives the points with "
+        "stone_id and stone_class, the polygons as a drawing (a polyline and an id label per stone) and a table (area, perimeter, "
+        "centroid, plane residual).";
+    tool.parameters = {
+        ParameterSpec::text("field", "Intensity field", "The field classified into stone and joint", "intensity").asFieldOf("input"),
+        ParameterSpec::choice("polarity", "Stones are", "dark: stones below the threshold; bright: above", {"dark", "bright"}, "dark"),
+        ParameterSpec::real("threshold", "Threshold",
+                            "The intensity separating stone from joint; absent: the thesis's iterative inter-means threshold", 0.0,
+                            -1e30, 1e30)
+            .asOptional(),
+        ParameterSpec::choice("method", "Method",
+                              "classify: every point by the threshold, isolated points removed; grow: regions grown on intensity "
+                              "from stone seeds (thesis 003 §II.2), one per stone",
+                              {"classify", "grow"}, "classify"),
+        ParameterSpec::real("alpha", "Alpha", "Largest circumradius of a stone's triangles (alpha-shape radius)", 0.0, 0.0, 1e9, "m")
+            .withZeroMeaning("automatic (knee of the sorted circumradii)"),
+        ParameterSpec::real("min-area", "Smallest stone", "Contours smaller than this are dropped", 0.0, 0.0, 1e12, "m²")
+            .withZeroMeaning("automatic (100 x the squared point spacing)"),
+        ParameterSpec::real("cleaning-radius", "Cleaning radius", "classify: radius of the isolated-point test", 0.0, 0.0, 1e9, "m")
+            .withZeroMeaning("automatic (2 x the point spacing)")
+            .onlyWith("method=classify"),
+        ParameterSpec::integer("cleaning-neighbours", "Cleaning neighbours",
+                               "classify: a stone point with fewer stone neighbours in the radius is isolated",
+                               defaults.cleaningNeighbours, 0, 1000)
+            .onlyWith("method=classify"),
+        ParameterSpec::real("grow-radius", "Growth radius R", "grow: neighbourhood radius", 0.0, 0.0, 1e9, "m")
+            .withZeroMeaning("automatic (2 x the point spacing, as the thesis)")
+            .onlyWith("method=grow"),
+        ParameterSpec::real("grow-variance", "Variance tolerance", "grow: largest intensity variance of a region", 0.0, 0.0, 1e30)
+            .withZeroMeaning("automatic (the variance of the stone class)")
+            .onlyWith("method=grow"),
+    };
+    tool.outputs = {OutputSpec{"stones", "Cloud with stone_id", DataKind::Cloud, true},
+                    OutputSpec{"drawing", "Stone contours", DataKind::Drawing, false, false, "stones"},
+                    OutputSpec{"table", "Stones", DataKind::Table, false, false, "stones"}};
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        const PointCloud& cloud = inputs.cloud();
+        StoneParams params;
+        params.field = values.text("field");
+        params.polarity = parseStonePolarity(values.text("polarity"));
+        if (values.has("threshold"))
+            params.threshold = values.real("threshold");
+        params.method = parseStoneMethod(values.text("method"));
+        params.alpha = values.real("alpha");
+        params.minStoneArea = values.real("min-area");
+        params.cleaningRadius = values.real("cleaning-radius");
+        params.cleaningNeighbours = static_cast<int>(values.integer("cleaning-neighbours"));
+        params.growRadius = values.real("grow-radius");
+        params.growVariance = values.real("grow-variance");
+        const StoneWallResult wall = extractStones(cloud, params, progress);
+
+        PointCloud labelled = cloud.clone();
+        for (const char* name : {"stone_id", "stone_class"})
+            labelled.addField(name);
+        std::vector<float>& id = labelled.field("stone_id")->values();
+        std::vector<float>& cls = labelled.field("stone_class")->values();
+        for (std::size_t i = 0; i < cloud.size(); ++i) {
+            id[i] = static_cast<float>(wall.stoneOfPoint[i]);
+            cls[i] = wall.stoneClass[i];
+        }
+        Drawing drawing;
+        Table table;
+        table.columns = {"id", "area", "perimeter", "centroid_x", "centroid_y", "centroid_z", "plane_rms", "points", "vertices"};
+        const double textHeight = std::max(0.01, 0.2 * std::sqrt(wall.stones.empty() ? 0.01 : wall.stones.front().area));
+        for (std::size_t s = 0; s < wall.stones.size(); ++s) {
+            const Stone& stone = wall.stones[s];
+            drawing.polylines.push_back({"STONES", stone.outline, true});
+            drawing.texts.push_back({"STONE_IDS", stone.centroid, textHeight, std::to_string(s)});
+            table.rows.push_back({static_cast<double>(s), stone.area, stone.perimeter, stone.centroid.x(), stone.centroid.y(),
+                                  stone.centroid.z(), stone.planeRms, static_cast<double>(stone.points),
+                                  static_cast<double>(stone.outline.size())});
+        }
+        ToolResult result;
+        result.add("stones", std::move(labelled));
+        result.add("drawing", std::move(drawing));
+        result.add("table", std::move(table));
+        std::ostringstream summary;
+        summary << wall.stones.size() << " stones; threshold " << wall.threshold
+                << (wall.thresholdIterations ? " (inter-means, " + std::to_string(wall.thresholdIterations) + " iterations)" : "")
+                << ", point spacing " << wall.spacing << " m, alpha " << wall.alpha << " m; " << wall.isolatedRemoved
+                << " isolated points removed, " << wall.smallDropped << " small and " << wall.nestedDropped
+                << " nested contours dropped; wall plane RMS " << wall.wall.rms << " m";
+        result.summary = summary.str();
+        return result;
+    };
+    return tool;
+}
+
+} // namespace
+
+} // namespace scandiff::plugins
+
+void scandiff_register_plugin_contours(scandiff::PluginRegistry& registry)
+{
+    using namespace scandiff::plugins;
+    registry.plugins.push_back({"contours", "Outlines and openings of planar segments; stone-by-stone wall drawings", "CGAL"});
+    registry.tools.add(contoursTool());
+    registry.tools.add(stonesTool());
+}

@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `scandiff-cli stones` and `scandiff-cli contours` end to end: a synthetic
+// wall and façade written as PLY, the commands' files in --out-dir read back.
+#include "CliRunner.h"
+
+#include <scandiff/io/FileIO.h>
+
+#include "DxfCheck.h"
+#include "TestSupport.h"
+#include "WallScenes.h"
+
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <set>
+
+using namespace scandiff;
+
+TEST(ContoursCli, StonesWriteTheLabelledPointsTheDrawingAndTheTable)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    test::StoneWallOptions options;
+    options.brightStones = true;
+    const test::StoneWallScene scene = test::makeStoneWall(options);
+    io::writePointCloud(registry.formats, scene.cloud, dir / "wall.ply");
+    const auto out = dir / "out";
+    std::filesystem::create_directories(out);
+    const test::CliRun r =
+        test::runCliInProcess(registry, {"stones", (dir / "wall.ply").string(), "--polarity", "bright", "--out-dir", out.string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find(std::to_string(scene.stones.size()) + " stones"), std::string::npos) << r.out;
+    // The points, in input order, with stone_id (positions to the float
+    // precision of the reader's global shift: float32 local coordinates).
+    const PointCloud labelled = io::readPointCloud(registry.formats, out / "stones.ply");
+    ASSERT_EQ(labelled.size(), scene.cloud.size());
+    ASSERT_NE(labelled.field("stone_id"), nullptr);
+    for (std::size_t i = 0; i < labelled.size(); i += 97)
+        ASSERT_LT((labelled.globalPosition(i) - scene.cloud.globalPosition(i)).norm(), 1e-4);
+    std::set<int> ids;
+    for (float v : labelled.field("stone_id")->values())
+        ids.insert(static_cast<int>(v));
+    EXPECT_EQ(ids.size(), scene.stones.size() + 1);
+    // A closed polyline and a label per stone, audited by ezdxf.
+    const test::DxfCheck dxf = test::checkDxf(out / "stones.dxf");
+    EXPECT_EQ(dxf.exitStatus, 0);
+    EXPECT_EQ(dxf.count("POLYLINE@STONES"), static_cast<int>(scene.stones.size()));
+    EXPECT_EQ(dxf.count("TEXT@STONE_IDS"), static_cast<int>(scene.stones.size()));
+    // The table: a header and a row per stone.
+    std::ifstream csv(out / "stones.csv");
+    std::string header, line;
+    std::getline(csv, header);
+    EXPECT_EQ(header.rfind("id,area,perimeter,centroid_x", 0), 0u) << header;
+    std::size_t rows = 0;
+    while (std::getline(csv, line))
+        rows += !line.empty();
+    EXPECT_EQ(rows, scene.stones.size());
+}
+
+TEST(ContoursCli, ContoursWriteTheDrawingAndTheJsonDocument)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    const test::FacadeScene scene = test::makeFacade();
+    io::writePointCloud(registry.formats, scene.cloud, dir / "facade.ply");
+    const auto out = dir / "out";
+    std::filesystem::create_directories(out);
+    const test::CliRun r = test::runCliInProcess(registry, {"contours", (dir / "facade.ply").string(), "--vectorise", "--out-dir", out.string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const test::DxfCheck dxf = test::checkDxf(out / "contours.dxf");
+    EXPECT_EQ(dxf.exitStatus, 0);
+    EXPECT_EQ(dxf.count("POLYLINE"), static_cast<int>(1 + scene.openings.size()));
+    std::ifstream file(out / "contours.json");
+    const auto json = nlohmann::json::parse(file);
+    ASSERT_EQ(json["planes"].size(), 1u);
+    const auto& polygon = json["planes"][0]["polygons"][0];
+    EXPECT_EQ(polygon["holes"].size(), scene.openings.size());
+    EXPECT_GT(polygon["outer"]["area"].get<double>(), 0.9 * 6 * 4 - 5.0);
+    EXPECT_TRUE(std::filesystem::exists(out / "contours.csv"));
+    // A bad option is the same clear error as anywhere else.
+    const test::CliRun bad = test::runCliInProcess(registry, {"contours", (dir / "facade.ply").string(), "--edge-threshold", "-3"});
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE(bad.err.find("edge-threshold"), std::string::npos) << bad.err;
+}

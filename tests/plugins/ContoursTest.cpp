@@ -1,0 +1,375 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Contours (thesis 001 ch. 4) and stone walls (thesis 003): outlines of
+// lattices whose Delaunay triangles are known, the inter-means threshold on
+// symmetric data, and the synthetic wall and façade of tests/support/WallScenes.h
+// measured against their true outlines.
+#include <scandiff/core/Error.h>
+#include <scandiff/io/DxfWriter.h>
+#include <scandiff/plugins/PluginRegistry.h>
+#include <scandiff/plugins/contours/PlanarContours.h>
+#include <scandiff/plugins/contours/PolygonMeasures.h>
+#include <scandiff/plugins/contours/StoneWall.h>
+#include <scandiff/plugins/contours/Vectorisation.h>
+
+#include "DxfCheck.h"
+#include "TestSupport.h"
+#include "WallScenes.h"
+
+#include <nlohmann/json.hpp>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+#include <set>
+
+using namespace scandiff;
+using namespace scandiff::plugins;
+
+namespace {
+
+//! Lattice points x0..x1 by y0..y1 (pitch 1).
+void addLattice(std::vector<Eigen::Vector2d>& points, int x0, int x1, int y0, int y1)
+{
+    for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x)
+            points.emplace_back(x, y);
+}
+
+OutlineParams alpha(double radius)
+{
+    OutlineParams p;
+    p.method = OutlineMethod::Alpha;
+    p.threshold = radius;
+    return p;
+}
+
+bool hasRepeatedVertex(const Ring2d& ring)
+{
+    std::set<std::pair<double, double>> seen;
+    for (const Eigen::Vector2d& q : ring)
+        if (!seen.insert({q.x(), q.y()}).second)
+            return true;
+    return false;
+}
+
+//! A truth outline in the fitted plane's coordinates.
+Ring2d inPlane(const test::Outline& outline, const test::WallFrame& frame, const PlaneFrame& plane)
+{
+    Ring2d out;
+    for (const Eigen::Vector2d& q : outline)
+        out.push_back(plane.toPlane(frame.world(q)));
+    return out;
+}
+
+//! A 3D polyline in the wall's own (along, up) coordinates.
+Ring2d inWall(const std::vector<Eigen::Vector3d>& polyline, const test::WallFrame& frame)
+{
+    Ring2d out;
+    for (const Eigen::Vector3d& p : polyline)
+        out.emplace_back((p - frame.origin).dot(frame.along()), (p - frame.origin).z());
+    return out;
+}
+
+} // namespace
+
+TEST(Outlines, ALatticeAboveItsCircumradiusIsOneSquare)
+{
+    // Every Delaunay triangle of a unit lattice has circumradius 1/sqrt(2) and
+    // longest edge sqrt(2): just above, the outline is the 10 x 10 square
+    // through the 40 border points; just below, nothing is kept.
+    std::vector<Eigen::Vector2d> points;
+    addLattice(points, 0, 10, 0, 10);
+    for (const OutlineParams& params : {alpha(0.7072), [] {
+             OutlineParams p;
+             p.threshold = 1.4143;
+             return p;
+         }()}) {
+        const OutlineResult result = extractOutlines(points, params);
+        ASSERT_EQ(result.parts.size(), 1u);
+        EXPECT_DOUBLE_EQ(result.parts[0].area, 100.0);
+        EXPECT_DOUBLE_EQ(ringArea(result.parts[0].outer), 100.0);
+        EXPECT_EQ(result.parts[0].outer.size(), 40u);
+        EXPECT_TRUE(result.parts[0].holes.empty());
+        EXPECT_EQ(result.parts[0].pointCount, points.size());
+        EXPECT_EQ(result.keptTriangles, 200u);
+    }
+    EXPECT_TRUE(extractOutlines(points, alpha(0.7070)).parts.empty());
+}
+
+TEST(Outlines, AHoleIsAClockwiseRingAndTheKneeFindsIt)
+{
+    // The lattice without its 3 x 3 centre: at alpha 0.75 the lattice
+    // triangles at the hole's corners stay, the hole is the octagon through
+    // (4,3), (6,3), (7,4) ... (area 16 - 4 x 0.5).
+    std::vector<Eigen::Vector2d> points;
+    for (int y = 0; y <= 10; ++y)
+        for (int x = 0; x <= 10; ++x)
+            if (!(x >= 4 && x <= 6 && y >= 4 && y <= 6))
+                points.emplace_back(x, y);
+    const OutlineResult exact = extractOutlines(points, alpha(0.75));
+    ASSERT_EQ(exact.parts.size(), 1u);
+    ASSERT_EQ(exact.parts[0].holes.size(), 1u);
+    EXPECT_DOUBLE_EQ(ringArea(exact.parts[0].holes[0]), -14.0);
+    EXPECT_DOUBLE_EQ(exact.parts[0].area, 86.0);
+    EXPECT_EQ(exact.parts[0].holes[0].size(), 12u);
+    EXPECT_DOUBLE_EQ(exact.spacing, 1.0);
+    // The knee (threshold 0) finds the hole with either criterion.
+    for (OutlineMethod method : {OutlineMethod::LongEdges, OutlineMethod::Alpha}) {
+        OutlineParams params;
+        params.method = method;
+        const OutlineResult result = extractOutlines(points, params);
+        ASSERT_EQ(result.parts.size(), 1u);
+        ASSERT_EQ(result.parts[0].holes.size(), 1u);
+        EXPECT_LE(ringArea(result.parts[0].holes[0]), -4.0);
+        EXPECT_GT(result.threshold, method == OutlineMethod::LongEdges ? std::sqrt(2.0) : std::sqrt(0.5));
+    }
+    // Without a gap, the knee keeps every triangle (its floor).
+    std::vector<Eigen::Vector2d> full;
+    addLattice(full, 0, 10, 0, 10);
+    const OutlineResult whole = extractOutlines(full, OutlineParams{});
+    ASSERT_EQ(whole.parts.size(), 1u);
+    EXPECT_TRUE(whole.parts[0].holes.empty());
+    EXPECT_DOUBLE_EQ(whole.parts[0].area, 100.0);
+}
+
+TEST(Outlines, TwoPatchesJoinedByOnePointStayTwoOutlines)
+{
+    // Thesis 003 §III.1.2.1: "two stones joined by a common point". Stones
+    // [0,5]² and [8,13]x[0,5], one stray point in the middle of the joint: its
+    // small triangles reach both stones, but it joins them by a vertex only,
+    // so each stone keeps its own ring and the point is a vertex of both.
+    std::vector<Eigen::Vector2d> points;
+    addLattice(points, 0, 5, 0, 5);
+    addLattice(points, 8, 13, 0, 5);
+    const Eigen::Vector2d bridge(6.5, 2.5);
+    points.push_back(bridge);
+    const OutlineResult result = extractOutlines(points, alpha(0.9));
+    ASSERT_EQ(result.parts.size(), 2u);
+    for (const OutlinePart& part : result.parts) {
+        EXPECT_DOUBLE_EQ(part.area, 25.75); // the stone and the triangle reaching the stray point
+        EXPECT_FALSE(hasRepeatedVertex(part.outer));
+        EXPECT_EQ(std::count(part.outer.begin(), part.outer.end(), bridge), 1);
+    }
+    for (std::size_t i = 0; i + 1 < points.size(); ++i)
+        EXPECT_EQ(result.partOfPoint[i], result.partOfPoint[i < 36 ? 0 : 36]) << i;
+}
+
+TEST(Outlines, SeparatePatchesAndDuplicatesAndBadInput)
+{
+    std::vector<Eigen::Vector2d> points;
+    addLattice(points, 0, 5, 0, 5);
+    addLattice(points, 9, 14, 0, 5);
+    points.push_back(points[7]); // a duplicate of a first-patch point
+    const OutlineResult result = extractOutlines(points, alpha(0.75));
+    ASSERT_EQ(result.parts.size(), 2u);
+    EXPECT_NE(result.partOfPoint[0], result.partOfPoint[36]);
+    EXPECT_EQ(result.partOfPoint.back(), result.partOfPoint[7]);
+    EXPECT_GE(result.partOfPoint.back(), 0);
+
+    EXPECT_TRUE(extractOutlines({{0, 0}, {1, 1}}, OutlineParams{}).parts.empty());
+    EXPECT_TRUE(extractOutlines({{0, 0}, {1, 1}, {2, 2}, {3, 3}}, OutlineParams{}).parts.empty()); // on a line
+    EXPECT_TRUE(extractOutlines({}, OutlineParams{}).parts.empty());
+    EXPECT_EQ(test::errorCodeOf([] { extractOutlines({{0, 0}, {1, 0}, {0, std::nan("")}}, OutlineParams{}); }), ErrorCode::InvalidData);
+    EXPECT_EQ(test::errorCodeOf([&] { extractOutlines(points, alpha(-1)); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(parseOutlineMethod("alpha"), OutlineMethod::Alpha);
+    EXPECT_EQ(test::errorCodeOf([] { parseOutlineMethod("concave"); }), ErrorCode::InvalidArgument);
+}
+
+TEST(Outlines, ThePlaneFrameIsOrthonormalAndExactFarFromTheOrigin)
+{
+    const test::WallFrame frame;
+    std::vector<Eigen::Vector3d> points;
+    for (int i = 0; i < 50; ++i)
+        for (int j = 0; j < 30; ++j)
+            points.push_back(frame.world({0.1 * i, 0.1 * j}, (i + j) % 2 ? 0.004 : -0.004));
+    const PlaneFrame plane = fitPlaneFrame(points);
+    EXPECT_NEAR(plane.u.dot(plane.v), 0.0, 1e-12);
+    EXPECT_NEAR(plane.u.norm(), 1.0, 1e-12);
+    EXPECT_NEAR(plane.normal.cross(frame.along().cross(Eigen::Vector3d::UnitZ())).norm(), 0.0, 1e-9);
+    EXPECT_NEAR(plane.u.z(), 0.0, 1e-12); // horizontal, and v up
+    EXPECT_GT(plane.v.z(), 0.999999);
+    EXPECT_NEAR(plane.rms, 0.004, 1e-9);
+    const Eigen::Vector3d p = points[123];
+    const Eigen::Vector3d projected = p - (p - plane.origin).dot(plane.normal) * plane.normal;
+    EXPECT_NEAR((plane.toWorld(plane.toPlane(p)) - projected).norm(), 0.0, 1e-9);
+    EXPECT_EQ(test::errorCodeOf([] { fitPlaneFrame({{0, 0, 0}, {1, 1, 1}, {2, 2, 2}}); }), ErrorCode::InvalidData);
+}
+
+TEST(InterMeans, SymmetricModesGiveTheMidpoint)
+{
+    // Mirror-symmetric about -1150: the fixed point is exactly the middle.
+    std::mt19937 rng(1);
+    std::normal_distribution<double> mode(250.0, 40.0);
+    std::vector<float> values;
+    for (int i = 0; i < 20000; ++i) {
+        const double d = std::round(mode(rng)); // integers: exact in float either side
+        values.push_back(static_cast<float>(-1150 - d));
+        values.push_back(static_cast<float>(-1150 + d));
+    }
+    const InterMeansThreshold t = interMeansThreshold(values);
+    EXPECT_NEAR(t.threshold, -1150.0, 1e-9);
+    EXPECT_EQ(t.lowCount, 20000u);
+    // Equal Gaussians drawn independently: within 1 % of the separation, from any start between the modes.
+    std::vector<float> drawn;
+    std::normal_distribution<double> dark(-1400, 40), light(-900, 40);
+    for (int i = 0; i < 50000; ++i) {
+        drawn.push_back(static_cast<float>(dark(rng)));
+        drawn.push_back(static_cast<float>(light(rng)));
+    }
+    for (double start : {-1350.0, -1150.0, -950.0})
+        EXPECT_NEAR(interMeansThreshold(drawn, start).threshold, -1150.0, 5.0) << start;
+    EXPECT_EQ(test::errorCodeOf([] { interMeansThreshold({3.0f, 3.0f, std::nanf("")}); }), ErrorCode::InvalidData);
+}
+
+TEST(Stones, EveryStoneIsOneClosedPolygonWithin3cmOfItsTruth)
+{
+    for (bool bright : {false, true}) {
+        test::StoneWallOptions options;
+        options.brightStones = bright;
+        const test::StoneWallScene scene = test::makeStoneWall(options);
+        StoneParams params;
+        params.polarity = bright ? StonePolarity::Bright : StonePolarity::Dark;
+        const StoneWallResult wall = extractStones(scene.cloud, params);
+        // Point level (thesis 003 P1, P2).
+        std::size_t truePositive = 0, detected = 0, real = 0;
+        for (std::size_t i = 0; i < scene.isStone.size(); ++i) {
+            truePositive += scene.isStone[i] && wall.stoneClass[i];
+            detected += wall.stoneClass[i];
+            real += scene.isStone[i];
+        }
+        EXPECT_GT(static_cast<double>(truePositive) / real, 0.99);
+        EXPECT_LT(1.0 - static_cast<double>(truePositive) / detected, 0.01);
+        EXPECT_NEAR(wall.threshold, -1150.0, 25.0);
+        // Contour level: one polygon per stone, IoU >= 0.8, within 3 cm.
+        std::vector<Polygon2d> model, truth;
+        for (const Stone& stone : wall.stones)
+            model.push_back({stone.outline2d, {}});
+        for (const test::Outline& outline : scene.stones)
+            truth.push_back({inPlane(outline, scene.frame, wall.wall), {}});
+        const PolygonMatching matching = matchPolygons(model, truth);
+        EXPECT_EQ(wall.stones.size(), scene.stones.size()) << (bright ? "bright" : "dark");
+        EXPECT_EQ(matching.correct, scene.stones.size());
+        for (std::size_t m = 0; m < model.size(); ++m) {
+            ASSERT_GE(matching.referenceOfModel[m], 0) << m;
+            EXPECT_LE(boundaryHausdorff(model[m].outer, truth[static_cast<std::size_t>(matching.referenceOfModel[m])].outer), 0.03) << m;
+            EXPECT_GT(ringArea(model[m].outer), 0.0);
+            // Planar, in the wall's plane.
+            for (const Eigen::Vector3d& p : wall.stones[m].outline)
+                EXPECT_NEAR((p - wall.wall.origin).dot(wall.wall.normal), 0.0, 1e-9);
+        }
+        EXPECT_GT(wall.isolatedRemoved, 0u);
+    }
+}
+
+TEST(Stones, RegionGrowingOnIntensityFindsTheSameStones)
+{
+    const test::StoneWallScene scene = test::makeStoneWall(test::StoneWallOptions{});
+    StoneParams params;
+    params.method = StoneMethod::Grow;
+    const StoneWallResult wall = extractStones(scene.cloud, params);
+    std::vector<Polygon2d> model, truth;
+    for (const Stone& stone : wall.stones)
+        model.push_back({stone.outline2d, {}});
+    for (const test::Outline& outline : scene.stones)
+        truth.push_back({inPlane(outline, scene.frame, wall.wall), {}});
+    const PolygonMatching matching = matchPolygons(model, truth);
+    EXPECT_EQ(matching.correct, scene.stones.size());
+    EXPECT_EQ(matching.falseRate, 0.0);
+}
+
+TEST(Stones, BadInputIsAClearError)
+{
+    test::StoneWallOptions small;
+    small.courses = 1;
+    small.stonesPerCourse = 2;
+    const test::StoneWallScene scene = test::makeStoneWall(small);
+    StoneParams params;
+    params.field = "reflectance";
+    EXPECT_EQ(test::errorCodeOf([&] { extractStones(scene.cloud, params); }), ErrorCode::InvalidArgument);
+    PointCloud two;
+    two.resize(2);
+    two.addField("intensity");
+    EXPECT_EQ(test::errorCodeOf([&] { extractStones(two, StoneParams{}); }), ErrorCode::InvalidData);
+    EXPECT_EQ(test::errorCodeOf([] { parseStonePolarity("grey"); }), ErrorCode::InvalidArgument);
+    // A wall of one intensity: no threshold separates anything.
+    PointCloud flat = scene.cloud.clone();
+    std::fill(flat.field("intensity")->values().begin(), flat.field("intensity")->values().end(), 7.0f);
+    EXPECT_EQ(test::errorCodeOf([&] { extractStones(flat, StoneParams{}); }), ErrorCode::InvalidData);
+}
+
+TEST(Contours, TheFacadeOpeningsAreFoundWithTheirCorners)
+{
+    // Through the tool, as the CLI and the workbench run it.
+    const test::FacadeScene scene = test::makeFacade();
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& tool = *registry.tools.find("contours");
+    for (const bool vectorise : {false, true}) {
+        ToolResult result = tool.execute(ToolInputs().add("input", scene.cloud), tool.resolve({{"vectorise", vectorise ? "true" : "false"}}), nullptr);
+        const Drawing& drawing = std::get<Drawing>(result.find("contours")->data);
+        std::vector<Ring2d> rings;
+        for (const DrawingPolyline& polyline : drawing.polylines) {
+            EXPECT_TRUE(polyline.closed);
+            EXPECT_EQ(polyline.layer, "PLANE_-001");
+            rings.push_back(inWall(polyline.points, scene.frame));
+        }
+        // The wall's outline (with the door's notch) and one ring per opening.
+        ASSERT_EQ(rings.size(), 1 + scene.openings.size()) << "vectorise " << vectorise;
+        for (std::size_t o = 0; o < scene.openings.size(); ++o) {
+            const Polygon2d truth{scene.openings[o], {}};
+            double best = 0.0;
+            std::size_t match = 0;
+            for (std::size_t r = 1; r < rings.size(); ++r) {
+                const AreaMeasures m = compareAreas({rings[r], {}}, truth);
+                if (m.detection > best) {
+                    best = m.detection;
+                    match = r;
+                }
+            }
+            EXPECT_GE(best, vectorise ? 0.98 : 0.95) << "opening " << o << " vectorise " << vectorise;
+            if (vectorise && o < scene.corners.size())
+                for (const Eigen::Vector2d& corner : scene.corners[o]) {
+                    double nearest = 1e9;
+                    for (const Eigen::Vector2d& q : rings[match])
+                        nearest = std::min(nearest, (q - corner).norm());
+                    EXPECT_LE(nearest, 0.02) << "opening " << o << " corner " << corner.transpose();
+                }
+        }
+        const auto json = nlohmann::json::parse(std::get<TextDocument>(result.find("document")->data).text);
+        ASSERT_EQ(json["planes"].size(), 1u);
+        EXPECT_EQ(json["planes"][0]["polygons"][0]["holes"].size(), scene.openings.size());
+        if (vectorise) {
+            std::size_t arcs = 0;
+            for (const auto& hole : json["planes"][0]["polygons"][0]["holes"])
+                for (const auto& piece : hole["pieces"])
+                    if (piece["type"] == "arc") {
+                        ++arcs;
+                        EXPECT_NEAR(piece["radius"].get<double>(), 0.5, 0.02);
+                    }
+            EXPECT_EQ(arcs, 1u);
+        }
+    }
+}
+
+TEST(Contours, TheDrawingPassesAnIndependentDxfAudit)
+{
+    const test::StoneWallScene scene = test::makeStoneWall(test::StoneWallOptions{});
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& tool = *registry.tools.find("stones");
+    ToolResult result = tool.execute(ToolInputs().add("input", scene.cloud), tool.defaults(), nullptr);
+    const Drawing& drawing = std::get<Drawing>(result.find("drawing")->data);
+    EXPECT_EQ(drawing.polylines.size(), scene.stones.size());
+    EXPECT_EQ(drawing.texts.size(), scene.stones.size());
+    const std::filesystem::path file = std::filesystem::temp_directory_path() / "scandiff-stones-test.dxf";
+    io::writeDrawingDxf(drawing, file);
+    const test::DxfCheck check = test::checkDxf(file);
+    EXPECT_EQ(check.exitStatus, 0);
+    EXPECT_EQ(check.count("POLYLINE@STONES"), static_cast<int>(scene.stones.size()));
+    std::filesystem::remove(file);
+    const PointCloud& labelled = std::get<PointCloud>(result.find("stones")->data);
+    ASSERT_NE(labelled.field("stone_id"), nullptr);
+    std::set<int> ids;
+    for (float v : labelled.field("stone_id")->values())
+        ids.insert(static_cast<int>(v));
+    EXPECT_EQ(ids.size(), scene.stones.size() + 1); // and -1
+}
