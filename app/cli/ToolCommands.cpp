@@ -4,6 +4,7 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/io/AtomicFile.h>
+#include <scandiff/io/DxfReader.h>
 #include <scandiff/io/DxfWriter.h>
 #include <scandiff/io/ResultFiles.h>
 
@@ -125,6 +126,7 @@ std::string outputHelp(const ToolSpec& tool)
 struct LoadedInputs
 {
     std::vector<std::unique_ptr<Entity>> entities; // stable addresses for ToolInputs
+    std::vector<std::unique_ptr<Drawing>> drawings;
     std::map<std::string, std::vector<Entity*>> byRole;
     ToolInputs inputs;
 };
@@ -137,6 +139,11 @@ void loadInputs(const ToolSpec& tool, const std::map<std::string, std::vector<st
         if (it == files.end())
             continue;
         for (const auto& path : it->second) {
+            if (spec.kind == DataKind::Drawing) {
+                loaded.drawings.push_back(std::make_unique<Drawing>(io::readDrawingDxf(path, options.progress)));
+                loaded.inputs.add(spec.role, *loaded.drawings.back());
+                continue;
+            }
             auto entity = std::make_unique<Entity>(io::readFile(registry.formats, path, options));
             if (spec.kind == DataKind::Mesh && !std::holds_alternative<Mesh>(*entity))
                 throw Error(ErrorCode::InvalidArgument, path + " holds a point cloud; --" + spec.role + " needs a mesh");

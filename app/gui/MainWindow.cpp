@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "MainWindow.h"
 
+#include <algorithm>
+
 #include "controllers/DistanceController.h"
 #include "controllers/FileController.h"
 #include "controllers/SegmentationController.h"
@@ -431,6 +433,9 @@ void MainWindow::buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu)
                 categories[existing->text().remove('&').toStdString()] = existing->menu();
     editMenu->addSeparator();
     for (const ToolSpec& tool : registry_.tools.tools()) {
+        // Drawings are files of the command line, not entities of the workbench (yet).
+        if (std::any_of(tool.inputs.begin(), tool.inputs.end(), [](const InputSpec& in) { return in.kind == DataKind::Drawing; }))
+            continue;
         QMenu*& menu = categories[tool.category];
         if (!menu) {
             QMenu* parent = underEdit.count(tool.category) ? editMenu : toolsMenu;

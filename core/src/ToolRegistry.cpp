@@ -288,7 +288,9 @@ void ToolSpec::checkInputs(const ToolInputs& given) const
         const std::size_t n = given.count(spec.role);
         if (n == 0 && !spec.optional)
             throw Error(ErrorCode::InvalidArgument, "tool '" + name + "' needs " +
-                                                        (spec.kind == DataKind::Mesh ? "a mesh" : "a point cloud") +
+                                                        (spec.kind == DataKind::Mesh      ? "a mesh"
+                                                         : spec.kind == DataKind::Drawing ? "a drawing"
+                                                                                          : "a point cloud") +
                                                         " as '" + spec.role + "' (" + spec.label + ")");
         if (n > 1 && !spec.repeated)
             throw Error(ErrorCode::InvalidArgument,
@@ -326,6 +328,20 @@ ToolInputs& ToolInputs::add(const std::string& role, const Entity& entity)
     return add(role, std::get<PointCloud>(entity));
 }
 
+ToolInputs& ToolInputs::add(const std::string& role, const Drawing& drawing)
+{
+    entities_[role].emplace_back(&drawing);
+    return *this;
+}
+
+const Drawing& ToolInputs::drawing(const std::string& role, std::size_t index) const
+{
+    const auto* drawing = std::get_if<const Drawing*>(&at(role, index));
+    if (!drawing)
+        throw Error(ErrorCode::InvalidArgument, "a drawing is needed as '" + role + "'");
+    return **drawing;
+}
+
 std::size_t ToolInputs::count(const std::string& role) const
 {
     const auto it = entities_.find(role);
@@ -345,7 +361,9 @@ const PointCloud& ToolInputs::cloud(const std::string& role, std::size_t index) 
     const Ref& ref = at(role, index);
     if (const auto* mesh = std::get_if<const Mesh*>(&ref))
         return (*mesh)->vertices;
-    return *std::get<const PointCloud*>(ref);
+    if (const auto* cloud = std::get_if<const PointCloud*>(&ref))
+        return **cloud;
+    throw Error(ErrorCode::InvalidArgument, "a point cloud is needed as '" + role + "', not a drawing");
 }
 
 const Mesh& ToolInputs::mesh(const std::string& role, std::size_t index) const

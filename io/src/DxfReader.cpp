@@ -15,6 +15,8 @@
 #include "internal/MeshReaders.h"
 #include "internal/TextUtil.h"
 
+#include <scandiff/io/DxfReader.h>
+
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
 #include <scandiff/core/Progress.h>
@@ -116,37 +118,43 @@ struct Entity
     }
 };
 
+double number(const Groups& groups, const Entity& e, int code, double fallback)
+{
+    const Group* g = e.find(code);
+    if (!g)
+        return fallback;
+    double v = 0;
+    std::string_view s = g->value;
+    if (!s.empty() && s.front() == '+')
+        s.remove_prefix(1);
+    const auto [end, error] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (error != std::errc() || end != s.data() + s.size() || !std::isfinite(v))
+        groups.fail(g->line, "group " + std::to_string(code) + " of " + std::string(e.type) + " must be a finite number, not " +
+                                 quoted(g->value));
+    return v;
+}
+
+long long integer(const Groups& groups, const Entity& e, int code, long long fallback)
+{
+    const double v = number(groups, e, code, static_cast<double>(fallback));
+    if (v != std::floor(v) || std::abs(v) > 2147483647.0)
+        groups.fail(e.find(code)->line, "group " + std::to_string(code) + " of " + std::string(e.type) + " must be an integer");
+    return static_cast<long long>(v);
+}
+
+Eigen::Vector3d point(const Groups& groups, const Entity& e, int xCode)
+{
+    return {number(groups, e, xCode, 0.0), number(groups, e, xCode + 10, 0.0), number(groups, e, xCode + 20, 0.0)};
+}
+
 class MeshBuilder
 {
 public:
     MeshBuilder(const Groups& groups) : groups_(groups) {}
 
-    double number(const Entity& e, int code, double fallback) const
-    {
-        const Group* g = e.find(code);
-        if (!g)
-            return fallback;
-        double v = 0;
-        std::string_view s = g->value;
-        if (!s.empty() && s.front() == '+')
-            s.remove_prefix(1);
-        const auto [end, error] = std::from_chars(s.data(), s.data() + s.size(), v);
-        if (error != std::errc() || end != s.data() + s.size() || !std::isfinite(v))
-            groups_.fail(g->line, "group " + std::to_string(code) + " of " + std::string(e.type) + " must be a finite number, not " +
-                                      quoted(g->value));
-        return v;
-    }
-    long long integer(const Entity& e, int code, long long fallback) const
-    {
-        const double v = number(e, code, static_cast<double>(fallback));
-        if (v != std::floor(v) || std::abs(v) > 2147483647.0)
-            groups_.fail(e.find(code)->line, "group " + std::to_string(code) + " of " + std::string(e.type) + " must be an integer");
-        return static_cast<long long>(v);
-    }
-    Eigen::Vector3d point(const Entity& e, int xCode) const
-    {
-        return {number(e, xCode, 0.0), number(e, xCode + 10, 0.0), number(e, xCode + 20, 0.0)};
-    }
+    double number(const Entity& e, int code, double fallback) const { return detail::number(groups_, e, code, fallback); }
+    long long integer(const Entity& e, int code, long long fallback) const { return detail::integer(groups_, e, code, fallback); }
+    Eigen::Vector3d point(const Entity& e, int xCode) const { return detail::point(groups_, e, xCode); }
 
     std::uint32_t layerOf(const Entity& e)
     {
@@ -269,58 +277,38 @@ void addPolyline(MeshBuilder& mesh, const Groups& groups, const Entity& polyline
     // Other polylines are lines, not surfaces.
 }
 
-} // namespace
 
-Mesh readDxfMesh(const fs::path& path, const ReadOptions& options)
+//! The ENTITIES section of an ASCII DXF, entity by entity: onEntity(e) for
+//! each one outside a POLYLINE, onPolyline(polyline, vertices) for each
+//! POLYLINE with the VERTEX entities after it, up to its SEQEND.
+template <class OnEntity, class OnPolyline>
+void walkEntities(Groups& groups, ProgressTicker& ticker, std::size_t fileSize, OnEntity&& onEntity, OnPolyline&& onPolyline)
 {
-    MappedFile file(path);
-    ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), file.size() + 1);
-    const std::string_view text = file.view();
-    constexpr std::string_view kBinary = "AutoCAD Binary DXF";
-    if (text.substr(0, kBinary.size()) == kBinary)
-        throw Error(ErrorCode::Unsupported, path.string() + ": binary DXF cannot be read; save it as ASCII DXF");
-    Groups groups(path, text);
-    MeshBuilder mesh(groups);
-    std::size_t inserts = 0, meshEntities = 0, reported = 0;
+    std::size_t reported = 0;
     bool inEntities = false;
     std::string_view section;
-    // Entities are gathered group by group; a POLYLINE owns the VERTEX
-    // entities after it, up to its SEQEND.
     Entity current, polyline;
     std::vector<Entity> polylineVertices;
     bool inPolyline = false;
     auto finishEntity = [&](const Entity& e) {
-        if (e.type.empty())
-            return;
-        if (!inEntities)
+        if (e.type.empty() || !inEntities)
             return;
         if (inPolyline) {
             if (e.type == "VERTEX") {
                 polylineVertices.push_back(e);
                 return;
             }
-            addPolyline(mesh, groups, polyline, polylineVertices);
+            onPolyline(polyline, polylineVertices);
             inPolyline = false;
             polylineVertices.clear();
             if (e.type == "SEQEND")
                 return;
         }
-        if (e.type == "3DFACE") {
-            const std::uint32_t layer = mesh.layerOf(e);
-            std::array<std::uint32_t, 4> c{};
-            for (int k = 0; k < 4; ++k) {
-                // A missing fourth corner repeats the third.
-                const int code = e.find(13) || k < 3 ? 10 + k : 12;
-                c[static_cast<std::size_t>(k)] = mesh.corner(mesh.point(e, code), layer, e.line);
-            }
-            mesh.face(c, 4);
-        } else if (e.type == "POLYLINE") {
+        if (e.type == "POLYLINE") {
             polyline = e;
             inPolyline = true;
-        } else if (e.type == "INSERT") {
-            ++inserts;
-        } else if (e.type == "MESH") {
-            ++meshEntities;
+        } else {
+            onEntity(e);
         }
     };
     Group g;
@@ -350,7 +338,65 @@ Mesh readDxfMesh(const fs::path& path, const ReadOptions& options)
     }
     finishEntity(current);
     if (inPolyline)
-        addPolyline(mesh, groups, polyline, polylineVertices);
+        onPolyline(polyline, polylineVertices);
+    ticker.step(fileSize + 1 - reported);
+}
+
+std::string_view checkedText(const MappedFile& file, const fs::path& path)
+{
+    const std::string_view text = file.view();
+    constexpr std::string_view kBinary = "AutoCAD Binary DXF";
+    if (text.substr(0, kBinary.size()) == kBinary)
+        throw Error(ErrorCode::Unsupported, path.string() + ": binary DXF cannot be read; save it as ASCII DXF");
+    return text;
+}
+
+//! The world axes of an entity's object coordinate system, from its
+//! extrusion direction (DXF Reference, "Arbitrary Axis Algorithm").
+Eigen::Matrix3d objectAxes(const Groups& groups, const Entity& e)
+{
+    Eigen::Vector3d n(number(groups, e, 210, 0.0), number(groups, e, 220, 0.0), number(groups, e, 230, 1.0));
+    if (!(n.norm() > 0))
+        groups.fail(e.line, std::string(e.type) + " has a zero extrusion direction");
+    n.normalize();
+    const Eigen::Vector3d ax = (std::abs(n.x()) < 1.0 / 64 && std::abs(n.y()) < 1.0 / 64 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ())
+                                   .cross(n)
+                                   .normalized();
+    Eigen::Matrix3d axes;
+    axes.col(0) = ax;
+    axes.col(1) = n.cross(ax).normalized();
+    axes.col(2) = n;
+    return axes;
+}
+
+} // namespace
+
+Mesh readDxfMesh(const fs::path& path, const ReadOptions& options)
+{
+    MappedFile file(path);
+    ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), file.size() + 1);
+    Groups groups(path, checkedText(file, path));
+    MeshBuilder mesh(groups);
+    std::size_t inserts = 0, meshEntities = 0;
+    walkEntities(
+        groups, ticker, file.size(),
+        [&](const Entity& e) {
+            if (e.type == "3DFACE") {
+                const std::uint32_t layer = mesh.layerOf(e);
+                std::array<std::uint32_t, 4> c{};
+                for (int k = 0; k < 4; ++k) {
+                    // A missing fourth corner repeats the third.
+                    const int code = e.find(13) || k < 3 ? 10 + k : 12;
+                    c[static_cast<std::size_t>(k)] = mesh.corner(mesh.point(e, code), layer, e.line);
+                }
+                mesh.face(c, 4);
+            } else if (e.type == "INSERT") {
+                ++inserts;
+            } else if (e.type == "MESH") {
+                ++meshEntities;
+            }
+        },
+        [&](const Entity& polyline, const std::vector<Entity>& vertices) { addPolyline(mesh, groups, polyline, vertices); });
     if (inserts > 0)
         logWarning(path.string() + ": " + std::to_string(inserts) +
                    " block references (INSERT) were not expanded; explode them in the CAD program to read their faces");
@@ -367,8 +413,78 @@ Mesh readDxfMesh(const fs::path& path, const ReadOptions& options)
     for (std::size_t i = 0; i < layers.size(); ++i)
         names += (i ? ", " : "") + std::to_string(i) + " = " + layers[i];
     logInfo(path.string() + ": field dxf_layer: " + names);
-    ticker.step(file.size() + 1 - reported);
     return result;
 }
 
 } // namespace scandiff::io::detail
+
+namespace scandiff::io {
+
+Drawing readDrawingDxf(const std::filesystem::path& path, ProgressObserver* progress)
+{
+    using namespace detail;
+    MappedFile file(path);
+    ProgressTicker ticker(progress, "Reading " + path.filename().string(), file.size() + 1);
+    Groups groups(path, checkedText(file, path));
+    Drawing drawing;
+    std::size_t bulges = 0;
+    auto layerOf = [](const detail::Entity& e) {
+        const Group* g = e.find(8);
+        return g ? std::string(g->value) : std::string("0");
+    };
+    walkEntities(
+        groups, ticker, file.size(),
+        [&](const detail::Entity& e) {
+            if (e.type == "LWPOLYLINE") {
+                // Vertices are repeated 10/20 pairs in the object system, at elevation 38.
+                const Eigen::Matrix3d axes = objectAxes(groups, e);
+                const double elevation = number(groups, e, 38, 0.0);
+                DrawingPolyline polyline{layerOf(e), {}, (integer(groups, e, 70, 0) & 1) != 0};
+                std::vector<Eigen::Vector2d> xy;
+                for (const Group& g : e.groups) {
+                    if (g.code == 10 || g.code == 20) {
+                        detail::Entity one{e.type, g.line, {g}};
+                        const double v = number(groups, one, g.code, 0.0);
+                        if (g.code == 10)
+                            xy.emplace_back(v, 0.0);
+                        else if (!xy.empty())
+                            xy.back().y() = v;
+                    } else if (g.code == 42) {
+                        ++bulges;
+                    }
+                }
+                for (const Eigen::Vector2d& q : xy)
+                    polyline.points.push_back(axes * Eigen::Vector3d(q.x(), q.y(), elevation));
+                if (polyline.points.size() >= 2)
+                    drawing.polylines.push_back(std::move(polyline));
+            } else if (e.type == "LINE") {
+                drawing.polylines.push_back({layerOf(e), {point(groups, e, 10), point(groups, e, 11)}, false});
+            } else if (e.type == "TEXT") {
+                const Group* text = e.find(1);
+                drawing.texts.push_back({layerOf(e), point(groups, e, 10), number(groups, e, 40, 1.0), text ? std::string(text->value) : ""});
+            }
+        },
+        [&](const detail::Entity& polyline, const std::vector<detail::Entity>& vertices) {
+            const long long flags = integer(groups, polyline, 70, 0);
+            if (flags & (16 | 64))
+                return; // a polygon or polyface mesh: a surface, not a line
+            const bool is3d = (flags & 8) != 0;
+            const Eigen::Matrix3d axes = is3d ? Eigen::Matrix3d::Identity() : objectAxes(groups, polyline);
+            const double elevation = number(groups, polyline, 30, 0.0);
+            DrawingPolyline out{layerOf(polyline), {}, (flags & 1) != 0};
+            for (const detail::Entity& v : vertices) {
+                Eigen::Vector3d p = point(groups, v, 10);
+                if (!is3d)
+                    p = axes * Eigen::Vector3d(p.x(), p.y(), elevation);
+                bulges += v.find(42) && number(groups, v, 42, 0.0) != 0.0;
+                out.points.push_back(p);
+            }
+            if (out.points.size() >= 2)
+                drawing.polylines.push_back(std::move(out));
+        });
+    if (bulges > 0)
+        logWarning(path.string() + ": " + std::to_string(bulges) + " arc segments (bulges) were read as straight chords");
+    return drawing;
+}
+
+} // namespace scandiff::io

@@ -3,6 +3,7 @@
 // wall and façade written as PLY, the commands' files in --out-dir read back.
 #include "CliRunner.h"
 
+#include <scandiff/io/DxfWriter.h>
 #include <scandiff/io/FileIO.h>
 
 #include "DxfCheck.h"
@@ -81,4 +82,21 @@ TEST(ContoursCli, ContoursWriteTheDrawingAndTheJsonDocument)
     const test::CliRun bad = test::runCliInProcess(registry, {"contours", (dir / "facade.ply").string(), "--edge-threshold", "-3"});
     EXPECT_NE(bad.status, 0);
     EXPECT_NE(bad.err.find("edge-threshold"), std::string::npos) << bad.err;
+}
+
+TEST(ContoursCli, ComparePolygonsReadsTwoDrawings)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    Drawing reference, model;
+    reference.polylines.push_back({"R", {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}}, true});
+    model.polylines.push_back({"M", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, true}); // half of it
+    io::writeDrawingDxf(reference, dir / "reference.dxf");
+    io::writeDrawingDxf(model, dir / "model.dxf");
+    const test::CliRun r =
+        test::runCliInProcess(registry, {"compare-polygons", (dir / "model.dxf").string(), (dir / "reference.dxf").string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    // rho_d = 1/2, rho_q = 1/2, branching = |R \ A| / |R ∩ A| = 1, miss = 0, failure = 0.
+    EXPECT_NE(r.out.find("0,R,0,2,1,0.5,0.5,1,0,0,0,1,"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("0 of 1 reference polygons found"), std::string::npos) << r.out;
 }

@@ -4,6 +4,8 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
+#include <scandiff/io/DxfReader.h>
+#include <scandiff/io/DxfWriter.h>
 #include <scandiff/io/FileIO.h>
 
 #include "../support/TestSupport.h"
@@ -11,6 +13,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
+#include <map>
 #include <array>
 #include <set>
 #include <string>
@@ -191,4 +195,52 @@ TEST(DxfReader, BrokenFilesAreClearErrors)
     expectError("lines.dxf", dxf({{0, "SECTION"}, {2, "ENTITIES"}, {0, "LINE"}, {0, "ENDSEC"}}), ErrorCode::InvalidData,
                 "no surface");
     expectError("binary.dxf", std::string("AutoCAD Binary DXF\r\n\x1a\0", 22), ErrorCode::Unsupported, "binary DXF");
+}
+
+TEST(DxfDrawingReader, LinesOfEveryKindInWorldCoordinates)
+{
+    // ezdxf's file (tests/data/dxf/README.md); the object coordinate system
+    // of the vertical square as ezdxf computes it.
+    test::CapturedLog log;
+    const Drawing drawing = io::readDrawingDxf(std::filesystem::path(SCANDIFF_TEST_DATA_DIR) / "dxf" / "ezdxf-lines.dxf");
+    std::map<std::string, const DrawingPolyline*> byLayer;
+    for (const DrawingPolyline& p : drawing.polylines)
+        byLayer[p.layer] = &p;
+    ASSERT_EQ(drawing.polylines.size(), 6u); // the polyface mesh is not a line
+    const DrawingPolyline& square = *byLayer.at("SQUARE");
+    EXPECT_TRUE(square.closed);
+    ASSERT_EQ(square.points.size(), 4u);
+    EXPECT_EQ(square.points[2], Eigen::Vector3d(4, 3, 2));
+    const DrawingPolyline& vertical = *byLayer.at("VERTICAL");
+    const std::vector<Eigen::Vector3d> expected{{5, 1, 1}, {5, 2, 1}, {5, 2, 2}, {5, 1, 2}};
+    ASSERT_EQ(vertical.points.size(), 4u);
+    for (std::size_t i = 0; i < 4; ++i)
+        EXPECT_LT((vertical.points[i] - expected[i]).norm(), 1e-12) << i;
+    EXPECT_FALSE(byLayer.at("ARC")->closed);
+    EXPECT_TRUE(log.has("bulges")); // the half circle, read as its chord
+    EXPECT_EQ(byLayer.at("P3D")->points[2], Eigen::Vector3d(1, 1, 2));
+    EXPECT_TRUE(byLayer.at("P3D")->closed);
+    EXPECT_EQ(byLayer.at("P2D")->points[1], Eigen::Vector3d(1, 0, 7));
+    EXPECT_EQ(byLayer.at("LINES")->points[1], Eigen::Vector3d(1, 2, 3));
+    ASSERT_EQ(drawing.texts.size(), 1u);
+    EXPECT_EQ(drawing.texts[0].text, "hello");
+    EXPECT_EQ(drawing.texts[0].position, Eigen::Vector3d(1, 2, 3));
+}
+
+TEST(DxfDrawingReader, WhatOurWriterWritesReadsBack)
+{
+    Drawing drawing;
+    drawing.polylines.push_back({"A", {{512000.125, 5423000.5, 101.25}, {512001, 5423000.5, 101.25}, {512001, 5423001, 102}}, true});
+    drawing.polylines.push_back({"B", {{0, 0, 0}, {1, 1, 1}}, false});
+    const auto file = test::tempDir() / "drawing.dxf";
+    io::writeDrawingDxf(drawing, file);
+    const Drawing back = io::readDrawingDxf(file);
+    ASSERT_EQ(back.polylines.size(), 2u);
+    EXPECT_EQ(back.polylines[0].points, drawing.polylines[0].points); // 6 decimals hold these exactly
+    EXPECT_TRUE(back.polylines[0].closed);
+    EXPECT_FALSE(back.polylines[1].closed);
+    // Damaged: a vertex coordinate that is not a number names its line.
+    const auto bad = file.parent_path() / "bad.dxf";
+    std::ofstream(bad) << "0\nSECTION\n2\nENTITIES\n0\nLWPOLYLINE\n8\nA\n90\n2\n10\n1.0\n20\nabc\n0\nENDSEC\n0\nEOF\n";
+    EXPECT_EQ(test::errorCodeOf([&] { io::readDrawingDxf(bad); }), ErrorCode::InvalidData);
 }

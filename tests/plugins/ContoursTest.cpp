@@ -373,3 +373,45 @@ TEST(Contours, TheDrawingPassesAnIndependentDxfAudit)
         ids.insert(static_cast<int>(v));
     EXPECT_EQ(ids.size(), scene.stones.size() + 1); // and -1
 }
+
+TEST(Contours, ComparePolygonsGivesTheThesisMeasures)
+{
+    // The façade's vectorised model against its true openings, drawn as a
+    // reference: every opening found, rho_d >= 0.98; and the reference
+    // against itself: every measure at its ideal.
+    const test::FacadeScene scene = test::makeFacade();
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& contours = *registry.tools.find("contours");
+    ToolResult model = contours.execute(ToolInputs().add("input", scene.cloud), contours.resolve({{"vectorise", "true"}}), nullptr);
+    const Drawing& modelDrawing = std::get<Drawing>(model.find("contours")->data);
+    Drawing reference;
+    for (const test::Outline& opening : scene.openings) {
+        DrawingPolyline polyline{"OPENINGS", {}, true};
+        for (const Eigen::Vector2d& q : opening)
+            polyline.points.push_back(scene.frame.world(q));
+        reference.polylines.push_back(polyline);
+    }
+    const ToolSpec& compare = *registry.tools.find("compare-polygons");
+    const ToolResult result = compare.execute(ToolInputs().add("input", modelDrawing).add("input", reference), compare.defaults(), nullptr);
+    const Table& table = result.table("measures");
+    ASSERT_EQ(table.rows.size(), scene.openings.size());
+    auto column = [&](const std::string& name) {
+        return static_cast<std::size_t>(std::find(table.columns.begin(), table.columns.end(), name) - table.columns.begin());
+    };
+    for (const auto& row : table.rows) {
+        EXPECT_GE(std::get<double>(row[column("detection")]), 0.98);
+        EXPECT_GE(std::get<double>(row[column("quality")]), 0.95);
+        EXPECT_LT(std::get<double>(row[column("vertex_max")]), 0.05);
+    }
+    EXPECT_NE(result.summary.find(std::to_string(scene.openings.size()) + " of " + std::to_string(scene.openings.size())), std::string::npos)
+        << result.summary;
+    const ToolResult self = compare.execute(ToolInputs().add("input", reference).add("input", reference), compare.defaults(), nullptr);
+    for (const auto& row : self.table("measures").rows) {
+        EXPECT_NEAR(std::get<double>(row[column("detection")]), 1.0, 1e-12);
+        EXPECT_NEAR(std::get<double>(row[column("quality")]), 1.0, 1e-12);
+        EXPECT_NEAR(std::get<double>(row[column("failure")]), 0.0, 1e-12);
+        EXPECT_NEAR(std::get<double>(row[column("vertex_max")]), 0.0, 1e-12);
+    }
+    EXPECT_EQ(test::errorCodeOf([&] { compare.execute(ToolInputs().add("input", reference), compare.defaults(), nullptr); }),
+              ErrorCode::InvalidArgument);
+}

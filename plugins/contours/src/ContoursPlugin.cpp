@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Registers the tools "contours" (outlines and openings of planar segments,
 // thesis 001 ch. 4) and "stones" (stone-by-stone wall drawing, thesis 003).
+#include "ContourTools.h"
+
 #include <scandiff/core/Error.h>
 #include <scandiff/core/segmentation/RegionReport.h>
 #include <scandiff/plugins/PluginRegistry.h>
@@ -355,4 +357,5 @@ void scandiff_register_plugin_contours(scandiff::PluginRegistry& registry)
     registry.plugins.push_back({"contours", "Outlines and openings of planar segments; stone-by-stone wall drawings", "CGAL"});
     registry.tools.add(contoursTool());
     registry.tools.add(stonesTool());
+    registry.tools.add(comparePolygonsTool());
 }

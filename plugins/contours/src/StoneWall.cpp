@@ -46,10 +46,11 @@ double medianSpacing(const octree::Octree& tree, const std::vector<Eigen::Vector
 //! stone-class points taken in a seeded random order; a seed whose R-disc has
 //! an intensity variance above tau is skipped (the thesis draws another); a
 //! region grows through R-discs, a point joining while the region's variance
-//! with it stays below tau and its intensity lies within 3 sqrt(tau) of the
-//! region's mean. The second test is ours: on a large region one joint point
-//! hardly moves the variance, which is how the thesis's regions leaked
-//! (8.6 % false stone points on its wall n°1).
+//! with it stays below tau, its intensity lies within 3 sqrt(tau) of the
+//! region's mean and on the stone side of the threshold. The last two tests
+//! are ours: on a large region one joint point hardly moves the variance,
+//! which is how the thesis's regions leaked (8.6 % false stone points on its
+//! wall n°1); the thesis constrains only its seeds to the stone side.
 std::vector<std::int32_t> growOnIntensity(const octree::Octree& tree, const std::vector<Eigen::Vector3f>& points,
                                           const std::vector<float>& intensity, const std::vector<std::uint8_t>& stoneClass,
                                           double radius, double tau, ProgressTicker& ticker)
@@ -108,7 +109,7 @@ std::vector<std::int32_t> growOnIntensity(const octree::Octree& tree, const std:
             const std::uint32_t at = front.front();
             front.pop_front();
             for (std::uint32_t j : lists[at]) {
-                if (region[j] >= 0 || !std::isfinite(intensity[j]))
+                if (region[j] >= 0 || !stoneClass[j])
                     continue;
                 const double value = intensity[j];
                 const double m = (sum + value) / static_cast<double>(count + 1);

@@ -139,7 +139,9 @@ struct TextDocument
     std::string text;
 };
 
-//! One input of a tool: an entity, or several, playing a role.
+//! One input of a tool: an entity, or several, playing a role. A Drawing
+//! input is a CAD drawing file (DXF) on the command line; the workbench has
+//! no drawing entities yet and does not list tools that need one.
 struct InputSpec
 {
     //! "input" is the CLI's positional argument (IN, or IN... when repeated);
@@ -184,6 +186,7 @@ public:
     ToolInputs& add(const std::string& role, const PointCloud& cloud);
     ToolInputs& add(const std::string& role, const Mesh& mesh);
     ToolInputs& add(const std::string& role, const Entity& entity);
+    ToolInputs& add(const std::string& role, const Drawing& drawing);
 
     std::size_t count(const std::string& role) const;
     bool has(const std::string& role) const { return count(role) != 0; }
@@ -193,9 +196,11 @@ public:
     const Mesh& mesh(const std::string& role = "input", std::size_t index = 0) const;
     //! Null when the entity is a cloud.
     const Mesh* meshOrNull(const std::string& role = "input", std::size_t index = 0) const;
+    //! Throws Error(InvalidArgument) when absent or not a drawing.
+    const Drawing& drawing(const std::string& role, std::size_t index = 0) const;
 
 private:
-    using Ref = std::variant<const PointCloud*, const Mesh*>;
+    using Ref = std::variant<const PointCloud*, const Mesh*, const Drawing*>;
     const Ref& at(const std::string& role, std::size_t index) const;
     std::map<std::string, std::vector<Ref>> entities_;
 };
