@@ -10,6 +10,7 @@
 #include "TestSupport.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/io/DxfReader.h>
 #include <scandiff/io/FileIO.h>
 
 #include <gtest/gtest.h>
@@ -38,6 +39,16 @@ void readOrRefuse(const io::FormatRegistry& registry, const fs::path& file, cons
     fs::copy_file(file, copy, fs::copy_options::overwrite_existing);
     try {
         io::readFile(registry, copy);
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(copy.string()), std::string::npos) << "the message names the file: " << e.what();
+        EXPECT_NE(e.code(), ErrorCode::Internal) << e.what();
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "not a scandiff::Error: " << e.what();
+    }
+    if (extension != "dxf")
+        return;
+    try {
+        io::readDrawingDxf(copy); // the lines of the same file
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find(copy.string()), std::string::npos) << "the message names the file: " << e.what();
         EXPECT_NE(e.code(), ErrorCode::Internal) << e.what();

@@ -7,6 +7,7 @@
 //! -DSCANDIFF_FUZZ=ON (clang); see docs/reliability.md for how to run it.
 
 #include <scandiff/core/Error.h>
+#include <scandiff/io/DxfReader.h>
 #include <scandiff/io/FileIO.h>
 
 #include <cstddef>
@@ -56,6 +57,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         scandiff::io::readFile(formats(), inputPath());
     } catch (const scandiff::Error&) {
         // A clean refusal: what a broken file must give.
+    }
+    if (std::string(SCANDIFF_FUZZ_EXTENSION) == "dxf") {
+        try {
+            scandiff::io::readDrawingDxf(inputPath()); // the same file as a drawing (lines)
+        } catch (const scandiff::Error&) {
+        }
     }
     return 0;
 }
