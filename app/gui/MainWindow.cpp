@@ -457,18 +457,6 @@ void MainWindow::buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu)
             auto* window = new TableDialog(title, tables, this);
             window->show();
         });
-        const QString proposedName = QString::fromStdString(tool.name) + ".dxf";
-        connect(controller, &ToolController::drawingReady, this, [this, proposedName](const QString& title, const Drawing& drawing) {
-            const QString path = QFileDialog::getSaveFileName(this, tr("Save %1 as DXF").arg(title), proposedName, tr("DXF drawing (*.dxf)"));
-            if (path.isEmpty())
-                return;
-            try {
-                io::writeDrawingDxf(drawing, path.toStdString());
-                console_->info(tr("wrote %1 (%2 polylines)").arg(path).arg(drawing.polylines.size()));
-            } catch (const Error& e) {
-                console_->error(QString::fromStdString(e.what()));
-            }
-        });
     }
 }
 

@@ -254,7 +254,7 @@ private slots:
         QCOMPARE(ranged.values().at("range"), std::string("0.5 1.5"));
     }
 
-    void aDrawingOutputIsOfferedForSaving()
+    void aDrawingOutputJoinsTheTreeUnderItsCloud()
     {
         const PluginRegistry registry = makePluginRegistry();
         gui::Document document;
@@ -264,15 +264,22 @@ private slots:
                 block.positions().emplace_back(0.1f * i, 0.1f * j, 0.0f);
         const gui::EntityId id = document.add("block", std::move(block));
         gui::ToolController controller(*registry.tools.find("sections"), document, nullptr);
-        QSignalSpy drawings(&controller, &gui::ToolController::drawingReady);
         QSignalSpy tables(&controller, &gui::ToolController::tablesReady);
         QVERIFY(controller.run(id, {{"axis", "x"}, {"thickness", "0.12"}, {"step", "0.5"}, {"first", "0.25"}}));
-        // The drawing goes to the window (which asks where to save it), the slabs into the tree.
-        QCOMPARE(drawings.count(), 1);
-        const auto drawing = drawings.at(0).at(1).value<scandiff::Drawing>();
-        QCOMPARE(drawing.polylines.size(), std::size_t(4)); // sections at 0.25, 0.75, 1.25, 1.75 m, two columns each
+        // The slabs and the drawing go into the tree, the drawing under the block.
+        QCOMPARE(document.size(), std::size_t(1 + 4 + 1));
+        const gui::Document::Item* drawing = nullptr;
+        for (gui::EntityId e : document.ids())
+            if (document.item(e).isDrawing())
+                drawing = &document.item(e);
+        QVERIFY(drawing);
+        QCOMPARE(drawing->parent, id);
+        QCOMPARE(drawing->drawing->polylines.size(), std::size_t(4)); // sections at 0.25, 0.75, 1.25, 1.75 m, two columns each
+        QVERIFY(drawing->cloud() == nullptr); // no tool takes it as a cloud
         QCOMPARE(tables.count(), 1);
-        QCOMPARE(document.size(), std::size_t(1 + 4));
+        // The tools' dialogs do not offer it as an input.
+        for (gui::EntityId e : gui::acceptedEntities(document, InputSpec{}))
+            QVERIFY(!document.item(e).isDrawing());
     }
 
     void alternativesAndRequiredParametersInTheForm()

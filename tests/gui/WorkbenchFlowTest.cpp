@@ -5,6 +5,9 @@
 // and restore the session. Answers are checked against core called directly
 // and against brute-force counts.
 #include "MainWindow.h"
+#include "WallScenes.h"
+
+#include <scandiff/io/DxfReader.h>
 #include "controllers/GlobalShiftDialog.h"
 #include "panels/ConsolePanel.h"
 #include "tools/MeasurePanel.h"
@@ -12,6 +15,7 @@
 #include "controllers/FileController.h"
 #include "controllers/SegmentationController.h"
 #include "controllers/SessionController.h"
+#include "controllers/FileController.h"
 #include "panels/EntityTree.h"
 #include "panels/PropertiesPanel.h"
 #include "panels/ScalarFieldPanel.h"
@@ -259,6 +263,47 @@ private slots:
             QCOMPARE(back.position[k], camera.position[k]);
             QCOMPARE(back.viewUp[k], camera.viewUp[k]);
         }
+    }
+
+    void stonesDrawnOverTheWallListedExportedAndKeptInTheSession()
+    {
+        // Tools > Contours > Stones on a synthetic wall of 20 stones: the
+        // points get stone_id, the contours join the tree under the wall and
+        // are drawn over it; File > Export writes them as DXF; a saved session
+        // brings them back.
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
+        test::StoneWallScene scene = test::makeStoneWall(test::StoneWallOptions{});
+        const EntityId wall = window.document().add("wall", std::move(scene.cloud));
+        QVERIFY(window.toolController("stones")->run(wall, {}));
+        QVERIFY(window.document().item(wall).points().field("stone_id"));
+        const gui::Document::Item* contours = nullptr;
+        for (EntityId id : window.document().ids())
+            if (window.document().item(id).isDrawing())
+                contours = &window.document().item(id);
+        QVERIFY(contours);
+        QCOMPARE(contours->parent, wall);
+        QCOMPARE(contours->drawing->polylines.size(), scene.stones.size());
+        QVERIFY(window.document().item(wall).display.visible); // the wall stays shown under its contours
+        window.view()->zoomToEntity(contours->id);
+        window.view()->render();
+        QTemporaryDir dir;
+        const QString dxf = dir.filePath("stones.dxf");
+        QVERIFY(window.files()->exportEntity(contours->id, dxf));
+        QCOMPARE(io::readDrawingDxf(dxf.toStdString()).polylines.size(), scene.stones.size());
+        const QString session = dir.filePath("stones.scandiff");
+        QVERIFY(window.sessions()->save(session));
+        window.document().clear();
+        QVERIFY(window.sessions()->restore(session));
+        std::size_t drawings = 0;
+        for (EntityId id : window.document().ids())
+            if (window.document().item(id).isDrawing()) {
+                ++drawings;
+                QCOMPARE(window.document().item(id).drawing->polylines.size(), scene.stones.size());
+                QVERIFY(window.document().item(window.document().item(id).parent).points().field("stone_id"));
+            }
+        QCOMPARE(drawings, std::size_t(1));
     }
 
     void processingToolsFromTheMenusDeclarations()

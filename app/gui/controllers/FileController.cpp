@@ -4,6 +4,8 @@
 
 #include "TaskRunner.h"
 
+#include <scandiff/core/Error.h>
+#include <scandiff/io/DxfWriter.h>
 #include <scandiff/io/FileIO.h>
 
 #include <QDir>
@@ -140,6 +142,17 @@ bool FileController::exportEntity(EntityId id, const QString& path)
         emit failed(tr("Nothing to export"));
         return false;
     }
+    if (item->isDrawing()) {
+        try {
+            io::writeDrawingDxf(*item->drawing, path.toStdString());
+        } catch (const Error& e) {
+            emit failed(QString::fromStdString(e.what()));
+            return false;
+        }
+        document_.markSaved(id);
+        emit finished(tr("exported %1 to %2 (%3 polylines)").arg(item->name, path).arg(item->drawing->polylines.size()));
+        return true;
+    }
     QElapsedTimer clock;
     clock.start();
     const TaskResult result = runTask(parentWindow_, tr("Writing %1").arg(QFileInfo(path).fileName()), [&](ProgressObserver& progress) {
@@ -171,9 +184,10 @@ void FileController::exportWithDialog(const std::vector<EntityId>& ids)
     }
     if (ids.size() == 1) {
         const Document::Item& item = document_.item(ids.front());
-        QString selectedFilter = "PLY (*.ply)";
-        const QString path = QFileDialog::getSaveFileName(parentWindow_, tr("Export %1").arg(item.name), item.name + ".ply",
-                                                          fileFilter(true), &selectedFilter);
+        QString selectedFilter = item.isDrawing() ? "DXF drawing (*.dxf)" : "PLY (*.ply)";
+        const QString path = QFileDialog::getSaveFileName(parentWindow_, tr("Export %1").arg(item.name),
+                                                          item.name + (item.isDrawing() ? ".dxf" : ".ply"),
+                                                          item.isDrawing() ? selectedFilter : fileFilter(true), &selectedFilter);
         if (!path.isEmpty() && exportEntity(ids.front(), path))
             return;
         return;
@@ -186,9 +200,10 @@ void FileController::exportWithDialog(const std::vector<EntityId>& ids)
         // Names become file names: no separators, and two entities never share a file.
         QString base = document_.item(id).name;
         base.replace(QRegularExpression(R"([/\\:*?"<>|])"), "_");
-        QString name = base + ".ply";
+        const QString extension = document_.item(id).isDrawing() ? ".dxf" : ".ply";
+        QString name = base + extension;
         for (int n = 2; used.contains(name) || QFileInfo::exists(QDir(folder).filePath(name)); ++n)
-            name = QString("%1_%2.ply").arg(base).arg(n);
+            name = QString("%1_%2%3").arg(base).arg(n).arg(extension);
         used.insert(name);
         if (!exportEntity(id, QDir(folder).filePath(name)))
             break;

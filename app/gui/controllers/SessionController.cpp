@@ -8,6 +8,8 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/io/AtomicFile.h>
+#include <scandiff/io/DxfReader.h>
+#include <scandiff/io/DxfWriter.h>
 #include <scandiff/io/FileIO.h>
 
 #include <nlohmann/json.hpp>
@@ -124,10 +126,14 @@ bool SessionController::save(const QString& qpath)
     // The description is made here, on the GUI thread; the worker only writes files.
     json entities = json::array();
     std::vector<std::pair<const io::Entity*, std::string>> files;
+    std::vector<std::pair<std::shared_ptr<const Drawing>, std::string>> drawings; // as DXF
     for (EntityId id : document_.ids()) {
         const Document::Item& item = document_.item(id);
-        const std::string file = "entity_" + std::to_string(id) + ".ply";
-        files.emplace_back(&item.entity, file);
+        const std::string file = "entity_" + std::to_string(id) + (item.isDrawing() ? ".dxf" : ".ply");
+        if (item.isDrawing())
+            drawings.emplace_back(item.drawing, file);
+        else
+            files.emplace_back(&item.entity, file);
         json fields = json::object();
         for (const auto& [name, display] : item.display.fields)
             fields[name] = {{"scale", display.scale.toText()},          {"low", bound(display.low)},
@@ -144,6 +150,7 @@ bool SessionController::save(const QString& qpath)
                             {"pointSize", item.display.pointSize},
                             {"outside", item.display.outside == FieldColouring::Outside::Grey ? "grey" : "hide"},
                             {"fields", fields},
+                            {"kind", item.isDrawing() ? "drawing" : "data"},
                             {"provenance", provenanceJson(item.points())}});
     }
     json scales = json::array();
@@ -177,6 +184,8 @@ bool SessionController::save(const QString& qpath)
         options.progress = &progress;
         for (const auto& [entity, file] : files)
             io::writeFile(registry_.formats, *entity, fresh / file, options);
+        for (const auto& [drawing, file] : drawings)
+            io::writeDrawingDxf(*drawing, fresh / file);
         fs::remove_all(previous, ec);
         if (fs::exists(data))
             fs::rename(data, previous);
@@ -214,6 +223,7 @@ bool SessionController::restore(const QString& qpath)
         FieldColouring::Outside outside = FieldColouring::Outside::Hide;
         std::map<std::string, FieldDisplay> fields;
         io::Entity entity;
+        std::optional<Drawing> drawing;
     };
     std::vector<Entry> entries;
     std::vector<ColourScale> scales;
@@ -255,6 +265,11 @@ bool SessionController::restore(const QString& qpath)
                     display.symmetric = f.value("symmetric", false);
                     entry.fields[name] = display;
                 }
+                if (e.value("kind", std::string("data")) == "drawing") {
+                    entry.drawing = io::readDrawingDxf(path.parent_path() / e.at("data").get<std::string>(), &progress);
+                    entries.push_back(std::move(entry));
+                    continue;
+                }
                 entry.entity = io::readFile(registry_.formats, path.parent_path() / e.at("data").get<std::string>(), options);
                 if (e.contains("provenance")) {
                     PointCloud& points = pointsOf(entry.entity);
@@ -293,7 +308,9 @@ bool SessionController::restore(const QString& qpath)
     std::map<int, EntityId> newIds;
     for (Entry& e : entries) {
         const auto parent = newIds.find(e.parent);
-        const EntityId id = document_.add(e.name, std::move(e.entity), parent == newIds.end() ? kNoEntity : parent->second, e.source);
+        const EntityId parentId = parent == newIds.end() ? kNoEntity : parent->second;
+        const EntityId id = e.drawing ? document_.addDrawing(e.name, std::move(*e.drawing), parentId, e.source)
+                                      : document_.add(e.name, std::move(e.entity), parentId, e.source);
         newIds[e.id] = id;
         for (const auto& [name, display] : e.fields)
             document_.setFieldDisplay(id, name, display);

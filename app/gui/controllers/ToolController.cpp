@@ -141,7 +141,6 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
     EntityId last = kNoEntity;
     bool addedEntities = false, updatedInputs = false;
     NamedTables tables;
-    std::vector<std::pair<QString, Drawing>> drawings;
     for (const OutputSpec& spec : tool_.outputs) {
         std::size_t repeat = 0;
         for (ToolOutput* output : result->findAll(spec.role)) {
@@ -151,7 +150,13 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
                 continue;
             }
             if (auto* drawing = std::get_if<Drawing>(&output->data)) {
-                drawings.emplace_back(QString::fromStdString(spec.label), std::move(*drawing));
+                // Drawn over its cloud and listed under it; File > Export writes it as DXF.
+                // It leaves its cloud shown (unlike a new cloud, which replaces its input on screen).
+                if (!drawing->polylines.empty() || !drawing->texts.empty()) {
+                    const EntityId added = document_.addDrawing(QString::fromStdString(spec.label), std::move(*drawing), firstInput);
+                    if (last == kNoEntity)
+                        last = added; // a cloud the run gave stays the one selected
+                }
                 continue;
             }
             if (std::holds_alternative<TextDocument>(output->data))
@@ -182,8 +187,6 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
             document_.setVisible(input, false);
     if (!tables.empty())
         emit tablesReady(title, tables);
-    for (auto& [label, drawing] : drawings)
-        emit drawingReady(title + " - " + label, drawing);
     emit finished(QString("%1 [%2]: %3; %4 s%5")
                       .arg(QString::fromStdString(tool_.name), commandLine(choice, parameters),
                            QString::fromStdString(result->summary))

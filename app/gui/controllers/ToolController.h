@@ -55,8 +55,6 @@ signals:
     void resultReady(EntityId id);
     //! The run's table outputs, for the window that shows them (and saves them as CSV).
     void tablesReady(const QString& title, const scandiff::gui::NamedTables& tables);
-    //! A drawing output (cross-section outlines...): the window offers to save it as DXF.
-    void drawingReady(const QString& title, const scandiff::Drawing& drawing);
 
 private:
     //! "scandiff-cli TOOL IN --role FILE ... --param value": what the console shows.

@@ -35,6 +35,22 @@ EntityId Document::add(QString name, io::Entity entity, EntityId parent, QString
     return id;
 }
 
+EntityId Document::addDrawing(QString name, Drawing drawing, EntityId parent, QString sourcePath)
+{
+    auto item = std::make_unique<Item>();
+    item->id = nextId_++;
+    item->name = std::move(name);
+    item->entity = PointCloud{};
+    item->drawing = std::make_shared<const Drawing>(std::move(drawing));
+    item->parent = contains(parent) ? parent : kNoEntity;
+    item->sourcePath = std::move(sourcePath);
+    item->unsaved = item->sourcePath.isEmpty();
+    const EntityId id = item->id;
+    items_.push_back(std::move(item));
+    emit added(id);
+    return id;
+}
+
 void Document::remove(EntityId id)
 {
     const Item* item = find(id);

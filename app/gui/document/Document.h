@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! The entities loaded in the workbench (clouds and meshes) and how each is
+//! The entities loaded in the workbench (clouds, meshes, drawings) and how each is
 //! shown: visibility, active scalar field, colour scale and thresholds per field.
 //! Owned here; the view, the panels and the controllers observe the signals.
 //! Entities have stable ids; a derived entity (a split part, closest points)
@@ -8,6 +8,7 @@
 
 #include "colour/ColourScale.h"
 
+#include <scandiff/core/Drawing.h>
 #include <scandiff/io/FileIO.h>
 
 #include <QObject>
@@ -71,14 +72,21 @@ public:
         //! moved points. Cleared when it is exported or the session saved.
         bool unsaved = false;
 
-        const PointCloud* cloud() const { return std::get_if<PointCloud>(&entity); }
+        //! A drawing a tool gave (contours, sections): its polylines, drawn
+        //! over the clouds; `entity` is then an empty cloud, and cloud() null.
+        std::shared_ptr<const Drawing> drawing;
+
+        const PointCloud* cloud() const { return drawing ? nullptr : std::get_if<PointCloud>(&entity); }
         const Mesh* mesh() const { return std::get_if<Mesh>(&entity); }
+        bool isDrawing() const { return drawing != nullptr; }
         //! The points of a cloud, or the vertices of a mesh.
         const PointCloud& points() const;
     };
 
     //! Takes ownership; returns the new id. A cloud's first scalar field becomes active.
     EntityId add(QString name, io::Entity entity, EntityId parent = kNoEntity, QString sourcePath = {});
+    //! Takes a drawing (polylines and labels, global coordinates); returns its id.
+    EntityId addDrawing(QString name, Drawing drawing, EntityId parent = kNoEntity, QString sourcePath = {});
     //! Removes the entity and its descendants.
     void remove(EntityId id);
     void clear();

@@ -12,6 +12,8 @@ constexpr int kFieldRole = Qt::UserRole + 1; //!< field name on field rows, empt
 
 QString describe(const Document::Item& item)
 {
+    if (item.isDrawing())
+        return QObject::tr("drawing, %1 polylines").arg(item.drawing->polylines.size());
     if (const Mesh* mesh = item.mesh())
         return QObject::tr("mesh, %1 triangles").arg(mesh->triangles.size());
     return QObject::tr("%1 points").arg(item.points().size());
@@ -55,7 +57,9 @@ void EntityTree::addRow(EntityId id)
     auto* row = new QTreeWidgetItem;
     row->setData(0, kEntityRole, id);
     row->setData(0, kFieldRole, QString());
-    row->setIcon(0, style()->standardIcon(item.mesh() ? QStyle::SP_FileDialogDetailedView : QStyle::SP_FileIcon));
+    row->setIcon(0, style()->standardIcon(item.isDrawing() ? QStyle::SP_FileDialogContentsView
+                                          : item.mesh()    ? QStyle::SP_FileDialogDetailedView
+                                                           : QStyle::SP_FileIcon));
     row->setFlags(row->flags() | Qt::ItemIsUserCheckable);
     row->setCheckState(0, item.display.visible ? Qt::Checked : Qt::Unchecked);
     updating_ = true;

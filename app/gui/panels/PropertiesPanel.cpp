@@ -6,6 +6,8 @@
 #include <QHeaderView>
 
 #include <cmath>
+#include <limits>
+#include <map>
 
 namespace scandiff::gui {
 
@@ -86,7 +88,35 @@ void PropertiesPanel::rebuild()
         row->setToolTip(1, value); // whole, when the column is narrower than a path or coordinates
         return row;
     };
-    if (const Document::Item* item = document_.find(entity_)) {
+    if (const Document::Item* item = document_.find(entity_); item && item->isDrawing()) {
+        add(nullptr, tr("Name"), item->name);
+        add(nullptr, tr("Type"), tr("Drawing"));
+        if (!item->sourcePath.isEmpty())
+            add(nullptr, tr("File"), item->sourcePath);
+        const Drawing& drawing = *item->drawing;
+        std::size_t closed = 0, vertices = 0;
+        std::map<std::string, std::size_t> layers;
+        Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), high = -low;
+        for (const DrawingPolyline& p : drawing.polylines) {
+            closed += p.closed;
+            vertices += p.points.size();
+            ++layers[p.layer];
+            for (const Eigen::Vector3d& v : p.points) {
+                low = low.cwiseMin(v);
+                high = high.cwiseMax(v);
+            }
+        }
+        add(nullptr, tr("Polylines"), tr("%1 (%2 closed), %3 vertices").arg(drawing.polylines.size()).arg(closed).arg(vertices));
+        add(nullptr, tr("Labels"), QString::number(drawing.texts.size()));
+        if (vertices > 0) {
+            add(nullptr, tr("Bounds min"), triple(low));
+            add(nullptr, tr("Bounds max"), triple(high));
+        }
+        QTreeWidgetItem* layerRows = add(nullptr, tr("Layers"), QString::number(layers.size()));
+        for (const auto& [name, count] : layers)
+            add(layerRows, QString::fromStdString(name), tr("%1 polylines").arg(count));
+        layerRows->setExpanded(layers.size() <= 20);
+    } else if (item) {
         const PointCloud& points = item->points();
         add(nullptr, tr("Name"), item->name);
         add(nullptr, tr("Type"), item->mesh() ? tr("Mesh") : tr("Point cloud"));

@@ -149,7 +149,8 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
 
 void ScalarFieldPanel::showEntity(EntityId id)
 {
-    entity_ = document_.contains(id) ? id : kNoEntity;
+    // A drawing has no scalar field: the panel waits for a cloud.
+    entity_ = document_.contains(id) && !document_.item(id).isDrawing() ? id : kNoEntity;
     refresh();
 }
 

@@ -2,11 +2,17 @@
 #include "view/ChunkGeometry.h"
 
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkFloatArray.h>
 #include <vtkNew.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkTypeInt32Array.h>
+#include <vtkUnsignedCharArray.h>
+
+#include <map>
+#include <string>
+#include <vector>
 
 namespace scandiff::gui {
 
@@ -64,6 +70,40 @@ void makeRasterGeometry(vtkPolyData& polyData, const PointCloud& cloud, std::siz
     }
     polyData.SetPoints(corners);
     polyData.SetPolys(quads);
+}
+
+vtkSmartPointer<vtkPolyData> drawingLines(const Drawing& drawing, const Eigen::Vector3d& origin)
+{
+    static const unsigned char palette[][3] = {{255, 60, 170}, {60, 210, 255}, {255, 225, 0}, {110, 255, 90}, {255, 140, 0}, {190, 120, 255}};
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    vtkNew<vtkCellArray> lines;
+    vtkNew<vtkUnsignedCharArray> colours;
+    colours->SetNumberOfComponents(3);
+    colours->SetName("layer colours");
+    std::map<std::string, std::size_t> layers;
+    std::vector<vtkIdType> ids;
+    for (const DrawingPolyline& polyline : drawing.polylines) {
+        if (polyline.points.size() < 2)
+            continue;
+        const std::size_t layer = layers.emplace(polyline.layer, layers.size()).first->second;
+        ids.clear();
+        for (const Eigen::Vector3d& v : polyline.points) {
+            const Eigen::Vector3d local = v - origin;
+            ids.push_back(points->InsertNextPoint(local.x(), local.y(), local.z()));
+        }
+        if (polyline.closed)
+            ids.push_back(ids.front());
+        lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+        colours->InsertNextTypedTuple(palette[layer % (sizeof palette / sizeof palette[0])]);
+    }
+    if (lines->GetNumberOfCells() == 0)
+        return nullptr;
+    auto polyData = vtkSmartPointer<vtkPolyData>::New();
+    polyData->SetPoints(points);
+    polyData->SetLines(lines);
+    polyData->GetCellData()->SetScalars(colours);
+    return polyData;
 }
 
 } // namespace scandiff::gui

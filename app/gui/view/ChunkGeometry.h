@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 //! The VTK geometry of the view's chunks: views on a cloud's positions, vertex
-//! cells, and a gridded cloud's cells as quads.
+//! cells, a gridded cloud's cells as quads, a drawing's polylines.
 
+#include <scandiff/core/Drawing.h>
 #include <scandiff/core/PointCloud.h>
 
 #include <vtkSmartPointer.h>
@@ -27,5 +28,11 @@ vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride)
 //! the ground plane at each cell's height: four corners per cell (float, about
 //! the cloud's origin like its points), and a quad per cell.
 void makeRasterGeometry(vtkPolyData& polyData, const PointCloud& cloud, std::size_t begin, std::size_t count, double cell);
+
+//! A drawing's polylines as lines about `origin` (double points: UTM
+//! coordinates keep their millimetres), each coloured by its layer (RGB cell
+//! scalars, a bright palette that stands out over clouds). Null when the
+//! drawing has no polyline of two points.
+vtkSmartPointer<vtkPolyData> drawingLines(const Drawing& drawing, const Eigen::Vector3d& origin);
 
 } // namespace scandiff::gui

@@ -259,6 +259,41 @@ CloudView::~CloudView() = default;
 
 void CloudView::addEntity(const Document::Item& item)
 {
+    if (item.isDrawing()) {
+        // Lines over the clouds, in the scene's frame (the first vertex sets
+        // it when the drawing comes first), coloured by layer, unlit.
+        const Drawing& drawing = *item.drawing;
+        const auto first = std::find_if(drawing.polylines.begin(), drawing.polylines.end(),
+                                        [](const DrawingPolyline& p) { return p.points.size() >= 2; });
+        if (first == drawing.polylines.end())
+            return;
+        if (!scene_->sceneOrigin)
+            scene_->sceneOrigin = first->points.front();
+        Shown& s = scene_->shown[item.id];
+        s.isCloud = false;
+        Shown::Chunk c;
+        c.full = drawingLines(drawing, *scene_->sceneOrigin);
+        c.fullMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+        c.fullMapper->SetInputData(c.full);
+        c.fullMapper->SetScalarModeToUseCellData();
+        c.fullMapper->SetColorModeToDirectScalars();
+        c.fullMapper->ScalarVisibilityOn();
+        // Lines lie on the scanned surface: drawn a little towards the eye so
+        // the points do not cover them.
+        c.fullMapper->SetResolveCoincidentTopologyToPolygonOffset();
+        c.fullMapper->SetRelativeCoincidentTopologyLineOffsetParameters(0.0, -2000.0);
+        c.actor = vtkSmartPointer<vtkActor>::New();
+        c.actor->SetMapper(c.fullMapper);
+        c.actor->GetProperty()->SetLineWidth(2.5f);
+        c.actor->GetProperty()->LightingOff();
+        c.actor->PickableOff(); // picks answer with a cloud's point, never a drawing's vertex
+        scene_->renderer->AddActor(c.actor);
+        s.chunks.push_back(c);
+        refreshEntity(item);
+        if (scene_->clipping)
+            applyClipping();
+        return;
+    }
     const PointCloud& points = item.points();
     if (points.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
         logWarning(item.name.toStdString() + ": more than 2^31 points cannot be shown (the data stays usable by the tools)");
