@@ -150,6 +150,13 @@ ParameterSpec ParameterSpec::withZeroMeaning(std::string meaning) const
     return s;
 }
 
+ParameterSpec ParameterSpec::asThresholdOf(std::string fieldParameter) const
+{
+    ParameterSpec s = *this;
+    s.thresholdOfField = std::move(fieldParameter);
+    return s;
+}
+
 ParameterSpec ParameterSpec::asAlternative(std::string group) const
 {
     ParameterSpec s = asOptional();

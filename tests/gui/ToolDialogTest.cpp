@@ -22,6 +22,8 @@
 #include <QSpinBox>
 #include <QtTest>
 
+#include <limits>
+
 #include <random>
 
 using namespace scandiff;
@@ -280,6 +282,38 @@ private slots:
         // The tools' dialogs do not offer it as an input.
         for (gui::EntityId e : gui::acceptedEntities(document, InputSpec{}))
             QVERIFY(!document.item(e).isDrawing());
+    }
+
+    void aThresholdStartsWhereTheHistogramsSliderWasDragged()
+    {
+        // The stones' threshold on "intensity": the upper bound the user
+        // dragged on the field's histogram (the low values shown), else the
+        // lower one; nothing dragged, nothing proposed (the tool's automatic one).
+        const PluginRegistry registry = makePluginRegistry();
+        gui::Document document;
+        PointCloud wall;
+        wall.resize(100);
+        ScalarField& intensity = wall.addField("intensity");
+        for (std::size_t i = 0; i < 100; ++i)
+            intensity.setValue(i, static_cast<double>(i));
+        const gui::EntityId id = document.add("wall", std::move(wall));
+        const ToolSpec& stones = *registry.tools.find("stones");
+        {
+            gui::ToolDialog dialog(stones, document, {{"input", {id}}});
+            QVERIFY(!dialog.values().count("threshold"));
+        }
+        gui::FieldDisplay display = document.fieldDisplay(id, "intensity");
+        display.high = 40.5;
+        document.setFieldDisplay(id, "intensity", display);
+        {
+            gui::ToolDialog dialog(stones, document, {{"input", {id}}});
+            QCOMPARE(QString::fromStdString(dialog.values().at("threshold")).toDouble(), 40.5);
+        }
+        display.high = std::numeric_limits<double>::infinity();
+        display.low = 60.25;
+        document.setFieldDisplay(id, "intensity", display);
+        gui::ToolDialog dialog(stones, document, {{"input", {id}}});
+        QCOMPARE(QString::fromStdString(dialog.values().at("threshold")).toDouble(), 60.25);
     }
 
     void alternativesAndRequiredParametersInTheForm()

@@ -171,6 +171,34 @@ ToolDialog::ToolDialog(const ToolSpec& tool, const Document& document, const Too
         fill();
         connect(entities, QOverload<int>::of(&QComboBox::currentIndexChanged), box, fill);
     }
+    proposeThresholds();
+}
+
+void ToolDialog::proposeThresholds()
+{
+    // A threshold on a field starts at the bound the user dragged on that
+    // field's histogram: the upper one when only it moved (the low values
+    // shown), else the lower one.
+    for (const ParameterSpec& p : tool_.parameters) {
+        if (p.thresholdOfField.empty())
+            continue;
+        const ParameterSpec* field = tool_.parameter(p.thresholdOfField);
+        auto* fieldBox = field ? qobject_cast<QComboBox*>(form_->editor(field->name)) : nullptr;
+        if (!fieldBox)
+            continue;
+        const EntityId id = chosenEntity(field->fieldOfInput);
+        const Document::Item* item = document_.find(id);
+        const std::string name = fieldBox->currentText().toStdString();
+        const ScalarField* values = item ? item->points().field(name) : nullptr;
+        if (!values)
+            continue;
+        const ValueRange range = values->range();
+        const FieldDisplay display = document_.fieldDisplay(id, name);
+        if (display.high < range.max)
+            form_->setValue(p.name, QString::number(display.high, 'g', 10));
+        else if (display.low > range.min)
+            form_->setValue(p.name, QString::number(display.low, 'g', 10));
+    }
 }
 
 std::map<std::string, std::string> ToolDialog::values() const { return form_->values(); }

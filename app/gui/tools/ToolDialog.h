@@ -61,6 +61,8 @@ signals:
     void pickModeRequested(bool on);
 
 private:
+    //! Thresholds on a field proposed from the field's display (see ParameterSpec::thresholdOfField).
+    void proposeThresholds();
     //! Runs the tool's preview on the current inputs and values, into the panel.
     void refreshPreview();
     EntityId chosenEntity(const std::string& role) const;

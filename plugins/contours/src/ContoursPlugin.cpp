@@ -266,9 +266,11 @@ ToolSpec stonesTool()
         ParameterSpec::text("field", "Intensity field", "The field classified into stone and joint", "intensity").asFieldOf("input"),
         ParameterSpec::choice("polarity", "Stones are", "dark: stones below the threshold; bright: above", {"dark", "bright"}, "dark"),
         ParameterSpec::real("threshold", "Threshold",
-                            "The intensity separating stone from joint; absent: the thesis's iterative inter-means threshold", 0.0,
-                            -1e30, 1e30)
-            .asOptional(),
+                            "The intensity separating stone from joint (the workbench proposes the bound dragged on the "
+                            "field's histogram); absent: the thesis's iterative inter-means threshold",
+                            0.0, -1e30, 1e30)
+            .asOptional()
+            .asThresholdOf("field"),
         ParameterSpec::choice("method", "Method",
                               "classify: every point by the threshold, isolated points removed; grow: regions grown on intensity "
                               "from stone seeds (thesis 003 §II.2), one per stone",

@@ -74,6 +74,11 @@ struct ParameterSpec
     //! Integer/Real: what 0 stands for ("automatic"); the GUI writes it in
     //! place of the number.
     std::string zeroMeans;
+    //! Real: a threshold on the field named by this other (Text, fieldOfInput)
+    //! parameter. The workbench proposes the bound the user dragged on that
+    //! field's histogram (its threshold range), so the value tuned live on
+    //! the view is the one the tool runs with.
+    std::string thresholdOfField;
 
     static ParameterSpec integer(std::string name, std::string label, std::string description, std::int64_t defaultValue,
                                  std::int64_t minimum, std::int64_t maximum, std::string unit = {});
@@ -99,6 +104,8 @@ struct ParameterSpec
     ParameterSpec onlyWith(std::string parameter) const;
     //! The same declaration, 0 standing for `meaning` (see `zeroMeans`).
     ParameterSpec withZeroMeaning(std::string meaning) const;
+    //! The same declaration, a threshold on the field `fieldParameter` names (see `thresholdOfField`).
+    ParameterSpec asThresholdOf(std::string fieldParameter) const;
 
     //! Parses user text ("12", "0.5", "true", "plane") into a valid value.
     //! Throws Error(InvalidArgument) naming the parameter and its valid range.
