@@ -71,6 +71,24 @@ Ring2d inWall(const std::vector<Eigen::Vector3d>& polyline, const test::WallFram
     return out;
 }
 
+//! The stones found against the true ones, in the fitted wall plane.
+struct StoneMatch
+{
+    std::vector<Polygon2d> model, truth;
+    PolygonMatching matching;
+};
+
+StoneMatch matchStones(const StoneWallResult& wall, const test::StoneWallScene& scene)
+{
+    StoneMatch out;
+    for (const Stone& stone : wall.stones)
+        out.model.push_back({stone.outline2d, {}});
+    for (const test::Outline& outline : scene.stones)
+        out.truth.push_back({inPlane(outline, scene.frame, wall.wall), {}});
+    out.matching = matchPolygons(out.model, out.truth);
+    return out;
+}
+
 } // namespace
 
 TEST(Outlines, ALatticeAboveItsCircumradiusIsOneSquare)
@@ -242,12 +260,7 @@ TEST(Stones, EveryStoneIsOneClosedPolygonWithin3cmOfItsTruth)
         EXPECT_LT(1.0 - static_cast<double>(truePositive) / detected, 0.01);
         EXPECT_NEAR(wall.threshold, -1150.0, 25.0);
         // Contour level: one polygon per stone, IoU >= 0.8, within 3 cm.
-        std::vector<Polygon2d> model, truth;
-        for (const Stone& stone : wall.stones)
-            model.push_back({stone.outline2d, {}});
-        for (const test::Outline& outline : scene.stones)
-            truth.push_back({inPlane(outline, scene.frame, wall.wall), {}});
-        const PolygonMatching matching = matchPolygons(model, truth);
+        const auto [model, truth, matching] = matchStones(wall, scene);
         EXPECT_EQ(wall.stones.size(), scene.stones.size()) << (bright ? "bright" : "dark");
         EXPECT_EQ(matching.correct, scene.stones.size());
         for (std::size_t m = 0; m < model.size(); ++m) {
@@ -267,15 +280,9 @@ TEST(Stones, RegionGrowingOnIntensityFindsTheSameStones)
     const test::StoneWallScene scene = test::makeStoneWall(test::StoneWallOptions{});
     StoneParams params;
     params.method = StoneMethod::Grow;
-    const StoneWallResult wall = extractStones(scene.cloud, params);
-    std::vector<Polygon2d> model, truth;
-    for (const Stone& stone : wall.stones)
-        model.push_back({stone.outline2d, {}});
-    for (const test::Outline& outline : scene.stones)
-        truth.push_back({inPlane(outline, scene.frame, wall.wall), {}});
-    const PolygonMatching matching = matchPolygons(model, truth);
-    EXPECT_EQ(matching.correct, scene.stones.size());
-    EXPECT_EQ(matching.falseRate, 0.0);
+    const StoneMatch found = matchStones(extractStones(scene.cloud, params), scene);
+    EXPECT_EQ(found.matching.correct, scene.stones.size());
+    EXPECT_EQ(found.matching.falseRate, 0.0);
 }
 
 TEST(Stones, BadInputIsAClearError)

@@ -8,6 +8,8 @@
 #include "StageWatcher.h"
 #include "TestSupport.h"
 
+#include <nlohmann/json.hpp>
+
 #include <gtest/gtest.h>
 
 #include <tbb/global_control.h>
@@ -311,4 +313,20 @@ TEST(Primitives, ThePlanesOutlinesAreADrawingOnALayerPerShape)
     // Curved shapes have no outline layer.
     for (const DrawingPolyline& p : drawing.polylines)
         EXPECT_EQ(p.layer.rfind("PLANE_", 0), 0u);
+
+    // The JSON document (DIR/primitives.json): every shape of the table, a
+    // plane as its unit normal and d with n.x + d = 0, in world coordinates.
+    const Table& table = result.table("table");
+    const auto json = nlohmann::json::parse(std::get<TextDocument>(result.find("document")->data).text);
+    ASSERT_EQ(json.at("primitives").size(), table.rows.size());
+    for (std::size_t k = 0; k < table.rows.size(); ++k) {
+        const auto& shape = json["primitives"][k];
+        EXPECT_EQ(shape.at("id").get<double>(), std::get<double>(table.rows[k][0]));
+        EXPECT_EQ(shape.at("type"), "plane");
+        EXPECT_EQ(shape.at("inliers").get<double>(), std::get<double>(table.rows[k][2]));
+        const Eigen::Vector3d n(shape["normal"][0], shape["normal"][1], shape["normal"][2]);
+        EXPECT_NEAR(n.norm(), 1.0, 1e-12);
+        const Eigen::Vector3d point(shape["point"][0], shape["point"][1], shape["point"][2]);
+        EXPECT_NEAR(n.dot(point) + shape.at("d").get<double>(), 0.0, 1e-9);
+    }
 }

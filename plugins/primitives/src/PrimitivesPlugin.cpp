@@ -7,6 +7,9 @@
 #include <scandiff/plugins/PluginRegistry.h>
 #include <scandiff/plugins/primitives/PrimitiveDetection.h>
 
+#include <nlohmann/json.hpp>
+
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -56,6 +59,58 @@ Table primitivesTable(const PrimitiveDetectionResult& result)
                           sphere ? nan : sigma("direction_deg"), position, radiusSigma, primitiveText(p)});
     }
     return t;
+}
+
+//! The shapes as the JSON document: {"primitives": [{"id", "type",
+//! "inliers", "rms", "area", then the type's parameters in world coordinates
+//! (plane: unit "normal" and "d" with n.x + d = 0; sphere: "center", "radius";
+//! cylinder: "axis_point", "axis_direction", "radius", "length"; cone: "apex",
+//! "axis_direction", "half_angle_deg"; torus: "center", "axis_direction",
+//! "major_radius", "minor_radius"), and "uncertainty" (standard uncertainties by name)}]}.
+std::string primitivesJson(const PrimitiveDetectionResult& result)
+{
+    auto triple = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
+    nlohmann::json list = nlohmann::json::array();
+    for (const DetectedPrimitive& s : result.primitives) {
+        const Primitive& p = s.primitive;
+        nlohmann::json shape = {{"id", s.id}, {"type", primitiveKindName(p.kind)}, {"inliers", s.inliers.size()}, {"rms", s.rms}, {"area", s.area}};
+        switch (p.kind) {
+        case PrimitiveKind::Plane:
+            shape["normal"] = triple(p.direction.normalized());
+            shape["d"] = -p.direction.normalized().dot(p.point);
+            shape["point"] = triple(p.point);
+            break;
+        case PrimitiveKind::Sphere:
+            shape["center"] = triple(p.point);
+            shape["radius"] = p.radius;
+            break;
+        case PrimitiveKind::Cylinder:
+            shape["axis_point"] = triple(p.point);
+            shape["axis_direction"] = triple(p.direction);
+            shape["radius"] = p.radius;
+            shape["length"] = s.length;
+            break;
+        case PrimitiveKind::Cone:
+            shape["apex"] = triple(p.point);
+            shape["axis_direction"] = triple(p.direction);
+            shape["half_angle_deg"] = p.halfAngle * kDegrees;
+            shape["length"] = s.length;
+            break;
+        case PrimitiveKind::Torus:
+            shape["center"] = triple(p.point);
+            shape["axis_direction"] = triple(p.direction);
+            shape["major_radius"] = p.radius;
+            shape["minor_radius"] = p.minorRadius;
+            break;
+        }
+        nlohmann::json uncertainty = nlohmann::json::object();
+        for (const auto& [name, value] : s.uncertainty)
+            if (std::isfinite(value))
+                uncertainty[name] = value;
+        shape["uncertainty"] = uncertainty;
+        list.push_back(shape);
+    }
+    return nlohmann::json({{"primitives", list}}).dump(1) + "\n";
 }
 
 //! Each plane's concave outline (and the outlines of its separate parts) in
@@ -151,10 +206,12 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
                             defaults.probability, 1e-6, 0.5),
         ParameterSpec::integer("seed", "Seed", "Random sampling seed (the same seed, the same shapes)", 0, 0, 4294967295LL),
     };
+    // With --out-dir: primitives.ply, TYPE_ID.ply, primitives.csv, primitives.dxf, primitives.json.
     tool.outputs = {OutputSpec{"primitives", "Cloud with primitive fields", DataKind::Cloud, true},
                     OutputSpec{"shape", "Shape", DataKind::Cloud, false, true},
-                    OutputSpec{"table", "Primitives", DataKind::Table, false},
-                    OutputSpec{"outlines", "Plane outlines", DataKind::Drawing, false}};
+                    OutputSpec{"table", "Primitives", DataKind::Table, false, false, "primitives"},
+                    OutputSpec{"outlines", "Plane outlines", DataKind::Drawing, false, false, "primitives"},
+                    OutputSpec{"document", "Primitives (JSON)", DataKind::Document, false, false, "primitives"}};
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
         const PointCloud& input = inputs.cloud();
         PrimitiveDetectionParams params;
@@ -195,6 +252,7 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
         }
         result.add("table", primitivesTable(detected));
         result.add("outlines", planeOutlines(input, detected, progress));
+        result.add("document", TextDocument{".json", primitivesJson(detected)});
         std::ostringstream summary;
         std::map<std::string, int> counts;
         std::size_t assigned = 0;
