@@ -8,6 +8,8 @@
 // contours), the worst Hausdorff distance of a found stone, and the time.
 //
 //   scandiff-stone-wall [--courses 16] [--stones 20] [--spacing 0.0044] [--sigma 40] [--write wall.ply] [--method classify|grow]
+//   scandiff-stone-wall --facade SPACING facade.ply       # the test façade and facade.ply.openings.dxf, for `contours`
+#include <scandiff/io/DxfWriter.h>
 #include <scandiff/io/FileIO.h>
 #include <scandiff/plugins/PluginRegistry.h>
 #include <scandiff/plugins/contours/PolygonMeasures.h>
@@ -44,6 +46,28 @@ int main(int argc, char** argv)
             write = value;
         else if (key == "--method")
             method = value;
+        else if (key == "--facade") {
+            // The test façade (three windows, a door, an arch) at this spacing, for timing `contours`.
+            if (i + 2 >= argc) {
+                std::fprintf(stderr, "--facade SPACING FILE\n");
+                return 2;
+            }
+            const test::FacadeScene facade = test::makeFacade(std::stod(value));
+            const PluginRegistry registry = makePluginRegistry();
+            io::writePointCloud(registry.formats, facade.cloud, argv[i + 2]);
+            // Its true openings as a reference drawing, for compare-polygons.
+            Drawing truth;
+            for (const test::Outline& opening : facade.openings) {
+                DrawingPolyline polyline{"OPENINGS", {}, true};
+                for (const Eigen::Vector2d& q : opening)
+                    polyline.points.push_back(facade.frame.world(q));
+                truth.polylines.push_back(std::move(polyline));
+            }
+            const std::string reference = std::string(argv[i + 2]) + ".openings.dxf";
+            io::writeDrawingDxf(truth, reference);
+            std::printf("wrote a façade of %zu points and its openings, %s\n", facade.cloud.size(), reference.c_str());
+            return 0;
+        }
         else {
             std::fprintf(stderr, "unknown option %s\n", key.c_str());
             return 2;
