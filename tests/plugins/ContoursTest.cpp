@@ -317,7 +317,7 @@ TEST(Contours, TheFacadeOpeningsAreFoundWithTheirCorners)
         std::vector<Ring2d> rings;
         for (const DrawingPolyline& polyline : drawing.polylines) {
             EXPECT_TRUE(polyline.closed);
-            EXPECT_EQ(polyline.layer, "PLANE_-001");
+            EXPECT_EQ(polyline.layer, "OUTLINE"); // the whole cloud: no segment field
             rings.push_back(inWall(polyline.points, scene.frame));
         }
         // The wall's outline (with the door's notch) and one ring per opening.

@@ -116,8 +116,12 @@ ToolSpec contoursTool()
         ParameterSpec::real("alpha", "Alpha", "alpha: the largest circumradius of the surface's triangles", 0.0, 0.0, 1e9, "m")
             .withZeroMeaning("automatic (knee of the sorted circumradii)")
             .onlyWith("method=alpha"),
-        ParameterSpec::text("segment-field", "Segment field", "The field holding each point's segment (-1: none)", "primitive_id")
-            .asFieldOf("input"),
+        // Free text rather than a list of the cloud's fields: a cloud without
+        // this field is one segment, never segmented by whatever field is shown.
+        ParameterSpec::text("segment-field", "Segment field",
+                            "The field holding each point's segment id (-1: none); a cloud without it is one segment",
+                            "primitive_id")
+            .withSuggestions({"primitive_id", "region_id", "stone_id"}),
         ParameterSpec::real("min-area", "Smallest area",
                             "Parts and holes smaller than this are dropped (missed points, occlusion specks)", 0.0, 0.0, 1e12, "m²")
             .withZeroMeaning("automatic (50 x the squared point spacing)"),
@@ -176,7 +180,7 @@ ToolSpec contoursTool()
             const bool vectorise = values.boolean("vectorise");
 
             nlohmann::json polygons = nlohmann::json::array();
-            const std::string layer = layerName("PLANE", segment.id);
+            const std::string layer = segment.id < 0 ? std::string("OUTLINE") : layerName("PLANE", segment.id);
             long partNumber = 0;
             for (const OutlinePart& part : parts.parts) {
                 if (part.area < minArea)
