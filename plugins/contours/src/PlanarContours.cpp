@@ -132,6 +132,75 @@ Ring2d coordinates(const std::vector<std::uint32_t>& ring, const std::vector<Eig
     return out;
 }
 
+//! The median distance of a point to its nearest neighbour, which is one of
+//! its Delaunay neighbours.
+double medianNearestDistance(const std::vector<Eigen::Vector2d>& points, const std::vector<Triangle>& triangles)
+{
+    std::vector<double> nearest(points.size(), std::numeric_limits<double>::infinity());
+    for (const Triangle& t : triangles)
+        for (int c = 0; c < 3; ++c) {
+            const double d = (points[t[c]] - points[t[(c + 1) % 3]]).norm();
+            nearest[t[c]] = std::min(nearest[t[c]], d);
+            nearest[t[(c + 1) % 3]] = std::min(nearest[t[(c + 1) % 3]], d);
+        }
+    nearest.erase(std::remove_if(nearest.begin(), nearest.end(), [](double d) { return !std::isfinite(d); }), nearest.end());
+    std::nth_element(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2), nearest.end());
+    return nearest.empty() ? 0.0 : nearest[nearest.size() / 2];
+}
+
+//! Each point joins the part with most of its kept triangles (partOfKept(k):
+//! the final part of kept triangle k, -1 when dropped); a duplicate joins its
+//! twin's part (the triangulation kept one of them).
+template <class PartOfKept>
+void assignPointsToParts(const std::vector<Eigen::Vector2d>& points, const std::vector<Triangle>& triangles,
+                         const std::vector<std::uint32_t>& kept, PartOfKept&& partOfKept, OutlineResult& result)
+{
+    std::vector<std::uint64_t> votes; // point << 32 | final part
+    votes.reserve(kept.size() * 3);
+    for (std::uint32_t k = 0; k < kept.size(); ++k) {
+        const std::int32_t part = partOfKept(k);
+        if (part >= 0)
+            for (std::uint32_t v : triangles[kept[k]])
+                votes.push_back(static_cast<std::uint64_t>(v) << 32 | static_cast<std::uint32_t>(part));
+    }
+    std::sort(votes.begin(), votes.end());
+    for (std::size_t i = 0; i < votes.size();) {
+        const std::uint32_t point = static_cast<std::uint32_t>(votes[i] >> 32);
+        std::size_t bestCount = 0;
+        std::int32_t bestPart = -1;
+        while (i < votes.size() && votes[i] >> 32 == point) {
+            std::size_t j = i;
+            while (j < votes.size() && votes[j] == votes[i])
+                ++j;
+            if (j - i > bestCount) {
+                bestCount = j - i;
+                bestPart = static_cast<std::int32_t>(votes[i] & 0xffffffffu);
+            }
+            i = j;
+        }
+        result.partOfPoint[point] = bestPart;
+        ++result.parts[static_cast<std::size_t>(bestPart)].pointCount;
+    }
+    std::vector<std::uint32_t> byPosition(points.size());
+    std::iota(byPosition.begin(), byPosition.end(), 0u);
+    auto less = [&](std::uint32_t a, std::uint32_t b) {
+        return points[a].x() != points[b].x() ? points[a].x() < points[b].x() : points[a].y() < points[b].y();
+    };
+    std::sort(byPosition.begin(), byPosition.end(), less);
+    for (std::size_t i = 0; i < byPosition.size();) {
+        std::size_t j = i + 1;
+        std::int32_t part = result.partOfPoint[byPosition[i]];
+        while (j < byPosition.size() && points[byPosition[j]] == points[byPosition[i]])
+            part = std::max(part, result.partOfPoint[byPosition[j++]]);
+        for (std::size_t k = i; k < j && j - i > 1; ++k)
+            if (result.partOfPoint[byPosition[k]] < 0 && part >= 0) {
+                result.partOfPoint[byPosition[k]] = part;
+                ++result.parts[static_cast<std::size_t>(part)].pointCount;
+            }
+        i = j;
+    }
+}
+
 } // namespace
 
 PlaneFrame fitPlaneFrame(const std::vector<Eigen::Vector3d>& points)
@@ -269,19 +338,7 @@ OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const 
         const std::int32_t a = params.labels[t[0]];
         return a < 0 || params.labels[t[1]] != a || params.labels[t[2]] != a;
     };
-    // The nearest neighbour of a point is one of its Delaunay neighbours.
-    {
-        std::vector<double> nearest(points.size(), std::numeric_limits<double>::infinity());
-        for (const Triangle& t : triangles)
-            for (int c = 0; c < 3; ++c) {
-                const double d = (points[t[c]] - points[t[(c + 1) % 3]]).norm();
-                nearest[t[c]] = std::min(nearest[t[c]], d);
-                nearest[t[(c + 1) % 3]] = std::min(nearest[t[(c + 1) % 3]], d);
-            }
-        nearest.erase(std::remove_if(nearest.begin(), nearest.end(), [](double d) { return !std::isfinite(d); }), nearest.end());
-        std::nth_element(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2), nearest.end());
-        result.spacing = nearest.empty() ? 0.0 : nearest[nearest.size() / 2];
-    }
+    result.spacing = medianNearestDistance(points, triangles);
     std::vector<double> measure(triangles.size());
     for (std::size_t t = 0; t < triangles.size(); ++t)
         measure[t] = mixed(triangles[t]) ? std::numeric_limits<double>::infinity()
@@ -389,52 +446,7 @@ OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const 
         result.parts.push_back(std::move(out));
     }
 
-    // Each point joins the part with most of its triangles.
-    std::vector<std::uint64_t> votes; // point << 32 | final part
-    votes.reserve(kept.size() * 3);
-    for (std::uint32_t k = 0; k < kept.size(); ++k) {
-        const std::int32_t part = finalIndex[partOfRoot[sets.find(k)]];
-        if (part >= 0)
-            for (std::uint32_t v : triangles[kept[k]])
-                votes.push_back(static_cast<std::uint64_t>(v) << 32 | static_cast<std::uint32_t>(part));
-    }
-    std::sort(votes.begin(), votes.end());
-    for (std::size_t i = 0; i < votes.size();) {
-        const std::uint32_t point = static_cast<std::uint32_t>(votes[i] >> 32);
-        std::size_t bestCount = 0;
-        std::int32_t bestPart = -1;
-        while (i < votes.size() && votes[i] >> 32 == point) {
-            std::size_t j = i;
-            while (j < votes.size() && votes[j] == votes[i])
-                ++j;
-            if (j - i > bestCount) {
-                bestCount = j - i;
-                bestPart = static_cast<std::int32_t>(votes[i] & 0xffffffffu);
-            }
-            i = j;
-        }
-        result.partOfPoint[point] = bestPart;
-        ++result.parts[static_cast<std::size_t>(bestPart)].pointCount;
-    }
-    // A duplicate shares its twin's part (the triangulation kept one of them).
-    std::vector<std::uint32_t> byPosition(points.size());
-    std::iota(byPosition.begin(), byPosition.end(), 0u);
-    auto less = [&](std::uint32_t a, std::uint32_t b) {
-        return points[a].x() != points[b].x() ? points[a].x() < points[b].x() : points[a].y() < points[b].y();
-    };
-    std::sort(byPosition.begin(), byPosition.end(), less);
-    for (std::size_t i = 0; i < byPosition.size();) {
-        std::size_t j = i + 1;
-        std::int32_t part = result.partOfPoint[byPosition[i]];
-        while (j < byPosition.size() && points[byPosition[j]] == points[byPosition[i]])
-            part = std::max(part, result.partOfPoint[byPosition[j++]]);
-        for (std::size_t k = i; k < j && j - i > 1; ++k)
-            if (result.partOfPoint[byPosition[k]] < 0 && part >= 0) {
-                result.partOfPoint[byPosition[k]] = part;
-                ++result.parts[static_cast<std::size_t>(part)].pointCount;
-            }
-        i = j;
-    }
+    assignPointsToParts(points, triangles, kept, [&](std::uint32_t k) { return finalIndex[partOfRoot[sets.find(k)]]; }, result);
     return result;
 }
 

@@ -122,6 +122,65 @@ std::vector<std::int32_t> growOnIntensity(const octree::Octree& tree, const std:
     return region;
 }
 
+//! The parts that are stones, in reading order (rows of
+//! the wall from the top, left to right): a part smaller than `minArea` is
+//! dropped, and so is one inside another's outline (a patch of missed points;
+//! a stone has no holes). `centre` gets each part's polygon centroid.
+std::vector<std::size_t> selectStones(const OutlineResult& parts, double minArea, StoneWallResult& result, std::vector<Eigen::Vector2d>& centre)
+{
+    struct Box
+    {
+        Eigen::Vector2d min, max;
+    };
+    std::vector<Box> boxes;
+    std::vector<std::size_t> accepted; // part indices, largest first
+    for (std::size_t p = 0; p < parts.parts.size(); ++p) {
+        const Ring2d& ring = parts.parts[p].outer;
+        if (ringArea(ring) < minArea) {
+            ++result.smallDropped;
+            continue;
+        }
+        Box box{ring.front(), ring.front()};
+        for (const Eigen::Vector2d& q : ring) {
+            box.min = box.min.cwiseMin(q);
+            box.max = box.max.cwiseMax(q);
+        }
+        bool nested = false;
+        for (std::size_t a = 0; a < accepted.size() && !nested; ++a) {
+            const Box& other = boxes[a];
+            if ((box.min.array() >= other.min.array()).all() && (box.max.array() <= other.max.array()).all())
+                nested = ringContains(parts.parts[accepted[a]].outer, 0.5 * (ring[0] + ring[ring.size() / 2]));
+        }
+        if (nested) {
+            ++result.nestedDropped;
+            continue;
+        }
+        accepted.push_back(p);
+        boxes.push_back(box);
+    }
+
+    // Stones numbered in reading order: by rows of the wall from the top, then left to right.
+    centre.assign(parts.parts.size(), Eigen::Vector2d::Zero());
+    for (std::size_t p : accepted) {
+        const Ring2d& ring = parts.parts[p].outer;
+        Eigen::Vector2d c = Eigen::Vector2d::Zero();
+        double twice = 0.0;
+        for (std::size_t i = 0; i < ring.size(); ++i) {
+            const Eigen::Vector2d a = ring[i] - ring[0], b = ring[(i + 1) % ring.size()] - ring[0];
+            const double cross = a.x() * b.y() - b.x() * a.y();
+            twice += cross;
+            c += cross * (a + b);
+        }
+        centre[p] = ring[0] + c / (3.0 * twice);
+    }
+    const double row = std::sqrt(minArea) * 2.0;
+    std::sort(accepted.begin(), accepted.end(), [&](std::size_t a, std::size_t b) {
+        const double ra = std::floor(-centre[a].y() / row), rb = std::floor(-centre[b].y() / row);
+        return ra != rb ? ra < rb : centre[a].x() < centre[b].x();
+    });
+    return accepted;
+}
+
 } // namespace
 
 InterMeansThreshold interMeansThreshold(const std::vector<float>& values, std::optional<double> initial)
@@ -278,60 +337,11 @@ StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params
     result.alpha = parts.threshold;
     ticker.checkCancel();
 
-    // 4. Small and nested contours dropped: a stone has no holes, and a
-    // contour inside another stone's is a patch of missed points.
+    // 4. Small and nested contours dropped, the others in reading order.
     const double minArea = params.minStoneArea > 0 ? params.minStoneArea : 100.0 * result.spacing * result.spacing;
-    struct Box
-    {
-        Eigen::Vector2d min, max;
-    };
-    std::vector<Box> boxes;
+    std::vector<Eigen::Vector2d> centre;
+    const std::vector<std::size_t> accepted = selectStones(parts, minArea, result, centre);
     std::vector<std::int32_t> stoneOfPart(parts.parts.size(), -1);
-    std::vector<std::size_t> accepted; // part indices, largest first
-    for (std::size_t p = 0; p < parts.parts.size(); ++p) {
-        const Ring2d& ring = parts.parts[p].outer;
-        if (ringArea(ring) < minArea) {
-            ++result.smallDropped;
-            continue;
-        }
-        Box box{ring.front(), ring.front()};
-        for (const Eigen::Vector2d& q : ring) {
-            box.min = box.min.cwiseMin(q);
-            box.max = box.max.cwiseMax(q);
-        }
-        bool nested = false;
-        for (std::size_t a = 0; a < accepted.size() && !nested; ++a) {
-            const Box& other = boxes[a];
-            if ((box.min.array() >= other.min.array()).all() && (box.max.array() <= other.max.array()).all())
-                nested = ringContains(parts.parts[accepted[a]].outer, 0.5 * (ring[0] + ring[ring.size() / 2]));
-        }
-        if (nested) {
-            ++result.nestedDropped;
-            continue;
-        }
-        accepted.push_back(p);
-        boxes.push_back(box);
-    }
-
-    // Stones numbered in reading order: by rows of the wall from the top, then left to right.
-    std::vector<Eigen::Vector2d> centre(parts.parts.size());
-    for (std::size_t p : accepted) {
-        const Ring2d& ring = parts.parts[p].outer;
-        Eigen::Vector2d c = Eigen::Vector2d::Zero();
-        double twice = 0.0;
-        for (std::size_t i = 0; i < ring.size(); ++i) {
-            const Eigen::Vector2d a = ring[i] - ring[0], b = ring[(i + 1) % ring.size()] - ring[0];
-            const double cross = a.x() * b.y() - b.x() * a.y();
-            twice += cross;
-            c += cross * (a + b);
-        }
-        centre[p] = ring[0] + c / (3.0 * twice);
-    }
-    const double row = std::sqrt(minArea) * 2.0;
-    std::sort(accepted.begin(), accepted.end(), [&](std::size_t a, std::size_t b) {
-        const double ra = std::floor(-centre[a].y() / row), rb = std::floor(-centre[b].y() / row);
-        return ra != rb ? ra < rb : centre[a].x() < centre[b].x();
-    });
     for (std::size_t p : accepted) {
         const OutlinePart& part = parts.parts[p];
         Stone stone;

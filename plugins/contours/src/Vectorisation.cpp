@@ -152,44 +152,40 @@ Eigen::Vector2d lineArcCorner(const Line& line, const Circle& circle, const Eige
     return (a - junction).norm() < (b - junction).norm() ? a : b;
 }
 
-} // namespace
+Eigen::Vector2d chord(const Piece& p) { return p.points.back() - p.points.front(); }
 
-const char* pieceKindName(PieceKind kind)
+//! The points of list[first, last) as one piece (shared end points once).
+Piece joined(const std::vector<Piece>& list, std::size_t first, std::size_t last)
 {
-    switch (kind) {
-    case PieceKind::Horizontal: return "horizontal";
-    case PieceKind::Vertical: return "vertical";
-    case PieceKind::Inclined: return "inclined";
-    case PieceKind::Arc: return "arc";
-    case PieceKind::Chain: return "chain";
-    }
-    return "";
+    Piece piece;
+    for (std::size_t j = first; j < last; ++j)
+        piece.points.insert(piece.points.end(), list[j].points.begin() + (j == first ? 0 : 1), list[j].points.end());
+    return piece;
 }
 
-VectorRing vectoriseRing(const Ring2d& ring, const VectoriseParams& params)
+double maxDeviation(const std::vector<Eigen::Vector2d>& points, const Line& line)
 {
-    if (!(params.tolerance > 0) || !(params.snapDegrees >= 0) || !(params.edgeOffset >= 0) || !(params.arcStepDegrees > 0))
-        throw Error(ErrorCode::InvalidArgument, "vectorisation: the tolerance and the arc step must be > 0, the snap angle and offset >= 0");
-    VectorRing out;
+    const Eigen::Vector2d normal(-line.direction.y(), line.direction.x());
+    double worst = 0.0;
+    for (const Eigen::Vector2d& q : points)
+        worst = std::max(worst, std::abs((q - line.point).dot(normal)));
+    return worst;
+}
+
+//! Step 1: the ring split where a point lies farthest from its chord, at half
+//! the tolerance (so that no piece straddles a corner), from the two points
+//! farthest apart; each piece with its total-least-squares line.
+std::vector<Piece> splitRing(const Ring2d& ring, double tolerance)
+{
     const std::size_t n = ring.size();
-    if (n < 4) {
-        out.vertices = ring;
-        out.pieces.push_back({PieceKind::Chain, ring.empty() ? Eigen::Vector2d::Zero() : ring.front(),
-                              ring.empty() ? Eigen::Vector2d::Zero() : ring.back()});
-        return out;
-    }
-    // 1. Split at the points farthest from their chords (at half the
-    // tolerance, so that no piece straddles a corner), starting from the two
-    // points farthest apart.
     std::size_t far = 0;
     for (std::size_t i = 1; i < n; ++i)
         if ((ring[i] - ring[0]).squaredNorm() > (ring[far] - ring[0]).squaredNorm())
             far = i;
     std::vector<std::size_t> breaks{0};
-    split(ring, 0, far, 0.5 * params.tolerance, breaks);
+    split(ring, 0, far, 0.5 * tolerance, breaks);
     breaks.push_back(far);
-    split(ring, far, n, 0.5 * params.tolerance, breaks);
-
+    split(ring, far, n, 0.5 * tolerance, breaks);
     std::vector<Piece> pieces;
     for (std::size_t k = 0; k < breaks.size(); ++k) {
         const std::size_t a = breaks[k], b = k + 1 < breaks.size() ? breaks[k + 1] : n; // n: back to the ring's start
@@ -199,99 +195,87 @@ VectorRing vectoriseRing(const Ring2d& ring, const VectoriseParams& params)
         piece.line = fitLine(piece.points);
         pieces.push_back(std::move(piece));
     }
+    return pieces;
+}
 
-    // 2. Arcs: runs of 3 or more pieces whose points fit one circle within a
-    // third of the tolerance, clearly better than one line, turning by 30
-    // degrees or more in all; each run grown while the circle holds.
-    auto chord = [](const Piece& p) { return p.points.back() - p.points.front(); };
-    auto joined = [](const std::vector<Piece>& list, std::size_t first, std::size_t last) {
-        Piece piece;
-        for (std::size_t j = first; j < last; ++j)
-            piece.points.insert(piece.points.end(), list[j].points.begin() + (j == first ? 0 : 1), list[j].points.end());
-        return piece;
-    };
-    auto arcOf = [&](std::size_t first, std::size_t last, Piece& arc) {
-        arc = joined(pieces, first, last);
-        arc.circle = fitCircle(arc.points);
-        arc.line = fitLine(arc.points);
-        const Eigen::Vector2d a = arc.points.front() - arc.circle.centre, b = arc.points.back() - arc.circle.centre;
-        const Eigen::Vector2d m = arc.points[arc.points.size() / 2] - arc.circle.centre;
-        const double swept = std::abs(turnAngle(a, m)) + std::abs(turnAngle(m, b));
-        if (!(arc.circle.rms <= params.tolerance / 3 && arc.circle.rms < 0.5 * arc.line.rms &&
-              arc.circle.radius < 10.0 * (arc.points.back() - arc.points.front()).norm() && swept >= 30 * kDegree))
-            return false;
-        // A corner rounded by the scan also fits a circle: it is two lines.
-        std::size_t split = 0;
-        double farthest = -1.0;
-        for (std::size_t i = 0; i < arc.points.size(); ++i) {
-            const double d = distanceToChord(arc.points[i], arc.points.front(), arc.points.back());
-            if (d > farthest) {
-                farthest = d;
-                split = i;
-            }
+//! Whether pieces[first, last) make one arc (into `arc`): their points fit a
+//! circle within a third of the tolerance, at least twice better than a line,
+//! sweeping 30 degrees or more, bulging from their chord by twice the
+//! tolerance at least, and not two lines (a corner the scan rounded).
+bool arcOf(const std::vector<Piece>& pieces, std::size_t first, std::size_t last, double tolerance, Piece& arc)
+{
+    arc = joined(pieces, first, last);
+    arc.circle = fitCircle(arc.points);
+    arc.line = fitLine(arc.points);
+    const Eigen::Vector2d a = arc.points.front() - arc.circle.centre, b = arc.points.back() - arc.circle.centre;
+    const Eigen::Vector2d m = arc.points[arc.points.size() / 2] - arc.circle.centre;
+    const double swept = std::abs(turnAngle(a, m)) + std::abs(turnAngle(m, b));
+    if (!(arc.circle.rms <= tolerance / 3 && arc.circle.rms < 0.5 * arc.line.rms &&
+          arc.circle.radius < 10.0 * (arc.points.back() - arc.points.front()).norm() && swept >= 30 * kDegree))
+        return false;
+    std::size_t splitAt = 0;
+    double farthest = -1.0;
+    for (std::size_t i = 0; i < arc.points.size(); ++i) {
+        const double d = distanceToChord(arc.points[i], arc.points.front(), arc.points.back());
+        if (d > farthest) {
+            farthest = d;
+            splitAt = i;
         }
-        // An arc bulges from its chord by twice the tolerance at least: a
-        // flatter one is a line within the tolerance, or a zigzag with a corner.
-        if (farthest < 2.0 * params.tolerance)
-            return false;
-        if (split < 2 || split + 2 >= arc.points.size())
-            return true;
-        auto deviation = [](const std::vector<Eigen::Vector2d>& p) {
-            const Line line = fitLine(p);
-            const Eigen::Vector2d normal(-line.direction.y(), line.direction.x());
-            double worst = 0.0;
-            for (const Eigen::Vector2d& q : p)
-                worst = std::max(worst, std::abs((q - line.point).dot(normal)));
-            return worst;
-        };
-        const std::vector<Eigen::Vector2d> head(arc.points.begin(), arc.points.begin() + static_cast<std::ptrdiff_t>(split + 1));
-        const std::vector<Eigen::Vector2d> tail(arc.points.begin() + static_cast<std::ptrdiff_t>(split), arc.points.end());
-        return !(deviation(head) <= params.tolerance && deviation(tail) <= params.tolerance);
-    };
-    std::vector<Piece> withArcs;
+    }
+    if (farthest < 2.0 * tolerance)
+        return false; // a line within the tolerance, or a zigzag with a corner
+    if (splitAt < 2 || splitAt + 2 >= arc.points.size())
+        return true;
+    const std::vector<Eigen::Vector2d> head(arc.points.begin(), arc.points.begin() + static_cast<std::ptrdiff_t>(splitAt + 1));
+    const std::vector<Eigen::Vector2d> tail(arc.points.begin() + static_cast<std::ptrdiff_t>(splitAt), arc.points.end());
+    return !(maxDeviation(head, fitLine(head)) <= tolerance && maxDeviation(tail, fitLine(tail)) <= tolerance);
+}
+
+//! Step 2: runs of pieces that make an arc replaced by it, each run grown
+//! while the circle holds (a zigzag or two inside it allowed).
+std::vector<Piece> findArcs(std::vector<Piece> pieces, double tolerance)
+{
+    std::vector<Piece> out;
     for (std::size_t k = 0; k < pieces.size();) {
         Piece best, candidate;
         std::size_t bestLast = 0;
         int failures = 0;
         for (std::size_t last = k + 3; last <= pieces.size() && failures < 3; ++last) {
-            if (arcOf(k, last, candidate)) {
+            if (arcOf(pieces, k, last, tolerance, candidate)) {
                 best = std::move(candidate);
                 bestLast = last;
                 failures = 0;
             } else if (bestLast) {
-                ++failures; // a run may hold a zigzag or two; beyond three, the arc has ended
+                ++failures;
             } else if (last - k >= 8) {
                 break;
             }
         }
         if (bestLast) {
             best.kind = PieceKind::Arc;
-            withArcs.push_back(std::move(best));
+            out.push_back(std::move(best));
             k = bestLast;
         } else {
-            withArcs.push_back(std::move(pieces[k++]));
+            out.push_back(std::move(pieces[k++]));
         }
     }
+    return out;
+}
 
-    // Neighbouring straight pieces merged while one line holds all their
-    // points within the tolerance: the split above cut each side into many
-    // short pieces (a sampled edge zigzags), and a corner never passes.
-    std::vector<Piece> merged;
-    auto maxDeviation = [](const Piece& p) {
-        const Eigen::Vector2d normal(-p.line.direction.y(), p.line.direction.x());
-        double worst = 0.0;
-        for (const Eigen::Vector2d& q : p.points)
-            worst = std::max(worst, std::abs((q - p.line.point).dot(normal)));
-        return worst;
-    };
+//! Step 3: neighbouring straight pieces merged while one line holds all their
+//! points within the tolerance (a sampled edge zigzags, so step 1 cut each
+//! side into many short pieces; a corner never passes).
+std::vector<Piece> mergeStraight(std::vector<Piece> pieces, double tolerance)
+{
     auto tryMerge = [&](const Piece& a, const Piece& b, Piece& out) {
         if (a.kind == PieceKind::Arc || b.kind == PieceKind::Arc)
             return false;
         out = joined(std::vector<Piece>{a, b}, 0, 2);
         out.line = fitLine(out.points);
-        return maxDeviation(out) <= params.tolerance;
+        return maxDeviation(out.points, out.line) <= tolerance;
     };
-    for (Piece& piece : withArcs) {
+    std::vector<Piece> merged;
+    for (Piece& piece : pieces) {
         Piece combined;
         if (!merged.empty() && tryMerge(merged.back(), piece, combined))
             merged.back() = std::move(combined);
@@ -303,10 +287,15 @@ VectorRing vectoriseRing(const Ring2d& ring, const VectoriseParams& params)
         merged.front() = std::move(combined);
         merged.pop_back();
     }
+    return merged;
+}
 
-    // 3. Straight pieces classified, snapped and moved out; short ones between
-    // two others are dropped (the corner rounded by the scan), the corner
-    // coming from their neighbours.
+//! Step 4: straight pieces classified, snapped and moved away from the
+//! surface (arcs' radii likewise); short ones dropped, and short inclined
+//! ones between a horizontal and a vertical one (corners the scan rounded):
+//! the corner then comes from their neighbours.
+std::vector<Piece> classifyPieces(std::vector<Piece> merged, const VectoriseParams& params)
+{
     const double minLine = 3.0 * params.tolerance;
     std::vector<Piece> kept;
     for (Piece& piece : merged) {
@@ -318,7 +307,7 @@ VectorRing vectoriseRing(const Ring2d& ring, const VectoriseParams& params)
             kept.push_back(std::move(piece));
             continue;
         }
-        if ((piece.points.back() - piece.points.front()).norm() < minLine && merged.size() > 3)
+        if (chord(piece).norm() < minLine && merged.size() > 3)
             continue;
         Line& line = piece.line;
         const double angle = std::atan2(line.direction.y(), line.direction.x());
@@ -337,26 +326,25 @@ VectorRing vectoriseRing(const Ring2d& ring, const VectoriseParams& params)
         line.point += params.edgeOffset * Eigen::Vector2d(line.direction.y(), -line.direction.x());
         kept.push_back(std::move(piece));
     }
-    // An inclined piece between a horizontal and a vertical one, short
-    // beside them, is a corner the scan rounded: the corner comes from them.
+    auto snapped = [](const Piece& p) { return p.kind == PieceKind::Horizontal || p.kind == PieceKind::Vertical; };
     for (std::size_t k = 0; k < kept.size() && kept.size() > 3;) {
         const Piece& before = kept[(k + kept.size() - 1) % kept.size()];
         const Piece& after = kept[(k + 1) % kept.size()];
-        auto snapped = [](const Piece& p) { return p.kind == PieceKind::Horizontal || p.kind == PieceKind::Vertical; };
-        const double length = (kept[k].points.back() - kept[k].points.front()).norm();
-        const double shorter = std::min((before.points.back() - before.points.front()).norm(), (after.points.back() - after.points.front()).norm());
-        if (kept[k].kind == PieceKind::Inclined && snapped(before) && snapped(after) && before.kind != after.kind && length < 0.2 * shorter)
+        const double shorter = std::min(chord(before).norm(), chord(after).norm());
+        if (kept[k].kind == PieceKind::Inclined && snapped(before) && snapped(after) && before.kind != after.kind &&
+            chord(kept[k]).norm() < 0.2 * shorter)
             kept.erase(kept.begin() + static_cast<std::ptrdiff_t>(k));
         else
             ++k;
     }
-    if (kept.size() < 3) {
-        out.vertices = ring;
-        out.pieces.push_back({PieceKind::Chain, ring.front(), ring.back()});
-        return out;
-    }
+    return kept;
+}
 
-    // 4. Corners between neighbours, then the outline.
+//! Step 5: the corners (intersections of neighbouring pieces) and the
+//! outline, arcs as polylines every arcStepDegrees.
+VectorRing assemble(const std::vector<Piece>& kept, const VectoriseParams& params)
+{
+    VectorRing out;
     const std::size_t m = kept.size();
     std::vector<Eigen::Vector2d> corner(m); // corner[k]: where piece k - 1 ends and piece k starts
     for (std::size_t k = 0; k < m; ++k) {
@@ -401,6 +389,37 @@ VectorRing vectoriseRing(const Ring2d& ring, const VectoriseParams& params)
         out.pieces.push_back(vp);
     }
     return out;
+}
+
+} // namespace
+
+const char* pieceKindName(PieceKind kind)
+{
+    switch (kind) {
+    case PieceKind::Horizontal: return "horizontal";
+    case PieceKind::Vertical: return "vertical";
+    case PieceKind::Inclined: return "inclined";
+    case PieceKind::Arc: return "arc";
+    case PieceKind::Chain: return "chain";
+    }
+    return "";
+}
+
+VectorRing vectoriseRing(const Ring2d& ring, const VectoriseParams& params)
+{
+    if (!(params.tolerance > 0) || !(params.snapDegrees >= 0) || !(params.edgeOffset >= 0) || !(params.arcStepDegrees > 0))
+        throw Error(ErrorCode::InvalidArgument, "vectorisation: the tolerance and the arc step must be > 0, the snap angle and offset >= 0");
+    const std::vector<Piece> kept =
+        ring.size() < 4 ? std::vector<Piece>{}
+                        : classifyPieces(mergeStraight(findArcs(splitRing(ring, params.tolerance), params.tolerance), params.tolerance), params);
+    if (kept.size() < 3) { // too small to split: the ring as it is
+        VectorRing out;
+        out.vertices = ring;
+        out.pieces.push_back({PieceKind::Chain, ring.empty() ? Eigen::Vector2d::Zero() : ring.front(),
+                              ring.empty() ? Eigen::Vector2d::Zero() : ring.back()});
+        return out;
+    }
+    return assemble(kept, params);
 }
 
 } // namespace scandiff::plugins
