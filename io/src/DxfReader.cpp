@@ -21,6 +21,7 @@
 #include <scandiff/core/Log.h>
 #include <scandiff/core/Progress.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -427,7 +428,7 @@ Drawing readDrawingDxf(const std::filesystem::path& path, ProgressObserver* prog
     ProgressTicker ticker(progress, "Reading " + path.filename().string(), file.size() + 1);
     Groups groups(path, checkedText(file, path));
     Drawing drawing;
-    std::size_t bulges = 0;
+    std::size_t arcs = 0;
     auto layerOf = [](const detail::Entity& e) {
         const Group* g = e.find(8);
         return g ? std::string(g->value) : std::string("0");
@@ -441,20 +442,26 @@ Drawing readDrawingDxf(const std::filesystem::path& path, ProgressObserver* prog
                 const double elevation = number(groups, e, 38, 0.0);
                 DrawingPolyline polyline{layerOf(e), {}, (integer(groups, e, 70, 0) & 1) != 0};
                 std::vector<Eigen::Vector2d> xy;
+                std::vector<double> bulge; // one per vertex: its 42 follows its 10/20
                 for (const Group& g : e.groups) {
-                    if (g.code == 10 || g.code == 20) {
+                    if (g.code == 10 || g.code == 20 || g.code == 42) {
                         detail::Entity one{e.type, g.line, {g}};
                         const double v = number(groups, one, g.code, 0.0);
-                        if (g.code == 10)
+                        if (g.code == 10) {
                             xy.emplace_back(v, 0.0);
-                        else if (!xy.empty())
-                            xy.back().y() = v;
-                    } else if (g.code == 42) {
-                        ++bulges;
+                            bulge.push_back(0.0);
+                        } else if (!xy.empty()) {
+                            (g.code == 20 ? xy.back().y() : bulge.back()) = v;
+                        }
                     }
                 }
                 for (const Eigen::Vector2d& q : xy)
                     polyline.points.push_back(axes * Eigen::Vector3d(q.x(), q.y(), elevation));
+                if (std::any_of(bulge.begin(), bulge.end(), [](double b) { return b != 0.0; })) {
+                    polyline.bulges = std::move(bulge);
+                    polyline.normal = axes.col(2);
+                    ++arcs;
+                }
                 if (polyline.points.size() >= 2)
                     drawing.polylines.push_back(std::move(polyline));
             } else if (e.type == "LINE") {
@@ -472,18 +479,24 @@ Drawing readDrawingDxf(const std::filesystem::path& path, ProgressObserver* prog
             const Eigen::Matrix3d axes = is3d ? Eigen::Matrix3d::Identity() : objectAxes(groups, polyline);
             const double elevation = number(groups, polyline, 30, 0.0);
             DrawingPolyline out{layerOf(polyline), {}, (flags & 1) != 0};
+            std::vector<double> bulge;
             for (const detail::Entity& v : vertices) {
                 Eigen::Vector3d p = point(groups, v, 10);
                 if (!is3d)
                     p = axes * Eigen::Vector3d(p.x(), p.y(), elevation);
-                bulges += v.find(42) && number(groups, v, 42, 0.0) != 0.0;
+                bulge.push_back(is3d ? 0.0 : number(groups, v, 42, 0.0)); // a 3D polyline has no arcs
                 out.points.push_back(p);
+            }
+            if (std::any_of(bulge.begin(), bulge.end(), [](double b) { return b != 0.0; })) {
+                out.bulges = std::move(bulge);
+                out.normal = axes.col(2);
+                ++arcs;
             }
             if (out.points.size() >= 2)
                 drawing.polylines.push_back(std::move(out));
         });
-    if (bulges > 0)
-        logWarning(path.string() + ": " + std::to_string(bulges) + " arc segments (bulges) were read as straight chords");
+    if (arcs > 0)
+        logInfo(path.string() + ": " + std::to_string(arcs) + " polylines with arcs (bulges)");
     return drawing;
 }
 

@@ -35,7 +35,7 @@ namespace fs = std::filesystem;
 
 struct DxfDrawing::Entity
 {
-    enum class Kind : unsigned char { Point, Polyline, Face, Text };
+    enum class Kind : unsigned char { Point, Polyline, ArcPolyline, Face, Text };
     Kind kind = Kind::Point;
     bool closed = false;
     bool planar = false;
@@ -44,6 +44,8 @@ struct DxfDrawing::Entity
     std::size_t vertexCount = 0;
     double height = 0.0;
     std::string text;
+    std::vector<double> bulges;                         // ArcPolyline: one per vertex
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitZ(); // ArcPolyline: its extrusion direction
 };
 
 namespace {
@@ -173,6 +175,17 @@ public:
         // turns -0 into 0.
         char text[400];
         const auto result = std::to_chars(text, text + sizeof text, value + 0.0, std::chars_format::fixed, 6);
+        buffer_.append(text, result.ptr);
+        buffer_ += '\n';
+        flushIfFull();
+    }
+    // The shortest text that reads back to the same double: for a bulge,
+    // whose six decimals would move an arc's end by 1e-7 of its chord.
+    void exact(int code, double value)
+    {
+        writeCode(code);
+        char text[64];
+        const auto result = std::to_chars(text, text + sizeof text, value + 0.0);
         buffer_.append(text, result.ptr);
         buffer_ += '\n';
         flushIfFull();
@@ -326,6 +339,34 @@ void writePolyline(DxfOutput& out, const std::string& layer, const Eigen::Vector
     out.group(8, layer);
 }
 
+// An R12 2D POLYLINE in its object coordinate system (extrusion 210/220/230,
+// elevation in the POLYLINE's z), each VERTEX with its bulge (42): how DXF
+// draws arcs. `vertices` are object coordinates at that elevation.
+void writeArcPolyline(DxfOutput& out, const std::string& layer, const Eigen::Vector3d* vertices, std::size_t count,
+                      const std::vector<double>& bulges, const Eigen::Vector3d& normal, bool closed)
+{
+    out.group(0, "POLYLINE");
+    out.group(8, layer);
+    out.group(66, 1);
+    out.point(10, Eigen::Vector3d(0.0, 0.0, vertices[0].z()));
+    out.group(70, closed ? 1 : 0);
+    // In full: at UTM magnitudes a direction rounded to 6 decimals turns the
+    // object axes enough to move the vertices by metres.
+    out.exact(210, normal.x());
+    out.exact(220, normal.y());
+    out.exact(230, normal.z());
+    for (std::size_t i = 0; i < count; ++i) {
+        out.group(0, "VERTEX");
+        out.group(8, layer);
+        out.point(10, vertices[i]);
+        if (bulges[i] != 0.0)
+            out.exact(42, bulges[i]);
+        out.group(70, 0);
+    }
+    out.group(0, "SEQEND");
+    out.group(8, layer);
+}
+
 void writeText(DxfOutput& out, const std::string& layer, const Eigen::Vector3d& position, double height,
                const std::string& text)
 {
@@ -422,6 +463,45 @@ void DxfDrawing::addPolyline(const std::string& layer, const std::vector<Eigen::
     entities_.push_back(std::move(e));
 }
 
+void DxfDrawing::addArcPolyline(const std::string& layer, const std::vector<Eigen::Vector3d>& vertices, const std::vector<double>& bulges,
+                                const Eigen::Vector3d& normal, bool closed)
+{
+    if (vertices.size() < 2 || bulges.size() != vertices.size())
+        invalidArgument("an arc polyline needs at least 2 vertices and one bulge per vertex");
+    if (!(normal.norm() > 0) || !normal.allFinite())
+        invalidArgument("an arc polyline needs the normal of its plane");
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        requireFinite(vertices[i], "polyline vertex");
+        if (!std::isfinite(bulges[i]))
+            invalidArgument("a bulge is not finite");
+    }
+    // The object coordinate system of DXF's arbitrary axis algorithm (DXF
+    // Reference, "Arbitrary Axis Algorithm"): what a reader rebuilds from 210/220/230.
+    const Eigen::Vector3d n = normal.normalized();
+    const Eigen::Vector3d ax =
+        ((std::abs(n.x()) < 1.0 / 64 && std::abs(n.y()) < 1.0 / 64) ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ()).cross(n).normalized();
+    const Eigen::Vector3d ay = n.cross(ax).normalized();
+    std::vector<Eigen::Vector3d> local;
+    local.reserve(vertices.size());
+    for (const Eigen::Vector3d& v : vertices)
+        local.emplace_back(v.dot(ax), v.dot(ay), v.dot(n));
+    const double elevation = local.front().z();
+    for (const Eigen::Vector3d& q : local)
+        if (std::abs(q.z() - elevation) > 1e-6 + 1e-12 * std::abs(elevation))
+            invalidArgument("an arc polyline's vertices are not in one plane normal to its extrusion direction");
+    for (Eigen::Vector3d& q : local)
+        q.z() = elevation;
+    Entity e;
+    e.kind = Entity::Kind::ArcPolyline;
+    e.closed = closed;
+    e.layer = layerIndex(layer);
+    e.firstVertex = addVertices(local.data(), local.size());
+    e.vertexCount = local.size();
+    e.bulges = bulges;
+    e.normal = n;
+    entities_.push_back(std::move(e));
+}
+
 void DxfDrawing::add3dFace(const std::string& layer, const std::array<Eigen::Vector3d, 3>& corners)
 {
     for (const auto& c : corners)
@@ -476,6 +556,7 @@ void DxfDrawing::write(const fs::path& path) const
         switch (e.kind) {
         case Entity::Kind::Point: writePoint(out, layer, v[0]); break;
         case Entity::Kind::Polyline: writePolyline(out, layer, v, e.vertexCount, e.closed, e.planar); break;
+        case Entity::Kind::ArcPolyline: writeArcPolyline(out, layer, v, e.vertexCount, e.bulges, e.normal, e.closed); break;
         case Entity::Kind::Face: writeFace(out, layer, v[0], v[1], v[2]); break;
         case Entity::Kind::Text: writeText(out, layer, v[0], e.height, e.text); break;
         }
@@ -584,6 +665,18 @@ void writeDrawingDxf(const Drawing& drawing, const std::filesystem::path& path)
         if (line.points.size() < 2)
             continue;
         declare(line.layer);
+        const bool arcs = line.bulges.size() == line.points.size() &&
+                          std::any_of(line.bulges.begin(), line.bulges.end(), [](double b) { return b != 0.0; });
+        if (arcs) {
+            try {
+                dxf.addArcPolyline(line.layer, line.points, line.bulges, line.normal, line.closed);
+                continue;
+            } catch (const Error&) {
+                // Not planar (or no normal): its arcs as points along them, in 3D.
+            }
+            dxf.addPolyline(line.layer, polylineVertices(line), line.closed);
+            continue;
+        }
         dxf.addPolyline(line.layer, line.points, line.closed);
     }
     for (const DrawingText& text : drawing.texts) {

@@ -216,8 +216,18 @@ TEST(DxfDrawingReader, LinesOfEveryKindInWorldCoordinates)
     ASSERT_EQ(vertical.points.size(), 4u);
     for (std::size_t i = 0; i < 4; ++i)
         EXPECT_LT((vertical.points[i] - expected[i]).norm(), 1e-12) << i;
-    EXPECT_FALSE(byLayer.at("ARC")->closed);
-    EXPECT_TRUE(log.has("bulges")); // the half circle, read as its chord
+    // The half circle (bulge 1, counter-clockwise from (0,0) to (2,0) seen
+    // from +z) passes through (1,-1).
+    const DrawingPolyline& arc = *byLayer.at("ARC");
+    EXPECT_FALSE(arc.closed);
+    ASSERT_EQ(arc.bulges.size(), 2u);
+    EXPECT_EQ(arc.bulges[0], 1.0);
+    EXPECT_EQ(arc.normal, Eigen::Vector3d::UnitZ());
+    const std::vector<Eigen::Vector3d> along = polylineVertices(arc, 2.0);
+    EXPECT_EQ(along.size(), 2u + 89u); // 90 steps of 2 degrees
+    for (const Eigen::Vector3d& p : along)
+        EXPECT_NEAR((p - Eigen::Vector3d(1, 0, 0)).norm(), 1.0, 1e-12);
+    EXPECT_LT((along[45] - Eigen::Vector3d(1, -1, 0)).norm(), 1e-12);
     EXPECT_EQ(byLayer.at("P3D")->points[2], Eigen::Vector3d(1, 1, 2));
     EXPECT_TRUE(byLayer.at("P3D")->closed);
     EXPECT_EQ(byLayer.at("P2D")->points[1], Eigen::Vector3d(1, 0, 7));
@@ -239,6 +249,34 @@ TEST(DxfDrawingReader, WhatOurWriterWritesReadsBack)
     EXPECT_EQ(back.polylines[0].points, drawing.polylines[0].points); // 6 decimals hold these exactly
     EXPECT_TRUE(back.polylines[0].closed);
     EXPECT_FALSE(back.polylines[1].closed);
+    // Arcs: a closed quarter-disc on a vertical plane turned 30 degrees at
+    // UTM coordinates (a normal that 6 decimals would turn), written as a 2D
+    // polyline with a bulge in its object coordinate system, read back with
+    // the same vertices, bulges and plane, its arc on its circle.
+    Drawing arcs;
+    const Eigen::Vector3d o(512000.25, 5423000.5, 101.0), u(std::cos(0.5235987755982988), std::sin(0.5235987755982988), 0.0),
+        up = Eigen::Vector3d::UnitZ();
+    DrawingPolyline quarter{"ARCS", {o, o + 2.0 * u, o + 2.0 * up}, true};
+    quarter.normal = u.cross(up);
+    quarter.bulges = {0.0, std::tan(3.14159265358979323846 / 8), 0.0}; // 90 degrees, counter-clockwise
+    arcs.polylines.push_back(quarter);
+    const auto arcFile = file.parent_path() / "arcs.dxf";
+    io::writeDrawingDxf(arcs, arcFile);
+    const Drawing arcsBack = io::readDrawingDxf(arcFile);
+    ASSERT_EQ(arcsBack.polylines.size(), 1u);
+    const DrawingPolyline& q = arcsBack.polylines[0];
+    ASSERT_EQ(q.points.size(), 3u);
+    for (std::size_t i = 0; i < 3; ++i)
+        EXPECT_LT((q.points[i] - quarter.points[i]).norm(), 2e-6) << i; // 6 decimals in the object system
+    ASSERT_EQ(q.bulges.size(), 3u);
+    EXPECT_EQ(q.bulges[1], quarter.bulges[1]); // written in full
+    EXPECT_LT((q.normal - quarter.normal).norm(), 1e-12);
+    const std::vector<Eigen::Vector3d> along = polylineVertices(q);
+    ASSERT_EQ(along.size(), 3u + 44u); // 45 steps of 2 degrees
+    for (std::size_t i = 1; i < along.size() - 1; ++i) {
+        EXPECT_LT(std::abs((along[i] - o).dot(quarter.normal)), 2e-6) << i; // in its plane
+        EXPECT_NEAR((along[i] - o).norm(), 2.0, 2e-6) << i;                // on its circle about o
+    }
     // Damaged: a vertex coordinate that is not a number names its line.
     const auto bad = file.parent_path() / "bad.dxf";
     std::ofstream(bad) << "0\nSECTION\n2\nENTITIES\n0\nLWPOLYLINE\n8\nA\n90\n2\n10\n1.0\n20\nabc\n0\nENDSEC\n0\nEOF\n";

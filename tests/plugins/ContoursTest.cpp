@@ -318,7 +318,7 @@ TEST(Contours, TheFacadeOpeningsAreFoundWithTheirCorners)
         for (const DrawingPolyline& polyline : drawing.polylines) {
             EXPECT_TRUE(polyline.closed);
             EXPECT_EQ(polyline.layer, "OUTLINE"); // the whole cloud: no segment field
-            rings.push_back(inWall(polyline.points, scene.frame));
+            rings.push_back(inWall(polylineVertices(polyline), scene.frame)); // the arch: points along its arc
         }
         // The wall's outline (with the door's notch) and one ring per opening.
         ASSERT_EQ(rings.size(), 1 + scene.openings.size()) << "vectorise " << vectorise;
@@ -354,6 +354,11 @@ TEST(Contours, TheFacadeOpeningsAreFoundWithTheirCorners)
                         EXPECT_NEAR(piece["radius"].get<double>(), 0.5, 0.02);
                     }
             EXPECT_EQ(arcs, 1u);
+            // The drawing holds the arch's arc as a bulge in the façade's plane.
+            std::size_t bulged = 0;
+            for (const DrawingPolyline& polyline : drawing.polylines)
+                bulged += std::count_if(polyline.bulges.begin(), polyline.bulges.end(), [](double b) { return b != 0.0; });
+            EXPECT_EQ(bulged, 1u);
         }
     }
 }

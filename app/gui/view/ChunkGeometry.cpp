@@ -88,7 +88,7 @@ vtkSmartPointer<vtkPolyData> drawingLines(const Drawing& drawing, const Eigen::V
             continue;
         const std::size_t layer = layers.emplace(polyline.layer, layers.size()).first->second;
         ids.clear();
-        for (const Eigen::Vector3d& v : polyline.points) {
+        for (const Eigen::Vector3d& v : polylineVertices(polyline)) { // arcs as points along them
             const Eigen::Vector3d local = v - origin;
             ids.push_back(points->InsertNextPoint(local.x(), local.y(), local.z()));
         }

@@ -193,9 +193,21 @@ ToolSpec contoursTool()
                 for (std::size_t r = 0; r < ringList.size(); ++r) {
                     Ring2d ring = ringList[r];
                     nlohmann::json pieces = nlohmann::json::array();
+                    DrawingPolyline polyline{layer, {}, true};
                     if (vectorise) {
                         const VectorRing vectorised = vectoriseRing(ring, vector);
                         ring = vectorised.vertices;
+                        // The drawing holds the corners and each arc as a bulge (CAD draws true arcs).
+                        bool arcs = false;
+                        for (const VectorPiece& piece : vectorised.pieces) {
+                            polyline.points.push_back(frame.toWorld(piece.start));
+                            polyline.bulges.push_back(piece.bulge);
+                            arcs = arcs || piece.bulge != 0.0;
+                        }
+                        if (arcs)
+                            polyline.normal = frame.normal;
+                        else
+                            polyline.bulges.clear();
                         for (const VectorPiece& piece : vectorised.pieces) {
                             nlohmann::json p = {{"type", pieceKindName(piece.kind)},
                                                 {"start", pointJson(frame.toWorld(piece.start))},
@@ -204,12 +216,17 @@ ToolSpec contoursTool()
                                 p["centre"] = pointJson(frame.toWorld(piece.centre));
                                 p["radius"] = piece.radius;
                                 p["sagitta"] = piece.sagitta;
+                                p["bulge"] = piece.bulge;
                             }
                             pieces.push_back(p);
                         }
                     }
                     const std::vector<Eigen::Vector3d> lifted = lift(frame, ring);
-                    drawing.polylines.push_back({layer, lifted, true});
+                    if (polyline.points.size() < 3) { // not vectorised, or a ring too small to split
+                        polyline.points = lifted;
+                        polyline.bulges.clear();
+                    }
+                    drawing.polylines.push_back(std::move(polyline));
                     const double area = std::abs(ringArea(ring)), perimeter = ringPerimeter(ring);
                     table.rows.push_back({static_cast<double>(segment.id), static_cast<double>(partNumber), std::string(r == 0 ? "outer" : "hole"),
                                           static_cast<double>(ring.size()), area, perimeter, parts.threshold, frame.rms});

@@ -25,7 +25,7 @@ std::vector<Polygon3d> closedPolygons(const Drawing& drawing)
 {
     std::vector<Polygon3d> out;
     for (const DrawingPolyline& polyline : drawing.polylines) {
-        std::vector<Eigen::Vector3d> points = polyline.points;
+        std::vector<Eigen::Vector3d> points = polylineVertices(polyline); // arcs as points along them
         const bool closesItself = points.size() > 3 && (points.front() - points.back()).norm() < 1e-9;
         if (!polyline.closed && !closesItself)
             continue;

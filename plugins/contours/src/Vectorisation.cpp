@@ -385,6 +385,7 @@ VectorRing assemble(const std::vector<Piece>& kept, const VectoriseParams& param
                 out.vertices.push_back(vp.centre + vp.radius * Eigen::Vector2d(std::cos(t), std::sin(t)));
             }
             vp.sagitta = vp.radius * (1.0 - std::cos(std::abs(sweep) / 2));
+            vp.bulge = std::tan(sweep / 4);
         }
         out.pieces.push_back(vp);
     }

@@ -4,7 +4,8 @@
 //! reference drawing: LWPOLYLINEs, 2D and 3D POLYLINEs (not the mesh kinds,
 //! which readPointCloud/readMesh read as surfaces), LINEs and TEXTs of the
 //! ENTITIES section, in world coordinates (object coordinate systems applied).
-//! Arc segments (bulges) are read as their chords, with a warning.
+//! Arc segments keep their bulges (DrawingPolyline::bulges, with the plane's
+//! normal); polylineVertices() gives points along them.
 
 #include <scandiff/core/Drawing.h>
 #include <scandiff/core/Progress.h>

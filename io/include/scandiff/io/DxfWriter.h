@@ -38,6 +38,12 @@ public:
     //! first vertex's elevation (all z must be equal, else InvalidArgument),
     //! otherwise a 3D POLYLINE.
     void addPolyline(const std::string& layer, const std::vector<Eigen::Vector3d>& vertices, bool closed, bool planar = false);
+    //! A polyline with arcs: a 2D POLYLINE in the object coordinate system of
+    //! `normal`, each vertex with its bulge (see DrawingPolyline::bulges).
+    //! Throws Error(InvalidArgument) unless there is one finite bulge per
+    //! vertex and every vertex lies in one plane normal to `normal` (1 µm).
+    void addArcPolyline(const std::string& layer, const std::vector<Eigen::Vector3d>& vertices, const std::vector<double>& bulges,
+                        const Eigen::Vector3d& normal, bool closed);
     //! A triangle, written as a 3DFACE whose 4th corner repeats the 3rd.
     void add3dFace(const std::string& layer, const std::array<Eigen::Vector3d, 3>& corners);
     //! Single-line text (line breaks become spaces) of the given height (> 0),
@@ -66,7 +72,8 @@ private:
 };
 
 //! Writes a tool's drawing as DXF (R12): each layer in turn one of the six
-//! basic colours, its closed or open polylines as 3D polylines, its texts.
+//! basic colours, its closed or open polylines as 3D polylines (those with
+//! arcs as 2D polylines with bulges in their plane), its texts.
 //! Polylines of fewer than 2 points are skipped. Throws Error(Io), or
 //! Error(InvalidArgument) for non-finite coordinates.
 void writeDrawingDxf(const Drawing& drawing, const std::filesystem::path& path);

@@ -35,6 +35,7 @@ struct VectorPiece
     Eigen::Vector2d centre = Eigen::Vector2d::Zero(); //!< Arc only
     double radius = 0.0;                              //!< Arc only
     double sagitta = 0.0; //!< Arc only: distance from the chord's middle to the arc (thesis 001 Fig. 4.19)
+    double bulge = 0.0;   //!< Arc only: DXF's tan(θ/4) of its signed angle θ in the plane's (u, v) frame
 };
 
 struct VectorRing
