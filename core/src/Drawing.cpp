@@ -35,7 +35,7 @@ std::vector<Eigen::Vector3d> polylineVertices(const DrawingPolyline& polyline, d
         const Eigen::Vector3d centre = 0.5 * (a + b) + left * (0.5 * length / std::tan(0.5 * angle));
         const double radius = (a - centre).norm();
         const Eigen::Vector3d u = (a - centre) / radius, v = normal.cross(u);
-        const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(angle) * 180.0 / 3.14159265358979323846 / stepDegrees)));
+        const int steps = static_cast<int>(std::clamp(std::ceil(std::abs(angle) * 180.0 / 3.14159265358979323846 / stepDegrees), 1.0, 100000.0));
         for (int s = 1; s < steps; ++s) {
             const double t = angle * s / steps;
             out.push_back(centre + radius * (std::cos(t) * u + std::sin(t) * v));

@@ -672,8 +672,10 @@ void writeDrawingDxf(const Drawing& drawing, const std::filesystem::path& path)
                 dxf.addArcPolyline(line.layer, line.points, line.bulges, line.normal, line.closed);
                 continue;
             } catch (const Error&) {
-                // Not planar (or no normal): its arcs as points along them, in 3D.
+                // Not planar: its arcs as points along them, in 3D.
             }
+            if (!(line.normal.norm() > 0))
+                logWarning("DXF: a polyline on layer " + line.layer + " has arcs but no plane: written with straight segments");
             dxf.addPolyline(line.layer, polylineVertices(line), line.closed);
             continue;
         }

@@ -194,6 +194,21 @@ TEST(Outlines, SeparatePatchesAndDuplicatesAndBadInput)
     EXPECT_EQ(test::errorCodeOf([] { parseOutlineMethod("concave"); }), ErrorCode::InvalidArgument);
 }
 
+TEST(Outlines, AHoleTouchingTheOutlineCountsAsAHoleInTheMeasures)
+{
+    // A square ring that passes twice through (0,0) around a clockwise
+    // triangle: the triangle is a hole (area 16 - 1.5) in every measure.
+    const Polygon2d keyhole{{{0, 0}, {4, 0}, {4, 4}, {0, 4}, {0, 0}, {1, 2}, {2, 1}}, {}};
+    EXPECT_DOUBLE_EQ(polygonArea(keyhole), 14.5);
+    EXPECT_DOUBLE_EQ(intersectionArea(keyhole, keyhole), 14.5);
+    const AreaMeasures self = compareAreas(keyhole, keyhole);
+    EXPECT_DOUBLE_EQ(self.quality, 1.0);
+    EXPECT_DOUBLE_EQ(self.detection, 1.0);
+    // An empty reference is no match, not a crash.
+    const PolygonMatching matching = matchPolygons({keyhole}, {Polygon2d{}, keyhole});
+    EXPECT_EQ(matching.referenceOfModel[0], 1);
+}
+
 TEST(Outlines, ThePlaneFrameIsOrthonormalAndExactFarFromTheOrigin)
 {
     const test::WallFrame frame;
@@ -351,7 +366,7 @@ TEST(Contours, TheFacadeOpeningsAreFoundWithTheirCorners)
                 for (const auto& piece : hole["pieces"])
                     if (piece["type"] == "arc") {
                         ++arcs;
-                        EXPECT_NEAR(piece["radius"].get<double>(), 0.5, 0.02);
+                        EXPECT_NEAR(piece["radius"].get<double>(), 0.5, 0.01);
                     }
             EXPECT_EQ(arcs, 1u);
             // The drawing holds the arch's arc as a bulge in the façade's plane.

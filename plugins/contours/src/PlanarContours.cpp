@@ -224,13 +224,13 @@ PlaneFrame fitPlaneFrame(const std::vector<Eigen::Vector3d>& points)
     // u horizontal, v up the slope; a horizontal plane keeps x and y.
     const Eigen::Vector3d horizontal = Eigen::Vector3d::UnitZ().cross(frame.normal);
     if (horizontal.norm() > 1e-6) {
-        frame.u = horizontal.normalized();
-        frame.v = frame.normal.cross(frame.u);
-        if (frame.v.z() < 0) {
+        // The eigenvector's sign is arbitrary: a fixed rule (the normal's
+        // horizontal part towards +y, else +x) keeps two scans of one wall
+        // in the same frame, not mirrored. v = n x u then points up.
+        if (frame.normal.y() < 0 || (frame.normal.y() == 0 && frame.normal.x() < 0))
             frame.normal = -frame.normal;
-            frame.u = -frame.u; // keeps (u, v, normal) right-handed with v upward
-            frame.v = frame.normal.cross(frame.u);
-        }
+        frame.u = Eigen::Vector3d::UnitZ().cross(frame.normal).normalized();
+        frame.v = frame.normal.cross(frame.u);
     } else {
         if (frame.normal.z() < 0)
             frame.normal = -frame.normal;
@@ -323,6 +323,8 @@ OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const 
     for (const Eigen::Vector2d& p : points)
         if (!p.allFinite())
             throw Error(ErrorCode::InvalidData, "outlines: a point has a non-finite coordinate");
+    if (!params.labels.empty() && params.labels.size() != points.size())
+        throw Error(ErrorCode::InvalidArgument, "outlines: one label per point expected");
     OutlineResult result;
     result.partOfPoint.assign(points.size(), -1);
     const std::vector<Triangle> triangles = delaunayTriangles(points);
@@ -330,8 +332,6 @@ OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const 
     if (triangles.empty())
         return result;
 
-    if (!params.labels.empty() && params.labels.size() != points.size())
-        throw Error(ErrorCode::InvalidArgument, "outlines: one label per point expected");
     auto mixed = [&](const Triangle& t) {
         if (params.labels.empty())
             return false;

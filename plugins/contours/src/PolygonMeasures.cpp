@@ -58,14 +58,23 @@ CgalPolygon toCgal(const Ring2d& loop)
     return polygon;
 }
 
-//! The polygon as a set: its outer ring's loops joined, its holes' removed
-//! (each ring taken whatever its orientation).
+//! The polygon as a set: the loops of its outer ring turning as its largest
+//! joined, those turning the other way (a hole touching the outline at a
+//! point, chained into it) and its holes' loops removed.
 CGAL::Polygon_set_2<Kernel> toSet(const Polygon2d& p)
 {
     CGAL::Polygon_set_2<Kernel> set;
-    for (const Ring2d& loop : simpleLoops(p.outer))
-        if (std::abs(ringArea(loop)) > 0)
+    const std::vector<Ring2d> loops = simpleLoops(p.outer);
+    double largest = 0.0;
+    for (const Ring2d& loop : loops)
+        if (std::abs(ringArea(loop)) > std::abs(largest))
+            largest = ringArea(loop);
+    for (const Ring2d& loop : loops)
+        if (ringArea(loop) * largest > 0)
             set.join(toCgal(loop));
+    for (const Ring2d& loop : loops)
+        if (ringArea(loop) * largest < 0)
+            set.difference(toCgal(loop));
     for (const Ring2d& hole : p.holes)
         for (const Ring2d& loop : simpleLoops(hole))
             if (std::abs(ringArea(loop)) > 0)
@@ -101,7 +110,7 @@ double directedHausdorff(const Ring2d& from, const Ring2d& to, double step)
     for (std::size_t i = 0; i < from.size(); ++i) {
         const Eigen::Vector2d& a = from[i];
         const Eigen::Vector2d& b = from[(i + 1) % from.size()];
-        const int samples = std::max(1, static_cast<int>(std::ceil((b - a).norm() / step)));
+        const int samples = static_cast<int>(std::clamp(std::ceil((b - a).norm() / step), 1.0, 1e7));
         for (int s = 0; s < samples; ++s)
             worst = std::max(worst, distance(a + (b - a) * (static_cast<double>(s) / samples)));
     }
@@ -175,8 +184,8 @@ PolygonMatching matchPolygons(const std::vector<Polygon2d>& model, const std::ve
     std::vector<Box> referenceBoxes;
     std::vector<double> referenceArea;
     for (const Polygon2d& r : reference) {
-        referenceBoxes.push_back(boxOf(r));
-        referenceArea.push_back(polygonArea(r));
+        referenceBoxes.push_back(r.outer.empty() ? Box{Eigen::Vector2d::Constant(INFINITY), Eigen::Vector2d::Constant(-INFINITY)} : boxOf(r));
+        referenceArea.push_back(r.outer.size() < 3 ? 0.0 : polygonArea(r));
     }
     std::vector<bool> found(reference.size(), false);
     for (std::size_t m = 0; m < model.size(); ++m) {
@@ -188,7 +197,7 @@ PolygonMatching matchPolygons(const std::vector<Polygon2d>& model, const std::ve
         double bestIou = 0.0;
         for (std::size_t r = 0; r < reference.size(); ++r) {
             const Box& rb = referenceBoxes[r];
-            if ((box.max.array() < rb.min.array()).any() || (box.min.array() > rb.max.array()).any())
+            if (reference[r].outer.size() < 3 || (box.max.array() < rb.min.array()).any() || (box.min.array() > rb.max.array()).any())
                 continue;
             const double common = intersectionArea(model[m], reference[r]);
             if (common > 0.1 * referenceArea[r])

@@ -149,7 +149,7 @@ std::vector<std::size_t> selectStones(const OutlineResult& parts, double minArea
         for (std::size_t a = 0; a < accepted.size() && !nested; ++a) {
             const Box& other = boxes[a];
             if ((box.min.array() >= other.min.array()).all() && (box.max.array() <= other.max.array()).all())
-                nested = ringContains(parts.parts[accepted[a]].outer, 0.5 * (ring[0] + ring[ring.size() / 2]));
+                nested = ringContains(parts.parts[accepted[a]].outer, ring[0]); // a vertex of the smaller one
         }
         if (nested) {
             ++result.nestedDropped;

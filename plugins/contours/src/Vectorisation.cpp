@@ -300,11 +300,14 @@ std::vector<Piece> classifyPieces(std::vector<Piece> merged, const VectorisePara
     std::vector<Piece> kept;
     for (Piece& piece : merged) {
         if (piece.kind == PieceKind::Arc) {
-            const Eigen::Vector2d travel = chord(piece);
-            const bool centreOnRight = travel.x() * (piece.circle.centre - piece.points.front()).y() -
-                                           travel.y() * (piece.circle.centre - piece.points.front()).x() < 0;
-            piece.circle.radius += centreOnRight ? params.edgeOffset : -params.edgeOffset;
-            kept.push_back(std::move(piece));
+            // An arc turning right (clockwise) has its centre on the right,
+            // away from the surface: moving away from the surface shrinks it.
+            const Eigen::Vector2d a = piece.points.front() - piece.circle.centre;
+            const Eigen::Vector2d m = piece.points[piece.points.size() / 2] - piece.circle.centre;
+            const bool centreOnRight = turnAngle(a, m) < 0;
+            piece.circle.radius += centreOnRight ? -params.edgeOffset : params.edgeOffset;
+            if (piece.circle.radius > 0)
+                kept.push_back(std::move(piece));
             continue;
         }
         if (chord(piece).norm() < minLine && merged.size() > 3)
@@ -378,7 +381,7 @@ VectorRing assemble(const std::vector<Piece>& kept, const VectoriseParams& param
             const double toMiddle = turnAngle(a, middle);
             if (sweep * toMiddle < 0 || std::abs(toMiddle) > std::abs(sweep))
                 sweep += sweep > 0 ? -2 * kPi : 2 * kPi;
-            const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(sweep) / (params.arcStepDegrees * kDegree))));
+            const int steps = static_cast<int>(std::clamp(std::ceil(std::abs(sweep) / (params.arcStepDegrees * kDegree)), 1.0, 100000.0));
             const double start = std::atan2(a.y(), a.x());
             for (int s = 1; s < steps; ++s) {
                 const double t = start + sweep * s / steps;

@@ -12,7 +12,9 @@
 //! chained into closed rings: one outer ring per part (counter-clockwise) and
 //! one ring per hole (clockwise). Two parts meeting at a single point stay two
 //! parts, and a ring passing twice through a point is chained so that it never
-//! crosses itself.
+//! crosses itself: a hole touching the outline at one point stays in the outer
+//! ring, which then passes twice through that point (its signed area is still
+//! the part's).
 
 #include <Eigen/Core>
 
@@ -23,9 +25,11 @@
 
 namespace scandiff::plugins {
 
-//! A plane with an orthonormal frame (u, v, normal). For a plane that is not
-//! horizontal, u is horizontal and v points up the slope (a façade's x and z),
-//! so straight pieces can be classified as horizontal or vertical.
+//! A plane with an orthonormal frame (u, v, normal), right-handed. For a plane
+//! that is not horizontal, u is horizontal and v points up the slope (a
+//! façade's x and z), so straight pieces can be classified as horizontal or
+//! vertical; its normal's horizontal part points towards +y (else +x). A
+//! horizontal plane's normal points up.
 struct PlaneFrame
 {
     Eigen::Vector3d origin = Eigen::Vector3d::Zero(); //!< the points' centroid, global
