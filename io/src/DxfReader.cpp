@@ -11,6 +11,7 @@
 //! Block definitions are not expanded (INSERT references are counted and
 //! reported), nor are the newer MESH entity and binary DXF (refused clearly).
 
+#include "internal/DxfObjectAxes.h"
 #include "internal/MappedFile.h"
 #include "internal/MeshReaders.h"
 #include "internal/TextUtil.h"
@@ -359,15 +360,7 @@ Eigen::Matrix3d objectAxes(const Groups& groups, const Entity& e)
     Eigen::Vector3d n(number(groups, e, 210, 0.0), number(groups, e, 220, 0.0), number(groups, e, 230, 1.0));
     if (!(n.norm() > 0))
         groups.fail(e.line, std::string(e.type) + " has a zero extrusion direction");
-    n.normalize();
-    const Eigen::Vector3d ax = (std::abs(n.x()) < 1.0 / 64 && std::abs(n.y()) < 1.0 / 64 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ())
-                                   .cross(n)
-                                   .normalized();
-    Eigen::Matrix3d axes;
-    axes.col(0) = ax;
-    axes.col(1) = n.cross(ax).normalized();
-    axes.col(2) = n;
-    return axes;
+    return dxfObjectAxes(n.normalized());
 }
 
 } // namespace
@@ -429,6 +422,14 @@ Drawing readDrawingDxf(const std::filesystem::path& path, ProgressObserver* prog
     Groups groups(path, checkedText(file, path));
     Drawing drawing;
     std::size_t arcs = 0;
+    // A polyline keeps its bulges, and its plane, only when it has an arc.
+    auto keepArcs = [&arcs](DrawingPolyline& polyline, std::vector<double> bulge, const Eigen::Matrix3d& axes) {
+        if (std::none_of(bulge.begin(), bulge.end(), [](double b) { return b != 0.0; }))
+            return;
+        polyline.bulges = std::move(bulge);
+        polyline.normal = axes.col(2);
+        ++arcs;
+    };
     auto layerOf = [](const detail::Entity& e) {
         const Group* g = e.find(8);
         return g ? std::string(g->value) : std::string("0");
@@ -457,11 +458,7 @@ Drawing readDrawingDxf(const std::filesystem::path& path, ProgressObserver* prog
                 }
                 for (const Eigen::Vector2d& q : xy)
                     polyline.points.push_back(axes * Eigen::Vector3d(q.x(), q.y(), elevation));
-                if (std::any_of(bulge.begin(), bulge.end(), [](double b) { return b != 0.0; })) {
-                    polyline.bulges = std::move(bulge);
-                    polyline.normal = axes.col(2);
-                    ++arcs;
-                }
+                keepArcs(polyline, std::move(bulge), axes);
                 if (polyline.points.size() >= 2)
                     drawing.polylines.push_back(std::move(polyline));
             } else if (e.type == "LINE") {
@@ -487,11 +484,7 @@ Drawing readDrawingDxf(const std::filesystem::path& path, ProgressObserver* prog
                 bulge.push_back(is3d ? 0.0 : number(groups, v, 42, 0.0)); // a 3D polyline has no arcs
                 out.points.push_back(p);
             }
-            if (std::any_of(bulge.begin(), bulge.end(), [](double b) { return b != 0.0; })) {
-                out.bulges = std::move(bulge);
-                out.normal = axes.col(2);
-                ++arcs;
-            }
+            keepArcs(out, std::move(bulge), axes);
             if (out.points.size() >= 2)
                 drawing.polylines.push_back(std::move(out));
         });

@@ -12,6 +12,7 @@
 
 #include <map>
 
+#include "internal/DxfObjectAxes.h"
 #include "internal/Formats.h"
 #include "internal/MeshReaders.h"
 
@@ -475,16 +476,12 @@ void DxfDrawing::addArcPolyline(const std::string& layer, const std::vector<Eige
         if (!std::isfinite(bulges[i]))
             invalidArgument("a bulge is not finite");
     }
-    // The object coordinate system of DXF's arbitrary axis algorithm (DXF
-    // Reference, "Arbitrary Axis Algorithm"): what a reader rebuilds from 210/220/230.
     const Eigen::Vector3d n = normal.normalized();
-    const Eigen::Vector3d ax =
-        ((std::abs(n.x()) < 1.0 / 64 && std::abs(n.y()) < 1.0 / 64) ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ()).cross(n).normalized();
-    const Eigen::Vector3d ay = n.cross(ax).normalized();
+    const Eigen::Matrix3d axes = detail::dxfObjectAxes(n);
     std::vector<Eigen::Vector3d> local;
     local.reserve(vertices.size());
     for (const Eigen::Vector3d& v : vertices)
-        local.emplace_back(v.dot(ax), v.dot(ay), v.dot(n));
+        local.emplace_back(v.dot(axes.col(0)), v.dot(axes.col(1)), v.dot(n));
     const double elevation = local.front().z();
     for (const Eigen::Vector3d& q : local)
         if (std::abs(q.z() - elevation) > 1e-6 + 1e-12 * std::abs(elevation))

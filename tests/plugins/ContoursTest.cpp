@@ -106,7 +106,7 @@ TEST(Outlines, ALatticeAboveItsCircumradiusIsOneSquare)
         const OutlineResult result = extractOutlines(points, params);
         ASSERT_EQ(result.parts.size(), 1u);
         EXPECT_DOUBLE_EQ(result.parts[0].area, 100.0);
-        EXPECT_DOUBLE_EQ(ringArea(result.parts[0].outer), 100.0);
+        EXPECT_DOUBLE_EQ(signedArea(result.parts[0].outer), 100.0);
         EXPECT_EQ(result.parts[0].outer.size(), 40u);
         EXPECT_TRUE(result.parts[0].holes.empty());
         EXPECT_EQ(result.parts[0].pointCount, points.size());
@@ -128,7 +128,7 @@ TEST(Outlines, AHoleIsAClockwiseRingAndTheKneeFindsIt)
     const OutlineResult exact = extractOutlines(points, alpha(0.75));
     ASSERT_EQ(exact.parts.size(), 1u);
     ASSERT_EQ(exact.parts[0].holes.size(), 1u);
-    EXPECT_DOUBLE_EQ(ringArea(exact.parts[0].holes[0]), -14.0);
+    EXPECT_DOUBLE_EQ(signedArea(exact.parts[0].holes[0]), -14.0);
     EXPECT_DOUBLE_EQ(exact.parts[0].area, 86.0);
     EXPECT_EQ(exact.parts[0].holes[0].size(), 12u);
     EXPECT_DOUBLE_EQ(exact.spacing, 1.0);
@@ -139,7 +139,7 @@ TEST(Outlines, AHoleIsAClockwiseRingAndTheKneeFindsIt)
         const OutlineResult result = extractOutlines(points, params);
         ASSERT_EQ(result.parts.size(), 1u);
         ASSERT_EQ(result.parts[0].holes.size(), 1u);
-        EXPECT_LE(ringArea(result.parts[0].holes[0]), -4.0);
+        EXPECT_LE(signedArea(result.parts[0].holes[0]), -4.0);
         EXPECT_GT(result.threshold, method == OutlineMethod::LongEdges ? std::sqrt(2.0) : std::sqrt(0.5));
     }
     // Without a gap, the knee keeps every triangle (its floor).
@@ -281,7 +281,7 @@ TEST(Stones, EveryStoneIsOneClosedPolygonWithin3cmOfItsTruth)
         for (std::size_t m = 0; m < model.size(); ++m) {
             ASSERT_GE(matching.referenceOfModel[m], 0) << m;
             EXPECT_LE(boundaryHausdorff(model[m].outer, truth[static_cast<std::size_t>(matching.referenceOfModel[m])].outer), 0.03) << m;
-            EXPECT_GT(ringArea(model[m].outer), 0.0);
+            EXPECT_GT(signedArea(model[m].outer), 0.0);
             // Planar, in the wall's plane.
             for (const Eigen::Vector3d& p : wall.stones[m].outline)
                 EXPECT_NEAR((p - wall.wall.origin).dot(wall.wall.normal), 0.0, 1e-9);

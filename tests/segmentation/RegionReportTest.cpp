@@ -2,6 +2,7 @@
 // Region measurements: outline, footprint, statistics, volume.
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/geometry/PlanarRings.h>
 #include <scandiff/core/segmentation/RegionReport.h>
 
 #include "TestSupport.h"
@@ -24,14 +25,6 @@ std::vector<Eigen::Vector2d> gridPoints(double x0, double y0, double x1, double 
     return p;
 }
 
-double ringArea(const Polygon2d& ring)
-{
-    double twice = 0;
-    for (std::size_t i = 0; i < ring.size(); ++i)
-        twice += ring[i].x() * ring[(i + 1) % ring.size()].y() - ring[(i + 1) % ring.size()].x() * ring[i].y();
-    return 0.5 * twice;
-}
-
 } // namespace
 
 TEST(Outline, SquareAndConcaveLShape)
@@ -43,7 +36,7 @@ TEST(Outline, SquareAndConcaveLShape)
     // to a cell beyond them: the area is that of the sampled square, exactly.
     EXPECT_NEAR(square.area, 0.98 * 0.98, 1e-9);
     EXPECT_EQ(square.rings[0].size(), 4u);         // straight sides collapse to 4 corners
-    EXPECT_GT(ringArea(square.rings[0]), 0.0);     // counter-clockwise
+    EXPECT_GT(signedArea(square.rings[0]), 0.0); // counter-clockwise
 
     // An L (the square minus its upper-right quarter): area 0.75, not the hull's 1.
     auto l = gridPoints(0, 0, 1, 0.5, 0.02);
@@ -66,7 +59,7 @@ TEST(Outline, SeparatePiecesGetSeparateRingsAndHolesAreFilled)
                  points.end());
     const Outline2d o = concaveOutline(points, 0.03);
     ASSERT_EQ(o.rings.size(), 2u);
-    EXPECT_GT(ringArea(o.rings[0]), ringArea(o.rings[1]));
+    EXPECT_GT(signedArea(o.rings[0]), signedArea(o.rings[1]));
     EXPECT_NEAR(o.area, 1.25, 0.15);
     EXPECT_TRUE(concaveOutline({}, 1.0).rings.empty());
     EXPECT_EQ(concaveOutline({{0, 0}}, 1.0).rings.size(), 1u);

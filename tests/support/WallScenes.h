@@ -7,6 +7,7 @@
 //! `yawDegrees` about z, far from the origin (UTM-like coordinates).
 
 #include <scandiff/core/PointCloud.h>
+#include <scandiff/core/geometry/PlanarRings.h>
 
 #include <Eigen/Core>
 
@@ -34,16 +35,6 @@ struct WallFrame
         return origin + q.x() * u + q.y() * v + depth * u.cross(v);
     }
 };
-
-inline bool insideOutline(const Outline& ring, const Eigen::Vector2d& p)
-{
-    bool inside = false;
-    for (std::size_t i = 0, n = ring.size(), j = n - 1; i < n; j = i++)
-        if ((ring[i].y() > p.y()) != (ring[j].y() > p.y()) &&
-            p.x() < (ring[j].x() - ring[i].x()) * (p.y() - ring[i].y()) / (ring[j].y() - ring[i].y()) + ring[i].x())
-            inside = !inside;
-    return inside;
-}
 
 //! A jittered grid over [0, width] x [0, height], each point kept if `keep` says so.
 template <class Keep>
@@ -128,7 +119,7 @@ inline StoneWallScene makeStoneWall(const StoneWallOptions& o)
         for (std::size_t c = 0; c < courseSpan.size(); ++c)
             if (q.y() >= courseSpan[c].first && q.y() <= courseSpan[c].second)
                 for (std::size_t s : stonesOfCourse[c])
-                    if (insideOutline(scene.stones[s], q))
+                    if (containsPoint(scene.stones[s], q))
                         return true;
         return false;
     };
@@ -187,10 +178,10 @@ inline FacadeScene makeFacade(double spacing = 0.015, unsigned seed = 5, double 
     const Outline door{{2.5, 0.0}, {3.4, 0.0}, {3.4, 1.9}, {2.5, 1.9}};
     std::mt19937 rng(seed);
     const std::vector<Eigen::Vector2d> grid = jitteredGrid(scene.width, scene.height, spacing, rng, [&](const Eigen::Vector2d& q) {
-        if (q.x() > scene.width || q.y() > scene.height || insideOutline(door, q))
+        if (q.x() > scene.width || q.y() > scene.height || containsPoint(door, q))
             return false;
         for (const Outline& opening : scene.openings)
-            if (insideOutline(opening, q))
+            if (containsPoint(opening, q))
                 return false;
         return true;
     });

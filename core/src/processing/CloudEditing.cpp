@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include <scandiff/core/processing/CloudEditing.h>
+#include <scandiff/core/geometry/PlanarRings.h>
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
@@ -330,23 +331,6 @@ std::vector<std::size_t> pointsInPolygon(const PointCloud& cloud, const CropPoly
     return out;
 }
 
-namespace {
-
-//! Even-odd crossing number of (x, y) against the closed polygon v.
-bool insidePolygon(const std::vector<Eigen::Vector2d>& v, double x, double y)
-{
-    bool in = false;
-    for (std::size_t j = 0, k = v.size() - 1; j < v.size(); k = j++)
-        if ((v[j].y() > y) != (v[k].y() > y)) {
-            const double cross = v[k].x() + (y - v[k].y()) * (v[j].x() - v[k].x()) / (v[j].y() - v[k].y());
-            if (x < cross)
-                in = !in;
-        }
-    return in;
-}
-
-} // namespace
-
 std::vector<std::size_t> pointsInScreenPolygon(const PointCloud& cloud, const Eigen::Matrix4d& globalToScreen,
                                                const std::vector<Eigen::Vector2d>& polygon)
 {
@@ -365,7 +349,7 @@ std::vector<std::size_t> pointsInScreenPolygon(const PointCloud& cloud, const Ei
         const Eigen::Vector4d h = localToScreen * cloud.positions()[i].cast<double>().homogeneous();
         if (!(h.w() > 0) || !h.allFinite())
             return; // behind the eye, or not a point
-        inside[i] = insidePolygon(polygon, h.x() / h.w(), h.y() / h.w());
+        inside[i] = containsPoint(polygon, Eigen::Vector2d(h.x() / h.w(), h.y() / h.w()));
     });
     std::vector<std::size_t> out;
     for (std::size_t i = 0; i < cloud.size(); ++i)

@@ -281,12 +281,12 @@ Outline2d concaveOutline(const std::vector<Eigen::Vector2d>& points, double cell
             for (const Eigen::Vector2i& corner : loop)
                 ring.push_back(lo + cellSize * (corner.cast<double>() - Eigen::Vector2d::Constant(pad)));
         } else {
-            outline.area += std::max(0.0, detail::signedArea(ring));
+            outline.area += std::max(0.0, signedArea(ring));
         }
         outline.rings.push_back(simplifyRing(ring, 0.5 * cellSize));
     }
     std::sort(outline.rings.begin(), outline.rings.end(),
-              [](const Polygon2d& a, const Polygon2d& b) { return std::abs(detail::signedArea(a)) > std::abs(detail::signedArea(b)); });
+              [](const Polygon2d& a, const Polygon2d& b) { return std::abs(signedArea(a)) > std::abs(signedArea(b)); });
     return outline;
 }
 

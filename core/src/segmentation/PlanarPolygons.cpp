@@ -6,17 +6,6 @@
 
 namespace scandiff::detail {
 
-double signedArea(const Polygon2d& ring)
-{
-    double twice = 0.0;
-    for (std::size_t i = 0; i < ring.size(); ++i) {
-        const Eigen::Vector2d& p = ring[i];
-        const Eigen::Vector2d& q = ring[(i + 1) % ring.size()];
-        twice += p.x() * q.y() - q.x() * p.y();
-    }
-    return 0.5 * twice;
-}
-
 namespace {
 
 //! Keeps the part of `in` where coordinate `axis` is >= bound (keepAbove) or <= bound.

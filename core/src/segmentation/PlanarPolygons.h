@@ -4,6 +4,7 @@
 //! and the area of a polygon inside an axis-aligned rectangle, which weighs
 //! each column of the 2.5D volume grid by the part of it inside the footprint.
 
+#include <scandiff/core/geometry/PlanarRings.h>
 #include <scandiff/core/segmentation/RegionReport.h>
 
 #include <cstdint>
@@ -12,9 +13,6 @@
 #include <vector>
 
 namespace scandiff::detail {
-
-//! Shoelace area: positive when counter-clockwise.
-double signedArea(const Polygon2d& ring);
 
 //! The area of `ring` (a simple polygon, either orientation) inside the
 //! rectangle [lo, hi]: the ring clipped by the rectangle's four half-planes

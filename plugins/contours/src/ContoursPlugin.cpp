@@ -187,7 +187,7 @@ ToolSpec contoursTool()
                     continue;
                 std::vector<Ring2d> ringList{part.outer};
                 for (const Ring2d& hole : part.holes)
-                    if (std::abs(ringArea(hole)) >= minArea)
+                    if (std::abs(signedArea(hole)) >= minArea)
                         ringList.push_back(hole);
                 nlohmann::json polygon = {{"holes", nlohmann::json::array()}};
                 for (std::size_t r = 0; r < ringList.size(); ++r) {
@@ -227,7 +227,7 @@ ToolSpec contoursTool()
                         polyline.bulges.clear();
                     }
                     drawing.polylines.push_back(std::move(polyline));
-                    const double area = std::abs(ringArea(ring)), perimeter = ringPerimeter(ring);
+                    const double area = std::abs(signedArea(ring)), perimeter = ringPerimeter(ring);
                     table.rows.push_back({static_cast<double>(segment.id), static_cast<double>(partNumber), std::string(r == 0 ? "outer" : "hole"),
                                           static_cast<double>(ring.size()), area, perimeter, parts.threshold, frame.rms});
                     nlohmann::json ringDoc = {{"vertices", ringJson(lifted)}, {"area", area}, {"perimeter", perimeter}};

@@ -110,7 +110,7 @@ ToolSpec comparePolygonsTool()
             std::vector<TableCell> row{static_cast<double>(r), reference[r].source->layer};
             if (best < 0) {
                 row.push_back(-1.0);
-                row.push_back(std::abs(ringArea(referenceRing)));
+                row.push_back(std::abs(signedArea(referenceRing)));
                 for (std::size_t c = row.size(); c < table.columns.size(); ++c)
                     row.push_back(nan);
                 table.rows.push_back(std::move(row));

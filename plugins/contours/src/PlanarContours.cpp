@@ -285,35 +285,12 @@ double kneeThreshold(std::vector<double> values, double floorFactor)
     return std::max(knee, floor);
 }
 
-double ringArea(const Ring2d& ring)
-{
-    double twice = 0.0;
-    for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
-        const Eigen::Vector2d& a = ring[i];
-        const Eigen::Vector2d& b = ring[(i + 1) % n];
-        twice += (a.x() - ring[0].x()) * (b.y() - ring[0].y()) - (b.x() - ring[0].x()) * (a.y() - ring[0].y());
-    }
-    return 0.5 * twice;
-}
-
 double ringPerimeter(const Ring2d& ring)
 {
     double length = 0.0;
     for (std::size_t i = 0, n = ring.size(); i < n; ++i)
         length += (ring[(i + 1) % n] - ring[i]).norm();
     return length;
-}
-
-bool ringContains(const Ring2d& ring, const Eigen::Vector2d& p)
-{
-    bool inside = false;
-    for (std::size_t i = 0, n = ring.size(), j = n - 1; i < n; j = i++) {
-        const Eigen::Vector2d& a = ring[i];
-        const Eigen::Vector2d& b = ring[j];
-        if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
-            inside = !inside;
-    }
-    return inside;
 }
 
 OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const OutlineParams& params)
@@ -419,7 +396,7 @@ OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const 
         std::size_t outerRing = rings.size();
         double largest = 0.0;
         for (std::size_t r = 0; r < rings.size(); ++r) {
-            const double a = ringArea(coordinates(rings[r], points));
+            const double a = signedArea(coordinates(rings[r], points));
             if (a > largest) {
                 largest = a;
                 outerRing = r;
@@ -437,7 +414,7 @@ OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const 
             // a part touching itself around an island of another part: it is
             // the outline of that island's surroundings, kept as a hole-free
             // detail of the outer ring; holes are the clockwise rings.
-            if (ringArea(ring) < 0 && -ringArea(ring) >= params.minHoleArea) {
+            if (signedArea(ring) < 0 && -signedArea(ring) >= params.minHoleArea) {
                 out.holes.push_back(std::move(ring));
                 out.holeIndices.push_back(rings[r]);
             }

@@ -67,17 +67,17 @@ CGAL::Polygon_set_2<Kernel> toSet(const Polygon2d& p)
     const std::vector<Ring2d> loops = simpleLoops(p.outer);
     double largest = 0.0;
     for (const Ring2d& loop : loops)
-        if (std::abs(ringArea(loop)) > std::abs(largest))
-            largest = ringArea(loop);
+        if (std::abs(signedArea(loop)) > std::abs(largest))
+            largest = signedArea(loop);
     for (const Ring2d& loop : loops)
-        if (ringArea(loop) * largest > 0)
+        if (signedArea(loop) * largest > 0)
             set.join(toCgal(loop));
     for (const Ring2d& loop : loops)
-        if (ringArea(loop) * largest < 0)
+        if (signedArea(loop) * largest < 0)
             set.difference(toCgal(loop));
     for (const Ring2d& hole : p.holes)
         for (const Ring2d& loop : simpleLoops(hole))
-            if (std::abs(ringArea(loop)) > 0)
+            if (std::abs(signedArea(loop)) > 0)
                 set.difference(toCgal(loop));
     return set;
 }
@@ -121,9 +121,9 @@ double directedHausdorff(const Ring2d& from, const Ring2d& to, double step)
 
 double polygonArea(const Polygon2d& p)
 {
-    double a = std::abs(ringArea(p.outer));
+    double a = std::abs(signedArea(p.outer));
     for (const Ring2d& hole : p.holes)
-        a -= std::abs(ringArea(hole));
+        a -= std::abs(signedArea(hole));
     return a;
 }
 

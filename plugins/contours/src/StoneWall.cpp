@@ -136,7 +136,7 @@ std::vector<std::size_t> selectStones(const OutlineResult& parts, double minArea
     std::vector<std::size_t> accepted; // part indices, largest first
     for (std::size_t p = 0; p < parts.parts.size(); ++p) {
         const Ring2d& ring = parts.parts[p].outer;
-        if (ringArea(ring) < minArea) {
+        if (signedArea(ring) < minArea) {
             ++result.smallDropped;
             continue;
         }
@@ -149,7 +149,7 @@ std::vector<std::size_t> selectStones(const OutlineResult& parts, double minArea
         for (std::size_t a = 0; a < accepted.size() && !nested; ++a) {
             const Box& other = boxes[a];
             if ((box.min.array() >= other.min.array()).all() && (box.max.array() <= other.max.array()).all())
-                nested = ringContains(parts.parts[accepted[a]].outer, ring[0]); // a vertex of the smaller one
+                nested = containsPoint(parts.parts[accepted[a]].outer, ring[0]); // a vertex of the smaller one
         }
         if (nested) {
             ++result.nestedDropped;
@@ -348,7 +348,7 @@ StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params
         stone.outline2d = part.outer;
         for (const Eigen::Vector2d& q : part.outer)
             stone.outline.push_back(result.wall.toWorld(q));
-        stone.area = ringArea(part.outer);
+        stone.area = signedArea(part.outer);
         stone.perimeter = ringPerimeter(part.outer);
         stone.centroid = result.wall.toWorld(centre[p]);
         stoneOfPart[p] = static_cast<std::int32_t>(result.stones.size());

@@ -16,6 +16,8 @@
 //! ring, which then passes twice through that point (its signed area is still
 //! the part's).
 
+#include <scandiff/core/geometry/PlanarRings.h>
+
 #include <Eigen/Core>
 
 #include <array>
@@ -108,11 +110,8 @@ OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const 
 //! a surface without gaps keeps all its triangles. Empty input: 0.
 double kneeThreshold(std::vector<double> values, double floorFactor);
 
-//! Signed area (counter-clockwise positive) and perimeter of a closed ring.
-double ringArea(const Ring2d& ring);
+//! Perimeter of a closed ring (its signed area: signedArea() of core's PlanarRings.h).
 double ringPerimeter(const Ring2d& ring);
-//! Even-odd test; a point on the boundary may go either way.
-bool ringContains(const Ring2d& ring, const Eigen::Vector2d& p);
 
 //! The triangles of the 2D Delaunay triangulation of the points (indices into
 //! `points`, counter-clockwise). Of several equal points, one is a vertex.
