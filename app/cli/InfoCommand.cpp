@@ -2,7 +2,9 @@
 #include "CliSupport.h"
 #include "Commands.h"
 
+#include <scandiff/core/Error.h>
 #include <scandiff/io/CoordinateSystem.h>
+#include <scandiff/io/E57.h>
 
 #include <nlohmann/json.hpp>
 
@@ -54,8 +56,73 @@ nlohmann::json describe(const io::Entity& entity, const std::string& file)
     return j;
 }
 
+nlohmann::json poseJson(const std::optional<io::E57Pose>& pose)
+{
+    if (!pose)
+        return nullptr;
+    const Eigen::Quaterniond& q = pose->rotation;
+    return {{"translation", vectorJson(pose->translation)}, {"rotation_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
+}
+
+//! The scans and images of an E57 file, as its XML section lists them.
+nlohmann::json describeE57(const io::E57Summary& summary)
+{
+    nlohmann::json j;
+    j["guid"] = summary.guid;
+    j["written_by"] = summary.libraryVersion;
+    j["scans"] = nlohmann::json::array();
+    for (const io::E57ScanSummary& scan : summary.scans) {
+        nlohmann::json s = {{"name", scan.name}, {"guid", scan.guid}, {"records", scan.recordCount}, {"pose", poseJson(scan.pose)},
+                            {"coordinates", scan.spherical ? "spherical" : "cartesian"}, {"fields", scan.fields}};
+        if (scan.intensityLimits)
+            s["intensity_limits"] = {scan.intensityLimits->first, scan.intensityLimits->second};
+        j["scans"].push_back(std::move(s));
+    }
+    j["images"] = nlohmann::json::array();
+    for (const io::E57ImageSummary& image : summary.images)
+        j["images"].push_back({{"name", image.name}, {"representation", image.representation}, {"format", image.format},
+                               {"width", image.width}, {"height", image.height}, {"bytes", image.byteLength}, {"pose", poseJson(image.pose)}});
+    return j;
+}
+
+void printE57(const nlohmann::json& j, std::ostream& out)
+{
+    auto pose = [](const nlohmann::json& p) {
+        if (p.is_null())
+            return std::string("no pose");
+        std::ostringstream s;
+        const auto& t = p["translation"];
+        const auto& q = p["rotation_wxyz"];
+        s << std::setprecision(10) << "at " << t[0].get<double>() << ", " << t[1].get<double>() << ", " << t[2].get<double>()
+          << "  rotation (w x y z) " << q[0].get<double>() << " " << q[1].get<double>() << " " << q[2].get<double>() << " "
+          << q[3].get<double>();
+        return s.str();
+    };
+    out << "E57 scans:     " << j["scans"].size() << '\n';
+    std::size_t index = 0;
+    for (const auto& s : j["scans"]) {
+        out << "  [" << index++ << "] '" << s["name"].get<std::string>() << "'  " << s["records"].get<std::uint64_t>() << " records, "
+            << s["coordinates"].get<std::string>() << ", " << pose(s["pose"]) << '\n';
+        std::string fields;
+        for (const auto& f : s["fields"])
+            fields += (fields.empty() ? "" : " ") + f.get<std::string>();
+        out << "      fields: " << fields << '\n';
+    }
+    out << "E57 images:    " << j["images"].size() << '\n';
+    index = 0;
+    for (const auto& i : j["images"])
+        out << "  [" << index++ << "] '" << i["name"].get<std::string>() << "'  " << i["representation"].get<std::string>() << ' '
+            << i["format"].get<std::string>() << ' ' << i["width"].get<std::int64_t>() << " x " << i["height"].get<std::int64_t>() << ", "
+            << i["bytes"].get<std::uint64_t>() << " bytes, " << pose(i["pose"]) << '\n';
+}
+
 void printText(const nlohmann::json& j, std::ostream& out)
 {
+    if (!j.contains("type")) {
+        out << "file:          " << j["file"].get<std::string>() << '\n';
+        printE57(j["e57"], out);
+        return;
+    }
     out << std::setprecision(10);
     out << "file:          " << j["file"].get<std::string>() << '\n';
     out << "type:          " << j["type"].get<std::string>() << '\n';
@@ -89,6 +156,8 @@ void printText(const nlohmann::json& j, std::ostream& out)
         else
             out << " min " << f["min"].get<double>() << "  max " << f["max"].get<double>() << "  (" << f["valid"].get<std::size_t>() << " values)\n";
     }
+    if (j.contains("e57"))
+        printE57(j["e57"], out);
 }
 
 } // namespace
@@ -99,17 +168,34 @@ void addInfoCommand(CLI::App& app, const PluginRegistry& registry, Streams strea
     {
         std::string file;
         bool json = false;
+        std::string imageFolder;
         ReadFlags read;
     };
     auto args = std::make_shared<Args>();
-    CLI::App* command = app.add_subcommand("info", "Describe a cloud or mesh file: counts, bounds, global shift, fields with min/max");
+    CLI::App* command = app.add_subcommand("info", "Describe a cloud or mesh file: counts, bounds, global shift, fields with min/max; an E57 file's scans (pose, counts) and images");
     command->add_option("FILE", args->file, "Input file")->required();
     command->add_flag("--json", args->json, "Print JSON instead of text");
+    command->add_option("--extract-images", args->imageFolder, "E57: write the file's images (JPEG/PNG) into this folder");
     args->read.addTo(*command);
     command->callback([args, &registry, streams] {
         TerminalProgress progress;
-        const io::Entity entity = io::readFile(registry.formats, args->file, args->read.toOptions(&progress));
-        const nlohmann::json j = describe(entity, args->file);
+        nlohmann::json j;
+        if (io::lowerExtension(args->file) == "e57") {
+            // Every scan and image the file lists; the points (all scans together) only when there are some.
+            const io::E57Summary summary = io::inspectE57(args->file);
+            if (!summary.scans.empty())
+                j = describe(io::readFile(registry.formats, args->file, args->read.toOptions(&progress)), args->file);
+            else
+                j["file"] = args->file;
+            j["e57"] = describeE57(summary);
+            if (!args->imageFolder.empty())
+                for (const auto& written : io::extractE57Images(args->file, args->imageFolder))
+                    streams.err << "wrote " << written.string() << '\n';
+        } else {
+            if (!args->imageFolder.empty())
+                throw scandiff::Error(ErrorCode::InvalidArgument, "--extract-images: only E57 files hold images");
+            j = describe(io::readFile(registry.formats, args->file, args->read.toOptions(&progress)), args->file);
+        }
         if (args->json)
             streams.out << j.dump(2) << '\n';
         else

@@ -10,6 +10,7 @@ void registerBuiltinFormats(FormatRegistry& registry)
     registry.add(detail::lasFormat());
     registry.add(detail::lazFormat());
     registry.add(detail::pcdFormat());
+    registry.add(detail::e57Format());
     registry.add(detail::meshFormat());
     registry.add(detail::dxfFormat());
     registry.add(detail::geoTiffFormat());

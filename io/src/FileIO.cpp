@@ -39,7 +39,9 @@ const FormatHandler& FormatRegistry::forPath(const fs::path& path) const
     throw Error(ErrorCode::Unsupported, path.string() + ": unknown file extension '" + ext + "' (supported: " + known + ")");
 }
 
-Entity readFile(const FormatRegistry& registry, const fs::path& path, const ReadOptions& options)
+namespace {
+
+const FormatHandler& readerFor(const FormatRegistry& registry, const fs::path& path)
 {
     const FormatHandler& handler = registry.forPath(path);
     if (!handler.read)
@@ -47,7 +49,12 @@ Entity readFile(const FormatRegistry& registry, const fs::path& path, const Read
     std::error_code ec;
     if (!fs::exists(path, ec))
         throw Error(ErrorCode::Io, path.string() + ": no such file");
-    Entity entity = handler.read(path, options);
+    return handler;
+}
+
+//! What every reader's result gets: the coordinate system given by the user, and a name.
+void finishEntity(Entity& entity, const fs::path& path, const ReadOptions& options)
+{
     if (!options.crsWkt.empty()) {
         PointCloud& points = std::holds_alternative<Mesh>(entity) ? std::get<Mesh>(entity).vertices : std::get<PointCloud>(entity);
         if (points.crsWkt().empty())
@@ -61,7 +68,29 @@ Entity readFile(const FormatRegistry& registry, const fs::path& path, const Read
         if (e.name.empty())
             e.name = stem;
     }, entity);
+}
+
+} // namespace
+
+Entity readFile(const FormatRegistry& registry, const fs::path& path, const ReadOptions& options)
+{
+    const FormatHandler& handler = readerFor(registry, path);
+    Entity entity = handler.read(path, options);
+    finishEntity(entity, path, options);
     return entity;
+}
+
+std::vector<Entity> readEntities(const FormatRegistry& registry, const fs::path& path, const ReadOptions& options)
+{
+    const FormatHandler& handler = readerFor(registry, path);
+    std::vector<Entity> entities;
+    if (handler.readAll)
+        entities = handler.readAll(path, options);
+    else
+        entities.push_back(handler.read(path, options));
+    for (Entity& entity : entities)
+        finishEntity(entity, path, options);
+    return entities;
 }
 
 PointCloud readPointCloud(const FormatRegistry& registry, const fs::path& path, const ReadOptions& options)
@@ -92,6 +121,22 @@ void writePointCloud(const FormatRegistry& registry, const PointCloud& cloud, co
         throw Error(ErrorCode::Unsupported, path.string() + ": " + handler.name + " cannot store point clouds");
     cloud.checkConsistency();
     handler.writeCloud(cloud, path, options);
+}
+
+void writePointClouds(const FormatRegistry& registry, const std::vector<const PointCloud*>& clouds, const fs::path& path,
+                      const WriteOptions& options)
+{
+    if (clouds.size() == 1) {
+        writePointCloud(registry, *clouds.front(), path, options);
+        return;
+    }
+    const FormatHandler& handler = registry.forPath(path);
+    if (!handler.writeClouds)
+        throw Error(ErrorCode::Unsupported, path.string() + ": " + handler.name + " holds one cloud, not " + std::to_string(clouds.size()) +
+                                                " (E57 holds several; or merge them first)");
+    for (const PointCloud* cloud : clouds)
+        cloud->checkConsistency();
+    handler.writeClouds(clouds, path, options);
 }
 
 void writeMesh(const FormatRegistry& registry, const Mesh& mesh, const fs::path& path, const WriteOptions& options)

@@ -2,6 +2,7 @@
 #include "CliRunner.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/io/E57.h>
 
 #include "TestSupport.h"
 
@@ -57,7 +58,7 @@ TEST(Cli, InfoTextAndConvertRoundTrip)
     ASSERT_EQ(run.status, 0) << run.err;
     EXPECT_NE(run.out.find("points:        4"), std::string::npos) << run.out;
     EXPECT_NE(run.out.find("intensity"), std::string::npos);
-    for (const char* ext : {"las", "xyz", "pcd", "ply"}) {
+    for (const char* ext : {"las", "xyz", "pcd", "e57", "ply"}) {
         const auto out = dir / (std::string("converted.") + ext);
         run = test::runCliInProcess(registry, {"convert", file.string(), out.string()});
         ASSERT_EQ(run.status, 0) << ext << ": " << run.err;
@@ -66,6 +67,53 @@ TEST(Cli, InfoTextAndConvertRoundTrip)
         EXPECT_NEAR(back.globalPosition(2).y(), 5423002.0, 1e-3) << ext;
         ASSERT_NE(back.field("intensity"), nullptr) << ext;
     }
+}
+
+TEST(Cli, InfoListsTheScansAndImagesOfAnE57AndConvertKeepsItsScans)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    const std::filesystem::path samples = std::filesystem::path(SCANDIFF_SAMPLE_DATA_DIR) / "e57";
+    // Images only: listed with their size, extracted as JPEG files.
+    test::CliRun run = test::runCliInProcess(registry, {"info", (samples / "PinholeImageWithDistortionParameters.e57").string(), "--json",
+                                                        "--extract-images", dir.string()});
+    ASSERT_EQ(run.status, 0) << run.err;
+    auto j = nlohmann::json::parse(run.out);
+    ASSERT_EQ(j["e57"]["images"].size(), 3u);
+    EXPECT_EQ(j["e57"]["images"][2]["name"], "JPEG Image Test 3");
+    EXPECT_EQ(j["e57"]["images"][2]["bytes"], 375);
+    EXPECT_TRUE(std::filesystem::exists(dir / "JPEG Image Test 3.jpg"));
+
+    // Two scans, one posed: info lists both with their pose and counts; convert E57 -> E57 keeps them apart.
+    PointCloud a, b;
+    a.name = "station A";
+    b.name = "station B";
+    a.resize(10);
+    b.resize(7);
+    SensorPose pose;
+    pose.position = Eigen::Vector3d(1, 2, 3);
+    a.sensors().push_back(pose);
+    const auto two = dir / "two.e57";
+    io::writePointClouds(registry.formats, {&a, &b}, two);
+    run = test::runCliInProcess(registry, {"info", two.string()});
+    ASSERT_EQ(run.status, 0) << run.err;
+    EXPECT_NE(run.out.find("E57 scans:     2"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("[0] 'station A'  10 records, cartesian, at 1, 2, 3"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("[1] 'station B'  7 records, cartesian, no pose"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("points:        17"), std::string::npos) << run.out;
+    run = test::runCliInProcess(registry, {"convert", two.string(), (dir / "copy.e57").string()});
+    ASSERT_EQ(run.status, 0) << run.err;
+    EXPECT_EQ(io::readE57Scans(dir / "copy.e57").size(), 2u);
+    run = test::runCliInProcess(registry, {"convert", two.string(), (dir / "merged.ply").string()});
+    ASSERT_EQ(run.status, 0) << run.err;
+    const PointCloud merged = io::readPointCloud(registry.formats, dir / "merged.ply");
+    EXPECT_EQ(merged.size(), 17u);
+    ASSERT_NE(merged.field("scan_index"), nullptr);
+
+    // Broken files: a message naming the problem and a non-zero status.
+    run = test::runCliInProcess(registry, {"info", (samples / "bad-crc.e57").string()});
+    EXPECT_NE(run.status, 0);
+    EXPECT_NE(run.err.find("checksum of page 0"), std::string::npos) << run.err;
 }
 
 TEST(Cli, ErrorsExitNonZeroWithAMessage)

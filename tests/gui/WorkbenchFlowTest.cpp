@@ -8,6 +8,7 @@
 #include "WallScenes.h"
 
 #include <scandiff/io/DxfReader.h>
+#include <scandiff/io/E57.h>
 #include "controllers/GlobalShiftDialog.h"
 #include "panels/ConsolePanel.h"
 #include "tools/MeasurePanel.h"
@@ -22,6 +23,7 @@
 #include "controllers/ToolController.h"
 #include "tools/ParameterForm.h"
 #include "tools/TableDialog.h"
+#include "tools/ToolDialog.h"
 #include "view/CloudView.h"
 #include "widgets/RangeEditor.h"
 
@@ -304,6 +306,64 @@ private slots:
                 QVERIFY(window.document().item(window.document().item(id).parent).points().field("stone_id"));
             }
         QCOMPARE(drawings, std::size_t(1));
+    }
+
+    void multiScanE57OpensAsAGroupOfScansAndExportsBack()
+    {
+        // An E57 of two stations opens as one entity per scan under a group
+        // named after the file; tools see the scans, not the group; exporting
+        // the group writes both scans to one E57; a session keeps the tree.
+        QTemporaryDir dir;
+        const std::string e57 = dir.filePath("survey.e57").toStdString();
+        {
+            PointCloud north, south;
+            north.name = "north";
+            south.name = "south";
+            for (PointCloud* scan : {&north, &south}) {
+                scan->setOrigin(Eigen::Vector3d(652000.0, 6862000.0, 0.0));
+                scan->resize(500);
+                for (std::size_t i = 0; i < 500; ++i)
+                    scan->positions()[i] = Eigen::Vector3f(float(i % 25), float(i / 25), scan == &north ? 10.0f : 12.5f);
+            }
+            SensorPose station;
+            station.position = Eigen::Vector3d(652010.0, 6862010.0, 1.5);
+            north.sensors().push_back(station);
+            io::writeE57({&north, &south}, e57);
+        }
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
+        QCOMPARE(window.openFiles({QString::fromStdString(e57)}, true), 2);
+        gui::Document& document = window.document();
+        QCOMPARE(document.size(), std::size_t(3));
+        const EntityId group = document.ids()[0];
+        QVERIFY(document.item(group).isGroup());
+        QCOMPARE(document.item(group).name, QString("survey"));
+        const std::vector<EntityId> scans = document.children(group);
+        QCOMPARE(scans.size(), std::size_t(2));
+        QCOMPARE(document.item(scans[0]).name, QString("north"));
+        QCOMPARE(document.item(scans[0]).points().size(), std::size_t(500));
+        QCOMPARE(document.item(scans[0]).points().sensors().size(), std::size_t(1));
+        // Both scans keep the site's origin: their points are where they were.
+        QCOMPARE(document.item(scans[1]).points().globalPosition(26), Eigen::Vector3d(652001.0, 6862001.0, 12.5));
+        const std::vector<EntityId> inputs = gui::acceptedEntities(document, InputSpec{});
+        QVERIFY(std::find(inputs.begin(), inputs.end(), group) == inputs.end());
+        QCOMPARE(inputs.size(), std::size_t(2));
+
+        const QString exported = dir.filePath("again.e57");
+        QVERIFY(window.files()->exportEntity(group, exported));
+        const std::vector<PointCloud> back = io::readE57Scans(exported.toStdString());
+        QCOMPARE(back.size(), std::size_t(2));
+        QCOMPARE(back[1].name, std::string("south"));
+        QCOMPARE(back[1].size(), std::size_t(500));
+
+        const QString session = dir.filePath("survey.scandiff");
+        QVERIFY(window.sessions()->save(session));
+        document.clear();
+        QVERIFY(window.sessions()->restore(session));
+        QCOMPARE(document.size(), std::size_t(3));
+        QVERIFY(document.item(document.ids()[0]).isGroup());
+        QCOMPARE(document.children(document.ids()[0]).size(), std::size_t(2));
     }
 
     void processingToolsFromTheMenusDeclarations()

@@ -56,13 +56,13 @@ std::vector<EntityId> FileController::open(const QStringList& paths, bool quiet)
 {
     std::vector<EntityId> loaded;
     for (const QString& path : paths) {
-        std::optional<io::Entity> entity;
+        std::vector<io::Entity> entities;
         QElapsedTimer clock;
         clock.start();
         const TaskResult result = runTask(parentWindow_, tr("Opening %1").arg(QFileInfo(path).fileName()), [&](ProgressObserver& progress) {
             io::ReadOptions options;
             options.progress = &progress;
-            entity = io::readFile(registry_.formats, path.toStdString(), options);
+            entities = io::readEntities(registry_.formats, path.toStdString(), options);
         });
         if (result.outcome != TaskOutcome::Done) {
             if (result.outcome == TaskOutcome::Cancelled) {
@@ -76,23 +76,57 @@ std::vector<EntityId> FileController::open(const QStringList& paths, bool quiet)
         }
         // The time the user takes to answer the global-shift question is not the file's.
         const qint64 readMilliseconds = clock.elapsed();
-        if (auto* cloud = std::get_if<PointCloud>(&*entity))
-            chooseOrigin(path, *cloud, quiet);
-        else
-            chooseOrigin(path, std::get<Mesh>(*entity).vertices, quiet);
+        // The scans of one file share their origin (the reader chose one for
+        // all): one question, and the answer applied to every scan.
+        std::optional<Eigen::Vector3d> chosen;
+        for (io::Entity& entity : entities) {
+            PointCloud& points = pointsOf(entity);
+            if (!chosen) {
+                chooseOrigin(path, points, quiet);
+                chosen = points.origin();
+            } else if (!points.empty() && points.origin() != *chosen) {
+                shiftIfPrecise(path, points, *chosen);
+            }
+        }
         clock.restart();
-        const bool isMesh = std::holds_alternative<Mesh>(*entity);
-        const std::size_t points = isMesh ? std::get<Mesh>(*entity).vertices.size() : std::get<PointCloud>(*entity).size();
+        const bool isMesh = entities.size() == 1 && std::holds_alternative<Mesh>(entities.front());
+        std::size_t points = 0;
+        for (const io::Entity& entity : entities)
+            points += pointsOf(entity).size();
         const QString absolute = QFileInfo(path).absoluteFilePath();
-        loaded.push_back(document_.add(QFileInfo(path).completeBaseName(), std::move(*entity), kNoEntity, absolute));
+        if (entities.size() == 1) {
+            loaded.push_back(document_.add(QFileInfo(path).completeBaseName(), std::move(entities.front()), kNoEntity, absolute));
+        } else {
+            // One entity per part (scan), grouped under the file as CloudCompare users expect.
+            Document::UndoGroup step(document_, tr("Open %1").arg(QFileInfo(path).fileName()));
+            const EntityId group = document_.addGroup(QFileInfo(path).completeBaseName(), kNoEntity, absolute);
+            for (io::Entity& entity : entities) {
+                const QString name = QString::fromStdString(pointsOf(entity).name);
+                loaded.push_back(document_.add(name, std::move(entity), group, absolute));
+            }
+        }
         remember(absolute);
-        emit finished(tr("opened %1: %2 %3 in %4 s")
+        emit finished(tr("opened %1: %2 %3%4 in %5 s")
                           .arg(absolute)
                           .arg(points)
                           .arg(isMesh ? tr("vertices") : tr("points"))
+                          .arg(entities.size() > 1 ? tr(" in %1 scans").arg(entities.size()) : QString())
                           .arg((readMilliseconds + clock.elapsed()) / 1000.0, 0, 'f', 3));
     }
     return loaded;
+}
+
+void FileController::shiftIfPrecise(const QString& path, PointCloud& points, const Eigen::Vector3d& origin)
+{
+    const BoundingBox box = points.bounds();
+    const double reach = std::max((box.min - origin).cwiseAbs().maxCoeff(), (box.max - origin).cwiseAbs().maxCoeff());
+    if (reach > 8192.0) {
+        emit failed(tr("%1: '%2' is %3 m from the origin of the file's other scans; kept its own origin to keep every millimetre")
+                        .arg(QFileInfo(path).fileName(), QString::fromStdString(points.name))
+                        .arg(reach, 0, 'f', 0));
+        return;
+    }
+    points.shiftOrigin(origin);
 }
 
 void FileController::chooseOrigin(const QString& path, PointCloud& points, bool quiet)
@@ -153,12 +187,25 @@ bool FileController::exportEntity(EntityId id, const QString& path)
         emit finished(tr("exported %1 to %2 (%3 polylines)").arg(item->name, path).arg(item->drawing->polylines.size()));
         return true;
     }
+    // A group's scans go together into one file of a format that holds several (E57).
+    std::vector<const PointCloud*> scans;
+    if (item->isGroup())
+        for (EntityId child : document_.children(id))
+            if (const PointCloud* cloud = document_.item(child).cloud())
+                scans.push_back(cloud);
+    if (item->isGroup() && scans.empty()) {
+        emit failed(tr("%1 holds no point cloud to export").arg(item->name));
+        return false;
+    }
     QElapsedTimer clock;
     clock.start();
     const TaskResult result = runTask(parentWindow_, tr("Writing %1").arg(QFileInfo(path).fileName()), [&](ProgressObserver& progress) {
         io::WriteOptions options;
         options.progress = &progress;
-        io::writeFile(registry_.formats, item->entity, path.toStdString(), options);
+        if (item->isGroup())
+            io::writePointClouds(registry_.formats, scans, path.toStdString(), options);
+        else
+            io::writeFile(registry_.formats, item->entity, path.toStdString(), options);
     });
     if (result.outcome != TaskOutcome::Done) {
         if (result.outcome == TaskOutcome::Cancelled)
@@ -168,9 +215,12 @@ bool FileController::exportEntity(EntityId id, const QString& path)
         return false;
     }
     document_.markSaved(id);
+    std::size_t points = item->points().size();
+    for (const PointCloud* scan : scans)
+        points += scan->size();
     emit finished(tr("exported %1 to %2 (%3 points, %4 fields) in %5 s")
                       .arg(item->name, path)
-                      .arg(item->points().size())
+                      .arg(points)
                       .arg(item->points().fields().size())
                       .arg(clock.elapsed() / 1000.0, 0, 'f', 3));
     return true;
@@ -184,9 +234,10 @@ void FileController::exportWithDialog(const std::vector<EntityId>& ids)
     }
     if (ids.size() == 1) {
         const Document::Item& item = document_.item(ids.front());
-        QString selectedFilter = item.isDrawing() ? "DXF drawing (*.dxf)" : "PLY (*.ply)";
+        // A group (the scans of one file) goes to E57, which holds several scans.
+        QString selectedFilter = item.isDrawing() ? "DXF drawing (*.dxf)" : item.isGroup() ? "E57 (*.e57)" : "PLY (*.ply)";
         const QString path = QFileDialog::getSaveFileName(parentWindow_, tr("Export %1").arg(item.name),
-                                                          item.name + (item.isDrawing() ? ".dxf" : ".ply"),
+                                                          item.name + (item.isDrawing() ? ".dxf" : item.isGroup() ? ".e57" : ".ply"),
                                                           item.isDrawing() ? selectedFilter : fileFilter(true), &selectedFilter);
         if (!path.isEmpty() && exportEntity(ids.front(), path))
             return;
@@ -200,7 +251,7 @@ void FileController::exportWithDialog(const std::vector<EntityId>& ids)
         // Names become file names: no separators, and two entities never share a file.
         QString base = document_.item(id).name;
         base.replace(QRegularExpression(R"([/\\:*?"<>|])"), "_");
-        const QString extension = document_.item(id).isDrawing() ? ".dxf" : ".ply";
+        const QString extension = document_.item(id).isDrawing() ? ".dxf" : document_.item(id).isGroup() ? ".e57" : ".ply";
         QString name = base + extension;
         for (int n = 2; used.contains(name) || QFileInfo::exists(QDir(folder).filePath(name)); ++n)
             name = QString("%1_%2%3").arg(base).arg(n).arg(extension);

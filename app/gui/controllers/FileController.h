@@ -53,6 +53,9 @@ private:
     //! A cloud far from 0 (the reader chose an origin): the global-shift
     //! question, unless `quiet` or answered for the whole session.
     void chooseOrigin(const QString& path, PointCloud& points, bool quiet);
+    //! Moves another part of the same file onto the origin chosen for its first
+    //! part, unless float32 could not then hold a millimetre of it.
+    void shiftIfPrecise(const QString& path, PointCloud& points, const Eigen::Vector3d& origin);
     std::optional<Eigen::Vector3d> sessionOrigin_; //!< "for every file of this session"
     const PluginRegistry& registry_;
     Document& document_;

@@ -129,10 +129,10 @@ bool SessionController::save(const QString& qpath)
     std::vector<std::pair<std::shared_ptr<const Drawing>, std::string>> drawings; // as DXF
     for (EntityId id : document_.ids()) {
         const Document::Item& item = document_.item(id);
-        const std::string file = "entity_" + std::to_string(id) + (item.isDrawing() ? ".dxf" : ".ply");
+        const std::string file = item.isGroup() ? std::string() : "entity_" + std::to_string(id) + (item.isDrawing() ? ".dxf" : ".ply");
         if (item.isDrawing())
             drawings.emplace_back(item.drawing, file);
-        else
+        else if (!item.isGroup())
             files.emplace_back(&item.entity, file);
         json fields = json::object();
         for (const auto& [name, display] : item.display.fields)
@@ -142,7 +142,7 @@ bool SessionController::save(const QString& qpath)
         entities.push_back({{"id", id},
                             {"name", item.name.toStdString()},
                             {"parent", item.parent},
-                            {"data", data.filename().string() + "/" + file},
+                            {"data", file.empty() ? std::string() : data.filename().string() + "/" + file},
                             {"source", item.sourcePath.toStdString()},
                             {"visible", item.display.visible},
                             {"activeField", item.display.activeField},
@@ -150,7 +150,7 @@ bool SessionController::save(const QString& qpath)
                             {"pointSize", item.display.pointSize},
                             {"outside", item.display.outside == FieldColouring::Outside::Grey ? "grey" : "hide"},
                             {"fields", fields},
-                            {"kind", item.isDrawing() ? "drawing" : "data"},
+                            {"kind", item.isGroup() ? "group" : item.isDrawing() ? "drawing" : "data"},
                             {"provenance", provenanceJson(item.points())}});
     }
     json scales = json::array();
@@ -224,6 +224,7 @@ bool SessionController::restore(const QString& qpath)
         std::map<std::string, FieldDisplay> fields;
         io::Entity entity;
         std::optional<Drawing> drawing;
+        bool group = false;
     };
     std::vector<Entry> entries;
     std::vector<ColourScale> scales;
@@ -264,6 +265,11 @@ bool SessionController::restore(const QString& qpath)
                     display.colourHigh = bound(f.value("colourHigh", json(nullptr)), std::numeric_limits<double>::infinity());
                     display.symmetric = f.value("symmetric", false);
                     entry.fields[name] = display;
+                }
+                if (e.value("kind", std::string("data")) == "group") {
+                    entry.group = true;
+                    entries.push_back(std::move(entry));
+                    continue;
                 }
                 if (e.value("kind", std::string("data")) == "drawing") {
                     entry.drawing = io::readDrawingDxf(path.parent_path() / e.at("data").get<std::string>(), &progress);
@@ -309,8 +315,9 @@ bool SessionController::restore(const QString& qpath)
     for (Entry& e : entries) {
         const auto parent = newIds.find(e.parent);
         const EntityId parentId = parent == newIds.end() ? kNoEntity : parent->second;
-        const EntityId id = e.drawing ? document_.addDrawing(e.name, std::move(*e.drawing), parentId, e.source)
-                                      : document_.add(e.name, std::move(e.entity), parentId, e.source);
+        const EntityId id = e.group     ? document_.addGroup(e.name, parentId, e.source)
+                            : e.drawing ? document_.addDrawing(e.name, std::move(*e.drawing), parentId, e.source)
+                                        : document_.add(e.name, std::move(e.entity), parentId, e.source);
         newIds[e.id] = id;
         for (const auto& [name, display] : e.fields)
             document_.setFieldDisplay(id, name, display);

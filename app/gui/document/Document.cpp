@@ -51,6 +51,30 @@ EntityId Document::addDrawing(QString name, Drawing drawing, EntityId parent, QS
     return id;
 }
 
+EntityId Document::addGroup(QString name, EntityId parent, QString sourcePath)
+{
+    auto item = std::make_unique<Item>();
+    item->id = nextId_++;
+    item->name = std::move(name);
+    item->entity = PointCloud{};
+    item->group = true;
+    item->parent = contains(parent) ? parent : kNoEntity;
+    item->sourcePath = std::move(sourcePath);
+    const EntityId id = item->id;
+    items_.push_back(std::move(item));
+    emit added(id);
+    return id;
+}
+
+std::vector<EntityId> Document::children(EntityId id) const
+{
+    std::vector<EntityId> out;
+    for (const auto& item : items_)
+        if (item->parent == id)
+            out.push_back(item->id);
+    return out;
+}
+
 void Document::remove(EntityId id)
 {
     const Item* item = find(id);

@@ -75,10 +75,16 @@ public:
         //! A drawing a tool gave (contours, sections): its polylines, drawn
         //! over the clouds; `entity` is then an empty cloud, and cloud() null.
         std::shared_ptr<const Drawing> drawing;
+        //! A folder of the tree holding the parts of one file (the scans of an
+        //! E57): no data of its own (`entity` is an empty cloud, cloud() null).
+        bool group = false;
 
-        const PointCloud* cloud() const { return drawing ? nullptr : std::get_if<PointCloud>(&entity); }
+        const PointCloud* cloud() const { return drawing || group ? nullptr : std::get_if<PointCloud>(&entity); }
         const Mesh* mesh() const { return std::get_if<Mesh>(&entity); }
         bool isDrawing() const { return drawing != nullptr; }
+        bool isGroup() const { return group; }
+        //! Holds points or triangles (not a drawing, not a group).
+        bool hasData() const { return !drawing && !group; }
         //! The points of a cloud, or the vertices of a mesh.
         const PointCloud& points() const;
     };
@@ -87,6 +93,10 @@ public:
     EntityId add(QString name, io::Entity entity, EntityId parent = kNoEntity, QString sourcePath = {});
     //! Takes a drawing (polylines and labels, global coordinates); returns its id.
     EntityId addDrawing(QString name, Drawing drawing, EntityId parent = kNoEntity, QString sourcePath = {});
+    //! A group for the parts of one file; its children name it as their parent.
+    EntityId addGroup(QString name, EntityId parent = kNoEntity, QString sourcePath = {});
+    //! The direct children of an entity, in the order they were added.
+    std::vector<EntityId> children(EntityId id) const;
     //! Removes the entity and its descendants.
     void remove(EntityId id);
     void clear();

@@ -14,6 +14,8 @@ QString describe(const Document::Item& item)
 {
     if (item.isDrawing())
         return QObject::tr("drawing, %1 polylines").arg(item.drawing->polylines.size());
+    if (item.isGroup())
+        return QObject::tr("group");
     if (const Mesh* mesh = item.mesh())
         return QObject::tr("mesh, %1 triangles").arg(mesh->triangles.size());
     return QObject::tr("%1 points").arg(item.points().size());
@@ -57,7 +59,8 @@ void EntityTree::addRow(EntityId id)
     auto* row = new QTreeWidgetItem;
     row->setData(0, kEntityRole, id);
     row->setData(0, kFieldRole, QString());
-    row->setIcon(0, style()->standardIcon(item.isDrawing() ? QStyle::SP_FileDialogContentsView
+    row->setIcon(0, style()->standardIcon(item.isGroup()     ? QStyle::SP_DirIcon
+                                          : item.isDrawing() ? QStyle::SP_FileDialogContentsView
                                           : item.mesh()    ? QStyle::SP_FileDialogDetailedView
                                                            : QStyle::SP_FileIcon));
     row->setFlags(row->flags() | Qt::ItemIsUserCheckable);

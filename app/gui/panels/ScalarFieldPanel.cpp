@@ -150,7 +150,7 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
 void ScalarFieldPanel::showEntity(EntityId id)
 {
     // A drawing has no scalar field: the panel waits for a cloud.
-    entity_ = document_.contains(id) && !document_.item(id).isDrawing() ? id : kNoEntity;
+    entity_ = document_.contains(id) && document_.item(id).hasData() ? id : kNoEntity;
     refresh();
 }
 

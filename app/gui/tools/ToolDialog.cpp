@@ -21,7 +21,7 @@ std::vector<EntityId> acceptedEntities(const Document& document, const InputSpec
 {
     std::vector<EntityId> out;
     for (EntityId id : document.ids())
-        if (!document.item(id).isDrawing() && (input.kind != DataKind::Mesh || document.item(id).mesh()))
+        if (document.item(id).hasData() && (input.kind != DataKind::Mesh || document.item(id).mesh()))
             out.push_back(id);
     return out;
 }

@@ -259,6 +259,8 @@ CloudView::~CloudView() = default;
 
 void CloudView::addEntity(const Document::Item& item)
 {
+    if (item.isGroup())
+        return; // its scans are entities of their own
     if (item.isDrawing()) {
         // Lines over the clouds, in the scene's frame (the first vertex sets
         // it when the drawing comes first), coloured by layer, unlit.

@@ -15,5 +15,6 @@ FormatHandler meshFormat();       // MeshFormats.cpp (readers in MeshReaders.cpp
 FormatHandler dxfFormat();        // DxfWriter.cpp (export only)
 FormatHandler geoTiffFormat();    // GeoTiffFormat.cpp (export of gridded clouds, GDAL)
 FormatHandler pngPreviewFormat();  // RasterPreview.cpp (picture of a gridded cloud, GDAL)
+FormatHandler e57Format();        // e57/E57Format.cpp (reader, writer and paged layer in e57/)
 
 } // namespace scandiff::io::detail

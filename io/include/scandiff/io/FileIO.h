@@ -3,7 +3,7 @@
 //! Reading and writing clouds and meshes, by file extension.
 //!
 //! A FormatRegistry maps extensions to format handlers. The built-in formats
-//! (PLY, ASCII XYZ/TXT/CSV/PTS/ASC, LAS, OBJ/STL/OFF read and written here, DXF export) are
+//! (PLY, ASCII XYZ/TXT/CSV/PTS/ASC, LAS/LAZ, E57, OBJ/STL/OFF read and written here, DXF export) are
 //! registered by registerBuiltinFormats(); plugins add more (PCD comes from the
 //! PCL plugin). Every writer goes through AtomicFile: an existing output file is
 //! never left half-written.
@@ -74,6 +74,11 @@ struct FormatHandler
     std::function<Entity(const std::filesystem::path&, const ReadOptions&)> read;
     std::function<void(const PointCloud&, const std::filesystem::path&, const WriteOptions&)> writeCloud;
     std::function<void(const Mesh&, const std::filesystem::path&, const WriteOptions&)> writeMesh;
+    //! Formats that hold several clouds (the scans of an E57 file): every one,
+    //! in file order. Null for formats of one entity.
+    std::function<std::vector<Entity>(const std::filesystem::path&, const ReadOptions&)> readAll;
+    //! Writes several clouds as the parts of one file (E57 scans). Null when the format holds one.
+    std::function<void(const std::vector<const PointCloud*>&, const std::filesystem::path&, const WriteOptions&)> writeClouds;
 };
 
 class FormatRegistry
@@ -89,16 +94,23 @@ private:
     std::vector<FormatHandler> handlers_;
 };
 
-//! Registers PLY, ASCII, LAS, PCD, OBJ/STL/OFF, DXF and GeoTIFF (gridded clouds).
+//! Registers PLY, ASCII, LAS/LAZ, E57, PCD, OBJ/STL/OFF, DXF and GeoTIFF (gridded clouds).
 void registerBuiltinFormats(FormatRegistry& registry);
 
 //! Reads any supported file. Throws Error naming the file on failure.
 Entity readFile(const FormatRegistry& registry, const std::filesystem::path& path, const ReadOptions& options = {});
+//! Every entity of a file: one per scan of a multi-scan format (E57), else
+//! the one readFile() gives. Each is named after its part ("scan 2") or the file.
+std::vector<Entity> readEntities(const FormatRegistry& registry, const std::filesystem::path& path, const ReadOptions& options = {});
 //! Reads a point cloud; a mesh file yields its vertices.
 PointCloud readPointCloud(const FormatRegistry& registry, const std::filesystem::path& path, const ReadOptions& options = {});
 //! Reads a mesh; throws Error(InvalidData) if the file holds no triangles.
 Mesh readMesh(const FormatRegistry& registry, const std::filesystem::path& path, const ReadOptions& options = {});
 void writePointCloud(const FormatRegistry& registry, const PointCloud& cloud, const std::filesystem::path& path, const WriteOptions& options = {});
+//! Writes several clouds into one file when the format holds several
+//! (E57), else throws Error(Unsupported) for more than one.
+void writePointClouds(const FormatRegistry& registry, const std::vector<const PointCloud*>& clouds, const std::filesystem::path& path,
+                      const WriteOptions& options = {});
 void writeMesh(const FormatRegistry& registry, const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options = {});
 void writeFile(const FormatRegistry& registry, const Entity& entity, const std::filesystem::path& path, const WriteOptions& options = {});
 
