@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-1800}
 shift || true
 extensions=("$@")
-[ ${#extensions[@]} -eq 0 ] && extensions=(ply pcd las xyz obj stl off)
+[ ${#extensions[@]} -eq 0 ] && extensions=(ply pcd las laz xyz obj stl off dxf e57)
 build=${FUZZ_BUILD_DIR:-build-fuzz}
 
 ./scripts/install-deps.sh fuzz

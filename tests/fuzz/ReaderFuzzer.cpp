@@ -8,6 +8,7 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/io/DxfReader.h>
+#include <scandiff/io/E57.h>
 #include <scandiff/io/FileIO.h>
 
 #include <cstddef>
@@ -57,6 +58,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         scandiff::io::readFile(formats(), inputPath());
     } catch (const scandiff::Error&) {
         // A clean refusal: what a broken file must give.
+    }
+    if (std::string(SCANDIFF_FUZZ_EXTENSION) == "e57") {
+        try {
+            scandiff::io::inspectE57(inputPath()); // scans and images as the XML lists them
+            scandiff::io::readEntities(formats(), inputPath());
+        } catch (const scandiff::Error&) {
+        }
     }
     if (std::string(SCANDIFF_FUZZ_EXTENSION) == "dxf") {
         try {

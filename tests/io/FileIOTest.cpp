@@ -39,15 +39,18 @@ TEST(FileIO, ExtensionsAreCaseInsensitive)
     EXPECT_EQ(io::lowerExtension("a/b/C.LaS"), "las");
 }
 
-TEST(FileIO, UnknownExtensionIsUnsupportedAndABrokenLazInvalid)
+TEST(FileIO, UnknownExtensionIsUnsupportedAndBrokenLazAndE57Invalid)
 {
     const auto registry = builtins();
     const auto dir = test::tempDir();
+    test::writeText(dir / "scan.fls", "x");
     test::writeText(dir / "scan.e57", "x");
     test::writeText(dir / "scan.laz", "LASF");
     std::string message;
-    EXPECT_EQ(readError(registry, dir / "scan.e57", &message), ErrorCode::Unsupported);
-    EXPECT_NE(message.find("scan.e57"), std::string::npos);
+    EXPECT_EQ(readError(registry, dir / "scan.fls", &message), ErrorCode::Unsupported);
+    EXPECT_NE(message.find("scan.fls"), std::string::npos);
+    EXPECT_EQ(readError(registry, dir / "scan.e57", &message), ErrorCode::InvalidData);
+    EXPECT_NE(message.find("not an E57 file"), std::string::npos) << message;
     EXPECT_EQ(readError(registry, dir / "scan.laz", &message), ErrorCode::InvalidData);
     EXPECT_NE(message.find("LAS header too short"), std::string::npos);
 }
