@@ -32,7 +32,8 @@ Entity readMerged(const fs::path& path, const ReadOptions& options)
     for (const PointCloud& scan : scans)
         parts.push_back(&scan);
     PointCloud merged = mergeClouds(parts, options.progress);
-    if (ScalarField* index = merged.field(fields::kSourceIndex))
+    // The scan each point came from; a file that already has such a field keeps it, and the index keeps merge's name.
+    if (ScalarField* index = merged.field(fields::kSourceIndex); index && !merged.field("scan_index"))
         index->rename("scan_index");
     merged.name = path.stem().string();
     return merged;

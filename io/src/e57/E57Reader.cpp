@@ -19,6 +19,12 @@
 #include <limits>
 #include <set>
 
+// E57's binary sections are little endian (ASTM E2807 §9): values are moved with
+// memcpy, which is only right on a little-endian host.
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "E57Reader.cpp assumes a little-endian host"
+#endif
+
 namespace scandiff::io {
 
 namespace fs = std::filesystem;
@@ -571,9 +577,9 @@ private:
                 if (copied.invalidFlag >= 0 && value(copied.invalidFlag, k) != 0.0)
                     continue; // stays NaN
                 const double v = value(copied.codec, k);
-                if (!offsetSet_[f]) {
+                if (!offsetSet_[f] && std::isfinite(v)) {
                     // Large values (a time stamp of ~1e9 s) around their first one, so the float view keeps detail.
-                    if (std::isfinite(v) && std::abs(v) > 1e5)
+                    if (std::abs(v) > 1e5)
                         fields_[f]->setOffset(std::floor(v));
                     offsetSet_[f] = true;
                 }

@@ -14,10 +14,17 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <cstring>
 #include <random>
 #include <sstream>
+
+// E57's binary sections are little endian (ASTM E2807 §9): values are moved with
+// memcpy, which is only right on a little-endian host.
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "E57Writer.cpp assumes a little-endian host"
+#endif
 
 namespace scandiff::io {
 
@@ -385,8 +392,20 @@ void writeScanSection(PagedWriter& writer, ScanPlan& plan, ProgressTicker& ticke
         for (std::size_t s = 0; s < plan.fields.size(); ++s) {
             const WrittenField& f = plan.fields[s];
             bytes[s].clear();
-            for (std::uint64_t i = begin; i < end; ++i)
-                streams[s].put(f.raw(static_cast<std::size_t>(i)), f.bits, bytes[s]);
+            if (f.bits % 8 == 0 && streams[s].bits == 0) {
+                // Whole bytes (coordinates, floats, 8-bit colours): the value's
+                // little-endian bytes as they are, without the bit shifting.
+                const std::size_t width = static_cast<std::size_t>(f.bits) / 8;
+                bytes[s].resize(width * static_cast<std::size_t>(end - begin));
+                char* out = bytes[s].data();
+                for (std::uint64_t i = begin; i < end; ++i, out += width) {
+                    const std::uint64_t raw = f.raw(static_cast<std::size_t>(i));
+                    std::memcpy(out, &raw, width);
+                }
+            } else {
+                for (std::uint64_t i = begin; i < end; ++i)
+                    streams[s].put(f.raw(static_cast<std::size_t>(i)), f.bits, bytes[s]);
+            }
             if (end == total)
                 streams[s].flush(bytes[s]);
         }
