@@ -81,7 +81,10 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
 
     // The view follows the document.
     connect(&document_, &Document::added, this, [this](EntityId id) {
-        const bool first = document_.size() == 1;
+        // The first entity with points frames the view (a group before its scans does not count).
+        bool first = document_.item(id).hasData();
+        for (EntityId other : document_.ids())
+            first = first && (other == id || !document_.item(other).hasData());
         view_->addEntity(document_.item(id));
         if (first)
             view_->resetCamera();

@@ -350,6 +350,12 @@ private slots:
         QVERIFY(std::find(inputs.begin(), inputs.end(), group) == inputs.end());
         QCOMPARE(inputs.size(), std::size_t(2));
 
+        // The group's checkbox hides and shows its scans.
+        document.setVisible(group, false);
+        QVERIFY(!document.item(scans[0]).display.visible && !document.item(scans[1]).display.visible);
+        document.setVisible(group, true);
+        QVERIFY(document.item(scans[0]).display.visible && document.item(scans[1]).display.visible);
+
         const QString exported = dir.filePath("again.e57");
         QVERIFY(window.files()->exportEntity(group, exported));
         const std::vector<PointCloud> back = io::readE57Scans(exported.toStdString());

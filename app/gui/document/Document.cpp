@@ -236,6 +236,10 @@ void Document::addField(EntityId id, ScalarField field)
 void Document::setVisible(EntityId id, bool visible)
 {
     setDisplayMember(id, &DisplayState::visible, visible);
+    // A group's checkbox is its scans'.
+    if (const Item* item = find(id); item && item->isGroup())
+        for (EntityId child : children(id))
+            setVisible(child, visible);
 }
 
 void Document::setActiveField(EntityId id, const std::string& fieldName)

@@ -116,6 +116,24 @@ void PropertiesPanel::rebuild()
         for (const auto& [name, count] : layers)
             add(layerRows, QString::fromStdString(name), tr("%1 polylines").arg(count));
         layerRows->setExpanded(layers.size() <= 20);
+    } else if (item && item->isGroup()) {
+        // The parts of one file (the scans of an E57): what they hold together.
+        add(nullptr, tr("Name"), item->name);
+        add(nullptr, tr("Type"), tr("Group"));
+        if (!item->sourcePath.isEmpty())
+            add(nullptr, tr("File"), item->sourcePath);
+        std::size_t total = 0;
+        QTreeWidgetItem* parts = add(nullptr, tr("Scans"), QString());
+        for (EntityId child : document_.children(item->id)) {
+            const Document::Item& part = document_.item(child);
+            total += part.points().size();
+            add(parts, part.name, tr("%1 points, %2").arg(part.points().size())
+                                      .arg(part.points().sensors().empty() ? tr("no sensor pose")
+                                                                           : tr("scanner at %1").arg(triple(part.points().sensors().front().position))));
+        }
+        parts->setText(1, QString::number(parts->childCount()));
+        parts->setExpanded(parts->childCount() <= 20);
+        add(nullptr, tr("Points"), QString::number(total));
     } else if (item) {
         const PointCloud& points = item->points();
         add(nullptr, tr("Name"), item->name);
