@@ -28,6 +28,11 @@
 //!                                              15 known shapes, 5 mm of noise,
 //!                                              5 % clutter, no normals; the truth
 //!                                              to OUTPUT.truth.txt, a shape a line)
+//!        scandiff-make-scan --facade POINTS OUTPUT SEED
+//!                                             (the sequential-RANSAC test's façade:
+//!                                              11 planes, turned 35° at UTM
+//!                                              coordinates, 3 mm of noise, 2 %
+//!                                              clutter; truth as above)
 
 #include "PrimitiveScene.h"
 #include "SyntheticSite.h"
@@ -148,10 +153,18 @@ int writeSite(int argc, char** argv)
     return 0;
 }
 
-int writePrimitiveScene(std::size_t points, const std::string& output, unsigned seed)
+int writePrimitiveScene(std::size_t points, const std::string& output, unsigned seed, bool facade)
 {
     using namespace scandiff;
-    const test::PrimitiveScene scene = test::makePrimitiveScene(test::testSceneShapes(), points, 0.005, 0.05, seed, false);
+    test::PrimitiveScene scene =
+        facade ? test::makePrimitiveScene(test::facadeSceneShapes(35.0 * M_PI / 180.0, Eigen::Vector3d::Zero()), points, 0.003, 0.02, seed, false)
+               : test::makePrimitiveScene(test::testSceneShapes(), points, 0.005, 0.05, seed, false);
+    if (facade) {
+        const Eigen::Vector3d at(512300.0, 5401200.0, 150.0);
+        scene.cloud.setOrigin(at);
+        for (auto& shape : scene.shapes)
+            shape.truth.point += at;
+    }
     io::FormatRegistry formats;
     io::registerBuiltinFormats(formats);
     io::writePointCloud(formats, scene.cloud, output);
@@ -166,9 +179,10 @@ int writePrimitiveScene(std::size_t points, const std::string& output, unsigned 
 
 int main(int argc, char** argv)
 {
-    if (argc == 5 && std::string(argv[1]) == "--primitives") {
+    if (argc == 5 && (std::string(argv[1]) == "--primitives" || std::string(argv[1]) == "--facade")) {
         try {
-            return writePrimitiveScene(std::stoull(argv[2]), argv[3], static_cast<unsigned>(std::stoul(argv[4])));
+            return writePrimitiveScene(std::stoull(argv[2]), argv[3], static_cast<unsigned>(std::stoul(argv[4])),
+                                       std::string(argv[1]) == "--facade");
         } catch (const std::exception& e) {
             std::cerr << "error: " << e.what() << '\n';
             return 1;

@@ -179,6 +179,55 @@ inline std::vector<SceneShape> testSceneShapes()
     return s;
 }
 
+//! A façade after thesis 001's scenes, turned by `azimuth` (radians) about
+//! the vertical: a 12 x 8 m wall with four windows, each window's glass 15 cm
+//! behind the wall (four disjoint coplanar plates), a sign 10 cm in front of
+//! the wall, a cornice and a string course (horizontal), two pilasters' sides
+//! across the façade, and a roof slope (inclined). The wall is shapes[0];
+//! the façade's outward normal is (-sin a, cos a, 0).
+inline std::vector<SceneShape> facadeSceneShapes(double azimuth, const Eigen::Vector3d& at)
+{
+    const Eigen::Vector3d along(std::cos(azimuth), std::sin(azimuth), 0), out(-std::sin(azimuth), std::cos(azimuth), 0),
+        up = Eigen::Vector3d::UnitZ();
+    struct Window
+    {
+        double x, z;
+    };
+    const std::vector<Window> windows = {{1.5, 1.0}, {4.5, 1.0}, {7.5, 1.0}, {1.5, 4.5}};
+    const double width = 1.2, height = 1.6;
+    std::vector<SceneShape> shapes;
+    // The wall: a rectangle sampled outside its windows (drawn again inside one).
+    SceneShape wall = scene::rectangle("wall", at, 12 * along, 8 * up);
+    wall.area = 96.0 - windows.size() * width * height;
+    wall.sample = [=](double a, double b, std::mt19937_64& rng, Eigen::Vector3d& p, Eigen::Vector3d& normal) {
+        std::uniform_real_distribution<double> uniform(0, 1);
+        for (;;) {
+            const double x = 12 * a, z = 8 * b;
+            bool inside = false;
+            for (const Window& w : windows)
+                inside = inside || (x > w.x && x < w.x + width && z > w.z && z < w.z + height);
+            if (!inside) {
+                p = at + x * along + z * up;
+                normal = out;
+                return;
+            }
+            a = uniform(rng);
+            b = uniform(rng);
+        }
+    };
+    shapes.push_back(wall);
+    for (std::size_t k = 0; k < windows.size(); ++k)
+        shapes.push_back(scene::rectangle("glass " + std::to_string(k), at + windows[k].x * along + windows[k].z * up - 0.15 * out,
+                                   width * along, height * up));
+    shapes.push_back(scene::rectangle("sign", at + 9.5 * along + 1.5 * up + 0.10 * out, 2.0 * along, 1.0 * up));
+    shapes.push_back(scene::rectangle("cornice", at + 8.0 * up, 12 * along, 0.4 * out));
+    shapes.push_back(scene::rectangle("string course", at + 3.2 * up, 12 * along, 0.2 * out));
+    shapes.push_back(scene::rectangle("pilaster left", at + 0.3 * along, 0.3 * out, 8 * up));
+    shapes.push_back(scene::rectangle("pilaster right", at + 11.7 * along, 0.3 * out, 8 * up));
+    shapes.push_back(scene::rectangle("roof", at + 8.0 * up - 0.5 * out, 12 * along, -3.0 * out + 2.0 * up));
+    return shapes;
+}
+
 //! Samples `shapes` with `points` points in all (a share `clutter` of them
 //! uniform in the box around the scene), noise along the normals, and sets
 //! the cloud's exact normals when asked.

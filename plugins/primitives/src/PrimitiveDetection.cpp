@@ -3,6 +3,7 @@
 
 #include "EfficientRansac.h"
 #include "RegionGrowing.h"
+#include "SequentialRansac.h"
 
 #include <scandiff/core/CloudOctree.h>
 #include <scandiff/core/Error.h>
@@ -247,8 +248,11 @@ void checkParameters(const PrimitiveDetectionParams& params)
     auto bad = [](const std::string& why) { throw Error(ErrorCode::InvalidArgument, "primitives: " + why); };
     if (params.kinds.empty())
         bad("no shape type asked for");
-    if (params.method == PrimitiveMethod::RegionGrowing && !params.kinds.count(PrimitiveKind::Plane))
-        bad("region growing grows planes: ask for planes, or use efficient RANSAC for curved shapes");
+    if (params.method != PrimitiveMethod::EfficientRansac && !params.kinds.count(PrimitiveKind::Plane))
+        bad(std::string(params.method == PrimitiveMethod::Sequential ? "sequential RANSAC finds" : "region growing grows") +
+            " planes: ask for planes, or use efficient RANSAC for curved shapes");
+    if (!(params.orientationToleranceDegrees > 0 && params.orientationToleranceDegrees < 45))
+        bad("the orientation tolerance must be between 0 and 45 degrees");
     if (params.epsilon && !(*params.epsilon > 0))
         bad("epsilon must be > 0");
     if (params.clusterEpsilon && !(*params.clusterEpsilon > 0))
@@ -271,7 +275,9 @@ PrimitiveMethod parsePrimitiveMethod(const std::string& name)
         return PrimitiveMethod::EfficientRansac;
     if (name == "region-growing")
         return PrimitiveMethod::RegionGrowing;
-    throw Error(ErrorCode::InvalidArgument, "primitives: method '" + name + "': expected efficient-ransac or region-growing");
+    if (name == "sequential")
+        return PrimitiveMethod::Sequential;
+    throw Error(ErrorCode::InvalidArgument, "primitives: method '" + name + "': expected efficient-ransac, region-growing or sequential");
 }
 
 PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const PrimitiveDetectionParams& params, ProgressObserver* progress)
@@ -295,7 +301,8 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
 
     std::vector<Eigen::Vector3f> normalsStore;
     const std::vector<Eigen::Vector3f>* normals = &cloud.normals();
-    if (!cloud.hasNormals()) {
+    // Sequential RANSAC uses coordinates only, as the thesis does.
+    if (!cloud.hasNormals() && params.method != PrimitiveMethod::Sequential) {
         // A neighbourhood wide enough for the noise to tilt a normal by no
         // more than about 5 degrees (radius >= 10 sigma), and holding a few
         // spacings: 12 neighbours of a dense, noisy scan give normals too
@@ -318,15 +325,17 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
     std::vector<Eigen::Vector3d> points(cloud.size()), unitNormals(cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         points[i] = cloud.positions()[i].cast<double>() - localCentre;
-        const Eigen::Vector3d n = (*normals)[i].cast<double>();
+        const Eigen::Vector3d n = normals->empty() ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : Eigen::Vector3d((*normals)[i].cast<double>());
         unitNormals[i] = n.norm() > 0 ? n.normalized() : Eigen::Vector3d::UnitZ();
     }
 
     std::vector<detail::RansacShape> found;
     bool cancelled = false;
     // A stage of its own: what the progress dialog shows (and the cancel-latency bench counts) after the normals.
-    const ProgressTicker findingStage(progress, params.method == PrimitiveMethod::RegionGrowing ? "Primitives: region growing"
-                                                                                                 : "Primitives: efficient RANSAC",
+    const ProgressTicker findingStage(progress,
+                                      params.method == PrimitiveMethod::RegionGrowing ? "Primitives: region growing"
+                                      : params.method == PrimitiveMethod::Sequential  ? "Primitives: sequential RANSAC"
+                                                                                      : "Primitives: efficient RANSAC",
                                       1);
     if (params.method == PrimitiveMethod::RegionGrowing) {
         detail::RegionGrowingSettings growing;
@@ -338,6 +347,21 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
             cancelled = cancelled || (progress && progress->cancelRequested());
             return !cancelled;
         });
+    } else if (params.method == PrimitiveMethod::Sequential) {
+        detail::SequentialSettings sequential;
+        sequential.distance = result.epsilon;
+        sequential.pixel = result.clusterEpsilon;
+        sequential.toleranceDegrees = params.orientationToleranceDegrees;
+        sequential.minPoints = params.minPoints;
+        sequential.probability = 1.0 - params.probability;
+        sequential.seed = params.seed;
+        detail::SequentialOutcome outcome = detail::sequentialPlanes(points, tree, sequential, [&] {
+            cancelled = cancelled || (progress && progress->cancelRequested());
+            return !cancelled;
+        });
+        found = std::move(outcome.planes);
+        result.facadeNormal = outcome.facadeNormal;
+        result.notes.insert(result.notes.end(), outcome.notes.begin(), outcome.notes.end());
     } else {
         found = findByRansac(points, unitNormals, params, result, progress, cancelled);
     }
@@ -346,10 +370,10 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
     ticker.step(60);
     // Region growing grows planes: the type check does not turn them into curved shapes.
     PrimitiveDetectionParams typeParams = params;
-    if (params.method == PrimitiveMethod::RegionGrowing) {
+    if (params.method != PrimitiveMethod::EfficientRansac) {
         typeParams.kinds = {PrimitiveKind::Plane};
         if (params.kinds.size() > 1)
-            result.notes.push_back("region growing grows planes: the other shape types asked for are left to efficient RANSAC");
+            result.notes.push_back("this method finds planes: the other shape types asked for are left to efficient RANSAC");
     }
 
     // Each shape refitted, its type checked; a curved shape that does not fit

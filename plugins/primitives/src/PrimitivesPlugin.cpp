@@ -184,8 +184,11 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
         ParameterSpec::choice("method", "Method",
                               "efficient-ransac: every shape type, from random samples (seeded); region-growing: planes grown from "
                               "the flattest points, each point joining a neighbour's region within the distance threshold and the "
-                              "normal deviation (no random draw), as thesis 004 compares with RANSAC",
-                              {"efficient-ransac", "region-growing"}, "efficient-ransac"),
+                              "normal deviation (no random draw), as thesis 004 compares with RANSAC; sequential: thesis 001's "
+                              "façade planes, one after the other by classes of orientation (across the façade, horizontal, "
+                              "inclined, parallel to it), each the largest connected region of its inliers (connectivity "
+                              "pixels of the connectivity distance), refitted by PCA; z must be up",
+                              {"efficient-ransac", "region-growing", "sequential"}, "efficient-ransac"),
         ParameterSpec::text("shapes", "Shape types", "Comma-separated: plane, sphere, cylinder, cone, torus",
                             "plane,sphere,cylinder,cone,torus")
             .withSuggestions({"plane,sphere,cylinder,cone,torus", "plane", "plane,cylinder", "plane,sphere,cylinder"}),
@@ -205,6 +208,11 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
         ParameterSpec::real("probability", "Miss probability", "RANSAC's chance of overlooking the largest remaining shape",
                             defaults.probability, 1e-6, 0.5),
         ParameterSpec::integer("seed", "Seed", "Random sampling seed (the same seed, the same shapes)", 0, 0, 4294967295LL),
+        ParameterSpec::real("orientation-tolerance", "Orientation tolerance",
+                            "Sequential: a plane belongs to a class when its normal is within this angle of the class's axis "
+                            "(the thesis's 1°)",
+                            defaults.orientationToleranceDegrees, 0.01, 44.9, "deg")
+            .onlyWith("method=sequential"),
     };
     // With --out-dir: primitives.ply, TYPE_ID.ply, primitives.csv, primitives.dxf, primitives.json.
     tool.outputs = {OutputSpec{"primitives", "Cloud with primitive fields", DataKind::Cloud, true},
@@ -225,6 +233,7 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
         params.minPoints = static_cast<std::size_t>(values.integer("min-points"));
         params.probability = values.real("probability");
         params.seed = static_cast<std::uint64_t>(values.integer("seed"));
+        params.orientationToleranceDegrees = values.real("orientation-tolerance");
         const PrimitiveDetectionResult detected = detectPrimitives(input, params, progress);
 
         ToolResult result;

@@ -26,11 +26,13 @@
 
 namespace scandiff::plugins {
 
-//! How shapes are found: efficient RANSAC (every type), or planar regions
-//! grown from the flattest points (planes only; no random draw).
-enum class PrimitiveMethod { EfficientRansac, RegionGrowing };
+//! How shapes are found: efficient RANSAC (every type), planar regions
+//! grown from the flattest points (planes only; no random draw), or the
+//! sequential RANSAC of thesis 001 for façades (planes only, by classes of
+//! orientation, each the largest connected region of its inliers).
+enum class PrimitiveMethod { EfficientRansac, RegionGrowing, Sequential };
 
-//! "efficient-ransac", "region-growing"; throws Error(InvalidArgument) otherwise.
+//! "efficient-ransac", "region-growing", "sequential"; throws Error(InvalidArgument) otherwise.
 PrimitiveMethod parsePrimitiveMethod(const std::string& name);
 
 struct PrimitiveDetectionParams
@@ -49,6 +51,8 @@ struct PrimitiveDetectionParams
     //! A shape's type is the simplest (plane, sphere, cylinder, cone, torus)
     //! whose least-squares RMS is within this fraction of the best type's.
     double typeTolerance = 0.2;
+    //! Sequential: a plane's normal within this angle of its class's axis (thesis 001: 1°).
+    double orientationToleranceDegrees = 1.0;
     std::uint64_t seed = 0;
 };
 
@@ -70,6 +74,8 @@ struct PrimitiveDetectionResult
     std::vector<float> distance;        //!< per input point, signed distance to its shape (NaN off every shape)
     double epsilon = 0, clusterEpsilon = 0; //!< the values used
     bool normalsComputed = false;       //!< the cloud had none: fitted within max(2.5 spacings, 10 x the noise)
+    //! Sequential: the façade's horizontal normal (the thesis's y axis), global frame.
+    std::optional<Eigen::Vector3d> facadeNormal;
     std::vector<std::string> notes;
 };
 
