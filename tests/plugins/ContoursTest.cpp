@@ -378,6 +378,88 @@ TEST(Contours, TheFacadeOpeningsAreFoundWithTheirCorners)
     }
 }
 
+TEST(Contours, NeighbouringPlanesMeetAlongTheirCommonLines)
+{
+    // A corner of a building at UTM coordinates: two walls at right angles
+    // (4 x 3 m and 3 x 3 m) standing on a floor (4 x 3 m), sampled every 2 cm
+    // with 1 mm of noise, one primitive_id per plane. Each outline stops
+    // short of the shared edges; joined, the vertices there lie on both
+    // planes (on the three at the corner) and the two outlines share them.
+    const Eigen::Vector3d at(652000.0, 6862000.0, 120.0);
+    PointCloud cloud;
+    cloud.setOrigin(at);
+    std::mt19937 random(4);
+    std::normal_distribution<float> noise(0.0f, 0.001f);
+    std::vector<Eigen::Vector3f> points;
+    std::vector<float> ids;
+    auto sample = [&](int id, const Eigen::Vector3f& corner, const Eigen::Vector3f& u, const Eigen::Vector3f& v, float lu, float lv) {
+        const Eigen::Vector3f n = u.cross(v);
+        for (float a = 0.01f; a < lu; a += 0.02f)
+            for (float b = 0.01f; b < lv; b += 0.02f) {
+                points.push_back(corner + a * u + b * v + noise(random) * n);
+                ids.push_back(static_cast<float>(id));
+            }
+    };
+    sample(0, {0, 0, 0}, Eigen::Vector3f::UnitX(), Eigen::Vector3f::UnitZ(), 4.0f, 3.0f); // wall y = 0
+    sample(1, {0, 0, 0}, Eigen::Vector3f::UnitY(), Eigen::Vector3f::UnitZ(), 3.0f, 3.0f); // wall x = 0
+    sample(2, {0, 0, 0}, Eigen::Vector3f::UnitX(), Eigen::Vector3f::UnitY(), 4.0f, 3.0f); // floor z = 0
+    cloud.resize(points.size());
+    cloud.positions() = points;
+    cloud.addField("primitive_id").values() = ids;
+
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& tool = *registry.tools.find("contours");
+    ToolResult result = tool.execute(ToolInputs().add("input", cloud), tool.resolve({{"vectorise", "true"}}), nullptr);
+    const Drawing& drawing = std::get<Drawing>(result.find("contours")->data);
+    ASSERT_EQ(drawing.polylines.size(), 3u);
+    const auto json = nlohmann::json::parse(std::get<TextDocument>(result.find("document")->data).text);
+    EXPECT_GT(json["joined_vertices"].get<std::size_t>(), 0u);
+    // Each outline's plane, from the JSON (n.x + d = 0).
+    std::map<std::string, std::pair<Eigen::Vector3d, double>> planeOf;
+    for (const auto& plane : json["planes"])
+        planeOf[plane["layer"].get<std::string>()] = {
+            Eigen::Vector3d(plane["normal"][0].get<double>(), plane["normal"][1].get<double>(), plane["normal"][2].get<double>()),
+            plane["d"].get<double>()};
+    ASSERT_EQ(planeOf.size(), 3u);
+    auto onPlanes = [&](const Eigen::Vector3d& p) {
+        std::size_t count = 0;
+        for (const auto& [layer, plane] : planeOf)
+            count += std::abs(plane.first.dot(p) + plane.second) < 1e-6;
+        return count;
+    };
+    // The corner of the three planes: one vertex of each outline, the same point.
+    std::vector<Eigen::Vector3d> corners;
+    std::size_t shared = 0;
+    for (const DrawingPolyline& polyline : drawing.polylines) {
+        for (const Eigen::Vector3d& p : polyline.points) {
+            const Eigen::Vector3d local = p - at;
+            const bool nearCorner = local.norm() < 0.1;
+            if (nearCorner) {
+                EXPECT_EQ(onPlanes(p), 3u) << local.transpose();
+                corners.push_back(p);
+            }
+            // A vertex along a shared edge (x = 0 or y = 0 or z = 0 for two planes) lies on both.
+            const int onEdges = (std::abs(local.x()) < 0.1) + (std::abs(local.y()) < 0.1) + (std::abs(local.z()) < 0.1);
+            if (onEdges >= 2) {
+                EXPECT_GE(onPlanes(p), 2u) << local.transpose();
+                ++shared;
+            }
+        }
+    }
+    ASSERT_EQ(corners.size(), 3u);
+    EXPECT_EQ(corners[0], corners[1]);
+    EXPECT_EQ(corners[1], corners[2]);
+    EXPECT_LT((corners[0] - at).norm(), 0.01); // the true corner, within the noise and the spacing
+    EXPECT_GE(shared, 9u); // each outline's two ends of each of its two shared edges... and the corner
+    // The same run without joining leaves the outlines apart.
+    ToolResult apart = tool.execute(ToolInputs().add("input", cloud), tool.resolve({{"vectorise", "true"}, {"join-planes", "false"}}), nullptr);
+    std::size_t onTwo = 0;
+    for (const DrawingPolyline& polyline : std::get<Drawing>(apart.find("contours")->data).polylines)
+        for (const Eigen::Vector3d& p : polyline.points)
+            onTwo += onPlanes(p) >= 2;
+    EXPECT_EQ(onTwo, 0u);
+}
+
 TEST(Contours, TheDrawingPassesAnIndependentDxfAudit)
 {
     const test::StoneWallScene scene = test::makeStoneWall(test::StoneWallOptions{});

@@ -6,6 +6,7 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/segmentation/RegionReport.h>
 #include <scandiff/plugins/PluginRegistry.h>
+#include <scandiff/plugins/contours/PlaneJoining.h>
 #include <scandiff/plugins/contours/PlanarContours.h>
 #include <scandiff/plugins/contours/StoneWall.h>
 #include <scandiff/plugins/contours/Vectorisation.h>
@@ -22,6 +23,22 @@ namespace scandiff::plugins {
 namespace {
 
 nlohmann::json pointJson(const Eigen::Vector3d& p) { return nlohmann::json::array({p.x(), p.y(), p.z()}); }
+
+//! The JSON's points that the plane joining moved, moved too (the same bits: the same computation gave them).
+void replaceMovedPoints(nlohmann::json& node, const std::map<std::array<double, 3>, Eigen::Vector3d>& moves)
+{
+    if (moves.empty())
+        return;
+    if (node.is_array() && node.size() == 3 && node[0].is_number() && node[1].is_number() && node[2].is_number()) {
+        const auto it = moves.find({node[0].get<double>(), node[1].get<double>(), node[2].get<double>()});
+        if (it != moves.end())
+            node = pointJson(it->second);
+        return;
+    }
+    if (node.is_array() || node.is_object())
+        for (auto& child : node)
+            replaceMovedPoints(child, moves);
+}
 
 nlohmann::json ringJson(const std::vector<Eigen::Vector3d>& ring)
 {
@@ -135,6 +152,15 @@ ToolSpec contoursTool()
                                "edge lies on average",
                                true)
             .onlyWith("vectorise"),
+        ParameterSpec::boolean("join-planes", "Join neighbouring planes",
+                               "Several planes: vertices near the line where two planes meet (inside the other's outline) are "
+                               "moved onto it, onto the point of three planes at a corner of three, and made one with the "
+                               "other outline's, so the 3D model's planes meet (thesis 001 §4.4)",
+                               true),
+        ParameterSpec::real("join-tolerance", "Join tolerance",
+                            "Join: largest distance of a vertex from the line where the planes meet", 0.0, 0.0, 1e9, "m")
+            .withZeroMeaning("automatic (3 x the largest point spacing of the planes)")
+            .onlyWith("join-planes"),
     };
     tool.outputs = {OutputSpec{"contours", "Contours", DataKind::Drawing},
                     OutputSpec{"rings", "Contour rings", DataKind::Table, false, false, "contours"},
@@ -152,6 +178,8 @@ ToolSpec contoursTool()
         Table table;
         table.columns = {"plane", "part", "ring", "vertices", "area", "perimeter", "threshold", "plane_rms"};
         nlohmann::json planes = nlohmann::json::array();
+        std::vector<OutlinedPlane> outlined; // for joining the planes
+        double largestSpacing = 0;
         std::size_t rings = 0, holes = 0, skipped = 0;
         for (const Segment& segment : segments) {
             ticker.checkCancel();
@@ -173,6 +201,8 @@ ToolSpec contoursTool()
                 uv.push_back(frame.toPlane(p));
             OutlineResult parts = extractOutlines(uv, outline);
             const double spacing = parts.spacing;
+            largestSpacing = std::max(largestSpacing, spacing);
+            outlined.push_back(OutlinedPlane{frame, {}, {}});
             const double minArea = values.real("min-area") > 0 ? values.real("min-area") : 50.0 * spacing * spacing;
             VectoriseParams vector;
             vector.tolerance = values.real("tolerance") > 0 ? values.real("tolerance") : std::max(1.5 * spacing, 1e-6);
@@ -226,6 +256,7 @@ ToolSpec contoursTool()
                         polyline.points = lifted;
                         polyline.bulges.clear();
                     }
+                    (r == 0 ? outlined.back().outer : outlined.back().holes).push_back(drawing.polylines.size());
                     drawing.polylines.push_back(std::move(polyline));
                     const double area = std::abs(signedArea(ring)), perimeter = ringPerimeter(ring);
                     table.rows.push_back({static_cast<double>(segment.id), static_cast<double>(partNumber), std::string(r == 0 ? "outer" : "hole"),
@@ -253,12 +284,21 @@ ToolSpec contoursTool()
                               {"threshold", parts.threshold},
                               {"polygons", polygons}});
         }
+        PlaneJoinResult joined;
+        if (values.boolean("join-planes") && outlined.size() >= 2) {
+            PlaneJoinParams join;
+            join.tolerance = values.real("join-tolerance") > 0 ? values.real("join-tolerance") : std::max(3.0 * largestSpacing, 1e-6);
+            joined = joinNeighbouringPlanes(drawing, outlined, join);
+            replaceMovedPoints(planes, joined.moves);
+        }
         ToolResult result;
         result.add("contours", std::move(drawing));
         result.add("rings", std::move(table));
-        result.add("document", TextDocument{".json", nlohmann::json({{"planes", planes}}).dump(1) + "\n"});
+        result.add("document", TextDocument{".json", nlohmann::json({{"planes", planes}, {"joined_vertices", joined.movedVertices}}).dump(1) + "\n"});
         std::ostringstream summary;
         summary << segments.size() - skipped << " planes outlined: " << rings - holes << " outer rings, " << holes << " holes";
+        if (joined.joints > 0)
+            summary << "; " << joined.joints << " pairs of planes joined (" << joined.movedVertices << " vertices moved onto their common lines)";
         if (skipped)
             summary << "; " << skipped << " segments skipped (fewer than 3 points or on a line)";
         if (!note.empty())
