@@ -24,7 +24,7 @@ if(SCANDIFF_BUILD_GUI)
   # Debian 12's VTK 9.1 resolves VTK::mpi only when MPI's C component was found first.
   scandiff_require(MPI libopenmpi-dev COMPONENTS C)
   scandiff_require(VTK libvtk9-qt-dev COMPONENTS GUISupportQt RenderingOpenGL2 RenderingCore
-                   InteractionStyle InteractionWidgets RenderingAnnotation CommonCore CommonDataModel IOImage)
+                   InteractionStyle InteractionWidgets RenderingAnnotation RenderingLabel CommonCore CommonDataModel IOImage)
 endif()
 if(SCANDIFF_BUILD_TESTS)
   scandiff_require(GTest "libgtest-dev libgmock-dev")

@@ -288,6 +288,12 @@ private slots:
         QCOMPARE(contours->parent, wall);
         QCOMPARE(contours->drawing->polylines.size(), scene.stones.size());
         QVERIFY(window.document().item(wall).display.visible); // the wall stays shown under its contours
+        // Each stone's id is a label in the view, hidden with its drawing.
+        QCOMPARE(window.view()->labelCount(contours->id), scene.stones.size());
+        QVERIFY(window.view()->labelsVisible(contours->id));
+        window.document().setVisible(contours->id, false);
+        QVERIFY(!window.view()->labelsVisible(contours->id));
+        window.document().setVisible(contours->id, true);
         window.view()->zoomToEntity(contours->id);
         window.view()->render();
         QTemporaryDir dir;

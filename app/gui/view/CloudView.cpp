@@ -13,6 +13,9 @@
 #include <vtkActor.h>
 #include <vtkActor2D.h>
 #include <vtkBillboardTextActor3D.h>
+#include <vtkLabelPlacementMapper.h>
+#include <vtkPointSetToLabelHierarchy.h>
+#include <vtkStringArray.h>
 #include <vtkBoundingBox.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
@@ -95,6 +98,9 @@ struct CloudView::Shown
     bool documentVisible = true; //!< its tick in the tree; the view may still hide it (setShownHere)
     std::vector<std::uint8_t> rgba; //!< 4 bytes per point, what the chunks' colour arrays show
     std::vector<Chunk> chunks;
+    //! A drawing's texts (stone ids), placed so that they never overlap: as
+    //! many as the view has room for, more as one zooms in.
+    vtkSmartPointer<vtkActor2D> labels;
 };
 
 struct CloudView::Scene
@@ -291,6 +297,34 @@ void CloudView::addEntity(const Document::Item& item)
         c.actor->PickableOff(); // picks answer with a cloud's point, never a drawing's vertex
         scene_->renderer->AddActor(c.actor);
         s.chunks.push_back(c);
+        if (!drawing.texts.empty()) {
+            vtkNew<vtkPoints> anchors;
+            vtkNew<vtkStringArray> texts;
+            texts->SetName("text");
+            for (const DrawingText& text : drawing.texts) {
+                const Eigen::Vector3d local = text.position - *scene_->sceneOrigin; // in double, then small
+                anchors->InsertNextPoint(local.x(), local.y(), local.z());
+                texts->InsertNextValue(text.text);
+            }
+            vtkNew<vtkPolyData> labelled;
+            labelled->SetPoints(anchors);
+            labelled->GetPointData()->AddArray(texts);
+            vtkNew<vtkPointSetToLabelHierarchy> hierarchy;
+            hierarchy->SetInputData(labelled);
+            hierarchy->SetLabelArrayName("text");
+            hierarchy->GetTextProperty()->SetFontSize(12);
+            hierarchy->GetTextProperty()->SetColor(1.0, 1.0, 0.6);
+            hierarchy->GetTextProperty()->SetJustificationToCentered();
+            vtkNew<vtkLabelPlacementMapper> placement;
+            placement->SetInputConnection(hierarchy->GetOutputPort());
+            placement->SetShapeToRoundedRect();
+            placement->SetBackgroundColor(0.1, 0.1, 0.1);
+            placement->SetBackgroundOpacity(0.6);
+            s.labels = vtkSmartPointer<vtkActor2D>::New();
+            s.labels->SetMapper(placement);
+            s.labels->PickableOff();
+            scene_->renderer->AddActor(s.labels);
+        }
         refreshEntity(item);
         if (scene_->clipping)
             applyClipping();
@@ -411,6 +445,8 @@ void CloudView::refreshEntity(const Document::Item& item)
         if (s.isCloud)
             c.actor->GetProperty()->SetPointSize(s.ownPointSize > 0 ? s.ownPointSize : scene_->pointSize);
     }
+    if (s.labels)
+        s.labels->SetVisibility(visible);
     if (visibilityChanged)
         updateStride();
     if (s.isCloud) {
@@ -436,6 +472,8 @@ void CloudView::removeEntity(EntityId id)
         return;
     for (auto& c : it->second.chunks)
         scene_->renderer->RemoveActor(c.actor);
+    if (it->second.labels)
+        scene_->renderer->RemoveActor(it->second.labels);
     scene_->shown.erase(it);
     if (scene_->shown.empty())
         scene_->sceneOrigin.reset();
@@ -482,9 +520,12 @@ void CloudView::setLegend(const ColourLegend& legend)
 
 void CloudView::clear()
 {
-    for (auto& [id, s] : scene_->shown)
+    for (auto& [id, s] : scene_->shown) {
         for (auto& c : s.chunks)
             scene_->renderer->RemoveActor(c.actor);
+        if (s.labels)
+            scene_->renderer->RemoveActor(s.labels);
+    }
     scene_->shown.clear();
     scene_->sceneOrigin.reset();
     scene_->scalarBar->VisibilityOff();
@@ -740,8 +781,27 @@ void CloudView::setShownHere(EntityId id, bool shown)
         return;
     for (auto& c : it->second.chunks)
         c.actor->SetVisibility(shown && it->second.documentVisible);
+    if (it->second.labels)
+        it->second.labels->SetVisibility(shown && it->second.documentVisible);
     updateStride();
     renderSoon();
+}
+
+std::size_t CloudView::labelCount(EntityId id) const
+{
+    const auto it = scene_->shown.find(id);
+    if (it == scene_->shown.end() || !it->second.labels)
+        return 0;
+    auto* placement = vtkLabelPlacementMapper::SafeDownCast(it->second.labels->GetMapper());
+    auto* hierarchy = placement ? vtkPointSetToLabelHierarchy::SafeDownCast(placement->GetInputAlgorithm()) : nullptr;
+    auto* labelled = hierarchy ? vtkPolyData::SafeDownCast(hierarchy->GetInputDataObject(0, 0)) : nullptr;
+    return labelled ? static_cast<std::size_t>(labelled->GetNumberOfPoints()) : 0;
+}
+
+bool CloudView::labelsVisible(EntityId id) const
+{
+    const auto it = scene_->shown.find(id);
+    return it != scene_->shown.end() && it->second.labels && it->second.labels->GetVisibility();
 }
 
 bool CloudView::isShownHere(EntityId id) const

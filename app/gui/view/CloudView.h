@@ -81,6 +81,9 @@ public:
     void setShownHere(EntityId id, bool shown);
     //! Whether the entity is drawn in this view (ticked, and not hidden here).
     bool isShownHere(EntityId id) const;
+    //! How many texts of a drawing are labelled in the view (0: none, or not a drawing), and whether they are shown.
+    std::size_t labelCount(EntityId id) const;
+    bool labelsVisible(EntityId id) const;
     //! Shares `leader`'s camera: both views then move together.
     void followCamera(CloudView& leader);
     //! Eye-Dome Lighting (VTK's EDL pass): shades clouds without normals by
