@@ -25,6 +25,7 @@
 #include "tools/TableDialog.h"
 #include "tools/ToolDialog.h"
 #include "view/CloudView.h"
+#include "widgets/HistogramWidget.h"
 #include "widgets/RangeEditor.h"
 
 #include <scandiff/core/distance/CloudToCloud.h>
@@ -288,6 +289,13 @@ private slots:
         QCOMPARE(contours->parent, wall);
         QCOMPARE(contours->drawing->polylines.size(), scene.stones.size());
         QVERIFY(window.document().item(wall).display.visible); // the wall stays shown under its contours
+        // The inter-means threshold and the two modes it separated are on the intensity histogram.
+        window.document().setActiveField(wall, "intensity");
+        window.scalarPanel()->showEntity(wall);
+        const auto& references = window.scalarPanel()->histogram()->referenceLines();
+        QCOMPARE(references.size(), std::size_t(3));
+        QVERIFY(references[0].second.startsWith("threshold"));
+        QVERIFY(references[1].first < references[0].first && references[0].first < references[2].first); // dark stones
         // Each stone's id is a label in the view, hidden with its drawing.
         QCOMPARE(window.view()->labelCount(contours->id), scene.stones.size());
         QVERIFY(window.view()->labelsVisible(contours->id));

@@ -180,6 +180,22 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
             addedEntities = true;
         }
     }
+    // What the tool found on an input's field (a threshold, the modes it
+    // separated) goes on that field's histogram; a new run's replace the old.
+    std::map<std::pair<EntityId, std::string>, std::vector<std::pair<double, std::string>>> marks;
+    for (const FieldMark& mark : result->marks) {
+        const auto role = choice.find(mark.role);
+        if (role != choice.end() && !role->second.empty())
+            marks[{role->second.front(), mark.field}].emplace_back(mark.value, mark.label);
+    }
+    for (auto& [where, values] : marks) {
+        const Document::Item* item = document_.find(where.first);
+        if (!item || !item->points().field(where.second))
+            continue;
+        FieldDisplay display = document_.fieldDisplay(where.first, where.second);
+        display.marks = std::move(values);
+        document_.setFieldDisplay(where.first, where.second, display);
+    }
     // A filter's result replaces its input on screen (it stays in the tree, unticked),
     // rather than being drawn over it.
     if (addedEntities && !updatedInputs)

@@ -39,6 +39,8 @@ struct FieldDisplay
     //! The colour range made [-m, m] (m its largest magnitude), so 0 sits at the
     //! scale's middle; a diverging scale always is.
     bool symmetric = false;
+    //! Values a tool found on this field (a threshold, class means), drawn on its histogram.
+    std::vector<std::pair<double, std::string>> marks;
 };
 
 struct DisplayState

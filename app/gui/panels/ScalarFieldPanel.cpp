@@ -217,6 +217,10 @@ void ScalarFieldPanel::refresh()
         symmetric_->setChecked(display.symmetric);
         histogram_->setColouring(display.scale, cmin, cmax);
         histogram_->setMarkedRange(range_->low(), range_->high());
+        std::vector<std::pair<double, QString>> references;
+        for (const auto& [value, label] : display.marks)
+            references.emplace_back(value, QString::fromStdString(label) + " " + QString::number(value, 'g', 6));
+        histogram_->setReferenceLines(std::move(references));
     } else {
         // Nothing of the previous entity's field stays on show.
         for (RangeEditor* editor : {range_, colours_}) {
@@ -226,6 +230,7 @@ void ScalarFieldPanel::refresh()
         symmetric_->setChecked(false);
         histogram_->setHistogram({});
         histogram_->setMarkedRange(-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+        histogram_->setReferenceLines({});
     }
     updating_ = false;
     updateInsideCount();

@@ -49,6 +49,12 @@ void HistogramWidget::setMarkedRange(double low, double high)
     update();
 }
 
+void HistogramWidget::setReferenceLines(std::vector<std::pair<double, QString>> lines)
+{
+    references_ = std::move(lines);
+    update();
+}
+
 void HistogramWidget::setLogarithmic(bool logarithmic)
 {
     logarithmic_ = logarithmic;
@@ -186,6 +192,21 @@ void HistogramWidget::paintEvent(QPaintEvent*)
         const int x = xOfValue(value);
         painter.setPen(QPen(palette().color(QPalette::Dark), 1, Qt::DashLine));
         painter.drawLine(x, plot.top(), x, plot.bottom());
+    }
+
+    // A tool's values: dotted, labelled at the top, staggered so neighbours stay legible.
+    int row = 0;
+    for (const auto& [value, label] : references_) {
+        if (!(value >= axisMin() && value <= axisMax()))
+            continue;
+        const int x = xOfValue(value);
+        painter.setPen(QPen(QColor(200, 40, 160), 1.5, Qt::DotLine));
+        painter.drawLine(x, plot.top(), x, plot.bottom());
+        painter.setPen(QColor(200, 40, 160));
+        const int y = plot.top() + 8 + fontMetrics().height() * (row++ % 3);
+        const int width = fontMetrics().horizontalAdvance(label);
+        const int left = x + 3 + width <= plot.right() ? x + 3 : x - 3 - width;
+        painter.drawText(QPoint(left, y + fontMetrics().ascent() - fontMetrics().height() / 2), label);
     }
 
     // Markers: a line with a small tab at the top to grab. Ends outside the axis

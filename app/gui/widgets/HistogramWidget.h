@@ -10,6 +10,9 @@
 
 #include <QWidget>
 
+#include <utility>
+#include <vector>
+
 namespace scandiff::gui {
 
 class HistogramWidget : public QWidget
@@ -25,6 +28,10 @@ public:
     void setMarkedRange(double low, double high);
     //! Bar heights on a log(1 + count) scale, so sparse tails stay visible.
     void setLogarithmic(bool logarithmic);
+    //! Values a tool found (a threshold, the modes it separated), drawn as
+    //! labelled dotted lines; they cannot be dragged. Empty: none.
+    void setReferenceLines(std::vector<std::pair<double, QString>> lines);
+    const std::vector<std::pair<double, QString>>& referenceLines() const { return references_; }
 
     const Histogram& histogram() const { return histogram_; }
     double markedLow() const { return markedLow_; }
@@ -64,6 +71,7 @@ private:
     double markedLow_ = -std::numeric_limits<double>::infinity();
     double markedHigh_ = std::numeric_limits<double>::infinity();
     bool logarithmic_ = false;
+    std::vector<std::pair<double, QString>> references_;
     Marker dragging_ = Marker::None;
 };
 

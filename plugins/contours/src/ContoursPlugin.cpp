@@ -403,8 +403,13 @@ ToolSpec stonesTool()
                 << (wall.thresholdIterations ? " (inter-means, " + std::to_string(wall.thresholdIterations) + " iterations)" : "")
                 << ", point spacing " << wall.spacing << " m, alpha " << wall.alpha << " m; " << wall.isolatedRemoved
                 << " isolated points removed, " << wall.smallDropped << " small and " << wall.nestedDropped
-                << " nested contours dropped; wall plane RMS " << wall.wall.rms << " m";
+                << " nested contours dropped; wall plane RMS " << wall.wall.rms << " m; mean intensity of the stones "
+                << wall.stoneMean << ", of the joints " << wall.jointMean;
         result.summary = summary.str();
+        // The threshold between the histogram's two modes, for the workbench to draw on the field's histogram.
+        result.marks = {FieldMark{"input", params.field, wall.threshold, "threshold"},
+                        FieldMark{"input", params.field, wall.stoneMean, "stones"},
+                        FieldMark{"input", params.field, wall.jointMean, "joints"}};
         return result;
     };
     return tool;

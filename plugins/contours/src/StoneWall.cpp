@@ -269,10 +269,18 @@ StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params
         result.thresholdIterations = found.iterations;
     }
     result.stoneClass.assign(n, 0);
+    double sums[2] = {0, 0};
+    std::size_t counts[2] = {0, 0};
     for (std::size_t i = 0; i < n; ++i) {
         const float v = intensity[i];
         result.stoneClass[i] = std::isfinite(v) && (params.polarity == StonePolarity::Dark ? v <= result.threshold : v > result.threshold);
+        if (std::isfinite(v)) {
+            sums[result.stoneClass[i]] += v;
+            ++counts[result.stoneClass[i]];
+        }
     }
+    result.jointMean = counts[0] ? sums[0] / static_cast<double>(counts[0]) : result.threshold;
+    result.stoneMean = counts[1] ? sums[1] / static_cast<double>(counts[1]) : result.threshold;
 
     const std::vector<Eigen::Vector3f> planar = planarPoints(uv);
     const octree::Octree tree(planar.data(), n);

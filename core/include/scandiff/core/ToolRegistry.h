@@ -220,10 +220,22 @@ struct ToolOutput
     OutputData data;
 };
 
+//! A value worth seeing on the histogram of an input's field: a threshold
+//! the tool chose, the means of the classes it separated.
+struct FieldMark
+{
+    std::string role = "input"; //!< the input whose field it is
+    std::string field;
+    double value = 0.0;
+    std::string label;          //!< "threshold", "stone mean"...
+};
+
 struct ToolResult
 {
     std::vector<ToolOutput> outputs; //!< in the order of the tool's OutputSpecs; an output may be absent
     std::string summary;             //!< one line for the log: what was done, counts
+    //! Shown by the workbench on the field's histogram (dashed, labelled); the CLI's summary says them.
+    std::vector<FieldMark> marks;
 
     ToolResult& add(std::string role, OutputData data);
     //! Null when the run produced no output of that role (the first, for a repeated role).

@@ -74,6 +74,7 @@ struct StoneWallResult
     PlaneFrame wall;
     double threshold = 0.0;
     int thresholdIterations = 0; //!< 0 when the threshold was given
+    double stoneMean = 0.0, jointMean = 0.0; //!< the two classes' mean intensities (the histogram's modes)
     double spacing = 0.0;        //!< median distance of a point to its nearest neighbour
     double alpha = 0.0;          //!< the one used
     std::vector<std::int32_t> stoneOfPoint; //!< -1: joint, isolated, or in a dropped contour
