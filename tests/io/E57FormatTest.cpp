@@ -313,6 +313,40 @@ TEST(E57Format, DamagedCopiesOfOurFileAreRefusedByName)
     EXPECT_NE(errorOf([&] { io::readE57Scans(broken); }).find("XML section is malformed"), std::string::npos);
 }
 
+TEST(E57Format, NamesXmlCannotHoldAreMadeSafeAndScansMayNotShareASection)
+{
+    // A name read from a file in another encoding, with a control character:
+    // written as '?' where XML 1.0 has no character, so the file reads back.
+    PointCloud a, b;
+    a.name = std::string("bad\x01name\xff");
+    a.resize(5);
+    b.name = "b";
+    b.resize(4);
+    for (std::size_t i = 0; i < 5; ++i)
+        a.positions()[i] = Eigen::Vector3f(float(i), 0, 0);
+    const fs::path path = tempDir() / "names.e57";
+    io::writeE57({&a, &b}, path);
+    const std::vector<PointCloud> back = io::readE57Scans(path);
+    ASSERT_EQ(back.size(), 2u);
+    EXPECT_EQ(back[0].name, "bad?name?");
+
+    // The second scan made to read the first one's points: refused, not read twice.
+    std::string bytes = readBytes(path);
+    const std::size_t first = bytes.find("fileOffset=\"");
+    const std::size_t second = bytes.find("fileOffset=\"", first + 1);
+    ASSERT_NE(second, std::string::npos);
+    const std::size_t valueStart = first + 12, valueEnd = bytes.find('"', valueStart);
+    const std::size_t secondStart = second + 12, secondEnd = bytes.find('"', secondStart);
+    std::string firstValue = bytes.substr(valueStart, valueEnd - valueStart);
+    ASSERT_LE(firstValue.size(), secondEnd - secondStart);
+    firstValue.resize(secondEnd - secondStart, ' '); // the same length: trailing spaces are trimmed
+    bytes.replace(secondStart, secondEnd - secondStart, firstValue);
+    resealPages(bytes);
+    const fs::path shared = tempDir() / "shared.e57";
+    writeBytes(shared, bytes);
+    EXPECT_NE(errorOf([&] { io::readE57Scans(shared); }).find("same points section"), std::string::npos);
+}
+
 TEST(E57Format, ConvertsBetweenE57AndPly)
 {
     const io::FormatRegistry registry = formats();

@@ -212,7 +212,11 @@ TEST_F(ProcessingTools, EveryLongToolStopsAtAnyPollAndLeavesItsInputAsItWas)
         ASSERT_NO_THROW(spec.execute(ToolInputs().add("input", cloud), values, &counting)) << name;
         const std::size_t polls = counting.polls();
         ASSERT_GE(polls, 3u) << name << " is polled " << polls << " times";
-        for (const std::size_t at : {std::size_t(1), polls / 3, 2 * polls / 3, polls}) {
+        // The last poll less a few: tools polled from both threads (normals)
+        // are polled a little more or less often from one run to the next, and
+        // a run polled 75 times never reaches a Cancel set at poll 76.
+        const std::size_t late = polls - std::max<std::size_t>(1, polls / 20);
+        for (const std::size_t at : {std::size_t(1), polls / 3, 2 * polls / 3, late}) {
             test::PollCounter cancel(std::max<std::size_t>(at, 1));
             EXPECT_EQ(test::errorCodeOf([&] { spec.execute(ToolInputs().add("input", cloud), values, &cancel); }),
                       ErrorCode::Cancelled)

@@ -91,8 +91,9 @@ void decodePending(FieldCodec& f, std::uint64_t records)
 {
     if (f.bits == 0)
         return;
-    // Values already assembled leave the queue first, so it stays one packet long.
-    if (f.decodedFront > 0) {
+    // Values already assembled leave the queue once they are half of it: a
+    // field far ahead of another is not shifted at every packet.
+    if (f.decodedFront > 0 && 2 * f.decodedFront >= f.decoded.size()) {
         f.decoded.erase(f.decoded.begin(), f.decoded.begin() + static_cast<std::ptrdiff_t>(f.decodedFront));
         f.decodedFront = 0;
     }
@@ -372,6 +373,11 @@ RecordLayout layoutOf(const Node& scan, const std::vector<FieldCodec>& codecs, c
             continue;
         const FieldCodec& c = codecs[i];
         RecordLayout::Copied copied{static_cast<int>(i), fieldNameFor(*c.node)};
+        // Two record fields of one name (a repeated element, intensity beside sdf:intensity) stay two fields.
+        for (int k = 2; std::any_of(layout.copied.begin(), layout.copied.end(),
+                                    [&](const RecordLayout::Copied& other) { return other.fieldName == copied.fieldName; });
+             ++k)
+            copied.fieldName = fieldNameFor(*c.node) + "_" + std::to_string(k);
         if (c.node->localName == "intensity" && c.node->namespaceUri == kE57Namespace)
             copied.invalidFlag = intensityInvalid;
         if (c.node->localName == "timeStamp" && c.node->namespaceUri == kE57Namespace)
@@ -395,9 +401,12 @@ public:
         records_ = recordCountOf(points, context);
         for (const Node& field : points.child("prototype")->children)
             codecs_.push_back(makeCodec(field, context));
-        if (const Node* codecs = points.child("codecs"); codecs && !codecs->children.empty())
-            throw Error(ErrorCode::Unsupported, context + ": scan " + std::to_string(index) +
-                                                    " names a codec other than the standard bit-pack codec");
+        // An empty codec list means bit-packing; a list may also name it explicitly.
+        if (const Node* codecs = points.child("codecs"))
+            for (const Node& codec : codecs->children)
+                if (!codec.child("bitPackCodec"))
+                    throw Error(ErrorCode::Unsupported, context + ": scan " + std::to_string(index) +
+                                                            " names a codec other than the standard bit-pack codec");
         layout_ = layoutOf(scan, codecs_, context, index);
         if (const Node* pose = scan.child("pose"))
             pose_ = poseOf(*pose, context);
@@ -469,8 +478,11 @@ private:
     void checkRecordCount(const SectionBounds& section) const
     {
         std::uint64_t bitsPerRecord = 0;
+        // A field of one constant value takes no bit in the file but a value
+        // per point in memory: counted as one bit, so the memory a file can
+        // ask for stays proportional to its size.
         for (const FieldCodec& c : codecs_)
-            bitsPerRecord += static_cast<std::uint64_t>(c.bits);
+            bitsPerRecord += static_cast<std::uint64_t>(std::max(c.bits, 1));
         const long double capacity = static_cast<long double>(section.length) * 8.0L / static_cast<long double>(std::max<std::uint64_t>(bitsPerRecord, 1));
         if (static_cast<long double>(records_) > capacity)
             pages_.fail("scan " + std::to_string(index_) + " claims " + std::to_string(records_) + " records, but its section of " +
@@ -645,8 +657,12 @@ ImageBlob imageOf(const Node& image, const std::string& context)
         if (!r)
             continue;
         s.representation = std::string(representation).substr(0, std::strlen(representation) - std::strlen("Representation"));
-        s.width = static_cast<std::int64_t>(numberOr(r, "imageWidth", 0, context));
-        s.height = static_cast<std::int64_t>(numberOr(r, "imageHeight", 0, context));
+        auto pixels = [&](const char* name) {
+            const double v = numberOr(r, name, 0, context);
+            return std::isfinite(v) && v >= 0 && v < 1e15 ? static_cast<std::int64_t>(v) : std::int64_t{-1};
+        };
+        s.width = pixels("imageWidth");
+        s.height = pixels("imageHeight");
         if (const Node* jpeg = r->child("jpegImage"); jpeg && jpeg->type == "Blob") {
             s.format = "jpeg";
             out.blob = jpeg;
@@ -715,6 +731,14 @@ std::vector<PointCloud> readE57Scans(const fs::path& path, const ReadOptions& op
     const std::string crs = stringOr(&file.root, "coordinateMetadata");
     ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), total);
     std::vector<PointCloud> clouds;
+    // Two scans may not read one section: a file of many scans pointing at one
+    // would otherwise ask for its points many times over.
+    std::set<std::int64_t> sections;
+    for (std::size_t i = 0; i < scans.size(); ++i) {
+        const Node& points = pointsOf(*scans[i], file.context, i);
+        if (recordCountOf(points, file.context) > 0 && !sections.insert(integerAttribute(points, "fileOffset", -1, file.context)).second)
+            file.pages.fail("scans " + std::to_string(i) + " and another read the same points section");
+    }
     for (std::size_t i = 0; i < scans.size(); ++i) {
         PointCloud cloud;
         cloud.setOrigin(origin);

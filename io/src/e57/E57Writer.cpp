@@ -196,8 +196,38 @@ struct BitStream
     }
 };
 
-std::string cdata(const std::string& text)
+//! The text with what XML 1.0 cannot hold replaced by '?': control characters
+//! (but tab, line feed, carriage return) and bytes that are not UTF-8 (a
+//! name read from a file in another encoding), so every reader can parse it.
+std::string xmlSafe(const std::string& text)
 {
+    std::string out;
+    out.reserve(text.size());
+    for (std::size_t i = 0; i < text.size();) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c < 0x80) {
+            out += (c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7F ? '?' : static_cast<char>(c);
+            ++i;
+            continue;
+        }
+        const std::size_t length = c >= 0xF0 && c <= 0xF4 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 && c <= 0xDF ? 2 : 0;
+        bool valid = length > 0 && i + length <= text.size();
+        for (std::size_t k = 1; valid && k < length; ++k)
+            valid = (static_cast<unsigned char>(text[i + k]) & 0xC0) == 0x80;
+        if (valid) {
+            out.append(text, i, length);
+            i += length;
+        } else {
+            out += '?';
+            ++i;
+        }
+    }
+    return out;
+}
+
+std::string cdata(const std::string& raw)
+{
+    const std::string text = xmlSafe(raw);
     std::string out = "<![CDATA[";
     std::size_t from = 0;
     for (std::size_t at; (at = text.find("]]>", from)) != std::string::npos; from = at + 2)
@@ -214,7 +244,7 @@ std::string number(double v)
 
 std::string newGuid()
 {
-    static std::mt19937_64 generator(std::random_device{}() ^ static_cast<std::uint64_t>(
+    thread_local std::mt19937_64 generator(std::random_device{}() ^ static_cast<std::uint64_t>(
                                                                   std::chrono::steady_clock::now().time_since_epoch().count()));
     const std::uint64_t a = generator(), b = generator();
     char text[40];
@@ -478,6 +508,11 @@ std::string scanXml(const ScanPlan& plan, std::size_t index)
 
 void writeE57(const std::vector<const PointCloud*>& clouds, const fs::path& path, const WriteOptions& options)
 {
+    for (const PointCloud* cloud : clouds)
+        // A packet lists each field's stream length in its header (16 bits for its whole length).
+        if (cloud->fields().size() > 10000)
+            throw Error(ErrorCode::Unsupported, path.string() + ": E57 packets cannot hold the " + std::to_string(cloud->fields().size()) +
+                                                    " fields of '" + cloud->name + "' (at most 10,000)");
     std::uint64_t total = 0;
     for (const PointCloud* cloud : clouds) {
         cloud->checkConsistency();

@@ -127,11 +127,29 @@ PlaneJoinResult joinNeighbouringPlanes(Drawing& drawing, const std::vector<Outli
             for (std::size_t i = 0; i < drawing.polylines[k].points.size(); ++i) {
                 const Eigen::Vector3d& v = drawing.polylines[k].points[i];
                 Vertex vertex{k, i, {a}, v};
+                // The planes it meets, nearest line first; at most two, each
+                // well apart from those taken (its own included), so the
+                // point on all of them exists, is unique and is on its own plane.
+                std::vector<std::pair<double, std::size_t>> candidates;
                 for (std::size_t b = 0; b < planes.size(); ++b) {
                     const auto line = lines.find({std::min(a, b), std::max(a, b)});
-                    if (b == a || line == lines.end() || distanceToLine(v, line->second) > params.tolerance)
+                    if (b == a || line == lines.end())
                         continue;
-                    if (!onOrNear(planes[b], drawing, v, params.tolerance))
+                    const double distance = distanceToLine(v, line->second);
+                    if (distance <= params.tolerance && onOrNear(planes[b], drawing, v, params.tolerance))
+                        candidates.emplace_back(distance, b);
+                }
+                std::sort(candidates.begin(), candidates.end());
+                for (const auto& [distance, b] : candidates) {
+                    if (vertex.planes.size() == 3)
+                        break;
+                    bool apart = true;
+                    for (std::size_t taken : vertex.planes)
+                        apart = apart && planes[taken].frame.normal.cross(planes[b].frame.normal).norm() >= minSine;
+                    if (vertex.planes.size() == 2) // three planes meet at one point only if their normals span space
+                        apart = apart && std::abs(planes[vertex.planes[0]].frame.normal.cross(planes[vertex.planes[1]].frame.normal)
+                                                      .dot(planes[b].frame.normal)) >= minSine * minSine;
+                    if (!apart)
                         continue;
                     vertex.planes.push_back(b);
                     meetingPairs.insert({std::min(a, b), std::max(a, b)});
@@ -159,7 +177,10 @@ PlaneJoinResult joinNeighbouringPlanes(Drawing& drawing, const std::vector<Outli
         std::sort(setI.begin(), setI.end());
         std::vector<std::size_t> cluster{i};
         for (std::size_t j = i + 1; j < joined.size(); ++j) {
-            if (done[j] || (joined[j].position - joined[i].position).norm() > params.tolerance)
+            // Only vertices of different outlines' planes become one: two
+            // vertices of one outline along a shared edge stay two.
+            if (done[j] || joined[j].planes.front() == joined[i].planes.front() ||
+                (joined[j].position - joined[i].position).norm() > params.tolerance)
                 continue;
             std::vector<std::size_t> setJ(joined[j].planes.begin(), joined[j].planes.end());
             std::sort(setJ.begin(), setJ.end());
