@@ -8,6 +8,7 @@
 #include <scandiff/plugins/registration/GlobalAlignment.h>
 #include <scandiff/plugins/registration/Icp.h>
 #include <scandiff/plugins/registration/PointPairs.h>
+#include <scandiff/plugins/registration/PrimitiveAlignment.h>
 #include <scandiff/plugins/registration/Stations.h>
 
 #include <fstream>
@@ -274,6 +275,95 @@ void addGlobalTool(ToolRegistry& registry)
     registry.add(std::move(tool));
 }
 
+void addPrimitivesTool(ToolRegistry& registry)
+{
+    ToolSpec tool;
+    tool.name = "register-primitives";
+    tool.title = "Alignment on planes";
+    tool.category = "Registration";
+    tool.description =
+        "Moves the moving cloud onto the reference on the planes both scans hold (thesis 004): planes found in each "
+        "(primitives, region growing by default), matched by the angles between them (three planes facing three ways make "
+        "a hypothesis, scored by the planes it brings onto planes of the other scan, weighted by area), the motion refined "
+        "on every match. From any start. Then, unless --refine is off, point-to-plane ICP with a robust kernel finishes it.";
+    tool.inputs = movingAndReference();
+    tool.outputs = registrationOutputs();
+    tool.outputs.push_back(OutputSpec{"matches", "Matched planes", DataKind::Table, false});
+    tool.parameters = {
+        ParameterSpec::choice("method", "Plane finder", "How the planes of each scan are found (see primitives)",
+                              {"region-growing", "efficient-ransac", "sequential"}, "region-growing"),
+        ParameterSpec::real("epsilon", "Plane thickness", "Largest distance of a point to its plane; absent: 3 x the noise", 0.01, 1e-9,
+                            1e9, "m")
+            .asOptional(),
+        ParameterSpec::integer("min-points", "Smallest plane", "Smallest number of points of a plane", 500, 10, 1000000000, "points"),
+        ParameterSpec::real("angle-tolerance", "Angle tolerance", "Matched pairs of planes make the same angle within this", 2.0, 0.01,
+                            30, "deg"),
+        ParameterSpec::real("distance-tolerance", "Distance tolerance", "A matched plane's offset after the motion", 0.05, 1e-6, 1e6,
+                            "m"),
+        ParameterSpec::boolean("refine", "Refine with ICP", "Finish with point-to-plane ICP (robust kernel)", true),
+        seedParameter(),
+    };
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        const PointCloud& moving = inputs.cloud("moving");
+        const Mesh* mesh = inputs.meshOrNull("reference");
+        const PointCloud& reference = mesh ? mesh->vertices : inputs.cloud("reference");
+        PrimitiveDetectionParams detection;
+        detection.method = parsePrimitiveMethod(values.text("method"));
+        detection.kinds = {PrimitiveKind::Plane};
+        if (values.has("epsilon"))
+            detection.epsilon = values.real("epsilon");
+        detection.minPoints = static_cast<std::size_t>(values.integer("min-points"));
+        detection.seed = static_cast<std::uint64_t>(values.integer("seed"));
+        const PrimitiveDetectionResult movingPlanes = detectPrimitives(moving, detection, progress);
+        const PrimitiveDetectionResult referencePlanes = detectPrimitives(reference, detection, progress);
+        PrimitiveAlignmentParams align;
+        align.angleToleranceDegrees = values.real("angle-tolerance");
+        align.distanceTolerance = values.real("distance-tolerance");
+        const PrimitiveAlignment aligned = alignOnPlanes(movingPlanes.primitives, referencePlanes.primitives, align);
+
+        RegistrationReport coarse;
+        coarse.method = "alignment on " + std::to_string(aligned.matches.size()) + " planes";
+        coarse.matrix = aligned.matrix;
+        coarse.rms = aligned.rmsOffset;
+        coarse.overlap = std::numeric_limits<double>::quiet_NaN();
+        coarse.converged = true;
+        coarse.degeneracy = aligned.degeneracy;
+        coarse.notes = aligned.notes;
+        coarse.notes.push_back("planes: RMS angle " + std::to_string(aligned.rmsAngleDegrees) + " deg, RMS offset " +
+                               std::to_string(aligned.rmsOffset) + " m");
+        ToolResult result;
+        if (values.boolean("refine")) {
+            IcpParams icp;
+            icp.kernel = RobustKernel::Cauchy;
+            icp.seed = static_cast<std::uint64_t>(values.integer("seed"));
+            icp.initial = aligned.matrix;
+            // From within a few plane thicknesses and spacings of the planes' motion.
+            icp.maxDistance = std::max(movingPlanes.clusterEpsilon, 5.0 * std::max(aligned.rmsOffset, movingPlanes.epsilon));
+            IcpResult fine = icpRegister(moving, mesh ? nullptr : &reference, mesh, icp, progress);
+            RegistrationReport report = std::move(fine.report);
+            report.method = coarse.method + ", then " + report.method;
+            report.notes.insert(report.notes.begin(), coarse.notes.begin(), coarse.notes.end());
+            result.summary = reportSummary(report);
+            result.add("output", movedCloud(moving, report.matrix, report.method, std::move(fine.residual), std::move(fine.excluded)));
+            result.add("matrix", report.matrix);
+            result.add("report", reportTable(report));
+            result.add("trace", traceTable(report));
+        } else {
+            result.summary = reportSummary(coarse);
+            result.add("output", transformCloud(moving, coarse.matrix, coarse.method));
+            result.add("matrix", coarse.matrix);
+            result.add("report", reportTable(coarse));
+        }
+        Table matches;
+        matches.columns = {"moving_plane", "reference_plane", "angle_deg", "offset_m"};
+        for (const PlaneMatch& m : aligned.matches)
+            matches.rows.push_back({static_cast<double>(m.moving), static_cast<double>(m.reference), m.angleDegrees, m.offset});
+        result.add("matches", std::move(matches));
+        return result;
+    };
+    registry.add(std::move(tool));
+}
+
 void addPointPairsTool(ToolRegistry& registry)
 {
     ToolSpec tool;
@@ -469,5 +559,6 @@ void scandiff_register_plugin_registration(scandiff::PluginRegistry& registry)
     scandiff::plugins::addIcpTool(registry.tools);
     scandiff::plugins::addGlobalTool(registry.tools);
     scandiff::plugins::addPointPairsTool(registry.tools);
+    scandiff::plugins::addPrimitivesTool(registry.tools);
     scandiff::plugins::addStationsTool(registry.tools);
 }

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! Registration on primitives (thesis 004: scans of a building consolidated
+//! on the planes they share): the planes found in each scan are matched, and
+//! the motion is the one that brings the moving scan's planes onto the
+//! reference's. Works from any start, since planes are matched by the angles
+//! between them, not by position; needs three planes that are not parallel to
+//! one line (two walls and a floor) in both scans.
+
+#include <scandiff/plugins/primitives/PrimitiveDetection.h>
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace scandiff::plugins {
+
+struct PrimitiveAlignmentParams
+{
+    double angleToleranceDegrees = 2.0; //!< two matched pairs of planes make the same angle within this
+    double distanceTolerance = 0.05;    //!< a matched plane's offset after the motion, m
+    std::size_t maxPlanes = 24;         //!< the largest planes of each scan taken (by area)
+};
+
+struct PlaneMatch
+{
+    int moving = -1, reference = -1;   //!< ids of the primitives
+    double angleDegrees = 0;           //!< between the reference plane and the moved one
+    double offset = 0;                 //!< distance between them at the moved plane's point (m)
+};
+
+struct PrimitiveAlignment
+{
+    Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity(); //!< moving -> reference, global coordinates
+    std::vector<PlaneMatch> matches;
+    double rmsAngleDegrees = 0, rmsOffset = 0;
+    //! Empty when the matched planes fix every direction; else names the free one (translation along it is unknown).
+    std::string degeneracy;
+    std::vector<std::string> notes;
+};
+
+//! Throws Error(InvalidData) when either scan has fewer than three planes
+//! whose normals span space, or no motion brings three planes onto three.
+PrimitiveAlignment alignOnPlanes(const std::vector<DetectedPrimitive>& moving, const std::vector<DetectedPrimitive>& reference,
+                                 const PrimitiveAlignmentParams& params);
+
+} // namespace scandiff::plugins
