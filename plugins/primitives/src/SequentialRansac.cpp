@@ -15,6 +15,7 @@
 #include <cmath>
 #include <random>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace scandiff::plugins::detail {
 
@@ -419,6 +420,79 @@ private:
     bool stopped_ = false;
 };
 
+//! The thesis's "linear errors" (§3.4.6) undone: a plane found early keeps
+//! the points of a later plane that lie on their line of intersection (the
+//! wall's points along a pilaster's edge), which tilt a narrow plane. A point
+//! goes to the later plane when it is closer to it, within ds, and on that
+//! plane's surface (a pixel of its raster, or next to one). Returns how many moved.
+std::size_t giveBackIntersectionPoints(const std::vector<Eigen::Vector3d>& points, std::vector<RansacShape>& planes, double distance,
+                                       double pixel)
+{
+    struct Surface
+    {
+        Plane plane;
+        std::unordered_set<std::uint64_t> cells;
+    };
+    auto key = [](std::int64_t u, std::int64_t v) { return (static_cast<std::uint64_t>(u) << 32) ^ static_cast<std::uint32_t>(v); };
+    auto cellOf = [&](const Plane& plane, const Eigen::Vector3d& p) {
+        const Eigen::Vector3d d = p - plane.point;
+        return std::make_pair(static_cast<std::int64_t>(std::floor(d.dot(plane.e1) / pixel)),
+                              static_cast<std::int64_t>(std::floor(d.dot(plane.e2) / pixel)));
+    };
+    std::vector<Surface> surfaces(planes.size());
+    for (std::size_t k = 0; k < planes.size(); ++k) {
+        surfaces[k].plane = fitPlane(points, planes[k].members);
+        for (std::uint32_t i : planes[k].members) {
+            const auto [u, v] = cellOf(surfaces[k].plane, points[i]);
+            surfaces[k].cells.insert(key(u, v));
+        }
+    }
+    auto onSurface = [&](const Surface& s, const Eigen::Vector3d& p) {
+        const auto [u, v] = cellOf(s.plane, p);
+        for (std::int64_t du = -1; du <= 1; ++du)
+            for (std::int64_t dv = -1; dv <= 1; ++dv)
+                if (s.cells.count(key(u + du, v + dv)))
+                    return true;
+        return false;
+    };
+    std::vector<std::vector<std::uint32_t>> given(planes.size());
+    std::size_t moved = 0;
+    for (std::size_t k = 0; k < planes.size(); ++k) {
+        std::vector<std::uint32_t> kept;
+        kept.reserve(planes[k].members.size());
+        for (std::uint32_t i : planes[k].members) {
+            const Eigen::Vector3d& p = points[i];
+            const double own = std::abs(surfaces[k].plane.normal.dot(p - surfaces[k].plane.point));
+            std::size_t target = planes.size();
+            double best = std::min(own, distance);
+            for (std::size_t j = k + 1; j < planes.size(); ++j) {
+                const double d = std::abs(surfaces[j].plane.normal.dot(p - surfaces[j].plane.point));
+                if (d < best && onSurface(surfaces[j], p)) {
+                    best = d;
+                    target = j;
+                }
+            }
+            if (target < planes.size()) {
+                given[target].push_back(i);
+                ++moved;
+            } else {
+                kept.push_back(i);
+            }
+        }
+        planes[k].members = std::move(kept);
+    }
+    for (std::size_t k = 0; k < planes.size(); ++k) {
+        planes[k].members.insert(planes[k].members.end(), given[k].begin(), given[k].end());
+        std::sort(planes[k].members.begin(), planes[k].members.end());
+        if (planes[k].members.size() >= 3) {
+            const Plane refit = fitPlane(points, planes[k].members);
+            planes[k].primitive.point = refit.point;
+            planes[k].primitive.direction = refit.normal;
+        }
+    }
+    return moved;
+}
+
 } // namespace
 
 SequentialOutcome sequentialPlanes(const std::vector<Eigen::Vector3d>& points, const octree::Octree& tree,
@@ -434,6 +508,9 @@ SequentialOutcome sequentialPlanes(const std::vector<Eigen::Vector3d>& points, c
         search.extractClass(c, frame, outcome.planes, outcome.notes);
     if (search.stopped())
         return SequentialOutcome{};
+    if (const std::size_t moved = giveBackIntersectionPoints(points, outcome.planes, settings.distance, settings.pixel))
+        outcome.notes.push_back("sequential RANSAC: " + std::to_string(moved) +
+                                " points on lines where planes meet given to the later plane they lie on");
     return outcome;
 }
 
