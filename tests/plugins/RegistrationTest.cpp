@@ -466,6 +466,40 @@ TEST(PrimitiveAlignment, TwoSamplingsOfAFacadeRegisterOnTheirPlanesFromAnyStart)
               ErrorCode::InvalidData);
 }
 
+TEST(PrimitiveAlignment, SphereTargetsRegisterTwoStationsFromAnyStart)
+{
+    // Five sphere targets (radii 10 to 20 cm) on a 6 x 6 m floor, sampled
+    // twice (2 mm of noise) at UTM coordinates; the moving scan turned 140°
+    // about a tilted axis. The targets matched by radius and distances give
+    // the motion within 0.05°, and 2 cm over the 60 m box (ten times the
+    // targets' spread: 1.3 cm here, their centres agreeing within 0.3 mm).
+    const Eigen::Vector3d origin(512300.0, 5401200.0, 150.0);
+    std::vector<test::SceneShape> shapes = {
+        test::scene::rectangle("floor", Eigen::Vector3d(-3, -3, 0), Eigen::Vector3d(6, 0, 0), Eigen::Vector3d(0, 6, 0)),
+        test::scene::sphere("target 1", Eigen::Vector3d(-2.0, -1.5, 0.8), 0.10),
+        test::scene::sphere("target 2", Eigen::Vector3d(2.2, -2.0, 1.2), 0.15),
+        test::scene::sphere("target 3", Eigen::Vector3d(1.5, 2.3, 0.6), 0.20),
+        test::scene::sphere("target 4", Eigen::Vector3d(-1.8, 2.0, 1.5), 0.12),
+        test::scene::sphere("target 5", Eigen::Vector3d(0.3, 0.2, 1.0), 0.18),
+    };
+    auto sample = [&](unsigned seed) {
+        test::PrimitiveScene s = test::makePrimitiveScene(shapes, 60000, 0.002, 0.0, seed, false);
+        s.cloud.setOrigin(origin);
+        return std::move(s.cloud);
+    };
+    const PointCloud reference = sample(31);
+    const Eigen::Matrix4d truth = test::rigidMotionAbout(140, 25, -15, Eigen::Vector3d(6, -4, 1), origin);
+    const PointCloud moving = transformCloud(sample(32), truth.inverse(), "the truth's inverse");
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& tool = *registry.tools.find("register-primitives");
+    const ToolInputs inputs = ToolInputs().add("moving", moving).add("reference", reference);
+    ToolResult result = tool.execute(inputs, tool.resolve({{"on", "spheres"}, {"refine", "false"}, {"min-points", "100"}}), nullptr);
+    const MotionError e = errorOf(std::get<Eigen::Matrix4d>(result.find("matrix")->data), truth, origin);
+    EXPECT_LT(e.degrees, 0.05) << result.summary;
+    EXPECT_LT(e.metres, 0.02) << result.summary;
+    EXPECT_GE(std::get<Table>(result.find("matches")->data).rows.size(), 4u) << result.summary;
+}
+
 TEST(GlobalAlignment, FourDegreesOfFreedomSearchOnlyTheHeading)
 {
     const Eigen::Vector3d origin = Eigen::Vector3d::Zero();

@@ -269,4 +269,148 @@ PrimitiveAlignment alignOnPlanes(const std::vector<DetectedPrimitive>& movingSha
     return result;
 }
 
+namespace {
+
+struct Target
+{
+    int id = -1;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero(); //!< in the scan's centred frame
+    double radius = 0;
+};
+
+std::vector<Target> targetsOf(const std::vector<DetectedPrimitive>& shapes, Eigen::Vector3d& centre)
+{
+    std::vector<Target> out;
+    centre = Eigen::Vector3d::Zero();
+    for (const DetectedPrimitive& s : shapes)
+        if (s.primitive.kind == PrimitiveKind::Sphere) {
+            out.push_back(Target{s.id, s.primitive.point, s.primitive.radius});
+            centre += s.primitive.point;
+        }
+    if (!out.empty())
+        centre /= static_cast<double>(out.size());
+    for (Target& t : out)
+        t.centre -= centre;
+    return out;
+}
+
+//! The rotation and translation taking the `from` points onto the `to` ones (Kabsch, proper).
+Motion rigidBetween(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to)
+{
+    Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < from.size(); ++k) {
+        a += from[k];
+        b += to[k];
+    }
+    a /= static_cast<double>(from.size());
+    b /= static_cast<double>(to.size());
+    std::vector<Eigen::Vector3d> x, y;
+    for (std::size_t k = 0; k < from.size(); ++k) {
+        x.push_back(from[k] - a);
+        y.push_back(to[k] - b);
+    }
+    Motion m;
+    m.rotation = rotationBetween(x, y, std::vector<double>(x.size(), 1.0));
+    m.translation = b - m.rotation * a;
+    return m;
+}
+
+std::vector<std::pair<std::size_t, std::size_t>> matchTargets(const Motion& m, const std::vector<Target>& moving,
+                                                              const std::vector<Target>& reference, double tolerance)
+{
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    std::vector<bool> used(moving.size(), false);
+    for (std::size_t r = 0; r < reference.size(); ++r) {
+        double best = tolerance;
+        std::size_t chosen = moving.size();
+        for (std::size_t k = 0; k < moving.size(); ++k) {
+            const double d = (m.rotation * moving[k].centre + m.translation - reference[r].centre).norm();
+            if (!used[k] && d <= best && std::abs(moving[k].radius - reference[r].radius) <= tolerance) {
+                best = d;
+                chosen = k;
+            }
+        }
+        if (chosen < moving.size()) {
+            used[chosen] = true;
+            pairs.emplace_back(chosen, r);
+        }
+    }
+    return pairs;
+}
+
+} // namespace
+
+PrimitiveAlignment alignOnSpheres(const std::vector<DetectedPrimitive>& movingShapes, const std::vector<DetectedPrimitive>& referenceShapes,
+                                  const PrimitiveAlignmentParams& params)
+{
+    Eigen::Vector3d movingCentre, referenceCentre;
+    const std::vector<Target> moving = targetsOf(movingShapes, movingCentre);
+    const std::vector<Target> reference = targetsOf(referenceShapes, referenceCentre);
+    const double tol = params.distanceTolerance;
+    auto spread = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) { return (b - a).cross(c - a).norm(); };
+    Motion best;
+    std::vector<std::pair<std::size_t, std::size_t>> bestPairs;
+    for (std::size_t i = 0; i < reference.size(); ++i)
+        for (std::size_t j = i + 1; j < reference.size(); ++j)
+            for (std::size_t k = j + 1; k < reference.size(); ++k) {
+                // Three centres on a line leave the rotation about it free.
+                if (spread(reference[i].centre, reference[j].centre, reference[k].centre) < 100 * tol * tol)
+                    continue;
+                const double dij = (reference[i].centre - reference[j].centre).norm(), dik = (reference[i].centre - reference[k].centre).norm(),
+                             djk = (reference[j].centre - reference[k].centre).norm();
+                for (std::size_t a = 0; a < moving.size(); ++a) {
+                    if (std::abs(moving[a].radius - reference[i].radius) > tol)
+                        continue;
+                    for (std::size_t b = 0; b < moving.size(); ++b) {
+                        if (b == a || std::abs(moving[b].radius - reference[j].radius) > tol ||
+                            std::abs((moving[a].centre - moving[b].centre).norm() - dij) > 2 * tol)
+                            continue;
+                        for (std::size_t c = 0; c < moving.size(); ++c) {
+                            if (c == a || c == b || std::abs(moving[c].radius - reference[k].radius) > tol ||
+                                std::abs((moving[a].centre - moving[c].centre).norm() - dik) > 2 * tol ||
+                                std::abs((moving[b].centre - moving[c].centre).norm() - djk) > 2 * tol)
+                                continue;
+                            const Motion m = rigidBetween({moving[a].centre, moving[b].centre, moving[c].centre},
+                                                          {reference[i].centre, reference[j].centre, reference[k].centre});
+                            auto pairs = matchTargets(m, moving, reference, tol);
+                            if (pairs.size() > bestPairs.size()) {
+                                bestPairs = std::move(pairs);
+                                best = m;
+                            }
+                        }
+                    }
+                }
+            }
+    if (bestPairs.size() < 3)
+        throw Error(ErrorCode::InvalidData, "sphere alignment: no motion brings three spheres of the moving scan onto three of the reference "
+                                            "(found " + std::to_string(moving.size()) + " and " + std::to_string(reference.size()) +
+                                                " spheres; three not on a line are needed in both)");
+    // Refitted on every matched centre, matched again.
+    for (int round = 0; round < 2; ++round) {
+        std::vector<Eigen::Vector3d> from, to;
+        for (const auto& [k, r] : bestPairs) {
+            from.push_back(moving[k].centre);
+            to.push_back(reference[r].centre);
+        }
+        best = rigidBetween(from, to);
+        bestPairs = matchTargets(best, moving, reference, tol);
+    }
+    PrimitiveAlignment result;
+    result.matrix.block<3, 3>(0, 0) = best.rotation;
+    result.matrix.block<3, 1>(0, 3) = best.translation + referenceCentre - best.rotation * movingCentre;
+    double sum = 0;
+    for (const auto& [k, r] : bestPairs) {
+        PlaneMatch match;
+        match.moving = moving[k].id;
+        match.reference = reference[r].id;
+        match.offset = (best.rotation * moving[k].centre + best.translation - reference[r].centre).norm();
+        sum += match.offset * match.offset;
+        result.matches.push_back(match);
+    }
+    result.rmsOffset = std::sqrt(sum / static_cast<double>(result.matches.size()));
+    result.notes.push_back(std::to_string(result.matches.size()) + " spheres matched of " + std::to_string(moving.size()) + " (moving) and " +
+                           std::to_string(reference.size()) + " (reference)");
+    return result;
+}
+
 } // namespace scandiff::plugins

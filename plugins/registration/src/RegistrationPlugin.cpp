@@ -279,19 +279,25 @@ void addPrimitivesTool(ToolRegistry& registry)
 {
     ToolSpec tool;
     tool.name = "register-primitives";
-    tool.title = "Alignment on planes";
+    tool.title = "Alignment on planes or targets";
     tool.category = "Registration";
     tool.description =
         "Moves the moving cloud onto the reference on the planes both scans hold (thesis 004): planes found in each "
         "(primitives, region growing by default), matched by the angles between them (three planes facing three ways make "
         "a hypothesis, scored by the planes it brings onto planes of the other scan, weighted by area), the motion refined "
-        "on every match. From any start. Then, unless --refine is off, point-to-plane ICP with a robust kernel finishes it.";
+        "on every match; or on sphere targets (--on spheres), matched by their radii and the distances between their centres. "
+        "From any start. Then, unless --refine is off, point-to-plane ICP with a robust kernel finishes it.";
     tool.inputs = movingAndReference();
     tool.outputs = registrationOutputs();
-    tool.outputs.push_back(OutputSpec{"matches", "Matched planes", DataKind::Table, false});
+    tool.outputs.push_back(OutputSpec{"matches", "Matched shapes", DataKind::Table, false});
     tool.parameters = {
+        ParameterSpec::choice("on", "Align on",
+                              "planes: the planes both scans hold (walls, floors, roofs); spheres: sphere targets (found by "
+                              "efficient RANSAC), matched by their radii and the distances between them",
+                              {"planes", "spheres"}, "planes"),
         ParameterSpec::choice("method", "Plane finder", "How the planes of each scan are found (see primitives)",
-                              {"region-growing", "efficient-ransac", "sequential"}, "region-growing"),
+                              {"region-growing", "efficient-ransac", "sequential"}, "region-growing")
+            .onlyWith("on=planes"),
         ParameterSpec::real("epsilon", "Plane thickness", "Largest distance of a point to its plane; absent: 3 x the noise", 0.01, 1e-9,
                             1e9, "m")
             .asOptional(),
@@ -307,9 +313,10 @@ void addPrimitivesTool(ToolRegistry& registry)
         const PointCloud& moving = inputs.cloud("moving");
         const Mesh* mesh = inputs.meshOrNull("reference");
         const PointCloud& reference = mesh ? mesh->vertices : inputs.cloud("reference");
+        const bool spheres = values.text("on") == "spheres";
         PrimitiveDetectionParams detection;
-        detection.method = parsePrimitiveMethod(values.text("method"));
-        detection.kinds = {PrimitiveKind::Plane};
+        detection.method = spheres ? PrimitiveMethod::EfficientRansac : parsePrimitiveMethod(values.text("method"));
+        detection.kinds = spheres ? std::set<PrimitiveKind>{PrimitiveKind::Plane, PrimitiveKind::Sphere} : std::set<PrimitiveKind>{PrimitiveKind::Plane};
         if (values.has("epsilon"))
             detection.epsilon = values.real("epsilon");
         detection.minPoints = static_cast<std::size_t>(values.integer("min-points"));
@@ -319,18 +326,20 @@ void addPrimitivesTool(ToolRegistry& registry)
         PrimitiveAlignmentParams align;
         align.angleToleranceDegrees = values.real("angle-tolerance");
         align.distanceTolerance = values.real("distance-tolerance");
-        const PrimitiveAlignment aligned = alignOnPlanes(movingPlanes.primitives, referencePlanes.primitives, align);
+        const PrimitiveAlignment aligned = spheres ? alignOnSpheres(movingPlanes.primitives, referencePlanes.primitives, align)
+                                                   : alignOnPlanes(movingPlanes.primitives, referencePlanes.primitives, align);
 
         RegistrationReport coarse;
-        coarse.method = "alignment on " + std::to_string(aligned.matches.size()) + " planes";
+        coarse.method = "alignment on " + std::to_string(aligned.matches.size()) + (spheres ? " spheres" : " planes");
         coarse.matrix = aligned.matrix;
         coarse.rms = aligned.rmsOffset;
         coarse.overlap = std::numeric_limits<double>::quiet_NaN();
         coarse.converged = true;
         coarse.degeneracy = aligned.degeneracy;
         coarse.notes = aligned.notes;
-        coarse.notes.push_back("planes: RMS angle " + std::to_string(aligned.rmsAngleDegrees) + " deg, RMS offset " +
-                               std::to_string(aligned.rmsOffset) + " m");
+        coarse.notes.push_back(spheres ? "spheres: RMS distance of the centres " + std::to_string(aligned.rmsOffset) + " m"
+                                       : "planes: RMS angle " + std::to_string(aligned.rmsAngleDegrees) + " deg, RMS offset " +
+                                             std::to_string(aligned.rmsOffset) + " m");
         ToolResult result;
         if (values.boolean("refine")) {
             IcpParams icp;
@@ -355,7 +364,7 @@ void addPrimitivesTool(ToolRegistry& registry)
             result.add("report", reportTable(coarse));
         }
         Table matches;
-        matches.columns = {"moving_plane", "reference_plane", "angle_deg", "offset_m"};
+        matches.columns = {"moving_shape", "reference_shape", "angle_deg", "offset_m"};
         for (const PlaneMatch& m : aligned.matches)
             matches.rows.push_back({static_cast<double>(m.moving), static_cast<double>(m.reference), m.angleDegrees, m.offset});
         result.add("matches", std::move(matches));

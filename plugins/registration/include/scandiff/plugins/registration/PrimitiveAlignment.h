@@ -40,6 +40,16 @@ struct PrimitiveAlignment
     std::vector<std::string> notes;
 };
 
+//! Registration on sphere targets (the surveyor's way): the spheres of both
+//! scans matched by their radii and the distances between their centres,
+//! three at a time, the motion from the centres (Kabsch), refitted on every
+//! sphere it brings onto a sphere of the same radius. `matches` then hold
+//! spheres (angle 0, offset the centres' distance). Throws Error(InvalidData)
+//! with fewer than three spheres not on a line in either scan, or no motion
+//! bringing three onto three.
+PrimitiveAlignment alignOnSpheres(const std::vector<DetectedPrimitive>& moving, const std::vector<DetectedPrimitive>& reference,
+                                  const PrimitiveAlignmentParams& params);
+
 //! Throws Error(InvalidData) when either scan has fewer than three planes
 //! whose normals span space, or no motion brings three planes onto three.
 PrimitiveAlignment alignOnPlanes(const std::vector<DetectedPrimitive>& moving, const std::vector<DetectedPrimitive>& reference,
