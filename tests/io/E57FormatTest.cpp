@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <random>
 
 namespace {
@@ -345,6 +346,69 @@ TEST(E57Format, NamesXmlCannotHoldAreMadeSafeAndScansMayNotShareASection)
     const fs::path shared = tempDir() / "shared.e57";
     writeBytes(shared, bytes);
     EXPECT_NE(errorOf([&] { io::readE57Scans(shared); }).find("same points section"), std::string::npos);
+}
+
+//! The file with its XML section replaced by `edit(xml)`: the pages'
+//! payloads joined, the XML swapped, the whole cut into checksummed pages again.
+std::string withXml(const std::string& file, const std::function<std::string(std::string)>& edit)
+{
+    std::uint64_t xmlPhysical = 0, xmlLength = 0;
+    std::memcpy(&xmlPhysical, file.data() + 24, 8);
+    std::memcpy(&xmlLength, file.data() + 32, 8);
+    std::string logical;
+    for (std::size_t page = 0; page + 1024 <= file.size(); page += 1024)
+        logical.append(file, page, 1020);
+    const std::size_t xmlLogical = xmlPhysical / 1024 * 1020 + xmlPhysical % 1024;
+    const std::string xml = edit(logical.substr(xmlLogical, xmlLength));
+    logical.resize(xmlLogical);
+    logical += xml;
+    logical.resize((logical.size() + 1019) / 1020 * 1020, '\0');
+    const std::uint64_t newLength = xml.size(), physical = logical.size() / 1020 * 1024;
+    std::memcpy(logical.data() + 16, &physical, 8);
+    std::memcpy(logical.data() + 32, &newLength, 8);
+    std::string out;
+    for (std::size_t page = 0; page < logical.size(); page += 1020) {
+        out.append(logical, page, 1020);
+        out.append(4, '\0');
+    }
+    resealPages(out);
+    return out;
+}
+
+TEST(E57Format, SphericalCoordinatesAreConvertedAndMakeASensor)
+{
+    // A scan stored as range, azimuth and elevation (what scanners record):
+    // our writer's doubles relabelled as the spherical fields.
+    PointCloud polar;
+    polar.name = "station";
+    polar.resize(200);
+    for (std::size_t i = 0; i < polar.size(); ++i)
+        polar.positions()[i] = Eigen::Vector3f(5.0f + 0.1f * float(i % 17), -3.0f + 0.03f * float(i), -0.5f + 0.005f * float(i));
+    const fs::path written = tempDir() / "polar.e57";
+    io::writeE57({&polar}, written);
+    const std::string spherical = withXml(readBytes(written), [](std::string xml) {
+        for (const auto& [from, to] : {std::pair<std::string, std::string>{"<cartesianX ", "<sphericalRange "},
+                                       {"<cartesianY ", "<sphericalAzimuth "},
+                                       {"<cartesianZ ", "<sphericalElevation "}})
+            xml.replace(xml.find(from), from.size(), to);
+        xml.replace(xml.find("<cartesianBounds"), xml.find("</cartesianBounds>") + 18 - xml.find("<cartesianBounds"), "");
+        return xml;
+    });
+    const fs::path path = tempDir() / "spherical.e57";
+    writeBytes(path, spherical);
+    const io::E57Summary summary = io::inspectE57(path);
+    ASSERT_EQ(summary.scans.size(), 1u);
+    EXPECT_TRUE(summary.scans[0].spherical);
+    const std::vector<PointCloud> scans = io::readE57Scans(path);
+    ASSERT_EQ(scans.size(), 1u);
+    ASSERT_EQ(scans[0].size(), polar.size());
+    EXPECT_EQ(scans[0].sensors().size(), 1u); // a spherical scan is a station at its frame's origin
+    for (std::size_t i = 0; i < polar.size(); ++i) {
+        const double r = polar.positions()[i].x(), azimuth = polar.positions()[i].y(), elevation = polar.positions()[i].z();
+        const Eigen::Vector3d expected(r * std::cos(elevation) * std::cos(azimuth), r * std::cos(elevation) * std::sin(azimuth),
+                                       r * std::sin(elevation));
+        ASSERT_LT((scans[0].globalPosition(i) - expected).norm(), 1e-5) << i;
+    }
 }
 
 TEST(E57Format, ConvertsBetweenE57AndPly)
