@@ -428,6 +428,23 @@ TEST(GlobalAlignment, Recovers140DegreesFromAnyStartThenIcpFinishes)
     EXPECT_LT(fine.metres, 0.002);
 }
 
+//! Two independent samplings of analytic shapes at `origin`, the moving one
+//! moved by the inverse of a 140° turn about a tilted axis (scene.truth).
+Scene twoSamplings(const std::vector<test::SceneShape>& shapes, std::size_t points, double noise, double clutter, unsigned seed,
+                   const Eigen::Vector3d& origin)
+{
+    auto sample = [&](unsigned s) {
+        test::PrimitiveScene scene = test::makePrimitiveScene(shapes, points, noise, clutter, s, false);
+        scene.cloud.setOrigin(origin);
+        return std::move(scene.cloud);
+    };
+    Scene scene;
+    scene.reference = sample(seed);
+    scene.truth = test::rigidMotionAbout(140, 25, -15, Eigen::Vector3d(6, -4, 1), origin);
+    scene.moving = transformCloud(sample(seed + 1), scene.truth.inverse(), "the truth's inverse");
+    return scene;
+}
+
 TEST(PrimitiveAlignment, TwoSamplingsOfAFacadeRegisterOnTheirPlanesFromAnyStart)
 {
     // Thesis 004: two independent samplings of a façade (wall, windows' glass,
@@ -436,14 +453,10 @@ TEST(PrimitiveAlignment, TwoSamplingsOfAFacadeRegisterOnTheirPlanesFromAnyStart)
     // shifted. Its planes matched with the reference's give the motion
     // within 0.05° and 1 cm over the site; ICP from there lands on the truth.
     const Eigen::Vector3d origin(512300.0, 5401200.0, 150.0);
-    auto sample = [&](unsigned seed) {
-        test::PrimitiveScene s = test::makePrimitiveScene(test::facadeSceneShapes(0.6, Eigen::Vector3d::Zero()), 120000, 0.003, 0.02, seed, false);
-        s.cloud.setOrigin(origin);
-        return std::move(s.cloud);
-    };
-    const PointCloud reference = sample(21);
-    const Eigen::Matrix4d truth = test::rigidMotionAbout(140, 25, -15, Eigen::Vector3d(6, -4, 1), origin);
-    const PointCloud moving = transformCloud(sample(22), truth.inverse(), "the truth's inverse");
+    const Scene scene = twoSamplings(test::facadeSceneShapes(0.6, Eigen::Vector3d::Zero()), 120000, 0.003, 0.02, 21, origin);
+    const PointCloud& reference = scene.reference;
+    const PointCloud& moving = scene.moving;
+    const Eigen::Matrix4d& truth = scene.truth;
     const PluginRegistry registry = makePluginRegistry();
     const ToolSpec& tool = *registry.tools.find("register-primitives");
     const ToolInputs inputs = ToolInputs().add("moving", moving).add("reference", reference);
@@ -482,17 +495,11 @@ TEST(PrimitiveAlignment, SphereTargetsRegisterTwoStationsFromAnyStart)
         test::scene::sphere("target 4", Eigen::Vector3d(-1.8, 2.0, 1.5), 0.12),
         test::scene::sphere("target 5", Eigen::Vector3d(0.3, 0.2, 1.0), 0.18),
     };
-    auto sample = [&](unsigned seed) {
-        test::PrimitiveScene s = test::makePrimitiveScene(shapes, 60000, 0.002, 0.0, seed, false);
-        s.cloud.setOrigin(origin);
-        return std::move(s.cloud);
-    };
-    const PointCloud reference = sample(31);
-    const Eigen::Matrix4d truth = test::rigidMotionAbout(140, 25, -15, Eigen::Vector3d(6, -4, 1), origin);
-    const PointCloud moving = transformCloud(sample(32), truth.inverse(), "the truth's inverse");
+    const Scene scene = twoSamplings(shapes, 60000, 0.002, 0.0, 31, origin);
+    const Eigen::Matrix4d& truth = scene.truth;
     const PluginRegistry registry = makePluginRegistry();
     const ToolSpec& tool = *registry.tools.find("register-primitives");
-    const ToolInputs inputs = ToolInputs().add("moving", moving).add("reference", reference);
+    const ToolInputs inputs = ToolInputs().add("moving", scene.moving).add("reference", scene.reference);
     ToolResult result = tool.execute(inputs, tool.resolve({{"on", "spheres"}, {"refine", "false"}, {"min-points", "100"}}), nullptr);
     const MotionError e = errorOf(std::get<Eigen::Matrix4d>(result.find("matrix")->data), truth, origin);
     EXPECT_LT(e.degrees, 0.05) << result.summary;

@@ -25,6 +25,16 @@ namespace scandiff::gui {
 namespace {
 
 constexpr int kRecentFiles = 10;
+
+//! Beyond this distance from their origin float32 coordinates no longer hold a millimetre.
+constexpr double kPreciseReach = 8192.0;
+
+//! How far the cloud's points lie from `origin` along the worst axis.
+double reachFrom(const PointCloud& points, const Eigen::Vector3d& origin)
+{
+    const BoundingBox box = points.bounds();
+    return std::max((box.min - origin).cwiseAbs().maxCoeff(), (box.max - origin).cwiseAbs().maxCoeff());
+}
 const char* kRecentKey = "recentFiles";
 
 } // namespace
@@ -118,9 +128,8 @@ std::vector<EntityId> FileController::open(const QStringList& paths, bool quiet)
 
 void FileController::shiftIfPrecise(const QString& path, PointCloud& points, const Eigen::Vector3d& origin)
 {
-    const BoundingBox box = points.bounds();
-    const double reach = std::max((box.min - origin).cwiseAbs().maxCoeff(), (box.max - origin).cwiseAbs().maxCoeff());
-    if (reach > 8192.0) {
+    const double reach = reachFrom(points, origin);
+    if (reach > kPreciseReach) {
         emit failed(tr("%1: '%2' is %3 m from the origin of the file's other scans; kept its own origin to keep every millimetre")
                         .arg(QFileInfo(path).fileName(), QString::fromStdString(points.name))
                         .arg(reach, 0, 'f', 0));
@@ -148,9 +157,8 @@ void FileController::chooseOrigin(const QString& path, PointCloud& points, bool 
         return;
     // The floats become relative to the chosen origin; refused when that would
     // put them so far from it that float32 could not hold a millimetre.
-    const BoundingBox box = points.bounds();
-    const double reach = std::max((box.min - *origin).cwiseAbs().maxCoeff(), (box.max - *origin).cwiseAbs().maxCoeff());
-    if (reach > 8192.0) {
+    const double reach = reachFrom(points, *origin);
+    if (reach > kPreciseReach) {
         emit failed(tr("%1: the origin %2, %3, %4 is %5 m from the points; kept the suggested one to keep every millimetre")
                         .arg(QFileInfo(path).fileName())
                         .arg(origin->x(), 0, 'f', 3)

@@ -734,11 +734,10 @@ std::vector<PointCloud> readE57Scans(const fs::path& path, const ReadOptions& op
     // Two scans may not read one section: a file of many scans pointing at one
     // would otherwise ask for its points many times over.
     std::set<std::int64_t> sections;
-    for (std::size_t i = 0; i < scans.size(); ++i) {
-        const Node& points = pointsOf(*scans[i], file.context, i);
-        if (recordCountOf(points, file.context) > 0 && !sections.insert(integerAttribute(points, "fileOffset", -1, file.context)).second)
+    for (std::size_t i = 0; i < scans.size(); ++i)
+        if (summaries[i].recordCount > 0 &&
+            !sections.insert(integerAttribute(*scans[i]->child("points"), "fileOffset", -1, file.context)).second)
             file.pages.fail("scans " + std::to_string(i) + " and another read the same points section");
-    }
     for (std::size_t i = 0; i < scans.size(); ++i) {
         PointCloud cloud;
         cloud.setOrigin(origin);

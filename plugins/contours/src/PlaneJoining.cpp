@@ -66,8 +66,24 @@ std::vector<Eigen::Vector2d> inPlane(const PlaneFrame& frame, const std::vector<
     return out;
 }
 
+//! A plane's rings in its own (u, v) frame, made once for every vertex's inside test.
+struct RingsInPlane
+{
+    std::vector<std::vector<Eigen::Vector2d>> outer, holes;
+};
+
+RingsInPlane ringsInPlane(const OutlinedPlane& plane, const Drawing& drawing)
+{
+    RingsInPlane rings;
+    for (std::size_t k : plane.outer)
+        rings.outer.push_back(inPlane(plane.frame, drawing.polylines[k].points));
+    for (std::size_t k : plane.holes)
+        rings.holes.push_back(inPlane(plane.frame, drawing.polylines[k].points));
+    return rings;
+}
+
 //! Whether `p` lies on the surface `plane` outlines (inside an outer ring, not in a hole) or within `tolerance` of its outline.
-bool onOrNear(const OutlinedPlane& plane, const Drawing& drawing, const Eigen::Vector3d& p, double tolerance)
+bool onOrNear(const OutlinedPlane& plane, const RingsInPlane& rings, const Drawing& drawing, const Eigen::Vector3d& p, double tolerance)
 {
     for (std::size_t k : plane.outer)
         if (distanceToRing(p, drawing.polylines[k].points) <= tolerance)
@@ -77,10 +93,10 @@ bool onOrNear(const OutlinedPlane& plane, const Drawing& drawing, const Eigen::V
             return true;
     const Eigen::Vector2d q = plane.frame.toPlane(p);
     bool inside = false;
-    for (std::size_t k : plane.outer)
-        inside = inside || containsPoint(inPlane(plane.frame, drawing.polylines[k].points), q);
-    for (std::size_t k : plane.holes)
-        inside = inside && !containsPoint(inPlane(plane.frame, drawing.polylines[k].points), q);
+    for (const auto& ring : rings.outer)
+        inside = inside || containsPoint(ring, q);
+    for (const auto& ring : rings.holes)
+        inside = inside && !containsPoint(ring, q);
     return inside;
 }
 
@@ -117,6 +133,10 @@ PlaneJoinResult joinNeighbouringPlanes(Drawing& drawing, const std::vector<Outli
             if (planes[a].frame.normal.cross(planes[b].frame.normal).norm() >= minSine)
                 lines[{a, b}] = intersection(planes[a].frame, planes[b].frame);
 
+    std::vector<RingsInPlane> flat;
+    for (const OutlinedPlane& plane : planes)
+        flat.push_back(ringsInPlane(plane, drawing));
+
     // Which planes each vertex meets.
     std::vector<Vertex> joined;
     std::set<std::pair<std::size_t, std::size_t>> meetingPairs;
@@ -136,7 +156,7 @@ PlaneJoinResult joinNeighbouringPlanes(Drawing& drawing, const std::vector<Outli
                     if (b == a || line == lines.end())
                         continue;
                     const double distance = distanceToLine(v, line->second);
-                    if (distance <= params.tolerance && onOrNear(planes[b], drawing, v, params.tolerance))
+                    if (distance <= params.tolerance && onOrNear(planes[b], flat[b], drawing, v, params.tolerance))
                         candidates.emplace_back(distance, b);
                 }
                 std::sort(candidates.begin(), candidates.end());

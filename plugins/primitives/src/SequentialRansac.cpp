@@ -106,6 +106,20 @@ Plane fitPlane(const std::vector<Eigen::Vector3d>& points, const std::vector<std
     return plane;
 }
 
+using Pixel = std::pair<std::int64_t, std::int64_t>;
+
+//! The pixel of `p` in the plane's raster (PCA axes, side `pixel`), and its hash key.
+Pixel pixelOf(const Plane& plane, const Eigen::Vector3d& p, double pixel)
+{
+    const Eigen::Vector3d d = p - plane.point;
+    return {static_cast<std::int64_t>(std::floor(d.dot(plane.e1) / pixel)), static_cast<std::int64_t>(std::floor(d.dot(plane.e2) / pixel))};
+}
+
+std::uint64_t pixelKey(std::int64_t u, std::int64_t v)
+{
+    return (static_cast<std::uint64_t>(u) << 32) ^ static_cast<std::uint32_t>(v);
+}
+
 //! The largest 8-connected region of the inliers' pixels in their plane
 //! (§3.4.6: a binary image, connected regions, the largest kept).
 std::vector<std::uint32_t> largestRegion(const std::vector<Eigen::Vector3d>& points, const std::vector<std::uint32_t>& inliers,
@@ -116,29 +130,23 @@ std::vector<std::uint32_t> largestRegion(const std::vector<Eigen::Vector3d>& poi
         std::vector<std::uint32_t> members;
         int label = -1;
     };
-    auto key = [](std::int64_t u, std::int64_t v) { return (static_cast<std::uint64_t>(u) << 32) ^ static_cast<std::uint32_t>(v); };
     std::unordered_map<std::uint64_t, Cell> cells;
     cells.reserve(inliers.size() / 4 + 1);
+    // The occupied pixels, sorted for a walk that never depends on the hash order.
+    std::vector<Pixel> coordinates;
+    coordinates.reserve(inliers.size());
     for (std::uint32_t i : inliers) {
-        const Eigen::Vector3d d = points[i] - plane.point;
-        const auto u = static_cast<std::int64_t>(std::floor(d.dot(plane.e1) / pixel));
-        const auto v = static_cast<std::int64_t>(std::floor(d.dot(plane.e2) / pixel));
-        cells[key(u, v)].members.push_back(i);
-    }
-    // Cells by their coordinates again, for the walk over neighbours.
-    std::vector<std::pair<std::int64_t, std::int64_t>> coordinates;
-    for (std::uint32_t i : inliers) {
-        const Eigen::Vector3d d = points[i] - plane.point;
-        coordinates.emplace_back(static_cast<std::int64_t>(std::floor(d.dot(plane.e1) / pixel)),
-                                 static_cast<std::int64_t>(std::floor(d.dot(plane.e2) / pixel)));
+        const Pixel at = pixelOf(plane, points[i], pixel);
+        cells[pixelKey(at.first, at.second)].members.push_back(i);
+        coordinates.push_back(at);
     }
     std::sort(coordinates.begin(), coordinates.end());
     coordinates.erase(std::unique(coordinates.begin(), coordinates.end()), coordinates.end());
     int labels = 0, best = -1;
     std::size_t bestArea = 0, bestPoints = 0;
-    std::vector<std::pair<std::int64_t, std::int64_t>> stack;
+    std::vector<Pixel> stack;
     for (const auto& start : coordinates) {
-        Cell& first = cells[key(start.first, start.second)];
+        Cell& first = cells[pixelKey(start.first, start.second)];
         if (first.label >= 0)
             continue;
         const int label = labels++;
@@ -148,12 +156,12 @@ std::vector<std::uint32_t> largestRegion(const std::vector<Eigen::Vector3d>& poi
         while (!stack.empty()) {
             const auto [u, v] = stack.back();
             stack.pop_back();
-            const Cell& here = cells[key(u, v)];
+            const Cell& here = cells[pixelKey(u, v)];
             ++area;
             count += here.members.size();
             for (std::int64_t du = -1; du <= 1; ++du)
                 for (std::int64_t dv = -1; dv <= 1; ++dv) {
-                    const auto it = cells.find(key(u + du, v + dv));
+                    const auto it = cells.find(pixelKey(u + du, v + dv));
                     if (it == cells.end() || it->second.label >= 0)
                         continue;
                     it->second.label = label;
@@ -433,25 +441,19 @@ std::size_t giveBackIntersectionPoints(const std::vector<Eigen::Vector3d>& point
         Plane plane;
         std::unordered_set<std::uint64_t> cells;
     };
-    auto key = [](std::int64_t u, std::int64_t v) { return (static_cast<std::uint64_t>(u) << 32) ^ static_cast<std::uint32_t>(v); };
-    auto cellOf = [&](const Plane& plane, const Eigen::Vector3d& p) {
-        const Eigen::Vector3d d = p - plane.point;
-        return std::make_pair(static_cast<std::int64_t>(std::floor(d.dot(plane.e1) / pixel)),
-                              static_cast<std::int64_t>(std::floor(d.dot(plane.e2) / pixel)));
-    };
     std::vector<Surface> surfaces(planes.size());
     for (std::size_t k = 0; k < planes.size(); ++k) {
         surfaces[k].plane = fitPlane(points, planes[k].members);
         for (std::uint32_t i : planes[k].members) {
-            const auto [u, v] = cellOf(surfaces[k].plane, points[i]);
-            surfaces[k].cells.insert(key(u, v));
+            const auto [u, v] = pixelOf(surfaces[k].plane, points[i], pixel);
+            surfaces[k].cells.insert(pixelKey(u, v));
         }
     }
     auto onSurface = [&](const Surface& s, const Eigen::Vector3d& p) {
-        const auto [u, v] = cellOf(s.plane, p);
+        const auto [u, v] = pixelOf(s.plane, p, pixel);
         for (std::int64_t du = -1; du <= 1; ++du)
             for (std::int64_t dv = -1; dv <= 1; ++dv)
-                if (s.cells.count(key(u + du, v + dv)))
+                if (s.cells.count(pixelKey(u + du, v + dv)))
                     return true;
         return false;
     };

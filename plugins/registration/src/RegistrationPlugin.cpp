@@ -116,38 +116,33 @@ GlobalAlignmentParams globalFrom(const ParameterValues& values)
     return params;
 }
 
-//! ICP after an optional global alignment: the result and the tool's outputs.
-ToolResult registerAndReport(const ToolInputs& inputs, IcpParams icp, const GlobalAlignmentParams* global, bool refine,
-                             ProgressObserver* progress)
+//! The tool's outputs after an optional coarse stage (global alignment,
+//! alignment on primitives) and, when `refine`, ICP from the coarse matrix;
+//! the coarse stage's notes lead the refined report's, after `notePrefix`.
+ToolResult refineAndReport(const ToolInputs& inputs, IcpParams icp, const RegistrationReport* coarse, const std::string& notePrefix,
+                           bool refine, ProgressObserver* progress)
 {
     const PointCloud& moving = inputs.cloud("moving");
     const Mesh* mesh = inputs.meshOrNull("reference");
     const PointCloud* referenceCloud = mesh ? nullptr : &inputs.cloud("reference");
-    std::vector<std::string> globalNotes;
-    RegistrationReport coarseReport;
-    if (global) {
-        const GlobalAlignmentResult coarse = globalAlign(moving, referenceCloud, mesh, *global, progress);
-        icp.initial = coarse.report.matrix;
-        // From within about a spacing: correspondences much farther are not
-        // the same surface (partial overlap).
-        if (!icp.maxDistance)
-            icp.maxDistance = 3 * coarse.spacing;
-        coarseReport = coarse.report;
-        for (const auto& note : coarse.report.notes)
-            globalNotes.push_back("global alignment: " + note);
-    }
     RegistrationReport report;
     ScalarField residual, excluded;
     if (refine) {
+        if (coarse)
+            icp.initial = coarse->matrix;
         IcpResult fine = icpRegister(moving, referenceCloud, mesh, icp, progress);
         report = std::move(fine.report);
         residual = std::move(fine.residual);
         excluded = std::move(fine.excluded);
-        if (global)
-            report.method = coarseReport.method + ", then " + report.method;
-        report.notes.insert(report.notes.begin(), globalNotes.begin(), globalNotes.end());
-    } else {
-        report = coarseReport;
+        if (coarse) {
+            report.method = coarse->method + ", then " + report.method;
+            std::vector<std::string> notes;
+            for (const auto& note : coarse->notes)
+                notes.push_back(notePrefix + note);
+            report.notes.insert(report.notes.begin(), notes.begin(), notes.end());
+        }
+    } else if (coarse) {
+        report = *coarse;
     }
     ToolResult result;
     result.summary = reportSummary(report);
@@ -160,6 +155,22 @@ ToolResult registerAndReport(const ToolInputs& inputs, IcpParams icp, const Glob
     if (refine)
         result.add("trace", traceTable(report));
     return result;
+}
+
+//! ICP after an optional global alignment: the result and the tool's outputs.
+ToolResult registerAndReport(const ToolInputs& inputs, IcpParams icp, const GlobalAlignmentParams* global, bool refine,
+                             ProgressObserver* progress)
+{
+    if (!global)
+        return refineAndReport(inputs, icp, nullptr, {}, refine, progress);
+    const Mesh* mesh = inputs.meshOrNull("reference");
+    const GlobalAlignmentResult coarse =
+        globalAlign(inputs.cloud("moving"), mesh ? nullptr : &inputs.cloud("reference"), mesh, *global, progress);
+    // From within about a spacing: correspondences much farther are not the
+    // same surface (partial overlap).
+    if (!icp.maxDistance)
+        icp.maxDistance = 3 * coarse.spacing;
+    return refineAndReport(inputs, icp, &coarse.report, "global alignment: ", refine, progress);
 }
 
 std::vector<ParameterSpec> icpParameters()
@@ -340,29 +351,12 @@ void addPrimitivesTool(ToolRegistry& registry)
         coarse.notes.push_back(spheres ? "spheres: RMS distance of the centres " + std::to_string(aligned.rmsOffset) + " m"
                                        : "planes: RMS angle " + std::to_string(aligned.rmsAngleDegrees) + " deg, RMS offset " +
                                              std::to_string(aligned.rmsOffset) + " m");
-        ToolResult result;
-        if (values.boolean("refine")) {
-            IcpParams icp;
-            icp.kernel = RobustKernel::Cauchy;
-            icp.seed = static_cast<std::uint64_t>(values.integer("seed"));
-            icp.initial = aligned.matrix;
-            // From within a few plane thicknesses and spacings of the planes' motion.
-            icp.maxDistance = std::max(movingPlanes.clusterEpsilon, 5.0 * std::max(aligned.rmsOffset, movingPlanes.epsilon));
-            IcpResult fine = icpRegister(moving, mesh ? nullptr : &reference, mesh, icp, progress);
-            RegistrationReport report = std::move(fine.report);
-            report.method = coarse.method + ", then " + report.method;
-            report.notes.insert(report.notes.begin(), coarse.notes.begin(), coarse.notes.end());
-            result.summary = reportSummary(report);
-            result.add("output", movedCloud(moving, report.matrix, report.method, std::move(fine.residual), std::move(fine.excluded)));
-            result.add("matrix", report.matrix);
-            result.add("report", reportTable(report));
-            result.add("trace", traceTable(report));
-        } else {
-            result.summary = reportSummary(coarse);
-            result.add("output", transformCloud(moving, coarse.matrix, coarse.method));
-            result.add("matrix", coarse.matrix);
-            result.add("report", reportTable(coarse));
-        }
+        IcpParams icp;
+        icp.kernel = RobustKernel::Cauchy;
+        icp.seed = static_cast<std::uint64_t>(values.integer("seed"));
+        // From within a few plane thicknesses and spacings of the planes' motion.
+        icp.maxDistance = std::max(movingPlanes.clusterEpsilon, 5.0 * std::max(aligned.rmsOffset, movingPlanes.epsilon));
+        ToolResult result = refineAndReport(inputs, icp, &coarse, {}, values.boolean("refine"), progress);
         Table matches;
         matches.columns = {"moving_shape", "reference_shape", "angle_deg", "offset_m"};
         for (const PlaneMatch& m : aligned.matches)
