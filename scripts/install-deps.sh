@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build ccache pkg-config
   libeigen3-dev libtbb-dev libmuparser-dev
   qtbase5-dev libqt5opengl5-dev
-  libvtk9-dev libvtk9-qt-dev libopenmpi-dev
+  libvtk9-dev libvtk9-qt-dev libopenmpi-dev openmpi-bin
   libpcl-dev libflann-dev libcgal-dev liblzf-dev libgdal-dev libxerces-c-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev

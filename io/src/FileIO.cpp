@@ -93,6 +93,40 @@ std::vector<Entity> readEntities(const FormatRegistry& registry, const fs::path&
     return entities;
 }
 
+bool canReadRecordRanges(const FormatRegistry& registry, const fs::path& path)
+{
+    const FormatHandler& handler = registry.forPath(path);
+    return handler.countRecords && handler.readRecords;
+}
+
+std::uint64_t pointRecordCount(const FormatRegistry& registry, const fs::path& path)
+{
+    const FormatHandler& handler = readerFor(registry, path);
+    if (!handler.countRecords)
+        throw Error(ErrorCode::Unsupported, path.string() + ": " + handler.name + " files cannot be read by ranges of records");
+    return handler.countRecords(path);
+}
+
+PointCloud readPointRecords(const FormatRegistry& registry, const fs::path& path, RecordRange range, const ReadOptions& options)
+{
+    const FormatHandler& handler = readerFor(registry, path);
+    if (!handler.readRecords)
+        throw Error(ErrorCode::Unsupported, path.string() + ": " + handler.name + " files cannot be read by ranges of records");
+    Entity entity = handler.readRecords(path, range, options);
+    finishEntity(entity, path, options);
+    return std::move(std::get<PointCloud>(entity));
+}
+
+std::unique_ptr<PointChunkWriter> openPointChunkWriter(const FormatRegistry& registry, const fs::path& path,
+                                                       const PointCloud& layout, std::uint64_t total,
+                                                       const WriteOptions& options)
+{
+    const FormatHandler& handler = registry.forPath(path);
+    if (!handler.openChunkWriter)
+        throw Error(ErrorCode::Unsupported, path.string() + ": " + handler.name + " files cannot be written chunk by chunk");
+    return handler.openChunkWriter(path, layout, total, options);
+}
+
 PointCloud readPointCloud(const FormatRegistry& registry, const fs::path& path, const ReadOptions& options)
 {
     Entity entity = readFile(registry, path, options);

@@ -711,19 +711,26 @@ std::unique_ptr<char[]> decompressRecords(const MappedFile& file, const LasHeade
     return records;
 }
 
-Entity readLas(const fs::path& path, const ReadOptions& options)
+//! The whole file, or with `range` the records of that range (uncompressed
+//! LAS only: a LAZ chunk cannot be decoded without those before it in its
+//! chunk, and its range reading is not written yet).
+Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<RecordRange> range = std::nullopt)
 {
     MappedFile file(path);
     const LasHeader h = parseHeader(file);
-    const std::size_t count = static_cast<std::size_t>(h.pointCount);
+    if (range && h.compressed)
+        throw Error(ErrorCode::Unsupported, path.string() + ": a range of records cannot be read from a LAZ file yet");
+    const std::uint64_t first = range ? std::min(range->first, h.pointCount) : 0;
+    const std::size_t count = static_cast<std::size_t>(range ? std::min(range->count, h.pointCount - first) : h.pointCount);
     // LAZ: the records decompressed into memory (freed at the end of the read).
     const std::unique_ptr<char[]> decompressed = h.compressed ? decompressRecords(file, h, options) : nullptr;
-    const char* records = h.compressed ? decompressed.get() : file.data() + h.offsetToPoints;
+    const char* allRecords = h.compressed ? decompressed.get() : file.data() + h.offsetToPoints;
+    const char* records = allRecords + first * h.recordLength;
     const int format = h.pointFormat;
     std::vector<ExtraDimension> extras = findExtraDimensions(file, h);
 
     PointCloud cloud;
-    cloud.setOrigin(chooseOrigin(h, records, options));
+    cloud.setOrigin(chooseOrigin(h, allRecords, options));
     cloud.setSourceGrid(CoordinateGrid{h.offset, h.scale});
     cloud.setCrsWkt(findCrs(file, h));
     double gpsTimeOffset = 0.0;
@@ -834,9 +841,10 @@ Entity readLas(const fs::path& path, const ReadOptions& options)
     // flags... in most files) carries nothing: dropping it saves 4 bytes per point
     // each, and writing LAS again puts 0 in its slot all the same. Extra Bytes
     // are the user's own dimensions and always kept.
+    // The ranges of one file keep them all, so that each has the same fields.
     std::vector<std::string> emptyStandardFields;
     for (const ScalarField& f : cloud.fields()) {
-        if (std::find(extraNames.begin(), extraNames.end(), f.name()) != extraNames.end())
+        if (range || std::find(extraNames.begin(), extraNames.end(), f.name()) != extraNames.end())
             continue;
         const ValueRange r = f.range();
         if (r.validCount == f.size() && r.min == 0.0 && r.max == 0.0)
@@ -1247,6 +1255,13 @@ FormatHandler lasFormat()
     handler.name = "LAS";
     handler.extensions = {"las"};
     handler.read = [](const fs::path& path, const ReadOptions& options) { return readLas(path, options); };
+    handler.countRecords = [](const fs::path& path) {
+        const MappedFile file(path);
+        return parseHeader(file).pointCount;
+    };
+    handler.readRecords = [](const fs::path& path, RecordRange range, const ReadOptions& options) -> PointCloud {
+        return std::get<PointCloud>(readLas(path, options, range));
+    };
     handler.writeCloud = [](const PointCloud& cloud, const fs::path& path, const WriteOptions& options) {
         writeLas(cloud, path, options, false);
     };

@@ -477,6 +477,27 @@ VertexLayout makeVertexLayout(const PlyElement& e, const Context& ctx)
     return layout;
 }
 
+//! Drops colours and scalar fields from a layout (ReadOptions::geometryOnly):
+//! their values are then never decoded.
+void keepGeometryOnly(VertexLayout& layout)
+{
+    std::vector<int> newIndex(layout.slots.size(), -1);
+    std::vector<Slot> kept;
+    for (const Slot& s : layout.slots)
+        if ((s.role >= Role::X && s.role <= Role::Z) || (s.role >= Role::Nx && s.role <= Role::Nz)) {
+            newIndex[s.index] = static_cast<int>(kept.size());
+            kept.push_back(s);
+            kept.back().index = static_cast<std::uint32_t>(newIndex[s.index]);
+        }
+    for (int& slot : layout.slotOfProperty)
+        if (slot >= 0)
+            slot = newIndex[static_cast<std::size_t>(slot)];
+    layout.slots = std::move(kept);
+    layout.fieldNames.clear();
+    layout.fieldIsWide.clear();
+    layout.hasColors = false;
+}
+
 //! Where decoded vertex values go. Coordinates and wide fields go to double
 //! staging buffers when their origin/offset can only be chosen after reading.
 //! Set the members, call compile(), then put() every value.
@@ -1020,10 +1041,13 @@ int faceIndexProperty(const PlyElement& e)
 class PlyReader
 {
 public:
-    PlyReader(const fs::path& path, const ReadOptions& options)
-        : path_(path), options_(options), ctx_(path), file_(path), header_(parseHeader(file_, ctx_))
+    PlyReader(const fs::path& path, const ReadOptions& options, std::optional<RecordRange> range = std::nullopt)
+        : path_(path), options_(options), range_(range), ctx_(path), file_(path), header_(parseHeader(file_, ctx_))
     {
     }
+
+    //! The number of vertex records the header announces.
+    std::uint64_t vertexRecordCount() const { return vertexCountFromHeader(); }
 
     Entity read()
     {
@@ -1034,7 +1058,11 @@ public:
         if (!vertexElement)
             ctx_.fail("no vertex element in the PLY header");
         layout_ = makeVertexLayout(*vertexElement, ctx_);
+        if (options_.geometryOnly)
+            keepGeometryOnly(layout_);
         cloud_.setCrsWkt(header_.crsWkt);
+        if (range_)
+            return readRecordRange(*vertexElement);
 
         const bool binary = header_.encoding != PlyEncoding::Ascii;
         const bool needsRanges =
@@ -1092,6 +1120,66 @@ private:
         }
     }
 
+    //! Records [first, first + count) of the vertex element, through the
+    //! parallel decoder of fixed-size records. The origin is the whole file's
+    //! (a pass over every record's coordinates) unless the options give one.
+    Entity readRecordRange(const PlyElement& vertexElement)
+    {
+        if (header_.encoding == PlyEncoding::Ascii || !vertexElement.fixedSize())
+            throw Error(ErrorCode::Unsupported, path_.string() +
+                                                    ": a range of records can only be read from a binary PLY whose vertex "
+                                                    "records have a fixed size");
+        const bool swap = (header_.encoding == PlyEncoding::BinaryBigEndian) == kHostLittleEndian;
+        if (swap)
+            readBinaryRange<true>(vertexElement);
+        else
+            readBinaryRange<false>(vertexElement);
+        // Faces are not read: a range of vertices cannot keep their indices.
+        return finish();
+    }
+
+    template <bool Swap>
+    void readBinaryRange(const PlyElement& vertexElement)
+    {
+        const char* ptr = file_.data() + header_.dataOffset;
+        const char* end = file_.data() + file_.size();
+        for (const auto& e : header_.elements) {
+            if (&e == &vertexElement)
+                break;
+            ptr = skipBinaryElement<Swap>(e, ptr, end, ctx_);
+        }
+        const std::size_t recordSize = vertexElement.minRecordSize();
+        if (recordSize == 0 || static_cast<std::uint64_t>(end - ptr) / recordSize < vertexElement.count)
+            ctx_.truncated(vertexElement, recordSize == 0 ? 0 : static_cast<std::uint64_t>(end - ptr) / recordSize);
+        const std::uint64_t first = std::min(range_->first, vertexElement.count);
+        PlyElement part = vertexElement;
+        part.count = std::min(range_->count, vertexElement.count - first);
+
+        std::optional<Eigen::Vector3d> origin = options_.origin;
+        ProgressTicker ticker(options_.progress, "Reading " + path_.filename().string(),
+                              part.count + (!origin && layout_.coordinatesAreDouble ? vertexElement.count : 0));
+        if (!origin && layout_.coordinatesAreDouble) {
+            VertexLayout coordinates = layout_;
+            coordinates.slots.erase(std::remove_if(coordinates.slots.begin(), coordinates.slots.end(),
+                                                   [](const Slot& s) { return s.role < Role::X || s.role > Role::Z; }),
+                                    coordinates.slots.end());
+            std::vector<RangeAccumulator> perChunk(static_cast<std::size_t>(vertexElement.count / kChunk + 1),
+                                                   RangeAccumulator(0));
+            visitBinaryVertices<Swap>(vertexElement, coordinates, ptr, end, ctx_, ticker,
+                                      [&perChunk](std::uint64_t i, const Slot& s, double v) {
+                                          perChunk[static_cast<std::size_t>(i / kChunk)].add(s, v);
+                                      });
+            RangeAccumulator whole(0);
+            for (const RangeAccumulator& chunk : perChunk)
+                whole.merge(chunk);
+            origin = suggestOrigin(whole.box());
+        }
+        const bool wideFields =
+            std::find(layout_.fieldIsWide.begin(), layout_.fieldIsWide.end(), true) != layout_.fieldIsWide.end();
+        readBinaryVertexElement<Swap>(part, ptr + first * recordSize, end, ticker, wideFields,
+                                      origin ? origin : std::optional<Eigen::Vector3d>(Eigen::Vector3d::Zero()));
+    }
+
     std::uint64_t vertexCountFromHeader() const
     {
         for (const auto& e : header_.elements)
@@ -1130,7 +1218,7 @@ private:
 
     template <bool Swap>
     const char* readBinaryVertexElement(const PlyElement& e, const char* ptr, const char* end, ProgressTicker& ticker,
-                                        bool needsRanges)
+                                        bool needsRanges, const std::optional<Eigen::Vector3d>& wholeFileOrigin = std::nullopt)
     {
         // Check the size before allocating: a corrupt count must not allocate gigabytes.
         const std::size_t minSize = std::max<std::size_t>(e.minRecordSize(), 1);
@@ -1153,6 +1241,8 @@ private:
         VertexSink sink = prepareCloud(e.count);
         if (options_.origin)
             sink.origin = *options_.origin;
+        else if (wholeFileOrigin)
+            sink.origin = *wholeFileOrigin;
         else if (layout_.coordinatesAreDouble)
             sink.origin = suggestOrigin(ranges.box());
         cloud_.setOrigin(sink.origin);
@@ -1198,8 +1288,10 @@ private:
                 continue;
             ScalarField& field = *cloud_.field(layout_.fieldNames[s.field]);
             // Residuals that held need no second look for a double property.
-            if (s.type != PlyType::Float64 || !field.doubles().empty())
-                field.compact(s.type == PlyType::Float64);
+            // A range of records keeps every wide field exact, whatever its
+            // values: the ranges of one file then all have the same types.
+            if (s.type != PlyType::Float64 || !field.doubles().empty() || range_)
+                field.compact(s.type == PlyType::Float64 || range_.has_value());
         }
     }
 
@@ -1294,6 +1386,7 @@ private:
 
     fs::path path_;
     const ReadOptions& options_;
+    std::optional<RecordRange> range_;
     Context ctx_;
     MappedFile file_;
     PlyHeader header_;
@@ -1365,7 +1458,7 @@ class PlyWriter
 public:
     PlyWriter(const PointCloud& cloud, const std::vector<Triangle>* triangles, const fs::path& path,
               const WriteOptions& options)
-        : cloud_(cloud), triangles_(triangles), path_(path), options_(options)
+        : cloud_(&cloud), triangles_(triangles), path_(path), options_(options)
     {
         switch (options.encoding) {
         case Encoding::Default:
@@ -1399,34 +1492,30 @@ public:
     {
         AtomicFile file(path_);
         std::ofstream& out = file.stream();
-        const std::string header = makeHeader();
+        const std::string header = makeHeader(cloud_->size());
         out.write(header.data(), static_cast<std::streamsize>(header.size()));
         const std::uint64_t faceCount = triangles_ ? triangles_->size() : 0;
-        ProgressTicker ticker(options_.progress, "Writing " + path_.filename().string(), cloud_.size() + faceCount);
-        if (encoding_ == PlyEncoding::Ascii)
-            writeAscii(out, ticker);
-        else if ((encoding_ == PlyEncoding::BinaryBigEndian) == kHostLittleEndian)
-            writeBinary<true>(out, ticker);
-        else
-            writeBinary<false>(out, ticker);
+        ProgressTicker ticker(options_.progress, "Writing " + path_.filename().string(), cloud_->size() + faceCount);
+        writeRecords(out, ticker);
         file.commit();
     }
 
-private:
-    std::string makeHeader() const
+    //! For writing chunk by chunk: the header for `vertexCount` vertices with
+    //! the columns of the cloud given to the constructor...
+    std::string makeHeader(std::uint64_t vertexCount) const
     {
         std::string h = "ply\nformat ";
         h += encoding_ == PlyEncoding::Ascii                ? "ascii"
              : encoding_ == PlyEncoding::BinaryLittleEndian ? "binary_little_endian"
                                                             : "binary_big_endian";
         h += " 1.0\ncomment Written by scandiff\n";
-        if (!cloud_.crsWkt().empty()) {
+        if (!cloud_->crsWkt().empty()) {
             // WKT ignores whitespace between its tokens: one line holds it.
-            std::string wkt = cloud_.crsWkt();
+            std::string wkt = cloud_->crsWkt();
             std::replace_if(wkt.begin(), wkt.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
             h += std::string(kCrsComment) + wkt + "\n";
         }
-        h += "element vertex " + std::to_string(cloud_.size()) + "\n";
+        h += "element vertex " + std::to_string(vertexCount) + "\n";
         for (const Column& c : columns_)
             h += std::string("property ") + plyTypeName(c.type) + " " + c.name + "\n";
         if (triangles_) {
@@ -1437,18 +1526,50 @@ private:
         return h;
     }
 
+    //! ...then the records of each chunk, a cloud with the same attributes.
+    void writeChunk(std::ofstream& out, const PointCloud& chunk, ProgressTicker& ticker)
+    {
+        const bool sameAttributes = chunk.hasColors() == cloud_->hasColors() &&
+                                    chunk.hasNormals() == cloud_->hasNormals() &&
+                                    chunk.fields().size() == cloud_->fields().size() &&
+                                    chunk.origin() == cloud_->origin();
+        if (!sameAttributes)
+            throw Error(ErrorCode::InvalidArgument,
+                        path_.string() + ": a chunk's colours, normals, fields or origin differ from the first chunk's");
+        for (const Column& c : columns_)
+            if (c.kind == ColumnKind::Field && c.type == PlyType::Float32) {
+                const ScalarField& field = chunk.fields()[static_cast<std::size_t>(c.index)];
+                if (field.isDouble() || field.offset() != 0.0)
+                    throw Error(ErrorCode::InvalidArgument, path_.string() + ": field '" + field.name() +
+                                                                "' needs doubles in a later chunk than the first");
+            }
+        cloud_ = &chunk;
+        writeRecords(out, ticker);
+    }
+
+private:
+    void writeRecords(std::ofstream& out, ProgressTicker& ticker)
+    {
+        if (encoding_ == PlyEncoding::Ascii)
+            writeAscii(out, ticker);
+        else if ((encoding_ == PlyEncoding::BinaryBigEndian) == kHostLittleEndian)
+            writeBinary<true>(out, ticker);
+        else
+            writeBinary<false>(out, ticker);
+    }
+
     double value(const Column& c, std::size_t i) const
     {
         switch (c.kind) {
         case ColumnKind::Coordinate:
-            return c.type == PlyType::Float64 ? cloud_.origin()[c.index] + static_cast<double>(cloud_.positions()[i][c.index])
-                                              : static_cast<double>(cloud_.positions()[i][c.index]);
+            return c.type == PlyType::Float64 ? cloud_->origin()[c.index] + static_cast<double>(cloud_->positions()[i][c.index])
+                                              : static_cast<double>(cloud_->positions()[i][c.index]);
         case ColumnKind::Color: {
-            const Rgb8& rgb = cloud_.colors()[i];
+            const Rgb8& rgb = cloud_->colors()[i];
             return c.index == 0 ? rgb.r : c.index == 1 ? rgb.g : rgb.b;
         }
-        case ColumnKind::Normal: return cloud_.normals()[i][c.index];
-        case ColumnKind::Field: return cloud_.fields()[static_cast<std::size_t>(c.index)].value(i);
+        case ColumnKind::Normal: return cloud_->normals()[i][c.index];
+        case ColumnKind::Field: return cloud_->fields()[static_cast<std::size_t>(c.index)].value(i);
         }
         return 0.0;
     }
@@ -1459,7 +1580,7 @@ private:
         std::size_t recordSize = 0;
         for (const Column& c : columns_)
             recordSize += typeSize(c.type);
-        const std::size_t n = cloud_.size();
+        const std::size_t n = cloud_->size();
         std::vector<char> buffer(static_cast<std::size_t>(kChunk) * std::max<std::size_t>(recordSize, 13));
         for (std::size_t start = 0; start < n; start += kChunk) {
             const std::size_t stop = std::min<std::size_t>(n, start + kChunk);
@@ -1510,7 +1631,7 @@ private:
                 text.clear();
             }
         };
-        const std::size_t n = cloud_.size();
+        const std::size_t n = cloud_->size();
         for (std::size_t i = 0; i < n; ++i) {
             for (std::size_t k = 0; k < columns_.size(); ++k) {
                 const Column& c = columns_[k];
@@ -1548,12 +1669,50 @@ private:
         out.write(text.data(), static_cast<std::streamsize>(text.size()));
     }
 
-    const PointCloud& cloud_;
+    const PointCloud* cloud_;
     const std::vector<Triangle>* triangles_;
     fs::path path_;
     const WriteOptions& options_;
     PlyEncoding encoding_ = PlyEncoding::BinaryLittleEndian;
     std::vector<Column> columns_;
+};
+
+//! A PLY written chunk by chunk: the header announces the total, each chunk's
+//! records follow, and the file is renamed into place once all have come.
+class PlyChunkWriter final : public PointChunkWriter
+{
+public:
+    PlyChunkWriter(const fs::path& path, const PointCloud& layout, std::uint64_t total, const WriteOptions& options)
+        : options_(options), file_(path), writer_(layout, nullptr, path, options_), total_(total),
+          ticker_(options_.progress, "Writing " + path.filename().string(), total)
+    {
+        const std::string header = writer_.makeHeader(total);
+        file_.stream().write(header.data(), static_cast<std::streamsize>(header.size()));
+    }
+
+    void append(const PointCloud& chunk) override
+    {
+        if (written_ + chunk.size() > total_)
+            throw Error(ErrorCode::InvalidArgument, file_.destination().string() + ": more points than the " +
+                                                        std::to_string(total_) + " announced");
+        writer_.writeChunk(file_.stream(), chunk, ticker_);
+        written_ += chunk.size();
+    }
+
+    void commit() override
+    {
+        if (written_ != total_)
+            throw Error(ErrorCode::InvalidArgument, file_.destination().string() + ": " + std::to_string(written_) +
+                                                        " points written of the " + std::to_string(total_) + " announced");
+        file_.commit();
+    }
+
+private:
+    WriteOptions options_;
+    AtomicFile file_;
+    PlyWriter writer_;
+    std::uint64_t total_ = 0, written_ = 0;
+    ProgressTicker ticker_;
 };
 
 } // namespace
@@ -1566,11 +1725,20 @@ FormatHandler plyFormat()
     handler.read = [](const fs::path& path, const ReadOptions& options) -> Entity {
         return PlyReader(path, options).read();
     };
+    handler.countRecords = [](const fs::path& path) { return PlyReader(path, ReadOptions{}).vertexRecordCount(); };
+    handler.readRecords = [](const fs::path& path, RecordRange range, const ReadOptions& options) -> PointCloud {
+        Entity entity = PlyReader(path, options, range).read();
+        return std::move(std::get<PointCloud>(entity));
+    };
     handler.writeCloud = [](const PointCloud& cloud, const fs::path& path, const WriteOptions& options) {
         PlyWriter(cloud, nullptr, path, options).write();
     };
     handler.writeMesh = [](const Mesh& mesh, const fs::path& path, const WriteOptions& options) {
         PlyWriter(mesh.vertices, &mesh.triangles, path, options).write();
+    };
+    handler.openChunkWriter = [](const fs::path& path, const PointCloud& layout, std::uint64_t total,
+                                 const WriteOptions& options) -> std::unique_ptr<PointChunkWriter> {
+        return std::make_unique<PlyChunkWriter>(path, layout, total, options);
     };
     return handler;
 }

@@ -563,3 +563,42 @@ TEST(CloudToCloud, DuplicatedReferencePointsCountOnceInTheModels)
                 << localModelName(model) << " point " << i;
     }
 }
+
+// The reach of every point (what a tiled run checks its halo against) is the
+// brute-force distance to the farthest reference point its value used.
+TEST(CloudToCloudReach, IsTheDistanceToTheLastNeighbourUsed)
+{
+    std::mt19937 rng(11);
+    const PointCloud reference = randomCloud(2000, rng);
+    const PointCloud compared = randomCloud(300, rng);
+    auto bruteForce = [&](std::size_t i, std::size_t k) {
+        std::vector<double> d;
+        for (const auto& q : reference.positions())
+            d.push_back((compared.positions()[i] - q).cast<double>().norm());
+        std::sort(d.begin(), d.end());
+        return std::make_pair(d[0], d[k - 1]);
+    };
+    CloudToCloudParams params;
+    params.reportReach = true;
+    const CloudToCloudResult nn = cloudToCloud(compared, reference, params);
+    params.maxDistance = 0.3;
+    const CloudToCloudResult capped = cloudToCloud(compared, reference, params);
+    params.maxDistance.reset();
+    params.model = LocalModel::Plane;
+    params.neighbours = 9;
+    const CloudToCloudResult knn = cloudToCloud(compared, reference, params);
+    params.radius = 0.7;
+    const CloudToCloudResult radius = cloudToCloud(compared, reference, params);
+    params.radius.reset();
+    params.neighbours = 12;
+    const CloudToCloudResult tooFew = cloudToCloud(compared, reference.subset({0, 1, 2, 3, 4}), params);
+    for (std::size_t i = 0; i < compared.size(); ++i) {
+        const auto [nearest, ninth] = bruteForce(i, 9);
+        EXPECT_NEAR(nn.reach[i], nearest, 1e-5);
+        EXPECT_NEAR(capped.reach[i], std::min(nearest, 0.3), 1e-5);
+        EXPECT_NEAR(knn.reach[i], ninth, 1e-5);
+        EXPECT_NEAR(radius.reach[i], nearest + 0.7, 1e-5);
+        EXPECT_TRUE(std::isinf(tooFew.reach[i])); // 5 points cannot give 12 neighbours
+    }
+    EXPECT_TRUE(cloudToCloud(compared, reference, CloudToCloudParams{}).reach.empty()); // not asked: not kept
+}

@@ -142,6 +142,9 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
         result.dz = ScalarField("c2c_dz", n);
     }
     constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+    if (params.reportReach)
+        result.reach.assign(n, 0.0f);
+    constexpr float kUnbounded = std::numeric_limits<float>::infinity();
     std::vector<std::uint32_t> closestIndex(params.closestPoints ? n : 0, kNone);
 
     const auto& refPoints = reference.positions();
@@ -229,6 +232,9 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
                     }
                     if (list[0].index == kNone)
                         continue; // NaN query, or not comparable: the value stays NaN
+                    if (params.reportReach)
+                        result.reach[order[j]] = list[k - 1].index == kNone ? kUnbounded
+                                                                            : std::sqrt(list[k - 1].squaredDistance);
                     s.points.clear();
                     for (std::size_t m = 0; m < k && list[m].index != kNone; ++m)
                         s.points.push_back(refPoints[list[m].index].cast<double>());
@@ -253,6 +259,8 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
                     if (nb.index == kNone)
                         continue; // NaN query, or not comparable: the value stays NaN
                     double d = std::sqrt(static_cast<double>(nb.squaredDistance));
+                    if (params.reportReach)
+                        result.reach[order[j]] = static_cast<float>(params.maxDistance ? std::min(d, *params.maxDistance) : d);
                     if (params.signedDistances && reference.normals()[nb.index].dot(chunkQueries[j - chunkBegin] - refPoints[nb.index]) < 0)
                         d = -d; // sign by the reference normal at the nearest neighbour
                     store(j, d);
@@ -312,6 +320,8 @@ CloudToCloudResult cloudToCloud(const PointCloud& compared, const PointCloud& re
                     const octree::Neighbour nb = chunkNeighbours[members[m]];
                     const Eigen::Vector3f& q = chunkQueries[members[m]];
                     double d = std::sqrt(static_cast<double>(nb.squaredDistance));
+                    if (params.reportReach)
+                        result.reach[order[j]] = static_cast<float>(d + *params.radius);
                     double modelSigned = 0;
                     if (fitted && detail::modelDistance(s.fitted, s.points, q.cast<double>(), modelSigned, s.model))
                         d = params.signedDistances ? modelSigned : std::abs(modelSigned);

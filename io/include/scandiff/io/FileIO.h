@@ -15,6 +15,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <variant>
@@ -45,6 +46,18 @@ struct ReadOptions
     //! without scandiff's comment, text, PCD...). A file's own system wins,
     //! with a warning when it differs.
     std::string crsWkt;
+    //! Positions and normals only: formats that can skip colours and scalar
+    //! fields (PLY) do not decode them; others read everything.
+    bool geometryOnly = false;
+};
+
+//! Records [first, first + count) of a file's points, in file order (the
+//! count is cut at the file's end). Reading a file range by range holds one
+//! range in memory at a time (scandiff-mpi streams its inputs so).
+struct RecordRange
+{
+    std::uint64_t first = 0;
+    std::uint64_t count = 0;
 };
 
 enum class Encoding
@@ -66,6 +79,20 @@ struct WriteOptions
 
 using Entity = scandiff::Entity;
 
+//! A cloud written chunk by chunk, for clouds larger than memory: the file is
+//! laid out for the total announced when it was opened and renamed into place
+//! by commit() once every point has come (until then the destination is untouched).
+class PointChunkWriter
+{
+public:
+    virtual ~PointChunkWriter() = default;
+    //! The next points, with the colours, normals, fields and origin of the
+    //! cloud the writer was opened with. Throws Error(InvalidArgument) otherwise.
+    virtual void append(const PointCloud& chunk) = 0;
+    //! Throws Error(InvalidArgument) unless exactly the announced points came.
+    virtual void commit() = 0;
+};
+
 struct FormatHandler
 {
     std::string name;                    //!< "PLY", "LAS"...
@@ -79,6 +106,17 @@ struct FormatHandler
     std::function<std::vector<Entity>(const std::filesystem::path&, const ReadOptions&)> readAll;
     //! Writes several clouds as the parts of one file (E57 scans). Null when the format holds one.
     std::function<void(const std::vector<const PointCloud*>&, const std::filesystem::path&, const WriteOptions&)> writeClouds;
+    //! The number of point records the file's header announces. Null when the
+    //! format cannot tell without reading (text) or cannot read ranges.
+    std::function<std::uint64_t(const std::filesystem::path&)> countRecords;
+    //! A range of the file's point records (see RecordRange), with the origin
+    //! the whole file gets unless ReadOptions::origin is set. May throw
+    //! Error(Unsupported) for a variant of the format that cannot seek (PLY text).
+    std::function<PointCloud(const std::filesystem::path&, RecordRange, const ReadOptions&)> readRecords;
+    //! A writer for `total` points laid out like `layout` (its attributes).
+    std::function<std::unique_ptr<PointChunkWriter>(const std::filesystem::path&, const PointCloud& layout,
+                                                    std::uint64_t total, const WriteOptions&)>
+        openChunkWriter;
 };
 
 class FormatRegistry
@@ -113,6 +151,17 @@ void writePointClouds(const FormatRegistry& registry, const std::vector<const Po
                       const WriteOptions& options = {});
 void writeMesh(const FormatRegistry& registry, const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options = {});
 void writeFile(const FormatRegistry& registry, const Entity& entity, const std::filesystem::path& path, const WriteOptions& options = {});
+
+//! Reading and writing by ranges of records (see RecordRange): whether the
+//! file's format can, the number of records, one range, a chunk writer.
+//! Each throws Error(Unsupported) naming the file where the format cannot.
+bool canReadRecordRanges(const FormatRegistry& registry, const std::filesystem::path& path);
+std::uint64_t pointRecordCount(const FormatRegistry& registry, const std::filesystem::path& path);
+PointCloud readPointRecords(const FormatRegistry& registry, const std::filesystem::path& path, RecordRange range,
+                            const ReadOptions& options = {});
+std::unique_ptr<PointChunkWriter> openPointChunkWriter(const FormatRegistry& registry, const std::filesystem::path& path,
+                                                       const PointCloud& layout, std::uint64_t total,
+                                                       const WriteOptions& options = {});
 
 //! Lower-case extension without the dot ("PLY" -> "ply").
 std::string lowerExtension(const std::filesystem::path& path);

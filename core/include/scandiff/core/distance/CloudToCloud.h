@@ -54,6 +54,9 @@ struct CloudToCloudParams
     bool closestPoints = false;
     //! Octree level 1..21; 0 chooses it from the reference's cell populations.
     int octreeLevel = 0;
+    //! Also output CloudToCloudResult::reach (for tiled runs that must know
+    //! whether their part of the reference was enough).
+    bool reportReach = false;
     //! Reference viewpoints for the visibility test; empty = no test.
     std::vector<SensorPose> viewpoints;
     VisibilityParams visibility;
@@ -68,6 +71,14 @@ struct CloudToCloudResult
     DistanceStatistics statistics;
     int level = 0;                         //!< the octree level used
     std::size_t modelFallbacks = 0;        //!< neighbourhoods too small or degenerate: plain NN used
+    //! With reportReach, per compared point: the radius around it that holds
+    //! every reference point its value depends on (the nearest neighbour's
+    //! distance, capped at maxDistance; the k-th neighbour's; the nearest's
+    //! plus the model radius), +inf when the reference has fewer points than
+    //! the model asks for, 0 for a point without a value to compute. A run on
+    //! any part of the reference that holds the ball of that radius around the
+    //! point gives the point the same value as the whole reference.
+    std::vector<float> reach;
 };
 
 //! Throws Error(InvalidData) for an empty reference or non-finite reference

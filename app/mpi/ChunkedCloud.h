@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! A point file read chunk by chunk, so that a rank holds one chunk of it at a
+//! time plus what it keeps. Formats that can read a range of records (binary
+//! PLY, LAS) are streamed; any other is read whole once and served from memory
+//! (said by streamed(), and in the run's report).
+
+#include <scandiff/core/PointCloud.h>
+#include <scandiff/io/FileIO.h>
+
+#include <filesystem>
+#include <optional>
+
+namespace scandiff::mpi {
+
+class ChunkedCloud
+{
+public:
+    //! Reads the header (and, when the origin must be chosen from every
+    //! point's coordinates, one pass over them). Throws Error like the readers.
+    ChunkedCloud(const io::FormatRegistry& formats, std::filesystem::path path, std::uint64_t chunkPoints,
+                 io::ReadOptions options);
+
+    const std::filesystem::path& path() const { return path_; }
+    std::size_t chunkCount() const;
+    //! The points of one chunk, in file order, in the frame a whole read gives
+    //! (same origin); non-finite points dropped as a whole read drops them.
+    //! Geometry only: positions and normals.
+    PointCloud read(std::size_t chunk, bool geometryOnly) const;
+    const Eigen::Vector3d& origin() const { return origin_; }
+    bool streamed() const { return !whole_; }
+
+private:
+    const io::FormatRegistry& formats_;
+    std::filesystem::path path_;
+    std::uint64_t chunkPoints_;
+    io::ReadOptions options_;
+    std::uint64_t records_ = 0;
+    Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
+    std::optional<PointCloud> whole_;
+};
+
+} // namespace scandiff::mpi

@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! The few MPI calls scandiff-mpi makes, typed. MPI's C API is used as is
+//! (Debian's OpenMPI); this header only spares the byte counting.
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <type_traits>
+#include <vector>
+
+namespace scandiff::mpi {
+
+struct Communicator
+{
+    MPI_Comm comm = MPI_COMM_WORLD;
+    int rank() const
+    {
+        int r = 0;
+        MPI_Comm_rank(comm, &r);
+        return r;
+    }
+    int size() const
+    {
+        int s = 1;
+        MPI_Comm_size(comm, &s);
+        return s;
+    }
+    void barrier() const { MPI_Barrier(comm); }
+};
+
+//! Every rank's vector, concatenated in rank order, on every rank.
+template <class T>
+std::vector<T> allGather(const Communicator& c, const std::vector<T>& mine)
+{
+    static_assert(std::is_trivially_copyable_v<T>, "sent as bytes");
+    const int bytes = static_cast<int>(mine.size() * sizeof(T));
+    std::vector<int> counts(static_cast<std::size_t>(c.size())), offsets(counts.size(), 0);
+    MPI_Allgather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, c.comm);
+    for (std::size_t r = 1; r < counts.size(); ++r)
+        offsets[r] = offsets[r - 1] + counts[r - 1];
+    std::vector<T> all(static_cast<std::size_t>(offsets.back() + counts.back()) / sizeof(T));
+    MPI_Allgatherv(mine.data(), bytes, MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, c.comm);
+    return all;
+}
+
+inline std::uint64_t sumOverRanks(const Communicator& c, std::uint64_t mine)
+{
+    std::uint64_t total = 0;
+    MPI_Allreduce(&mine, &total, 1, MPI_UINT64_T, MPI_SUM, c.comm);
+    return total;
+}
+
+} // namespace scandiff::mpi
