@@ -226,9 +226,12 @@ int main(int argc, char** argv)
         cloud.setOrigin({512000.0, 5423000.0, 100.0});
         cloud.resize(n);
         auto& colours = cloud.enableColors();
-        auto& intensity = cloud.addField("intensity");
-        auto& classification = cloud.addField("classification");
-        auto& gps = cloud.addField("gps_time");
+        for (const char* name : {"intensity", "classification", "gps_time"})
+            cloud.addField(name);
+        // References once all exist: adding a field may move the others.
+        auto& intensity = *cloud.field("intensity");
+        auto& classification = *cloud.field("classification");
+        auto& gps = *cloud.field("gps_time");
         gps.setOffset(3.0e8);
         for (std::size_t i = 0; i < n; ++i) {
             const float x = u(rng), y = u(rng);

@@ -44,6 +44,22 @@ std::vector<T> allGather(const Communicator& c, const std::vector<T>& mine)
     return all;
 }
 
+//! Every rank's vector, concatenated in rank order, on rank 0 (the others get an empty one).
+template <class T>
+std::vector<T> gatherToRoot(const Communicator& c, const std::vector<T>& mine)
+{
+    static_assert(std::is_trivially_copyable_v<T>, "sent as bytes");
+    const int bytes = static_cast<int>(mine.size() * sizeof(T));
+    const bool root = c.rank() == 0;
+    std::vector<int> counts(root ? static_cast<std::size_t>(c.size()) : 1, 0), offsets(counts.size(), 0);
+    MPI_Gather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, c.comm);
+    for (std::size_t r = 1; r < counts.size(); ++r)
+        offsets[r] = offsets[r - 1] + counts[r - 1];
+    std::vector<T> all(root ? static_cast<std::size_t>(offsets.back() + counts.back()) / sizeof(T) : 0);
+    MPI_Gatherv(mine.data(), bytes, MPI_BYTE, all.data(), counts.data(), offsets.data(), MPI_BYTE, 0, c.comm);
+    return all;
+}
+
 inline std::uint64_t sumOverRanks(const Communicator& c, std::uint64_t mine)
 {
     std::uint64_t total = 0;

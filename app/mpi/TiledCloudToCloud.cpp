@@ -3,7 +3,6 @@
 
 #include "ChunkedCloud.h"
 #include "Tiling.h"
-#include "ValueFile.h"
 
 #include "CliSupport.h"
 
@@ -16,12 +15,26 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <fstream>
+#include <cstdlib>
 #include <limits>
 #include <unordered_map>
 
 namespace scandiff::mpi {
 
 namespace {
+
+void memoryNote(const char* what)
+{
+    if (!std::getenv("SCANDIFF_MPI_MEMORY"))
+        return;
+    std::ifstream status("/proc/self/status");
+    std::string line, out;
+    while (std::getline(status, line))
+        if (line.rfind("VmHWM", 0) == 0 || line.rfind("VmRSS", 0) == 0 || line.rfind("RssFile", 0) == 0 || line.rfind("RssAnon", 0) == 0)
+            out += " " + line;
+    std::cerr << what << ":" << out << std::endl;
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -159,37 +172,41 @@ public:
     void run(std::ostream& out)
     {
         const auto start = Clock::now();
-        const std::map<TileKey, int> owners = assignTiles(countTilePoints(c_, compared_, grid_), c_.size());
+        const std::map<TileKey, std::uint64_t> counts = countTilePoints(c_, compared_, grid_);
+        const std::map<TileKey, int> owners = assignTiles(counts, c_.size());
         std::vector<TileKey> mine;
         for (const auto& [key, rank] : owners)
-            if (rank == c_.rank())
+            if (rank == c_.rank()) {
                 mine.push_back(key);
+                expectedCompared_ += counts.at(key);
+            }
         report_.tiles = mine.size();
+        memoryNote("counted");
         collectCompared(std::unordered_set<TileKey, TileKeyHash>(mine.begin(), mine.end()));
         Representatives representatives(grid_, std::min<std::size_t>(pointsNeeded(params_), 64));
+        memoryNote("compared collected");
         ReferencePart part = collectReference(mine, &representatives);
+        memoryNote("reference collected");
         report_.referenceHeld = part.positions.size();
         report_.referenceInTiles = part.inOwnTiles;
         computeOwnTiles(std::move(part));
+        memoryNote("computed");
         widen(representatives);
         report_.seconds = std::chrono::duration<double>(Clock::now() - start).count();
 
         const DistanceStatistics statistics = statisticsOverRanks();
-        const std::vector<std::vector<float>> planes = resultPlanes();
-        std::filesystem::path valuesFile;
-        if (!job_.output.empty()) {
-            valuesFile = job_.output;
-            valuesFile += ".values.tmp";
-            writeValuePlanes(c_, valuesFile, totalCompared_, comparedIndex_, planes);
-        }
+        comparedCloud_ = PointCloud(); // only the values and their indices are needed from here on
         const std::vector<RankReport> reports = allGather(c_, std::vector<RankReport>{report_});
         if (c_.rank() == 0) {
             cli::printStatistics(out, "c2c " + std::string(localModelName(params_.model)) + " (compared -> reference)", statistics);
             printReport(out, reports);
-            writeOutput(out, valuesFile);
-            out << std::fixed << std::setprecision(3)
-                << std::chrono::duration<double>(Clock::now() - start).count() << " s\n" << std::defaultfloat;
         }
+        if (!job_.output.empty())
+            writeOutput(out);
+        if (c_.rank() == 0)
+            out << std::fixed << std::setprecision(3) << std::chrono::duration<double>(Clock::now() - start).count() << " s\n"
+                << std::defaultfloat;
+        memoryNote("done");
         c_.barrier();
     }
 
@@ -198,7 +215,10 @@ private:
     void collectCompared(const std::unordered_set<TileKey, TileKeyHash>& mine)
     {
         std::uint64_t index = 0;
+        comparedPositions_.reserve(static_cast<std::size_t>(expectedCompared_));
+        comparedIndex_.reserve(static_cast<std::size_t>(expectedCompared_));
         for (std::size_t k = 0; k < compared_.chunkCount(); ++k) {
+            chunkStarts_.push_back(index);
             const PointCloud chunk = compared_.read(k, true);
             for (std::size_t i = 0; i < chunk.size(); ++i) {
                 const Eigen::Vector3d p = chunk.globalPosition(i);
@@ -209,6 +229,7 @@ private:
             }
             index += chunk.size();
         }
+        chunkStarts_.push_back(index);
         totalCompared_ = index;
         report_.compared = comparedIndex_.size();
     }
@@ -259,6 +280,8 @@ private:
     void computeOwnTiles(ReferencePart&& part)
     {
         const std::size_t n = comparedPositions_.size();
+        if (n == 0)
+            comparedCloud_ = makeCloud(compared_.origin(), {}, {}, {});
         distance_.assign(n, std::numeric_limits<float>::quiet_NaN());
         if (params_.splitComponents)
             for (auto* plane : {&dx_, &dy_, &dz_})
@@ -266,19 +289,21 @@ private:
         if (n == 0)
             return;
         if (part.positions.empty()) {
+            comparedCloud_ = makeCloud(compared_.origin(), std::move(comparedPositions_), {}, {});
             for (std::size_t j = 0; j < n; ++j)
                 pending_.push_back({j, std::numeric_limits<double>::infinity()});
             return;
         }
         const PointCloud reference =
             makeCloud(reference_.origin(), std::move(part.positions), std::move(part.normals), referenceLayout_.sensors());
-        const PointCloud compared = makeCloud(compared_.origin(), std::vector<Eigen::Vector3f>(comparedPositions_), {}, {});
+        comparedCloud_ = makeCloud(compared_.origin(), std::move(comparedPositions_), {}, {});
+        const PointCloud& compared = comparedCloud_;
         const CloudToCloudResult result = cloudToCloud(compared, reference, params_);
         for (std::size_t j = 0; j < n; ++j) {
             const Eigen::Vector3d p = compared.globalPosition(j);
             const double depth = grid_.depthInGrownTile(grid_.tileOf(p.x(), p.y()), halo_, p.x(), p.y());
             const double reach = result.reach[j];
-            if (reach + margin(comparedPositions_[j], reach) <= depth)
+            if (reach + margin(compared.positions()[j], reach) <= depth)
                 store(j, result, j);
             else
                 pending_.push_back({j, reach});
@@ -293,13 +318,13 @@ private:
         report_.widened = pending_.size();
         const std::size_t needed = pointsNeeded(params_);
         for (Pending& w : pending_) {
-            const Eigen::Vector3d p = compared_.origin() + comparedPositions_[w.index].cast<double>();
+            const Eigen::Vector3d p = comparedCloud_.globalPosition(w.index);
             if (!std::isfinite(w.radius)) {
                 w.radius = representatives.kthDistance(p, needed);
                 if (params_.radius)
                     w.radius += *params_.radius;
             }
-            w.radius += margin(comparedPositions_[w.index], w.radius);
+            w.radius += margin(comparedCloud_.positions()[w.index], w.radius);
         }
         while (!pending_.empty()) {
             ++report_.widenings;
@@ -313,7 +338,7 @@ private:
             std::unordered_map<TileKey, std::vector<std::size_t>, TileKeyHash> byCell;
             std::vector<Eigen::Vector3d> centres(pending_.size());
             for (std::size_t m = 0; m < pending_.size(); ++m) {
-                centres[m] = compared_.origin() + comparedPositions_[pending_[m].index].cast<double>();
+                centres[m] = comparedCloud_.globalPosition(pending_[m].index);
                 byCell[cells.tileOf(centres[m].x(), centres[m].y())].push_back(m);
             }
             ReferencePart part = streamReference(
@@ -337,7 +362,7 @@ private:
             const bool wholeReference = part.positions.size() == totalReference_;
             std::vector<Eigen::Vector3f> queries;
             for (const Pending& w : pending_)
-                queries.push_back(comparedPositions_[w.index]);
+                queries.push_back(comparedCloud_.positions()[w.index]);
             if (part.positions.empty())
                 throw Error(ErrorCode::InvalidData, job_.reference.string() + ": no reference point to compare with");
             const PointCloud reference =
@@ -347,7 +372,7 @@ private:
             std::vector<Pending> still;
             for (std::size_t m = 0; m < pending_.size(); ++m) {
                 const double reach = result.reach[m];
-                if (wholeReference || reach + margin(comparedPositions_[pending_[m].index], reach) <= pending_[m].radius)
+                if (wholeReference || reach + margin(comparedCloud_.positions()[pending_[m].index], reach) <= pending_[m].radius)
                     store(pending_[m].index, result, m);
                 else
                     still.push_back({pending_[m].index, 2 * std::max(pending_[m].radius, reach)});
@@ -364,18 +389,6 @@ private:
             dy_[j] = result.dy->values()[m];
             dz_[j] = result.dz->values()[m];
         }
-    }
-
-    std::vector<std::vector<float>> resultPlanes()
-    {
-        std::vector<std::vector<float>> planes;
-        planes.push_back(std::move(distance_));
-        if (params_.splitComponents) {
-            planes.push_back(std::move(dx_));
-            planes.push_back(std::move(dy_));
-            planes.push_back(std::move(dz_));
-        }
-        return planes;
     }
 
     //! Those of scandiff-cli, summed over the ranks (in another order: the
@@ -413,39 +426,63 @@ private:
         return s;
     }
 
-    //! Rank 0: the compared cloud with its new fields, in input order, chunk by chunk.
-    void writeOutput(std::ostream& out, const std::filesystem::path& valuesFile)
+    //! The values of one chunk of the compared cloud as a rank sends them:
+    //! each point's place in the chunk and its value in every output field.
+    struct ChunkValue
     {
-        if (job_.output.empty())
-            return;
-        ValuePlaneReader values(valuesFile, totalCompared_);
+        std::uint32_t offset;
+        float values[4];
+    };
+
+    //! Rank 0 writes the compared cloud with its new fields in input order,
+    //! chunk by chunk; for each chunk every rank sends it the values it owns
+    //! there, so no rank ever holds more than one chunk of them.
+    void writeOutput(std::ostream& out)
+    {
+        const std::size_t planeCount = params_.splitComponents ? 4 : 1;
+        const std::vector<float>* planes[4] = {&distance_, &dx_, &dy_, &dz_};
         std::unique_ptr<io::PointChunkWriter> writer;
-        std::uint64_t first = 0;
-        for (std::size_t k = 0; k < compared_.chunkCount(); ++k) {
+        std::size_t next = 0; // this rank's first value not sent yet (its indices are sorted)
+        for (std::size_t k = 0; k + 1 < chunkStarts_.size(); ++k) {
+            std::vector<ChunkValue> mine;
+            for (; next < comparedIndex_.size() && comparedIndex_[next] < chunkStarts_[k + 1]; ++next) {
+                ChunkValue v{static_cast<std::uint32_t>(comparedIndex_[next] - chunkStarts_[k]), {}};
+                for (std::size_t f = 0; f < planeCount; ++f)
+                    v.values[f] = (*planes[f])[next];
+                mine.push_back(v);
+            }
+            const std::vector<ChunkValue> gathered = gatherToRoot(c_, mine);
+            if (c_.rank() != 0)
+                continue;
             PointCloud chunk = compared_.read(k, false);
             const std::size_t n = chunk.size();
+            if (gathered.size() != n)
+                throw Error(ErrorCode::Internal, "chunk " + std::to_string(k) + " of the compared cloud: " +
+                                                     std::to_string(gathered.size()) + " values for " + std::to_string(n) + " points");
             CloudToCloudResult result;
             result.distance = ScalarField("c2c_distance", n);
-            values.read(0, first, n, result.distance.values().data());
+            ScalarField* fields[4] = {&result.distance, nullptr, nullptr, nullptr};
             if (params_.splitComponents) {
                 result.dx = ScalarField("c2c_dx", n);
                 result.dy = ScalarField("c2c_dy", n);
                 result.dz = ScalarField("c2c_dz", n);
-                values.read(1, first, n, result.dx->values().data());
-                values.read(2, first, n, result.dy->values().data());
-                values.read(3, first, n, result.dz->values().data());
+                fields[1] = &*result.dx;
+                fields[2] = &*result.dy;
+                fields[3] = &*result.dz;
             }
+            for (const ChunkValue& v : gathered)
+                for (std::size_t f = 0; f < planeCount; ++f)
+                    fields[f]->values()[v.offset] = v.values[f];
             attachFields(chunk, std::move(result));
             if (!writer)
                 writer = io::openPointChunkWriter(formats_, job_.output, chunk, totalCompared_, job_.write);
             writer->append(chunk);
-            first += n;
         }
+        if (c_.rank() != 0)
+            return;
         if (!writer) // an empty compared cloud gives an empty output all the same
             writer = io::openPointChunkWriter(formats_, job_.output, compared_.read(0, false), 0, job_.write);
         writer->commit();
-        std::error_code ignored;
-        std::filesystem::remove(valuesFile, ignored);
         out << "wrote " << job_.output.string() << '\n';
     }
 
@@ -492,9 +529,11 @@ private:
     CloudToCloudParams params_;
     double halo_ = 0;
     bool needNormals_ = false;
-    std::vector<Eigen::Vector3f> comparedPositions_;
+    std::vector<Eigen::Vector3f> comparedPositions_; //!< while collecting; then in comparedCloud_
+    PointCloud comparedCloud_;
+    std::vector<std::uint64_t> chunkStarts_; //!< index of each compared chunk's first point, and the total
     std::vector<std::uint64_t> comparedIndex_;
-    std::uint64_t totalCompared_ = 0, totalReference_ = 0;
+    std::uint64_t totalCompared_ = 0, totalReference_ = 0, expectedCompared_ = 0;
     std::vector<float> distance_, dx_, dy_, dz_;
     std::vector<Pending> pending_;
     RankReport report_;

@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdlib>
 #include <iostream>
 #include <memory>
 
@@ -114,6 +115,11 @@ int run(int argc, char** argv, const mpi::Communicator& world)
 
 int main(int argc, char** argv)
 {
+    // A rank waiting in a collective call gives its core away instead of
+    // polling: with more ranks than cores (a workstation, a shared node) the
+    // ranks still computing get it. OpenMPI reads this before MPI_Init; a value
+    // set by the user (mpirun --mca) wins.
+    setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0);
     MPI_Init(&argc, &argv);
     const scandiff::mpi::Communicator world;
     const int status = run(argc, argv, world);
