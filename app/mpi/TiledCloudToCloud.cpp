@@ -24,6 +24,8 @@ namespace scandiff::mpi {
 
 namespace {
 
+//! With SCANDIFF_MPI_MEMORY set, a rank's resident and peak memory after a
+//! stage, on stderr: how the per-rank figures of docs/benchmarks.md were taken apart.
 void memoryNote(const char* what)
 {
     if (!std::getenv("SCANDIFF_MPI_MEMORY"))
