@@ -184,10 +184,11 @@ public:
             }
         report_.tiles = mine.size();
         memoryNote("counted");
-        collectCompared(std::unordered_set<TileKey, TileKeyHash>(mine.begin(), mine.end()));
+        const HaloRegion region(grid_, mine, halo_);
+        collectCompared(region);
         Representatives representatives(grid_, std::min<std::size_t>(pointsNeeded(params_), 64));
         memoryNote("compared collected");
-        ReferencePart part = collectReference(mine, &representatives);
+        ReferencePart part = collectReference(region, &representatives);
         memoryNote("reference collected");
         report_.referenceHeld = part.positions.size();
         report_.referenceInTiles = part.inOwnTiles;
@@ -214,7 +215,7 @@ public:
 
 private:
     //! Pass 2: this rank's compared points (positions, input indices).
-    void collectCompared(const std::unordered_set<TileKey, TileKeyHash>& mine)
+    void collectCompared(const HaloRegion& region)
     {
         std::uint64_t index = 0;
         comparedPositions_.reserve(static_cast<std::size_t>(expectedCompared_));
@@ -224,7 +225,7 @@ private:
             const PointCloud chunk = compared_.read(k, true);
             for (std::size_t i = 0; i < chunk.size(); ++i) {
                 const Eigen::Vector3d p = chunk.globalPosition(i);
-                if (mine.count(grid_.tileOf(p.x(), p.y())) != 0) {
+                if (region.owns(grid_.tileOf(p.x(), p.y()))) {
                     comparedPositions_.push_back(chunk.positions()[i]);
                     comparedIndex_.push_back(index + i);
                 }
@@ -260,16 +261,14 @@ private:
         return part;
     }
 
-    ReferencePart collectReference(const std::vector<TileKey>& mine, Representatives* representatives)
+    ReferencePart collectReference(const HaloRegion& region, Representatives* representatives)
     {
-        const HaloRegion region(grid_, mine, halo_);
-        const std::unordered_set<TileKey, TileKeyHash> own(mine.begin(), mine.end());
         std::uint64_t inOwn = 0;
         ReferencePart part = streamReference(
             [&](const Eigen::Vector3d& p) {
-                if (own.empty() || !region.contains(p.x(), p.y()))
+                if (!region.contains(p.x(), p.y()))
                     return false;
-                inOwn += own.count(grid_.tileOf(p.x(), p.y()));
+                inOwn += region.owns(grid_.tileOf(p.x(), p.y()));
                 return true;
             },
             representatives);

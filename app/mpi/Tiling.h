@@ -67,6 +67,7 @@ class HaloRegion
 public:
     HaloRegion(const TileGrid& grid, const std::vector<TileKey>& tiles, double halo);
     bool contains(double x, double y) const;
+    bool owns(const TileKey& key) const { return owned_.count(key) != 0; }
 
 private:
     enum Status : std::uint8_t { Far, Owned, Border };

@@ -10,9 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <random>
 #include <sstream>
@@ -64,24 +62,10 @@ PointCloud sampleSite(unsigned seed, double perSquareMetre, bool withHole, bool 
     return cloud;
 }
 
-struct Outcome
+//! The command's output with its errors.
+CommandOutcome run(const std::string& command)
 {
-    int status = 0;
-    std::string output;
-};
-
-Outcome run(const std::string& command)
-{
-    Outcome outcome;
-    FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-    if (!pipe)
-        return {-1, "popen failed"};
-    std::array<char, 4096> buffer;
-    while (std::fgets(buffer.data(), buffer.size(), pipe))
-        outcome.output += buffer.data();
-    const int status = pclose(pipe);
-    outcome.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return outcome;
+    return runCommand(command + " 2>&1");
 }
 
 std::string mpirun(int ranks)
@@ -113,14 +97,14 @@ protected:
     {
         const std::string inputs = " --reference " + (dir_ / "reference.ply").string() + " --compared " +
                                    (dir_ / "compared.ply").string() + " " + options;
-        const Outcome cli = run(std::string(SCANDIFF_CLI_PATH) + " c2c" + inputs + " -o " + (dir_ / "cli.ply").string());
+        const CommandOutcome cli = run(std::string(SCANDIFF_CLI_PATH) + " c2c" + inputs + " -o " + (dir_ / "cli.ply").string());
         ASSERT_EQ(cli.status, 0) << cli.output;
         const auto registry = formats();
         const PointCloud expected = io::readPointCloud(registry, dir_ / "cli.ply");
         fields.push_back("intensity");
         for (const int ranks : {1, 2, 4}) {
             const fs::path output = dir_ / ("mpi" + std::to_string(ranks) + ".ply");
-            const Outcome mpi = run(mpirun(ranks) + " c2c" + inputs + " " + tiling + " -o " + output.string());
+            const CommandOutcome mpi = run(mpirun(ranks) + " c2c" + inputs + " " + tiling + " -o " + output.string());
             ASSERT_EQ(mpi.status, 0) << mpi.output;
             const PointCloud got = io::readPointCloud(registry, output);
             ASSERT_EQ(got.size(), expected.size()) << ranks << " ranks";
@@ -183,17 +167,17 @@ TEST_F(ScaleOut, BadOptionsGiveTheCliErrors)
         " c2c --reference " + (dir_ / "reference.ply").string() + " --compared " + (dir_ / "compared.ply").string();
     for (const std::string& bad : {std::string(" --clamp"), std::string(" --knn 2 --model plane"),
                                    std::string(" --max-dist -1")}) {
-        const Outcome cli = run(std::string(SCANDIFF_CLI_PATH) + inputs + bad);
-        const Outcome mpi = run(mpirun(2) + inputs + bad);
+        const CommandOutcome cli = run(std::string(SCANDIFF_CLI_PATH) + inputs + bad);
+        const CommandOutcome mpi = run(mpirun(2) + inputs + bad);
         EXPECT_NE(cli.status, 0) << bad;
         EXPECT_EQ(mpi.status, cli.status) << bad << "\n" << mpi.output;
         EXPECT_NE(mpi.output.find(cli.output), std::string::npos) << bad << "\ncli: " << cli.output << "\nmpi: " << mpi.output;
     }
-    const Outcome missing = run(mpirun(2) + " c2c --reference " + (dir_ / "nothing.ply").string() + " --compared " +
+    const CommandOutcome missing = run(mpirun(2) + " c2c --reference " + (dir_ / "nothing.ply").string() + " --compared " +
                                 (dir_ / "compared.ply").string());
     EXPECT_NE(missing.status, 0);
     EXPECT_NE(missing.output.find("nothing.ply: no such file"), std::string::npos) << missing.output;
-    const Outcome tiles = run(mpirun(1) + inputs + " --tile-size 0");
+    const CommandOutcome tiles = run(mpirun(1) + inputs + " --tile-size 0");
     EXPECT_NE(tiles.output.find("--tile-size must be a positive number"), std::string::npos) << tiles.output;
 }
 

@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "TestSupport.h"
+
 #ifndef SCANDIFF_TEST_SCRIPTS_DIR
 #error "SCANDIFF_TEST_SCRIPTS_DIR must be defined by CMake (the absolute path of tests/io)"
 #endif
@@ -43,17 +45,13 @@ inline DxfCheck checkDxf(const std::filesystem::path& file)
                                 (std::filesystem::path(SCANDIFF_TEST_SCRIPTS_DIR) / "check_dxf.py").string() + "' '" +
                                 file.string() + "'";
     DxfCheck check;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (!pipe) {
+    const CommandOutcome outcome = runCommand(command);
+    if (!outcome.started) {
         ADD_FAILURE() << "cannot run " << command;
         return check;
     }
-    std::string output;
-    char buffer[4096];
-    while (const std::size_t n = std::fread(buffer, 1, sizeof buffer, pipe))
-        output.append(buffer, n);
-    const int status = ::pclose(pipe);
-    check.exitStatus = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    const std::string& output = outcome.output;
+    check.exitStatus = outcome.status;
 
     // The script prints one flat JSON object: "key": integer, and "version": "ACxxxx".
     static const std::regex number("\"([^\"]+)\": (\\d+)");

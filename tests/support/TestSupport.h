@@ -6,12 +6,15 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
 #include <string>
 #include <vector>
+
+#include <sys/wait.h>
 
 #include <gtest/gtest.h>
 
@@ -51,6 +54,30 @@ inline std::string readBytes(const std::filesystem::path& path)
 {
     std::ifstream in(path, std::ios::binary);
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+//! What a shell command printed on its standard output and its exit status
+//! (-1 when it did not exit normally).
+struct CommandOutcome
+{
+    bool started = false; //!< false when the shell could not be started
+    int status = -1;
+    std::string output;
+};
+
+inline CommandOutcome runCommand(const std::string& command)
+{
+    CommandOutcome outcome;
+    FILE* pipe = ::popen(command.c_str(), "r");
+    if (!pipe)
+        return outcome;
+    outcome.started = true;
+    char buffer[4096];
+    while (const std::size_t n = std::fread(buffer, 1, sizeof buffer, pipe))
+        outcome.output.append(buffer, n);
+    const int status = ::pclose(pipe);
+    outcome.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return outcome;
 }
 
 //! The code of the scandiff::Error that `f` throws; Internal if it throws none.
