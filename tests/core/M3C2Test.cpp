@@ -385,3 +385,71 @@ TEST(M3C2, SignificantChangeBecomesRegionsWithTheirMeanDistance)
     explicitField.uncertaintyField = "nothing";
     EXPECT_EQ(test::errorCodeOf([&] { regionReport(cores, explicitField); }), ErrorCode::InvalidArgument);
 }
+
+namespace {
+
+//! The points of `cloud` within `reach` (in X and Y) of the box [lo, hi], in order.
+PointCloud cropAround(const PointCloud& cloud, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double reach)
+{
+    std::vector<std::size_t> kept;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Eigen::Vector3d p = cloud.globalPosition(i);
+        if (p.x() >= lo.x() - reach && p.x() <= hi.x() + reach && p.y() >= lo.y() - reach && p.y() <= hi.y() + reach)
+            kept.push_back(i);
+    }
+    return cloud.subset(kept);
+}
+
+} // namespace
+
+TEST(M3C2, OnPartsHoldingTheSearchReachGivesTheWholeResultToTheBit)
+{
+    // scandiff-mpi's tiles: the core points of one square, each epoch cropped
+    // to the square grown by the search reach (another octree, other cells,
+    // points in another order in memory): the values must not change at all.
+    const Eigen::Vector3d origin(500000, 4000000, 100);
+    const PointCloud reference = roughSurface(60000, 30, 0.0, 0.01, 11, origin);
+    const PointCloud compared = roughSurface(50000, 30, 0.03, 0.01, 12, origin + Eigen::Vector3d(3, -2, 1));
+    M3c2Params params;
+    params.normalScales = {0.6, 1.5};
+    params.projectionScale = 0.7;
+    params.maxDepth = 0.8;
+    params.orientation = parseNormalOrientation("centroid");
+    const M3c2Result whole = m3c2(reference, compared, reference, params);
+
+    const Eigen::Vector2d lo(500010, 4000010), hi(500017, 4000016);
+    const double reach = std::max(1.5 / 2, std::hypot(0.7 / 2, 0.8)) + 1e-3;
+    std::vector<std::size_t> coreIndex;
+    for (std::size_t i = 0; i < reference.size(); ++i) {
+        const Eigen::Vector3d p = reference.globalPosition(i);
+        if (p.x() >= lo.x() && p.x() < hi.x() && p.y() >= lo.y() && p.y() < hi.y())
+            coreIndex.push_back(i);
+    }
+    ASSERT_GT(coreIndex.size(), 1000u);
+    // The centroid rule looks at every core point: the whole set's, given.
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3f& p : reference.positions())
+        centroid += p.cast<double>();
+    params.orientation.centroid = centroid / static_cast<double>(reference.size());
+    const M3c2Result part = m3c2OnParts(cropAround(reference, lo, hi, reach), cropAround(compared, lo, hi, reach),
+                                        reference.subset(coreIndex), params);
+    const PointCloud& a = part.corePoints;
+    const PointCloud& b = whole.corePoints;
+    std::size_t measured = 0;
+    for (std::size_t j = 0; j < coreIndex.size(); ++j) {
+        const std::size_t i = coreIndex[j];
+        ASSERT_EQ(a.normals()[j], b.normals()[i]) << j;
+        for (const char* name : {fields::kM3c2Distance, fields::kM3c2Uncertainty, fields::kM3c2Significant, fields::kM3c2N1,
+                                 fields::kM3c2N2, fields::kM3c2Std1, fields::kM3c2Std2, fields::kM3c2NormalScale}) {
+            const float x = a.field(name)->values()[j], y = b.field(name)->values()[i];
+            ASSERT_TRUE(x == y || (std::isnan(x) && std::isnan(y))) << name << " of core point " << j << ": " << x << " vs " << y;
+        }
+        measured += !std::isnan(a.field(fields::kM3c2Distance)->values()[j]);
+    }
+    EXPECT_GT(measured, coreIndex.size() * 9 / 10);
+
+    // An empty compared part: normals all the same, no distance.
+    const M3c2Result empty = m3c2OnParts(cropAround(reference, lo, hi, reach), PointCloud(), reference.subset(coreIndex), params);
+    EXPECT_EQ(empty.measuredCount, 0u);
+    EXPECT_EQ(empty.corePoints.normals()[0], b.normals()[coreIndex[0]]);
+}

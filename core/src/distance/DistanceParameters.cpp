@@ -2,6 +2,7 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/TextLists.h>
 #include <scandiff/core/distance/DistanceParameters.h>
+#include <scandiff/core/processing/Normals.h>
 
 #include <cmath>
 
@@ -38,6 +39,31 @@ void checkClamp(const ParameterValues& values)
 {
     if (values.boolean("clamp") && !values.has("max-dist"))
         throw Error(ErrorCode::InvalidArgument, "clamp needs a maximum distance (max-dist)");
+}
+
+std::vector<double> scalesFrom(const ParameterValues& values)
+{
+    if (!values.has("normal-scales"))
+        return {values.real("normal-scale")};
+    std::vector<double> scales;
+    for (const std::string& item : splitList(values.text("normal-scales"), ',')) {
+        char* end = nullptr;
+        const double d = std::strtod(item.c_str(), &end);
+        if (end == item.c_str() || *end != '\0')
+            throw Error(ErrorCode::InvalidArgument, "m3c2: --normal-scales takes diameters separated by commas, not '" + item + "'");
+        scales.push_back(d);
+    }
+    return scales;
+}
+
+ParameterSpec m3c2Orientation()
+{
+    return ParameterSpec::text("orientation", "Normal orientation",
+                               "The side every normal is turned to: +z (default), -x..., a direction x,y,z, sensor (towards "
+                               "the reference's scanner), sensor:X,Y,Z, centroid (away from the core points' centroid), "
+                               "-centroid; the sign of the distances follows it",
+                               "+z")
+        .withSuggestions({"+z", "-z", "+x", "+y", "sensor", "centroid", "-centroid"});
 }
 
 } // namespace
@@ -191,6 +217,53 @@ CloudToMeshParams cloudToMeshSettings(const ParameterValues& values)
         params.maxDistance = values.real("max-dist");
     params.clampBeyondMax = values.boolean("clamp");
     params.octreeLevel = static_cast<int>(values.integer("octree-level"));
+    return params;
+}
+
+const std::vector<ParameterSpec>& m3c2Parameters()
+{
+    static const std::vector<ParameterSpec> parameters = {
+        ParameterSpec::real("normal-scale", "Normal scale D", "Diameter of the reference neighbourhood the normal is fitted on",
+                            1.0, 1e-6, 1e6, "m")
+            .asRequired(),
+        ParameterSpec::text("normal-scales", "Normal scales",
+                            "Several diameters D1,D2,D3 (multi-scale normal: the most planar is kept); replaces the normal scale")
+            .asOptional(),
+        ParameterSpec::real("projection-scale", "Projection scale d", "Diameter of the cylinder each epoch is averaged in",
+                            1.0, 1e-6, 1e6, "m")
+            .asRequired(),
+        ParameterSpec::real("max-depth", "Maximum depth", "Half-length of the cylinder along the normal", 1.0, 1e-6, 1e6, "m")
+            .asRequired(),
+        ParameterSpec::real("registration-error", "Registration error", "Added to the level of detection", 0.0, 0.0, 1e6, "m"),
+        ParameterSpec::integer("min-points", "Minimum points",
+                               "Points each cylinder needs for a level of detection and a significance", 5, 1, 1000000),
+        ParameterSpec::real("core-spacing", "Core point spacing",
+                            "Core points: the reference subsampled to points this far apart (without core-points)", 0.1, 1e-9, 1e9, "m")
+            .asOptional(),
+        m3c2Orientation(),
+        ParameterSpec::boolean("robust", "Median and IQR", "Median and IQR / 1.349 instead of mean and standard deviation", false),
+        ParameterSpec::boolean("sample-std", "Sample standard deviation",
+                               "Divide by n - 1 (as py4dgeo) rather than n (as CloudCompare)", false),
+        ParameterSpec::real("raster-cell", "Raster cell",
+                            "Also rasterise the results on square cells of this size (the raster output: mean distance, "
+                            "uncertainty and share of significant core points per cell; write it as .tif for a GeoTIFF)",
+                            1.0, 1e-6, 1e6, "m")
+            .asOptional(),
+    };
+    return parameters;
+}
+
+M3c2Params m3c2Settings(const ParameterValues& values)
+{
+    M3c2Params params;
+    params.normalScales = scalesFrom(values);
+    params.projectionScale = values.real("projection-scale");
+    params.maxDepth = values.real("max-depth");
+    params.registrationError = values.real("registration-error");
+    params.minPoints = static_cast<std::size_t>(values.integer("min-points"));
+    params.robust = values.boolean("robust");
+    params.sampleStd = values.boolean("sample-std");
+    params.orientation = parseNormalOrientation(values.text("orientation"));
     return params;
 }
 

@@ -60,7 +60,11 @@ std::vector<Eigen::Vector3f> inFrame(const PointCloud& cloud, const Eigen::Vecto
     return out;
 }
 
-//! The normal of every core point: the most planar of the scales.
+//! The normal of every core point: the most planar of the scales. The
+//! neighbours are summed in the order of their indices, not in the octree's:
+//! a core point's normal then depends only on which reference points lie within
+//! the scale, so scandiff-mpi's tiles (a part of the reference, another octree)
+//! give it to the bit.
 void fitNormals(const octree::Octree& reference, const std::vector<Eigen::Vector3f>& cores, const M3c2Params& params,
                 std::vector<Eigen::Vector3d>& normals, std::vector<double>& scales, ProgressObserver* progress)
 {
@@ -69,26 +73,40 @@ void fitNormals(const octree::Octree& reference, const std::vector<Eigen::Vector
     scales.assign(n, kNaN);
     std::vector<double> variation(n, std::numeric_limits<double>::infinity());
     ProgressTicker ticker(progress, "M3C2: normals", n * params.normalScales.size());
+    const Eigen::Vector3f* points = reference.points();
+    tbb::enumerable_thread_specific<std::vector<std::uint32_t>> scratch;
     for (double scale : params.normalScales) {
         for (std::size_t begin = 0; begin < n; begin += kQueriesPerBatch) {
             const std::size_t count = std::min(kQueriesPerBatch, n - begin);
-            reference.radiusMomentsBatch(cores.data() + begin, count, static_cast<float>(scale / 2),
-                                         [&](std::uint32_t q, const octree::NeighbourhoodMoments& m) {
-                                             // Per query: Cancel is heard inside a batch, even
-                                             // when a large scale makes each query long.
-                                             detail::stepSparingly(ticker);
-                                             detail::LocalPlane plane;
-                                             if (!detail::fitLocalPlane(m, false, plane))
-                                                 return;
-                                             const double sum = plane.values.sum();
-                                             const double v = plane.values[0] / sum;
-                                             const std::size_t i = begin + q;
-                                             if (v < variation[i]) {
-                                                 variation[i] = v;
-                                                 normals[i] = plane.normal;
-                                                 scales[i] = scale;
-                                             }
-                                         });
+            reference.withinRadiusBatch(
+                cores.data() + begin, count, static_cast<float>(scale / 2),
+                [&](std::uint32_t q, const octree::Neighbour* list, std::size_t size) {
+                    // Per query: Cancel is heard inside a batch, even when a
+                    // large scale makes each query long.
+                    detail::stepSparingly(ticker);
+                    std::vector<std::uint32_t>& indices = scratch.local();
+                    indices.resize(size);
+                    for (std::size_t k = 0; k < size; ++k)
+                        indices[k] = list[k].index;
+                    std::sort(indices.begin(), indices.end());
+                    const std::size_t i = begin + q;
+                    const Eigen::Vector3f& c = cores[i];
+                    // The offsets in float, as the octree's moments take them.
+                    octree::NeighbourhoodMoments m;
+                    for (const std::uint32_t k : indices) {
+                        const Eigen::Vector3f d = points[k] - c;
+                        m.add(d.cast<double>());
+                    }
+                    detail::LocalPlane plane;
+                    if (!detail::fitLocalPlane(m, false, plane))
+                        return;
+                    const double v = plane.values[0] / plane.values.sum();
+                    if (v < variation[i]) {
+                        variation[i] = v;
+                        normals[i] = plane.normal;
+                        scales[i] = scale;
+                    }
+                });
             ticker.checkCancel();
         }
     }
@@ -167,6 +185,7 @@ std::vector<CylinderStats> cylinderStats(const octree::Octree& epoch, const std:
     std::vector<CylinderStats> stats(n);
     std::vector<octree::Octree::CylinderQuery> cylinders(std::min(kQueriesPerBatch, n));
     tbb::enumerable_thread_specific<std::vector<double>> positions;
+    tbb::enumerable_thread_specific<std::vector<std::pair<std::uint32_t, double>>> pairs;
     ProgressTicker ticker(progress, stage, n);
     for (std::size_t begin = 0; begin < n; begin += kQueriesPerBatch) {
         const std::size_t count = std::min(kQueriesPerBatch, n - begin);
@@ -179,10 +198,18 @@ std::vector<CylinderStats> cylinderStats(const octree::Octree& epoch, const std:
             cylinder.halfLength = params.maxDepth;
         }
         epoch.withinCylinderBatch(cylinders.data(), count,
-                                  [&](std::uint32_t q, const std::uint32_t*, const double* along, std::size_t size) {
+                                  [&](std::uint32_t q, const std::uint32_t* indices, const double* along, std::size_t size) {
                                       detail::stepSparingly(ticker);
+                                      // In the order of the points' indices (see fitNormals).
+                                      std::vector<std::pair<std::uint32_t, double>>& byIndex = pairs.local();
+                                      byIndex.resize(size);
+                                      for (std::size_t k = 0; k < size; ++k)
+                                          byIndex[k] = {indices[k], along[k]};
+                                      std::sort(byIndex.begin(), byIndex.end());
                                       std::vector<double>& t = positions.local();
-                                      t.assign(along, along + size);
+                                      t.resize(size);
+                                      for (std::size_t k = 0; k < size; ++k)
+                                          t[k] = byIndex[k].second;
                                       stats[begin + q] = summarise(t, params);
                                   });
         ticker.checkCancel();
@@ -192,12 +219,34 @@ std::vector<CylinderStats> cylinderStats(const octree::Octree& epoch, const std:
 
 } // namespace
 
+namespace {
+
+M3c2Result m3c2Measure(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints,
+                       const M3c2Params& params, ProgressObserver* progress);
+
+} // namespace
+
 M3c2Result m3c2(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints, const M3c2Params& params,
                 ProgressObserver* progress)
 {
     checkParams(params);
     checkCloud(reference, "reference");
     checkCloud(compared, "compared");
+    return m3c2Measure(reference, compared, corePoints, params, progress);
+}
+
+M3c2Result m3c2OnParts(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints,
+                       const M3c2Params& params, ProgressObserver* progress)
+{
+    checkParams(params);
+    return m3c2Measure(reference, compared, corePoints, params, progress);
+}
+
+namespace {
+
+M3c2Result m3c2Measure(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints,
+                       const M3c2Params& params, ProgressObserver* progress)
+{
     const Eigen::Vector3d origin = reference.origin();
     const std::vector<Eigen::Vector3f> cores = inFrame(corePoints, origin);
     for (const Eigen::Vector3f& c : cores)
@@ -205,17 +254,19 @@ M3c2Result m3c2(const PointCloud& reference, const PointCloud& compared, const P
             throw Error(ErrorCode::InvalidData, "m3c2: the core points of '" + corePoints.name + "' include a non-finite one");
     // One epoch's octree at a time: the reference's is gone before the
     // compared one is built (the peak holds one).
-    std::vector<Eigen::Vector3d> normals;
-    std::vector<double> scales;
-    std::vector<CylinderStats> first;
-    {
+    // An empty epoch (a part of one, m3c2OnParts) gives no normal, empty cylinders.
+    std::vector<Eigen::Vector3d> normals(cores.size(), Eigen::Vector3d::Zero());
+    std::vector<double> scales(cores.size(), kNaN);
+    std::vector<CylinderStats> first(cores.size()), second(cores.size());
+    if (!reference.empty()) {
         const octree::Octree referenceTree = buildOctree(reference, std::nullopt, progress);
         fitNormals(referenceTree, cores, params, normals, scales, progress);
         orient(reference, cores, params, normals, progress);
         first = cylinderStats(referenceTree, cores, normals, params, "M3C2: reference cylinders", progress);
+    } else {
+        orient(reference, cores, params, normals, progress); // its errors all the same
     }
-    std::vector<CylinderStats> second;
-    {
+    if (!compared.empty()) {
         PointCloud shifted;
         shifted.name = compared.name;
         shifted.positions() = inFrame(compared, origin);
@@ -271,5 +322,7 @@ M3c2Result m3c2(const PointCloud& reference, const PointCloud& compared, const P
     }
     return result;
 }
+
+} // namespace
 
 } // namespace scandiff

@@ -382,10 +382,12 @@ std::size_t orientNormals(const PointCloud& cloud, std::vector<Eigen::Vector3f>&
     }
     case Kind::AwayFromCentroid:
     case Kind::TowardsCentroid: {
-        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-        for (const auto& p : cloud.positions())
-            centroid += p.cast<double>();
-        centroid /= static_cast<double>(cloud.size());
+        Eigen::Vector3d centroid = orientation.centroid ? *orientation.centroid : Eigen::Vector3d::Zero();
+        if (!orientation.centroid) {
+            for (const auto& p : cloud.positions())
+                centroid += p.cast<double>();
+            centroid /= static_cast<double>(cloud.size());
+        }
         orientTowards(cloud, normals, [&](std::size_t) { return centroid; });
         if (orientation.kind == Kind::AwayFromCentroid)
             for (auto& normal : normals)

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! The parameters of the cloud-to-cloud and cloud-to-mesh distances, declared
+//! The parameters of the cloud-to-cloud, cloud-to-mesh and M3C2 distances, declared
 //! once for every front end: `scandiff-cli c2c`/`c2m` turn them into options,
 //! the workbench into its distance dialogs. The defaults are those of
 //! CloudToCloudParams / CloudToMeshParams, read from the structs themselves.
@@ -8,6 +8,7 @@
 #include <scandiff/core/ToolRegistry.h>
 #include <scandiff/core/distance/CloudToCloud.h>
 #include <scandiff/core/distance/CloudToMesh.h>
+#include <scandiff/core/distance/M3C2.h>
 
 #include <vector>
 
@@ -43,6 +44,15 @@ CloudToCloudRun runCloudToCloud(const PointCloud& compared, const PointCloud& re
 //! signed, max-dist, clamp, octree-level.
 const std::vector<ParameterSpec>& cloudToMeshParameters();
 CloudToMeshParams cloudToMeshSettings(const ParameterValues& values);
+
+//! normal-scale, normal-scales, projection-scale, max-depth,
+//! registration-error, min-points, core-spacing, orientation, robust,
+//! sample-std, raster-cell: the m3c2 tool's, and scandiff-mpi m3c2's.
+const std::vector<ParameterSpec>& m3c2Parameters();
+//! The computation's settings (core-spacing and raster-cell are the tool's:
+//! which core points, and what it makes of the result). Throws
+//! Error(InvalidArgument) for a malformed normal-scales or orientation.
+M3c2Params m3c2Settings(const ParameterValues& values);
 
 //! A viewpoint from "X,Y,Z[,HEADING,PITCH,ROLL]" (degrees; heading about Z, then
 //! pitch about Y, then roll about X) with optional angular step "DEG" or

@@ -82,4 +82,15 @@ struct M3c2Result
 M3c2Result m3c2(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints,
                 const M3c2Params& params, ProgressObserver* progress = nullptr);
 
+//! The same on parts of the epochs (scandiff-mpi's tiles): each part must hold
+//! every point of its epoch within the search reach of the core points given
+//! (half the largest normal scale, and the cylinder's half-diagonal
+//! sqrt((d/2)^2 + H^2)), in the epoch's order; each value is then the one m3c2
+//! gives on the whole epochs, to the bit (neighbourhoods are summed in index
+//! order). A part may be empty: no normal without reference points, empty
+//! cylinders in an empty compared part. With a centroid orientation, give the
+//! whole set of core points' centroid in params.orientation.centroid.
+M3c2Result m3c2OnParts(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints,
+                       const M3c2Params& params, ProgressObserver* progress = nullptr);
+
 } // namespace scandiff

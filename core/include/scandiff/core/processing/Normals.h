@@ -49,6 +49,10 @@ struct NormalOrientation
     //! TowardsSensor: this position (global coordinates); absent: the cloud's
     //! sensor poses (each point towards the nearest one).
     std::optional<Eigen::Vector3d> sensor;
+    //! Away/TowardsCentroid: this point, in the cloud's frame (its local
+    //! coordinates); absent: the centroid of the cloud's points. For a cloud
+    //! that is a part of a larger one (scandiff-mpi's tiles) whose centroid counts.
+    std::optional<Eigen::Vector3d> centroid;
     //! MinimumSpanningTree: neighbours per point in the graph. Each connected
     //! part of the graph starts from its highest point, oriented upwards (+Z),
     //! where an outward normal of a closed surface points up.
