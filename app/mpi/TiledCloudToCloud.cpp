@@ -2,6 +2,7 @@
 #include "TiledCloudToCloud.h"
 
 #include "ChunkedCloud.h"
+#include "TiledRun.h"
 #include "Tiling.h"
 
 #include "CliSupport.h"
@@ -23,29 +24,6 @@
 namespace scandiff::mpi {
 
 namespace {
-
-//! With SCANDIFF_MPI_MEMORY set, a rank's resident and peak memory after a
-//! stage, on stderr: how the per-rank figures of docs/benchmarks.md were taken apart.
-void memoryNote(const char* what)
-{
-    if (!std::getenv("SCANDIFF_MPI_MEMORY"))
-        return;
-    std::ifstream status("/proc/self/status");
-    std::string line, out;
-    while (std::getline(status, line))
-        if (line.rfind("VmHWM", 0) == 0 || line.rfind("VmRSS", 0) == 0 || line.rfind("RssFile", 0) == 0 || line.rfind("RssAnon", 0) == 0)
-            out += " " + line;
-    std::cerr << what << ":" << out << std::endl;
-}
-
-using Clock = std::chrono::steady_clock;
-
-//! What each rank tells rank 0 for the report.
-struct RankReport
-{
-    double seconds = 0;
-    std::uint64_t tiles = 0, compared = 0, referenceHeld = 0, referenceInTiles = 0, widened = 0, widenings = 0;
-};
 
 //! The part of the reference a rank holds, in the reference file's frame.
 struct ReferencePart
@@ -98,56 +76,10 @@ std::size_t pointsNeeded(const CloudToCloudParams& params)
     return params.model != LocalModel::None && !params.radius ? static_cast<std::size_t>(params.neighbours) : 1;
 }
 
-//! Rounding allowance of the exactness test: reach is computed in float32 from
-//! local coordinates, the tile's edges in double from world ones.
-double margin(const Eigen::Vector3f& local, double reach)
-{
-    return 1e-6 + 5e-7 * static_cast<double>(local.cwiseAbs().maxCoeff()) + 1e-6 * reach;
-}
-
-PointCloud makeCloud(const Eigen::Vector3d& origin, std::vector<Eigen::Vector3f>&& positions,
-                     std::vector<Eigen::Vector3f>&& normals, const std::vector<SensorPose>& sensors)
-{
-    PointCloud cloud;
-    cloud.setOrigin(origin);
-    cloud.resize(positions.size());
-    cloud.positions() = std::move(positions);
-    if (!normals.empty())
-        cloud.enableNormals() = std::move(normals);
-    cloud.sensors() = sensors;
-    return cloud;
-}
-
-//! Pass 1: the compared points of every tile, counted by each rank on its
-//! share of the chunks, summed over the ranks.
-std::map<TileKey, std::uint64_t> countTilePoints(const Communicator& c, const ChunkedCloud& compared, const TileGrid& grid)
-{
-    std::map<TileKey, std::uint64_t> mine;
-    for (std::size_t k = static_cast<std::size_t>(c.rank()); k < compared.chunkCount(); k += static_cast<std::size_t>(c.size())) {
-        const PointCloud chunk = compared.read(k, true);
-        for (std::size_t i = 0; i < chunk.size(); ++i) {
-            const Eigen::Vector3d p = chunk.globalPosition(i);
-            ++mine[grid.tileOf(p.x(), p.y())];
-        }
-    }
-    struct Entry
-    {
-        std::int64_t x, y;
-        std::uint64_t count;
-    };
-    std::vector<Entry> entries;
-    for (const auto& [key, count] : mine)
-        entries.push_back({key.x, key.y, count});
-    std::map<TileKey, std::uint64_t> all;
-    for (const Entry& e : allGather(c, entries))
-        all[{e.x, e.y}] += e.count;
-    return all;
-}
-
-class TiledRun
+class CloudToCloudRun
 {
 public:
-    TiledRun(const Communicator& c, const io::FormatRegistry& formats, const CloudToCloudJob& job)
+    CloudToCloudRun(const Communicator& c, const io::FormatRegistry& formats, const CloudToCloudJob& job)
         : c_(c), formats_(formats), job_(job),
           compared_(formats, job.compared, job.tiling.chunkPoints, job.read),
           reference_(formats, job.reference, job.tiling.chunkPoints, job.read),
@@ -166,44 +98,33 @@ public:
         params_.reportReach = true;
         halo_ = job.tiling.halo ? *job.tiling.halo : defaultHalo(job.values, job.tiling.tileSize);
         needNormals_ = params_.signedDistances && params_.model == LocalModel::None;
-        if (!job.output.empty() && !formats.forPath(job.output).openChunkWriter)
-            throw Error(ErrorCode::Unsupported, job.output.string() + ": scandiff-mpi writes its output chunk by chunk, which " +
-                                                    formats.forPath(job.output).name + " files cannot be yet (use .ply)");
+        checkChunkedOutput(formats, job.output);
     }
 
     void run(std::ostream& out)
     {
         const auto start = Clock::now();
-        const std::map<TileKey, std::uint64_t> counts = countTilePoints(c_, compared_, grid_);
-        const std::map<TileKey, int> owners = assignTiles(counts, c_.size());
-        std::vector<TileKey> mine;
-        for (const auto& [key, rank] : owners)
-            if (rank == c_.rank()) {
-                mine.push_back(key);
-                expectedCompared_ += counts.at(key);
-            }
-        report_.tiles = mine.size();
-        memoryNote("counted");
-        const HaloRegion region(grid_, mine, halo_);
-        collectCompared(region);
+        owned_ = collectOwnedPoints(c_, compared_, grid_);
+        report_.tiles = owned_.tiles.size();
+        report_.points = owned_.index.size();
+        const HaloRegion region(grid_, owned_.tiles, halo_);
         Representatives representatives(grid_, std::min<std::size_t>(pointsNeeded(params_), 64));
         memoryNote("compared collected");
         ReferencePart part = collectReference(region, &representatives);
         memoryNote("reference collected");
-        report_.referenceHeld = part.positions.size();
-        report_.referenceInTiles = part.inOwnTiles;
+        report_.held = part.positions.size();
+        report_.heldInTiles = part.inOwnTiles;
         computeOwnTiles(std::move(part));
         memoryNote("computed");
         widen(representatives);
         report_.seconds = std::chrono::duration<double>(Clock::now() - start).count();
 
-        const DistanceStatistics statistics = statisticsOverRanks();
+        const DistanceStatistics statistics = statisticsOverRanks(c_, distance_);
         comparedCloud_ = PointCloud(); // only the values and their indices are needed from here on
-        const std::vector<RankReport> reports = allGather(c_, std::vector<RankReport>{report_});
-        if (c_.rank() == 0) {
+        if (c_.rank() == 0)
             cli::printStatistics(out, "c2c " + std::string(localModelName(params_.model)) + " (compared -> reference)", statistics);
-            printReport(out, reports);
-        }
+        reportRanks(c_, report_, {"c2c", "compared points", "reference points"}, grid_.size(), halo_,
+                    compared_.streamed() && reference_.streamed(), out);
         if (!job_.output.empty())
             writeOutput(out);
         if (c_.rank() == 0)
@@ -214,29 +135,6 @@ public:
     }
 
 private:
-    //! Pass 2: this rank's compared points (positions, input indices).
-    void collectCompared(const HaloRegion& region)
-    {
-        std::uint64_t index = 0;
-        comparedPositions_.reserve(static_cast<std::size_t>(expectedCompared_));
-        comparedIndex_.reserve(static_cast<std::size_t>(expectedCompared_));
-        for (std::size_t k = 0; k < compared_.chunkCount(); ++k) {
-            chunkStarts_.push_back(index);
-            const PointCloud chunk = compared_.read(k, true);
-            for (std::size_t i = 0; i < chunk.size(); ++i) {
-                const Eigen::Vector3d p = chunk.globalPosition(i);
-                if (region.owns(grid_.tileOf(p.x(), p.y()))) {
-                    comparedPositions_.push_back(chunk.positions()[i]);
-                    comparedIndex_.push_back(index + i);
-                }
-            }
-            index += chunk.size();
-        }
-        chunkStarts_.push_back(index);
-        totalCompared_ = index;
-        report_.compared = comparedIndex_.size();
-    }
-
     //! The reference points `keep` accepts, streamed from the file.
     template <class Keep>
     ReferencePart streamReference(Keep&& keep, Representatives* representatives)
@@ -280,9 +178,9 @@ private:
     //! whose reach pokes out of their tile's halo are left for widen().
     void computeOwnTiles(ReferencePart&& part)
     {
-        const std::size_t n = comparedPositions_.size();
+        const std::size_t n = owned_.positions.size();
         if (n == 0)
-            comparedCloud_ = makeCloud(compared_.origin(), {}, {}, {});
+            comparedCloud_ = makeCloud(compared_.origin(), {});
         distance_.assign(n, std::numeric_limits<float>::quiet_NaN());
         if (params_.splitComponents)
             for (auto* plane : {&dx_, &dy_, &dz_})
@@ -290,14 +188,14 @@ private:
         if (n == 0)
             return;
         if (part.positions.empty()) {
-            comparedCloud_ = makeCloud(compared_.origin(), std::move(comparedPositions_), {}, {});
+            comparedCloud_ = makeCloud(compared_.origin(), std::move(owned_.positions));
             for (std::size_t j = 0; j < n; ++j)
                 pending_.push_back({j, std::numeric_limits<double>::infinity()});
             return;
         }
         const PointCloud reference =
             makeCloud(reference_.origin(), std::move(part.positions), std::move(part.normals), referenceLayout_.sensors());
-        comparedCloud_ = makeCloud(compared_.origin(), std::move(comparedPositions_), {}, {});
+        comparedCloud_ = makeCloud(compared_.origin(), std::move(owned_.positions));
         const PointCloud& compared = comparedCloud_;
         const CloudToCloudResult result = cloudToCloud(compared, reference, params_);
         for (std::size_t j = 0; j < n; ++j) {
@@ -368,7 +266,7 @@ private:
                 throw Error(ErrorCode::InvalidData, job_.reference.string() + ": no reference point to compare with");
             const PointCloud reference =
                 makeCloud(reference_.origin(), std::move(part.positions), std::move(part.normals), referenceLayout_.sensors());
-            const PointCloud compared = makeCloud(compared_.origin(), std::move(queries), {}, {});
+            const PointCloud compared = makeCloud(compared_.origin(), std::move(queries));
             const CloudToCloudResult result = cloudToCloud(compared, reference, params_);
             std::vector<Pending> still;
             for (std::size_t m = 0; m < pending_.size(); ++m) {
@@ -392,127 +290,32 @@ private:
         }
     }
 
-    //! Those of scandiff-cli, summed over the ranks (in another order: the
-    //! last digits of the mean may differ).
-    DistanceStatistics statisticsOverRanks() const
-    {
-        double local[3] = {0, 0, 0}; // count, sum, sum of squares
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (const float v : distance_)
-            if (!std::isnan(v)) {
-                local[0] += 1;
-                local[1] += v;
-                local[2] += static_cast<double>(v) * v;
-                lo = std::min(lo, static_cast<double>(v));
-                hi = std::max(hi, static_cast<double>(v));
-            }
-        double total[3];
-        MPI_Allreduce(local, total, 3, MPI_DOUBLE, MPI_SUM, c_.comm);
-        MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_DOUBLE, MPI_MIN, c_.comm);
-        MPI_Allreduce(MPI_IN_PLACE, &hi, 1, MPI_DOUBLE, MPI_MAX, c_.comm);
-        DistanceStatistics s;
-        s.count = static_cast<std::size_t>(total[0]);
-        if (s.count == 0)
-            return s;
-        s.mean = total[1] / total[0];
-        double deviations = 0;
-        for (const float v : distance_)
-            if (!std::isnan(v))
-                deviations += (v - s.mean) * (v - s.mean);
-        MPI_Allreduce(MPI_IN_PLACE, &deviations, 1, MPI_DOUBLE, MPI_SUM, c_.comm);
-        s.standardDeviation = std::sqrt(deviations / total[0]);
-        s.min = lo;
-        s.max = hi;
-        s.rms = std::sqrt(total[2] / total[0]);
-        return s;
-    }
-
-    //! The values of one chunk of the compared cloud as a rank sends them:
-    //! each point's place in the chunk and its value in every output field.
-    struct ChunkValue
-    {
-        std::uint32_t offset;
-        float values[4];
-    };
-
-    //! Rank 0 writes the compared cloud with its new fields in input order,
-    //! chunk by chunk; for each chunk every rank sends it the values it owns
-    //! there, so no rank ever holds more than one chunk of them.
+    //! Rank 0 writes the compared cloud with its new fields in input order.
     void writeOutput(std::ostream& out)
     {
-        const std::size_t planeCount = params_.splitComponents ? 4 : 1;
-        const std::vector<float>* planes[4] = {&distance_, &dx_, &dy_, &dz_};
-        std::unique_ptr<io::PointChunkWriter> writer;
-        std::size_t next = 0; // this rank's first value not sent yet (its indices are sorted)
-        for (std::size_t k = 0; k + 1 < chunkStarts_.size(); ++k) {
-            std::vector<ChunkValue> mine;
-            for (; next < comparedIndex_.size() && comparedIndex_[next] < chunkStarts_[k + 1]; ++next) {
-                ChunkValue v{static_cast<std::uint32_t>(comparedIndex_[next] - chunkStarts_[k]), {}};
-                for (std::size_t f = 0; f < planeCount; ++f)
-                    v.values[f] = (*planes[f])[next];
-                mine.push_back(v);
-            }
-            const std::vector<ChunkValue> gathered = gatherToRoot(c_, mine);
-            if (c_.rank() != 0)
-                continue;
-            PointCloud chunk = compared_.read(k, false);
-            const std::size_t n = chunk.size();
-            if (gathered.size() != n)
-                throw Error(ErrorCode::Internal, "chunk " + std::to_string(k) + " of the compared cloud: " +
-                                                     std::to_string(gathered.size()) + " values for " + std::to_string(n) + " points");
-            CloudToCloudResult result;
-            result.distance = ScalarField("c2c_distance", n);
-            ScalarField* fields[4] = {&result.distance, nullptr, nullptr, nullptr};
-            if (params_.splitComponents) {
-                result.dx = ScalarField("c2c_dx", n);
-                result.dy = ScalarField("c2c_dy", n);
-                result.dz = ScalarField("c2c_dz", n);
-                fields[1] = &*result.dx;
-                fields[2] = &*result.dy;
-                fields[3] = &*result.dz;
-            }
-            for (const ChunkValue& v : gathered)
-                for (std::size_t f = 0; f < planeCount; ++f)
-                    fields[f]->values()[v.offset] = v.values[f];
-            attachFields(chunk, std::move(result));
-            if (!writer)
-                writer = io::openPointChunkWriter(formats_, job_.output, chunk, totalCompared_, job_.write);
-            writer->append(chunk);
-        }
-        if (c_.rank() != 0)
-            return;
-        if (!writer) // an empty compared cloud gives an empty output all the same
-            writer = io::openPointChunkWriter(formats_, job_.output, compared_.read(0, false), 0, job_.write);
-        writer->commit();
-        out << "wrote " << job_.output.string() << '\n';
-    }
-
-    void printReport(std::ostream& out, const std::vector<RankReport>& reports) const
-    {
-        std::uint64_t compared = 0, held = 0, inTiles = 0, widened = 0;
-        std::uint64_t most = 0;
-        double slowest = 0;
-        out << "scandiff-mpi c2c: " << reports.size() << " ranks, tiles of " << grid_.size() << " m, halo " << halo_ << " m"
-            << (compared_.streamed() && reference_.streamed() ? "" : " (a file whose format cannot be streamed was read whole)")
-            << '\n';
-        for (std::size_t r = 0; r < reports.size(); ++r) {
-            const RankReport& rr = reports[r];
-            out << "  rank " << r << ": " << rr.tiles << " tiles, " << rr.compared << " compared points, " << rr.referenceHeld
-                << " reference points held (" << rr.referenceInTiles << " in its tiles), " << rr.widened
-                << " widened in " << rr.widenings << " passes, " << std::fixed << std::setprecision(3) << rr.seconds << " s\n"
-                << std::defaultfloat;
-            compared += rr.compared;
-            held += rr.referenceHeld;
-            inTiles += rr.referenceInTiles;
-            widened += rr.widened;
-            most = std::max(most, rr.compared);
-            slowest = std::max(slowest, rr.seconds);
-        }
-        const double mean = static_cast<double>(compared) / static_cast<double>(reports.size());
-        out << "  halo overhead " << std::setprecision(3)
-            << (inTiles ? 100.0 * static_cast<double>(held - inTiles) / static_cast<double>(inTiles) : 0.0)
-            << " % of the reference points, imbalance " << (mean > 0 ? static_cast<double>(most) / mean : 1.0)
-            << " (most points on a rank / mean), " << widened << " points widened\n";
+        std::vector<const std::vector<float>*> planes{&distance_};
+        if (params_.splitComponents)
+            planes.insert(planes.end(), {&dx_, &dy_, &dz_});
+        const bool split = params_.splitComponents;
+        writeInInputOrder(
+            c_, formats_, compared_, owned_, planes,
+            [split](PointCloud& chunk, std::vector<std::vector<float>>&& values) {
+                const std::size_t n = chunk.size();
+                CloudToCloudResult result;
+                result.distance = ScalarField("c2c_distance", n);
+                if (split) {
+                    result.dx = ScalarField("c2c_dx", n);
+                    result.dy = ScalarField("c2c_dy", n);
+                    result.dz = ScalarField("c2c_dz", n);
+                }
+                ScalarField* fields[4] = {&result.distance, split ? &*result.dx : nullptr, split ? &*result.dy : nullptr,
+                                          split ? &*result.dz : nullptr};
+                for (std::size_t f = 0; f < values.size(); ++f)
+                    if (values[f].size() == n)
+                        fields[f]->values() = std::move(values[f]);
+                attachFields(chunk, std::move(result));
+            },
+            job_.output, job_.write, out);
     }
 
     struct Pending
@@ -520,6 +323,11 @@ private:
         std::size_t index; //!< in this rank's compared points
         double radius;     //!< the reach to fetch (+inf: unknown)
     };
+
+    static double margin(const Eigen::Vector3f& local, double reach)
+    {
+        return roundingMargin(static_cast<double>(local.cwiseAbs().maxCoeff()), reach);
+    }
 
     const Communicator& c_;
     const io::FormatRegistry& formats_;
@@ -530,11 +338,9 @@ private:
     CloudToCloudParams params_;
     double halo_ = 0;
     bool needNormals_ = false;
-    std::vector<Eigen::Vector3f> comparedPositions_; //!< while collecting; then in comparedCloud_
+    OwnedPoints owned_;        //!< positions moved into comparedCloud_ once collected
     PointCloud comparedCloud_;
-    std::vector<std::uint64_t> chunkStarts_; //!< index of each compared chunk's first point, and the total
-    std::vector<std::uint64_t> comparedIndex_;
-    std::uint64_t totalCompared_ = 0, totalReference_ = 0, expectedCompared_ = 0;
+    std::uint64_t totalReference_ = 0;
     std::vector<float> distance_, dx_, dy_, dz_;
     std::vector<Pending> pending_;
     RankReport report_;
@@ -553,22 +359,10 @@ double defaultHalo(const ParameterValues& values, double tileSize)
 
 void runTiledCloudToCloud(const Communicator& c, const io::FormatRegistry& formats, const CloudToCloudJob& job, std::ostream& out)
 {
-    if (!(job.tiling.tileSize > 0) || !std::isfinite(job.tiling.tileSize))
-        throw Error(ErrorCode::InvalidArgument, "--tile-size must be a positive number of metres");
-    if (job.tiling.halo && !(*job.tiling.halo >= 0))
-        throw Error(ErrorCode::InvalidArgument, "--halo must be a non-negative number of metres");
-    TiledRun run(c, formats, job);
-    // From here on the ranks meet in collective calls: one that fails alone
-    // would leave the others waiting, so it stops them all.
-    try {
-        run.run(out);
-    } catch (const Error& e) {
-        std::cerr << "error: (rank " << c.rank() << ") " << e.what() << std::endl;
-        MPI_Abort(c.comm, e.exitStatus());
-    } catch (const std::exception& e) {
-        std::cerr << "error: (rank " << c.rank() << ") " << e.what() << std::endl;
-        MPI_Abort(c.comm, static_cast<int>(ErrorCode::Internal));
-    }
+    checkTilingOptions(job.tiling);
+    CloudToCloudRun run(c, formats, job);
+    // From here on the ranks meet in collective calls.
+    runCollectively(c, [&] { run.run(out); });
 }
 
 } // namespace scandiff::mpi

@@ -4,6 +4,7 @@
 //! tiles over MPI ranks, value for value the same (docs/scale-out.md).
 
 #include "Mpi.h"
+#include "TiledRun.h"
 
 #include <scandiff/core/ToolRegistry.h>
 #include <scandiff/io/FileIO.h>
@@ -13,13 +14,6 @@
 #include <ostream>
 
 namespace scandiff::mpi {
-
-struct TilingOptions
-{
-    double tileSize = 100.0;         //!< metres, > 0
-    std::optional<double> halo;      //!< metres, >= 0; default from the options (see defaultHalo)
-    std::uint64_t chunkPoints = 1u << 20; //!< records read at a time
-};
 
 struct CloudToCloudJob
 {

@@ -83,4 +83,24 @@ bool HaloRegion::contains(double x, double y) const
     return false;
 }
 
+bool HaloRegion::intersects(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const
+{
+    const auto overlaps = [&](const TileKey& key) {
+        const Eigen::Vector2d tileLo = grid_.tileMin(key), tileHi = grid_.tileMax(key);
+        return lo.x() <= tileHi.x() + halo_ && hi.x() >= tileLo.x() - halo_ && lo.y() <= tileHi.y() + halo_ &&
+               hi.y() >= tileLo.y() - halo_;
+    };
+    const TileKey first = grid_.tileOf(lo.x() - halo_, lo.y() - halo_), last = grid_.tileOf(hi.x() + halo_, hi.y() + halo_);
+    // A large box (a big triangle of a CAD model) looks at the owned tiles
+    // instead of every tile it spans.
+    const double spanned = (static_cast<double>(last.x - first.x) + 1) * (static_cast<double>(last.y - first.y) + 1);
+    if (spanned > static_cast<double>(owned_.size()))
+        return std::any_of(owned_.begin(), owned_.end(), overlaps);
+    for (std::int64_t x = first.x; x <= last.x; ++x)
+        for (std::int64_t y = first.y; y <= last.y; ++y)
+            if (owned_.count({x, y}) && overlaps({x, y}))
+                return true;
+    return false;
+}
+
 } // namespace scandiff::mpi

@@ -68,6 +68,9 @@ public:
     HaloRegion(const TileGrid& grid, const std::vector<TileKey>& tiles, double halo);
     bool contains(double x, double y) const;
     bool owns(const TileKey& key) const { return owned_.count(key) != 0; }
+    //! Whether the XY box [lo, hi] comes within the halo of an owned tile
+    //! (a triangle a rank must hold of a reference mesh).
+    bool intersects(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const;
 
 private:
     enum Status : std::uint8_t { Far, Owned, Border };

@@ -5,6 +5,8 @@
 
 #include "Mpi.h"
 #include "TiledCloudToCloud.h"
+#include "TiledCloudToMesh.h"
+#include "TiledM3c2.h"
 
 #include "CliSupport.h"
 
@@ -34,8 +36,8 @@ struct TilingFlags
         command.add_option("--tile-size", tileSize, "Side of the square tiles the compared cloud is split into, metres")
             ->capture_default_str();
         command.add_option("--halo", halo,
-                           "Reference margin each rank reads around its tiles, metres (default: the maximum distance, "
-                           "twice the model radius, else a tenth of the tile; points needing more are widened, never wrong)");
+                           "Reference margin each rank reads around its tiles, metres (default: what the options imply, see "
+                           "docs/scale-out.md; c2c and c2m widen the points needing more, never wrong)");
         command.add_option("--chunk-points", chunkPoints, "Points read from a file at a time")->capture_default_str();
     }
     mpi::TilingOptions options() const
@@ -61,36 +63,83 @@ int run(int argc, char** argv, const mpi::Communicator& world)
     app.require_subcommand(1);
     app.set_version_flag("--version", "scandiff 0.1.0");
 
+    //! What every subcommand takes beside its computation's options.
     struct Args
     {
-        std::string reference, compared, output;
+        std::string reference, compared, corePoints, output;
         std::shared_ptr<std::map<std::string, std::string>> values = std::make_shared<std::map<std::string, std::string>>();
         int threads = 0;
         cli::ReadFlags read;
         cli::WriteFlags write;
         TilingFlags tiling;
-    } args;
+    };
+    const auto addCommon = [](CLI::App& command, Args& args, const char* what) {
+        command.add_option("-o,--output", args.output, std::string("Output: ") + what + " (PLY; written by rank 0)");
+        cli::ThreadLimit::addOption(command, args.threads);
+        args.read.addTo(command);
+        args.write.addTo(command);
+        args.tiling.addTo(command);
+    };
+
+    Args c2cArgs;
     CLI::App* c2c = app.add_subcommand("c2c", "Cloud-to-cloud distance, as scandiff-cli c2c, on tiles over the ranks");
-    c2c->add_option("--reference", args.reference, "Reference cloud")->required();
-    c2c->add_option("--compared", args.compared, "Compared cloud (the output keeps its points, in order)")->required();
-    c2c->add_option("-o,--output", args.output, "Output: the compared cloud with c2c_distance (PLY; written by rank 0)");
-    const auto options = cli::addParameterOptions(*c2c, cloudToCloudParameters(), args.values);
+    c2c->add_option("--reference", c2cArgs.reference, "Reference cloud")->required();
+    c2c->add_option("--compared", c2cArgs.compared, "Compared cloud (the output keeps its points, in order)")->required();
+    const auto options = cli::addParameterOptions(*c2c, cloudToCloudParameters(), c2cArgs.values);
     options.at("knn")->excludes(options.at("radius"));
-    cli::ThreadLimit::addOption(*c2c, args.threads);
-    args.read.addTo(*c2c);
-    args.write.addTo(*c2c);
-    args.tiling.addTo(*c2c);
+    addCommon(*c2c, c2cArgs, "the compared cloud with c2c_distance");
     c2c->callback([&] {
-        const cli::ThreadLimit threadLimit(args.threads);
+        const cli::ThreadLimit threadLimit(c2cArgs.threads);
         mpi::CloudToCloudJob job;
-        job.reference = args.reference;
-        job.compared = args.compared;
-        job.output = args.output;
-        job.values = resolveParameters(cloudToCloudParameters(), *args.values, "c2c");
-        job.tiling = args.tiling.options();
-        job.read = args.read.toOptions(nullptr);
-        job.write = args.write.toOptions(nullptr);
+        job.reference = c2cArgs.reference;
+        job.compared = c2cArgs.compared;
+        job.output = c2cArgs.output;
+        job.values = resolveParameters(cloudToCloudParameters(), *c2cArgs.values, "c2c");
+        job.tiling = c2cArgs.tiling.options();
+        job.read = c2cArgs.read.toOptions(nullptr);
+        job.write = c2cArgs.write.toOptions(nullptr);
         mpi::runTiledCloudToCloud(world, formats, job, out);
+    });
+
+    Args c2mArgs;
+    CLI::App* c2m = app.add_subcommand("c2m", "Cloud-to-mesh distance, as scandiff-cli c2m, on tiles of the compared cloud over the ranks");
+    c2m->add_option("--reference", c2mArgs.reference, "Reference mesh (PLY, OBJ, STL, OFF...; every rank reads it, keeps its part)")
+        ->required();
+    c2m->add_option("--compared", c2mArgs.compared, "Compared cloud (the output keeps its points, in order)")->required();
+    cli::addParameterOptions(*c2m, cloudToMeshParameters(), c2mArgs.values);
+    addCommon(*c2m, c2mArgs, "the compared cloud with c2m_distance");
+    c2m->callback([&] {
+        const cli::ThreadLimit threadLimit(c2mArgs.threads);
+        mpi::CloudToMeshJob job;
+        job.reference = c2mArgs.reference;
+        job.compared = c2mArgs.compared;
+        job.output = c2mArgs.output;
+        job.values = resolveParameters(cloudToMeshParameters(), *c2mArgs.values, "c2m");
+        job.tiling = c2mArgs.tiling.options();
+        job.read = c2mArgs.read.toOptions(nullptr);
+        job.write = c2mArgs.write.toOptions(nullptr);
+        mpi::runTiledCloudToMesh(world, formats, job, out);
+    });
+
+    Args m3c2Args;
+    CLI::App* m3c2 = app.add_subcommand("m3c2", "M3C2, as scandiff-cli m3c2, on tiles of the core points over the ranks");
+    m3c2->add_option("--reference", m3c2Args.reference, "The first epoch: its normals orient the comparison")->required();
+    m3c2->add_option("--compared", m3c2Args.compared, "The second epoch")->required();
+    m3c2->add_option("--core-points", m3c2Args.corePoints, "Where to measure (default: every reference point)");
+    cli::addParameterOptions(*m3c2, m3c2Parameters(), m3c2Args.values);
+    addCommon(*m3c2, m3c2Args, "the core points with their normals and the m3c2_* fields");
+    m3c2->callback([&] {
+        const cli::ThreadLimit threadLimit(m3c2Args.threads);
+        mpi::M3c2Job job;
+        job.reference = m3c2Args.reference;
+        job.compared = m3c2Args.compared;
+        job.corePoints = m3c2Args.corePoints;
+        job.output = m3c2Args.output;
+        job.values = resolveParameters(m3c2Parameters(), *m3c2Args.values, "m3c2");
+        job.tiling = m3c2Args.tiling.options();
+        job.read = m3c2Args.read.toOptions(nullptr);
+        job.write = m3c2Args.write.toOptions(nullptr);
+        mpi::runTiledM3c2(world, formats, job, out);
     });
 
     try {

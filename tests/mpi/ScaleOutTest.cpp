@@ -4,6 +4,7 @@
 // through a change and through a hole of the reference, where a compared
 // point's nearest reference point lies far outside its tile's halo.
 #include <scandiff/core/Error.h>
+#include <scandiff/core/Mesh.h>
 #include <scandiff/io/FileIO.h>
 
 #include "TestSupport.h"
@@ -80,6 +81,35 @@ bool sameValue(float a, float b)
     return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a) && std::isnan(b));
 }
 
+//! A mesh of the surface on a grid of `step` metres over the 60 m square,
+//! without the triangles of a hole across the tile borders x = 20 and y = 40
+//! (compared points there have their nearest triangle metres away).
+Mesh sampleMesh(double step)
+{
+    Mesh mesh;
+    mesh.name = "surface";
+    mesh.vertices.setOrigin(Eigen::Vector3d(500000.0, 5400000.0, 100.0));
+    const int n = static_cast<int>(60.0 / step);
+    std::vector<Eigen::Vector3f> vertices;
+    for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j) {
+            const double x = i * step, y = j * step;
+            vertices.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(surface(x, y)));
+        }
+    const auto at = [n](int i, int j) { return static_cast<std::uint32_t>(i * (n + 1) + j); };
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const double x = (i + 0.5) * step, y = (j + 0.5) * step;
+            if (x > 14 && x < 27 && y > 33 && y < 47)
+                continue;
+            mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+            mesh.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
+    mesh.vertices.resize(vertices.size());
+    mesh.vertices.positions() = vertices;
+    return mesh;
+}
+
 class ScaleOut : public ::testing::Test
 {
 protected:
@@ -87,29 +117,42 @@ protected:
     {
         dir_ = tempDir();
         const auto registry = formats();
-        io::writePointCloud(registry, sampleSite(1, 4.0, true, false), dir_ / "reference.ply");
+        const PointCloud reference = sampleSite(1, 4.0, true, false);
+        io::writePointCloud(registry, reference, dir_ / "reference.ply");
         io::writePointCloud(registry, sampleSite(2, 3.0, false, true), dir_ / "compared.ply");
+        io::writeMesh(registry, sampleMesh(1.5), dir_ / "mesh.ply");
+        std::vector<std::size_t> every7th;
+        for (std::size_t i = 0; i < reference.size(); i += 7)
+            every7th.push_back(i);
+        io::writePointCloud(registry, reference.subset(every7th), dir_ / "cores.ply");
     }
 
+    std::string file(const char* name) const { return (dir_ / name).string(); }
+
     //! scandiff-cli's output, then scandiff-mpi's on 1, 2 and 4 ranks, each
-    //! compared field by field, value by value.
-    void expectSameAsCli(const std::string& options, const std::string& tiling, std::vector<std::string> fields)
+    //! compared point by point (position, normal) and field by field, value
+    //! by value.
+    void expectSameAsCli(const std::string& command, const std::string& inputs, const std::string& options,
+                         const std::string& tiling, std::vector<std::string> fields)
     {
-        const std::string inputs = " --reference " + (dir_ / "reference.ply").string() + " --compared " +
-                                   (dir_ / "compared.ply").string() + " " + options;
-        const CommandOutcome cli = run(std::string(SCANDIFF_CLI_PATH) + " c2c" + inputs + " -o " + (dir_ / "cli.ply").string());
+        const std::string arguments = " " + command + " " + inputs + " " + options;
+        const CommandOutcome cli = run(std::string(SCANDIFF_CLI_PATH) + arguments + " -o " + file("cli.ply"));
         ASSERT_EQ(cli.status, 0) << cli.output;
         const auto registry = formats();
         const PointCloud expected = io::readPointCloud(registry, dir_ / "cli.ply");
         fields.push_back("intensity");
         for (const int ranks : {1, 2, 4}) {
             const fs::path output = dir_ / ("mpi" + std::to_string(ranks) + ".ply");
-            const CommandOutcome mpi = run(mpirun(ranks) + " c2c" + inputs + " " + tiling + " -o " + output.string());
+            const CommandOutcome mpi = run(mpirun(ranks) + arguments + " " + tiling + " -o " + output.string());
             ASSERT_EQ(mpi.status, 0) << mpi.output;
             const PointCloud got = io::readPointCloud(registry, output);
             ASSERT_EQ(got.size(), expected.size()) << ranks << " ranks";
-            for (std::size_t i = 0; i < got.size(); ++i)
+            ASSERT_EQ(got.hasNormals(), expected.hasNormals());
+            for (std::size_t i = 0; i < got.size(); ++i) {
                 ASSERT_EQ(got.globalPosition(i), expected.globalPosition(i)) << "point " << i;
+                if (got.hasNormals())
+                    ASSERT_EQ(got.normals()[i], expected.normals()[i]) << ranks << " ranks, normal of point " << i;
+            }
             ASSERT_EQ(got.fields().size(), expected.fields().size());
             for (const std::string& name : fields) {
                 const ScalarField* a = got.field(name);
@@ -126,6 +169,13 @@ protected:
             }
             lastReport_ = mpi.output;
         }
+    }
+
+    //! c2c of the compared cloud against the reference.
+    void expectSameAsCli(const std::string& options, const std::string& tiling, std::vector<std::string> fields)
+    {
+        expectSameAsCli("c2c", "--reference " + file("reference.ply") + " --compared " + file("compared.ply"), options, tiling,
+                        std::move(fields));
     }
 
     fs::path dir_;
@@ -179,6 +229,62 @@ TEST_F(ScaleOut, BadOptionsGiveTheCliErrors)
     EXPECT_NE(missing.output.find("nothing.ply: no such file"), std::string::npos) << missing.output;
     const CommandOutcome tiles = run(mpirun(1) + inputs + " --tile-size 0");
     EXPECT_NE(tiles.output.find("--tile-size must be a positive number"), std::string::npos) << tiles.output;
+}
+
+const std::vector<std::string> kM3c2Fields{"m3c2_distance", "m3c2_uncertainty", "m3c2_significant", "m3c2_n1",
+                                           "m3c2_n2",       "m3c2_std1",        "m3c2_std2",        "m3c2_normal_scale"};
+
+TEST_F(ScaleOut, CloudToMeshSignedWidensAroundTheMeshHole)
+{
+    expectSameAsCli("c2m", "--reference " + file("mesh.ply") + " --compared " + file("compared.ply"), "--signed",
+                    "--tile-size 10 --chunk-points 5000", {"c2m_distance"});
+    // The hole of the mesh is metres wide, the default halo 1 m.
+    EXPECT_EQ(lastReport_.find(" 0 points widened"), std::string::npos) << lastReport_;
+}
+
+TEST_F(ScaleOut, CloudToMeshWithinAClampedMaximumDistance)
+{
+    expectSameAsCli("c2m", "--reference " + file("mesh.ply") + " --compared " + file("compared.ply"), "--max-dist 0.3 --clamp",
+                    "--tile-size 7", {"c2m_distance"});
+}
+
+TEST_F(ScaleOut, M3c2AtCorePointsAcrossTileBordersAndTheHole)
+{
+    // Tiles of 10 m cut through the raised block and the reference's hole
+    // (core points at its rim see a one-sided neighbourhood).
+    expectSameAsCli("m3c2",
+                    "--reference " + file("reference.ply") + " --compared " + file("compared.ply") + " --core-points " +
+                        file("cores.ply"),
+                    "--normal-scale 1 --normal-scales 0.6,1.2,2 --projection-scale 2 --max-depth 1", "--tile-size 10",
+                    kM3c2Fields);
+}
+
+TEST_F(ScaleOut, M3c2OnEveryReferencePointRobustTowardsTheCentroid)
+{
+    expectSameAsCli("m3c2", "--reference " + file("reference.ply") + " --compared " + file("compared.ply"),
+                    "--normal-scale 1.5 --projection-scale 2 --max-depth 0.8 --min-points 4 --robust --orientation -centroid",
+                    "--tile-size 12 --chunk-points 4000", kM3c2Fields);
+}
+
+TEST_F(ScaleOut, M3c2AndC2mBadOptionsGiveTheCliErrors)
+{
+    const std::string m3c2 = " m3c2 --reference " + file("reference.ply") + " --compared " + file("compared.ply");
+    const std::string c2m = " c2m --reference " + file("mesh.ply") + " --compared " + file("compared.ply");
+    for (const std::string& bad : {m3c2 + " --projection-scale 1 --max-depth 1", // no normal scale
+                                   m3c2 + " --normal-scale 1 --projection-scale 1 --max-depth 1 --orientation mst",
+                                   m3c2 + " --normal-scale 1 --normal-scales 1,x --projection-scale 1 --max-depth 1",
+                                   c2m + " --clamp", c2m + " --octree-level 40",
+                                   " c2m --reference " + file("nothing.ply") + " --compared " + file("compared.ply")}) {
+        const CommandOutcome cli = run(std::string(SCANDIFF_CLI_PATH) + bad);
+        const CommandOutcome mpi = run(mpirun(2) + bad);
+        EXPECT_NE(cli.status, 0) << bad;
+        EXPECT_EQ(mpi.status, cli.status) << bad << "\n" << mpi.output;
+        EXPECT_NE(mpi.output.find(cli.output), std::string::npos) << bad << "\ncli: " << cli.output << "\nmpi: " << mpi.output;
+    }
+    // A halo shorter than M3C2's search could only give other values: refused.
+    const CommandOutcome shortHalo = run(mpirun(1) + m3c2 + " --normal-scale 2 --projection-scale 1 --max-depth 1 --halo 0.5");
+    EXPECT_NE(shortHalo.status, 0);
+    EXPECT_NE(shortHalo.output.find("--halo 0.5 is shorter than M3C2's search (1.11803 m"), std::string::npos) << shortHalo.output;
 }
 
 } // namespace
