@@ -62,6 +62,28 @@ public:
         return distances[k - 1];
     }
 
+    //! Every rank's representatives, the same on every rank (rank order, up
+    //! to perTile per tile).
+    void mergeOverRanks(const Communicator& c)
+    {
+        struct Entry
+        {
+            std::int64_t x, y;
+            double p[3];
+        };
+        std::vector<Entry> mine;
+        for (const auto& [key, list] : byTile_)
+            for (const Eigen::Vector3d& q : list)
+                mine.push_back({key.x, key.y, {q.x(), q.y(), q.z()}});
+        byTile_.clear();
+        last_ = nullptr;
+        for (const Entry& e : allGather(c, mine)) {
+            std::vector<Eigen::Vector3d>& list = byTile_[{e.x, e.y}];
+            if (list.size() < perTile_)
+                list.emplace_back(e.p[0], e.p[1], e.p[2]);
+        }
+    }
+
 private:
     TileGrid grid_;
     std::size_t perTile_;
@@ -107,10 +129,9 @@ public:
         owned_ = collectOwnedPoints(c_, compared_, grid_);
         report_.tiles = owned_.tiles.size();
         report_.points = owned_.index.size();
-        const HaloRegion region(grid_, owned_.tiles, halo_);
         Representatives representatives(grid_, std::min<std::size_t>(pointsNeeded(params_), 64));
         memoryNote("compared collected");
-        ReferencePart part = collectReference(region, &representatives);
+        ReferencePart part = collectReference(representatives);
         memoryNote("reference collected");
         report_.held = part.positions.size();
         report_.heldInTiles = part.inOwnTiles;
@@ -125,6 +146,7 @@ public:
             cli::printStatistics(out, "c2c " + std::string(localModelName(params_.model)) + " (compared -> reference)", statistics);
         reportRanks(c_, report_, {"c2c", "compared points", "reference points"}, grid_.size(), halo_,
                     compared_.streamed() && reference_.streamed(), out);
+        memoryNote("reported");
         if (!job_.output.empty())
             writeOutput(out);
         if (c_.rank() == 0)
@@ -159,18 +181,24 @@ private:
         return part;
     }
 
-    ReferencePart collectReference(const HaloRegion& region, Representatives* representatives)
+    //! The reference read once across the ranks, each point sent to every
+    //! rank whose halo holds it; the representatives from every rank's share.
+    ReferencePart collectReference(Representatives& representatives)
     {
-        std::uint64_t inOwn = 0;
-        ReferencePart part = streamReference(
-            [&](const Eigen::Vector3d& p) {
-                if (!region.contains(p.x(), p.y()))
-                    return false;
-                inOwn += region.owns(grid_.tileOf(p.x(), p.y()));
-                return true;
-            },
-            representatives);
-        part.inOwnTiles = inOwn;
+        const RegionRouter router(grid_, owned_.owners, c_.size(), halo_);
+        ReceivedPoints received =
+            distributePoints(c_, reference_, {needNormals_, false, 0}, router,
+                             [&](const Eigen::Vector3d& p) { representatives.offer(p); });
+        representatives.mergeOverRanks(c_);
+        totalReference_ = received.chunkStarts.back();
+        ReferencePart part;
+        const HaloRegion own(grid_, owned_.tiles, 0.0);
+        for (const Eigen::Vector3f& q : received.positions) {
+            const Eigen::Vector3d p = reference_.origin() + q.cast<double>();
+            part.inOwnTiles += own.owns(grid_.tileOf(p.x(), p.y()));
+        }
+        part.positions = std::move(received.positions);
+        part.normals = std::move(received.normals);
         return part;
     }
 

@@ -31,27 +31,25 @@ double searchReach(const M3c2Params& params)
     return std::max(normal, std::hypot(params.projectionScale / 2, params.maxDepth));
 }
 
-//! One epoch's points within the region, streamed from the file (positions only).
+//! One epoch's points within a rank's region, read once across the ranks.
 struct EpochPart
 {
     std::vector<Eigen::Vector3f> positions;
     std::uint64_t inOwnTiles = 0, total = 0;
 };
 
-EpochPart collectEpoch(const ChunkedCloud& epoch, const TileGrid& grid, const HaloRegion& region)
+EpochPart collectEpoch(const Communicator& c, const ChunkedCloud& epoch, const TileGrid& grid, const RegionRouter& router,
+                       const std::vector<TileKey>& ownTiles)
 {
+    ReceivedPoints received = distributePoints(c, epoch, {}, router);
     EpochPart part;
-    for (std::size_t k = 0; k < epoch.chunkCount(); ++k) {
-        const PointCloud chunk = epoch.read(k, true);
-        part.total += chunk.size();
-        for (std::size_t i = 0; i < chunk.size(); ++i) {
-            const Eigen::Vector3d p = chunk.globalPosition(i);
-            if (!region.contains(p.x(), p.y()))
-                continue;
-            part.positions.push_back(chunk.positions()[i]);
-            part.inOwnTiles += region.owns(grid.tileOf(p.x(), p.y()));
-        }
+    part.total = received.chunkStarts.back();
+    const HaloRegion own(grid, ownTiles, 0.0);
+    for (const Eigen::Vector3f& q : received.positions) {
+        const Eigen::Vector3d p = epoch.origin() + q.cast<double>();
+        part.inOwnTiles += own.owns(grid.tileOf(p.x(), p.y()));
     }
+    part.positions = std::move(received.positions);
     return part;
 }
 
@@ -96,14 +94,15 @@ public:
         report_.points = owned_.index.size();
         orientTowardsTheWholeCentroid();
         // Every point within the search reach is held, whatever the rounding:
-        // the halo grows by the margin of the largest coordinate met.
+        // the halo grows by the margin of the largest coordinate of a core point.
         const Eigen::Vector3d shift = cores_.origin() - reference_.origin();
         double magnitude = 0;
         for (const Eigen::Vector3f& p : owned_.positions)
             magnitude = std::max(magnitude, (shift + p.cast<double>()).cwiseAbs().maxCoeff());
-        const HaloRegion region(grid_, owned_.tiles, halo_ + roundingMargin(magnitude + reach_, reach_));
-        EpochPart reference = collectEpoch(reference_, grid_, region);
-        EpochPart compared = collectEpoch(compared_, grid_, region);
+        MPI_Allreduce(MPI_IN_PLACE, &magnitude, 1, MPI_DOUBLE, MPI_MAX, c_.comm);
+        const RegionRouter router(grid_, owned_.owners, c_.size(), halo_ + roundingMargin(magnitude + reach_, reach_));
+        EpochPart reference = collectEpoch(c_, reference_, grid_, router, owned_.tiles);
+        EpochPart compared = collectEpoch(c_, compared_, grid_, router, owned_.tiles);
         if (reference.total == 0 || compared.total == 0)
             throw Error(ErrorCode::InvalidData, std::string("m3c2: the ") + (reference.total == 0 ? "reference" : "compared") +
                                                     " cloud '" +

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -34,7 +35,8 @@ void memoryNote(const char* what)
         if (line.rfind("VmHWM", 0) == 0 || line.rfind("VmRSS", 0) == 0 || line.rfind("RssFile", 0) == 0 ||
             line.rfind("RssAnon", 0) == 0)
             out += " " + line;
-    std::cerr << what << ":" << out << std::endl;
+    static const auto start = Clock::now();
+    std::cerr << what << " at " << std::chrono::duration<double>(Clock::now() - start).count() << " s:" << out << std::endl;
 }
 
 double roundingMargin(double localMagnitude, double reach)
@@ -89,32 +91,172 @@ OwnedPoints collectOwnedPoints(const Communicator& c, const ChunkedCloud& cloud,
 {
     const std::map<TileKey, std::uint64_t> counts = countTilePoints(c, cloud, grid);
     OwnedPoints owned;
-    std::uint64_t expected = 0;
-    for (const auto& [key, rank] : assignTiles(counts, c.size()))
-        if (rank == c.rank()) {
+    owned.owners = assignTiles(counts, c.size());
+    std::unordered_map<TileKey, int, TileKeyHash> owner(owned.owners.begin(), owned.owners.end());
+    for (const auto& [key, rank] : owned.owners)
+        if (rank == c.rank())
             owned.tiles.push_back(key);
-            expected += counts.at(key);
-        }
     memoryNote("counted");
-    // Pass 2: this rank's points, positions and input indices.
-    const HaloRegion region(grid, owned.tiles, 0.0);
-    owned.positions.reserve(static_cast<std::size_t>(expected));
-    owned.index.reserve(static_cast<std::size_t>(expected));
-    std::uint64_t index = 0;
-    for (std::size_t k = 0; k < cloud.chunkCount(); ++k) {
-        owned.chunkStarts.push_back(index);
-        const PointCloud chunk = cloud.read(k, true);
+    // Pass 2: every point to its tile's rank.
+    DistributeOptions options;
+    options.withIndex = true;
+    for (const TileKey& key : owned.tiles)
+        options.expected += static_cast<std::size_t>(counts.at(key));
+    ReceivedPoints mine = distributePoints(c, cloud, options, [&](const Eigen::Vector3d& p, std::vector<int>& ranks) {
+        ranks.push_back(owner.at(grid.tileOf(p.x(), p.y())));
+    });
+    owned.positions = std::move(mine.positions);
+    owned.index = std::move(mine.index);
+    owned.chunkStarts = std::move(mine.chunkStarts);
+    return owned;
+}
+
+ReceivedPoints distributePoints(const Communicator& c, const ChunkedCloud& cloud, const DistributeOptions& options,
+                                const Destinations& destinations, const std::function<void(const Eigen::Vector3d&)>& seen)
+{
+    // A record: position, then the normal and the input index when asked.
+    const std::size_t recordFloats = 3 + (options.withNormals ? 3 : 0) + (options.withIndex ? 2 : 0);
+    const auto ranks = static_cast<std::size_t>(c.size());
+    ReceivedPoints received;
+    received.positions.reserve(options.expected);
+    if (options.withIndex)
+        received.index.reserve(options.expected);
+    std::uint64_t base = 0;
+    std::vector<int> targets, sendCounts(ranks), sendOffsets(ranks), receiveCounts(ranks), receiveOffsets(ranks);
+    std::vector<std::uint32_t> destinationsOf; // every point's targets, flattened, for the second pass
+    std::vector<std::uint32_t> targetCounts;
+    std::vector<float> sendBuffer, receiveBuffer;
+    for (std::size_t round = 0; round * ranks < cloud.chunkCount(); ++round) {
+        const std::size_t chunkIndex = round * ranks + static_cast<std::size_t>(c.rank());
+        const PointCloud chunk = chunkIndex < cloud.chunkCount() ? cloud.read(chunkIndex, true) : PointCloud();
+        // The round's chunk sizes give every point its input index.
+        const std::vector<std::uint64_t> sizes = allGather(c, std::vector<std::uint64_t>{chunk.size()});
+        std::uint64_t first = base;
+        for (std::size_t r = 0; r < ranks; ++r) {
+            if (round * ranks + r < cloud.chunkCount())
+                received.chunkStarts.push_back(base);
+            if (r < static_cast<std::size_t>(c.rank()))
+                first += sizes[r];
+            base += sizes[r];
+        }
+        // Where each point goes, counted per rank; then the records written
+        // straight at their rank's place in one send buffer.
+        std::fill(sendCounts.begin(), sendCounts.end(), 0);
+        destinationsOf.clear();
+        targetCounts.assign(chunk.size(), 0);
         for (std::size_t i = 0; i < chunk.size(); ++i) {
             const Eigen::Vector3d p = chunk.globalPosition(i);
-            if (region.owns(grid.tileOf(p.x(), p.y()))) {
-                owned.positions.push_back(chunk.positions()[i]);
-                owned.index.push_back(index + i);
+            if (seen)
+                seen(p);
+            targets.clear();
+            destinations(p, targets);
+            targetCounts[i] = static_cast<std::uint32_t>(targets.size());
+            for (const int r : targets) {
+                destinationsOf.push_back(static_cast<std::uint32_t>(r));
+                ++sendCounts[static_cast<std::size_t>(r)];
             }
         }
-        index += chunk.size();
+        std::vector<std::size_t> place(ranks, 0);
+        for (std::size_t r = 1; r < ranks; ++r)
+            place[r] = place[r - 1] + static_cast<std::size_t>(sendCounts[r - 1]) * recordFloats;
+        const std::size_t sendFloats = place.back() + static_cast<std::size_t>(sendCounts.back()) * recordFloats;
+        for (std::size_t r = 0; r < ranks; ++r) {
+            sendOffsets[r] = static_cast<int>(place[r] * sizeof(float));
+            sendCounts[r] = static_cast<int>(static_cast<std::size_t>(sendCounts[r]) * recordFloats * sizeof(float));
+        }
+        sendBuffer.resize(sendFloats);
+        const bool normals = options.withNormals && chunk.hasNormals();
+        std::size_t next = 0;
+        for (std::size_t i = 0; i < chunk.size(); ++i)
+            for (std::uint32_t t = 0; t < targetCounts[i]; ++t) {
+                float* record = sendBuffer.data() + place[destinationsOf[next++]];
+                place[destinationsOf[next - 1]] += recordFloats;
+                std::copy(chunk.positions()[i].data(), chunk.positions()[i].data() + 3, record);
+                float* rest = record + 3;
+                if (options.withNormals) {
+                    if (normals)
+                        std::copy(chunk.normals()[i].data(), chunk.normals()[i].data() + 3, rest);
+                    else
+                        rest[0] = std::numeric_limits<float>::quiet_NaN(); // no normal
+                    rest += 3;
+                }
+                if (options.withIndex) {
+                    const std::uint64_t index = first + i;
+                    std::memcpy(rest, &index, sizeof index);
+                }
+            }
+        MPI_Alltoall(sendCounts.data(), 1, MPI_INT, receiveCounts.data(), 1, MPI_INT, c.comm);
+        std::size_t total = 0;
+        for (std::size_t r = 0; r < ranks; ++r) {
+            receiveOffsets[r] = static_cast<int>(total);
+            total += static_cast<std::size_t>(receiveCounts[r]);
+        }
+        receiveBuffer.resize(total / sizeof(float));
+        MPI_Alltoallv(sendBuffer.data(), sendCounts.data(), sendOffsets.data(), MPI_BYTE, receiveBuffer.data(),
+                      receiveCounts.data(), receiveOffsets.data(), MPI_BYTE, c.comm);
+        // Rank s sent chunk qN + s: in rank order, the records are in input order.
+        for (std::size_t at = 0; at < receiveBuffer.size(); at += recordFloats) {
+            const float* record = receiveBuffer.data() + at;
+            received.positions.emplace_back(record[0], record[1], record[2]);
+            const float* rest = record + 3;
+            if (options.withNormals) {
+                if (!std::isnan(rest[0]))
+                    received.normals.emplace_back(rest[0], rest[1], rest[2]);
+                rest += 3;
+            }
+            if (options.withIndex) {
+                std::uint64_t index = 0;
+                std::memcpy(&index, rest, sizeof index);
+                received.index.push_back(index);
+            }
+        }
     }
-    owned.chunkStarts.push_back(index);
-    return owned;
+    received.chunkStarts.push_back(base);
+    // Normals only when every point received has one (a file has them or not).
+    if (received.normals.size() != received.positions.size())
+        received.normals.clear();
+    return received;
+}
+
+RegionRouter::RegionRouter(const TileGrid& grid, const std::map<TileKey, int>& owners, int ranks, double halo)
+    : grid_(grid), owner_(owners.begin(), owners.end()), halo_(halo),
+      reach_(static_cast<std::int64_t>(std::ceil(halo / grid.size())))
+{
+    std::vector<std::vector<TileKey>> tiles(static_cast<std::size_t>(ranks));
+    for (const auto& [key, rank] : owners)
+        tiles[static_cast<std::size_t>(rank)].push_back(key);
+    for (const std::vector<TileKey>& own : tiles)
+        regions_.emplace_back(grid, own, halo);
+}
+
+const std::vector<int>& RegionRouter::candidatesOf(const TileKey& key) const
+{
+    const auto found = candidates_.find(key);
+    if (found != candidates_.end())
+        return found->second;
+    std::vector<int> ranks;
+    for (std::int64_t dx = -reach_; dx <= reach_; ++dx)
+        for (std::int64_t dy = -reach_; dy <= reach_; ++dy) {
+            const auto near = owner_.find({key.x + dx, key.y + dy});
+            if (near != owner_.end() && std::find(ranks.begin(), ranks.end(), near->second) == ranks.end())
+                ranks.push_back(near->second);
+        }
+    std::sort(ranks.begin(), ranks.end());
+    return candidates_.emplace(key, std::move(ranks)).first->second;
+}
+
+void RegionRouter::operator()(const Eigen::Vector3d& world, std::vector<int>& ranks) const
+{
+    const TileKey key = grid_.tileOf(world.x(), world.y());
+    const auto owner = owner_.find(key);
+    // Most points lie deeper than the halo inside their tile: only its rank's.
+    if (owner != owner_.end() && grid_.depthInGrownTile(key, -halo_, world.x(), world.y()) > 0) {
+        ranks.push_back(owner->second);
+        return;
+    }
+    for (const int r : candidatesOf(key))
+        if (regions_[static_cast<std::size_t>(r)].contains(world.x(), world.y()))
+            ranks.push_back(r);
 }
 
 DistanceStatistics statisticsOverRanks(const Communicator& c, const std::vector<float>& values)

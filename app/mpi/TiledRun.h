@@ -16,6 +16,8 @@
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <map>
+#include <unordered_map>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -50,7 +52,8 @@ PointCloud makeCloud(const Eigen::Vector3d& origin, std::vector<Eigen::Vector3f>
 //! The points of the measured cloud this rank owns, and where they sit in the file.
 struct OwnedPoints
 {
-    std::vector<TileKey> tiles;
+    std::map<TileKey, int> owners; //!< every tile's rank
+    std::vector<TileKey> tiles;    //!< this rank's
     std::vector<Eigen::Vector3f> positions;  //!< in the file's frame, in input order
     std::vector<std::uint64_t> index;        //!< their input indices, increasing
     std::vector<std::uint64_t> chunkStarts;  //!< each chunk's first input index, then the total
@@ -61,6 +64,51 @@ struct OwnedPoints
 //! chunks), gives the tiles out by point counts (assignTiles) and reads this
 //! rank's points.
 OwnedPoints collectOwnedPoints(const Communicator& c, const ChunkedCloud& cloud, const TileGrid& grid);
+
+//! Points a rank receives from a file read once across the ranks.
+struct ReceivedPoints
+{
+    std::vector<Eigen::Vector3f> positions, normals; //!< in the file's frame, in input order (normals if asked and present)
+    std::vector<std::uint64_t> index;                //!< their input indices, increasing (if asked)
+    std::vector<std::uint64_t> chunkStarts;          //!< each chunk's first input index, then the file's total
+};
+
+//! Which ranks a point goes to (world coordinates; `ranks` comes cleared).
+using Destinations = std::function<void(const Eigen::Vector3d& world, std::vector<int>& ranks)>;
+
+struct DistributeOptions
+{
+    bool withNormals = false; //!< send the normals (when the file has them)
+    bool withIndex = false;   //!< send the input indices
+    std::size_t expected = 0; //!< points this rank will receive, when known (room made at once)
+};
+
+//! Collective. Reads `cloud` once across the ranks, one round of N chunks at a
+//! time (rank r reads chunk qN + r in round q), and delivers each point to the
+//! ranks `destinations` names (MPI_Alltoallv), so a rank decodes 1/N of the
+//! file and holds one chunk of it in transit. `seen` is called on every point
+//! this rank reads.
+ReceivedPoints distributePoints(const Communicator& c, const ChunkedCloud& cloud, const DistributeOptions& options,
+                                const Destinations& destinations,
+                                const std::function<void(const Eigen::Vector3d&)>& seen = {});
+
+//! The ranks whose halo region holds a point, from every rank's tiles: what a
+//! reference point's destinations are.
+class RegionRouter
+{
+public:
+    RegionRouter(const TileGrid& grid, const std::map<TileKey, int>& owners, int ranks, double halo);
+    void operator()(const Eigen::Vector3d& world, std::vector<int>& ranks) const;
+
+private:
+    const std::vector<int>& candidatesOf(const TileKey& key) const;
+    TileGrid grid_;
+    std::unordered_map<TileKey, int, TileKeyHash> owner_;
+    std::vector<HaloRegion> regions_;
+    double halo_;
+    std::int64_t reach_;
+    mutable std::unordered_map<TileKey, std::vector<int>, TileKeyHash> candidates_;
+};
 
 //! Collective. scandiff-cli's statistics of the non-NaN values, summed over
 //! the ranks (in another order: the last digits of the mean may differ).

@@ -4,6 +4,7 @@
 //! executable so that scandiff-cli and the workbench never need MPI.
 
 #include "Mpi.h"
+#include "TiledRun.h"
 #include "TiledCloudToCloud.h"
 #include "TiledCloudToMesh.h"
 #include "TiledM3c2.h"
@@ -170,6 +171,7 @@ int main(int argc, char** argv)
     // set by the user (mpirun --mca) wins.
     setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0);
     MPI_Init(&argc, &argv);
+    scandiff::mpi::memoryNote("started");
     const scandiff::mpi::Communicator world;
     const int status = run(argc, argv, world);
     MPI_Finalize();
