@@ -149,11 +149,7 @@ public:
         memoryNote("reported");
         if (!job_.output.empty())
             writeOutput(out);
-        if (c_.rank() == 0)
-            out << std::fixed << std::setprecision(3) << std::chrono::duration<double>(Clock::now() - start).count() << " s\n"
-                << std::defaultfloat;
-        memoryNote("done");
-        c_.barrier();
+        finishRun(c_, start, out);
     }
 
 private:

@@ -133,11 +133,7 @@ public:
                     chunk.addField(std::move(distance));
                 },
                 job_.output, job_.write, out);
-        if (c_.rank() == 0)
-            out << std::fixed << std::setprecision(3) << std::chrono::duration<double>(Clock::now() - start).count() << " s\n"
-                << std::defaultfloat;
-        memoryNote("done");
-        c_.barrier();
+        finishRun(c_, start, out);
     }
 
 private:

@@ -125,11 +125,7 @@ public:
                     reference_.streamed() && compared_.streamed() && cores_.streamed(), out);
         if (!job_.output.empty())
             writeOutput(out);
-        if (c_.rank() == 0)
-            out << std::fixed << std::setprecision(3) << std::chrono::duration<double>(Clock::now() - start).count() << " s\n"
-                << std::defaultfloat;
-        memoryNote("done");
-        c_.barrier();
+        finishRun(c_, start, out);
     }
 
 private:

@@ -374,6 +374,15 @@ void reportRanks(const Communicator& c, const RankReport& mine, const ReportWord
         << " (most points on a rank / mean), " << widened << " points widened\n";
 }
 
+void finishRun(const Communicator& c, Clock::time_point start, std::ostream& out)
+{
+    if (c.rank() == 0)
+        out << std::fixed << std::setprecision(3) << std::chrono::duration<double>(Clock::now() - start).count() << " s\n"
+            << std::defaultfloat;
+    memoryNote("done");
+    c.barrier();
+}
+
 void runCollectively(const Communicator& c, const std::function<void()>& body)
 {
     try {

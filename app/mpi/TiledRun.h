@@ -147,6 +147,10 @@ struct ReportWords
 void reportRanks(const Communicator& c, const RankReport& mine, const ReportWords& words, double tileSize, double halo,
                  bool allStreamed, std::ostream& out);
 
+//! Collective. The end of every command: rank 0 prints the wall time since
+//! `start`; the ranks meet before leaving.
+void finishRun(const Communicator& c, Clock::time_point start, std::ostream& out);
+
 //! Runs the collective part of a command: an exception on one rank prints
 //! "error: (rank R) ..." and aborts the job, so no rank waits forever.
 void runCollectively(const Communicator& c, const std::function<void()>& body);

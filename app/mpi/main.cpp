@@ -52,6 +52,33 @@ struct TilingFlags
     }
 };
 
+//! What every subcommand takes beside its computation's options.
+struct Args
+{
+    std::string reference, compared, corePoints, output;
+    std::shared_ptr<std::map<std::string, std::string>> values = std::make_shared<std::map<std::string, std::string>>();
+    int threads = 0;
+    cli::ReadFlags read;
+    cli::WriteFlags write;
+    TilingFlags tiling;
+
+    //! The job of a subcommand from its options, its values resolved
+    //! against its computation's parameters.
+    template <class Job>
+    Job job(const std::vector<ParameterSpec>& parameters, const char* command) const
+    {
+        Job made;
+        made.reference = reference;
+        made.compared = compared;
+        made.output = output;
+        made.values = resolveParameters(parameters, *values, command);
+        made.tiling = tiling.options();
+        made.read = read.toOptions(nullptr);
+        made.write = write.toOptions(nullptr);
+        return made;
+    }
+};
+
 int run(int argc, char** argv, const mpi::Communicator& world)
 {
     io::FormatRegistry formats;
@@ -64,16 +91,6 @@ int run(int argc, char** argv, const mpi::Communicator& world)
     app.require_subcommand(1);
     app.set_version_flag("--version", "scandiff 0.1.0");
 
-    //! What every subcommand takes beside its computation's options.
-    struct Args
-    {
-        std::string reference, compared, corePoints, output;
-        std::shared_ptr<std::map<std::string, std::string>> values = std::make_shared<std::map<std::string, std::string>>();
-        int threads = 0;
-        cli::ReadFlags read;
-        cli::WriteFlags write;
-        TilingFlags tiling;
-    };
     const auto addCommon = [](CLI::App& command, Args& args, const char* what) {
         command.add_option("-o,--output", args.output, std::string("Output: ") + what + " (PLY; written by rank 0)");
         cli::ThreadLimit::addOption(command, args.threads);
@@ -91,14 +108,7 @@ int run(int argc, char** argv, const mpi::Communicator& world)
     addCommon(*c2c, c2cArgs, "the compared cloud with c2c_distance");
     c2c->callback([&] {
         const cli::ThreadLimit threadLimit(c2cArgs.threads);
-        mpi::CloudToCloudJob job;
-        job.reference = c2cArgs.reference;
-        job.compared = c2cArgs.compared;
-        job.output = c2cArgs.output;
-        job.values = resolveParameters(cloudToCloudParameters(), *c2cArgs.values, "c2c");
-        job.tiling = c2cArgs.tiling.options();
-        job.read = c2cArgs.read.toOptions(nullptr);
-        job.write = c2cArgs.write.toOptions(nullptr);
+        auto job = c2cArgs.job<mpi::CloudToCloudJob>(cloudToCloudParameters(), "c2c");
         mpi::runTiledCloudToCloud(world, formats, job, out);
     });
 
@@ -111,14 +121,7 @@ int run(int argc, char** argv, const mpi::Communicator& world)
     addCommon(*c2m, c2mArgs, "the compared cloud with c2m_distance");
     c2m->callback([&] {
         const cli::ThreadLimit threadLimit(c2mArgs.threads);
-        mpi::CloudToMeshJob job;
-        job.reference = c2mArgs.reference;
-        job.compared = c2mArgs.compared;
-        job.output = c2mArgs.output;
-        job.values = resolveParameters(cloudToMeshParameters(), *c2mArgs.values, "c2m");
-        job.tiling = c2mArgs.tiling.options();
-        job.read = c2mArgs.read.toOptions(nullptr);
-        job.write = c2mArgs.write.toOptions(nullptr);
+        auto job = c2mArgs.job<mpi::CloudToMeshJob>(cloudToMeshParameters(), "c2m");
         mpi::runTiledCloudToMesh(world, formats, job, out);
     });
 
@@ -131,15 +134,8 @@ int run(int argc, char** argv, const mpi::Communicator& world)
     addCommon(*m3c2, m3c2Args, "the core points with their normals and the m3c2_* fields");
     m3c2->callback([&] {
         const cli::ThreadLimit threadLimit(m3c2Args.threads);
-        mpi::M3c2Job job;
-        job.reference = m3c2Args.reference;
-        job.compared = m3c2Args.compared;
+        auto job = m3c2Args.job<mpi::M3c2Job>(m3c2Parameters(), "m3c2");
         job.corePoints = m3c2Args.corePoints;
-        job.output = m3c2Args.output;
-        job.values = resolveParameters(m3c2Parameters(), *m3c2Args.values, "m3c2");
-        job.tiling = m3c2Args.tiling.options();
-        job.read = m3c2Args.read.toOptions(nullptr);
-        job.write = m3c2Args.write.toOptions(nullptr);
         mpi::runTiledM3c2(world, formats, job, out);
     });
 
