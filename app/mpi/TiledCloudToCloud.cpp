@@ -14,10 +14,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <iomanip>
-#include <iostream>
-#include <fstream>
-#include <cstdlib>
 #include <limits>
 #include <unordered_map>
 
@@ -153,27 +149,22 @@ public:
     }
 
 private:
-    //! The reference points `keep` accepts, streamed from the file.
+    //! The reference points `keep` accepts, streamed from the file (this rank
+    //! alone: the points it widens).
     template <class Keep>
-    ReferencePart streamReference(Keep&& keep, Representatives* representatives)
+    ReferencePart streamReference(Keep&& keep)
     {
         ReferencePart part;
-        std::uint64_t total = 0;
         for (std::size_t k = 0; k < reference_.chunkCount(); ++k) {
             const PointCloud chunk = reference_.read(k, true);
-            total += chunk.size();
             for (std::size_t i = 0; i < chunk.size(); ++i) {
-                const Eigen::Vector3d p = chunk.globalPosition(i);
-                if (representatives)
-                    representatives->offer(p);
-                if (!keep(p))
+                if (!keep(chunk.globalPosition(i)))
                     continue;
                 part.positions.push_back(chunk.positions()[i]);
                 if (needNormals_ && chunk.hasNormals())
                     part.normals.push_back(chunk.normals()[i]);
             }
         }
-        totalReference_ = total;
         return part;
     }
 
@@ -188,11 +179,7 @@ private:
         representatives.mergeOverRanks(c_);
         totalReference_ = received.chunkStarts.back();
         ReferencePart part;
-        const HaloRegion own(grid_, owned_.tiles, 0.0);
-        for (const Eigen::Vector3f& q : received.positions) {
-            const Eigen::Vector3d p = reference_.origin() + q.cast<double>();
-            part.inOwnTiles += own.owns(grid_.tileOf(p.x(), p.y()));
-        }
+        part.inOwnTiles = countInTiles(received.positions, reference_.origin(), grid_, owned_.tiles);
         part.positions = std::move(received.positions);
         part.normals = std::move(received.normals);
         return part;
@@ -251,37 +238,14 @@ private:
         }
         while (!pending_.empty()) {
             ++report_.widenings;
-            const bool all = std::any_of(pending_.begin(), pending_.end(), [](const Pending& w) { return !std::isfinite(w.radius); });
-            // Pending points by cells as large as the largest radius: a reference
-            // point then only looks at the 3 x 3 cells around it.
-            double largest = 0;
-            for (const Pending& w : pending_)
-                largest = std::max(largest, w.radius);
-            const TileGrid cells(std::max(largest, grid_.size()));
-            std::unordered_map<TileKey, std::vector<std::size_t>, TileKeyHash> byCell;
-            std::vector<Eigen::Vector3d> centres(pending_.size());
-            for (std::size_t m = 0; m < pending_.size(); ++m) {
-                centres[m] = comparedCloud_.globalPosition(pending_[m].index);
-                byCell[cells.tileOf(centres[m].x(), centres[m].y())].push_back(m);
+            std::vector<Eigen::Vector2d> centres;
+            std::vector<double> radii;
+            for (const Pending& w : pending_) {
+                centres.push_back(comparedCloud_.globalPosition(w.index).head<2>());
+                radii.push_back(w.radius);
             }
-            ReferencePart part = streamReference(
-                [&](const Eigen::Vector3d& q) {
-                    if (all)
-                        return true;
-                    const TileKey cell = cells.tileOf(q.x(), q.y());
-                    for (std::int64_t dx = -1; dx <= 1; ++dx)
-                        for (std::int64_t dy = -1; dy <= 1; ++dy) {
-                            const auto found = byCell.find({cell.x + dx, cell.y + dy});
-                            if (found == byCell.end())
-                                continue;
-                            for (const std::size_t m : found->second)
-                                if (std::abs(q.x() - centres[m].x()) <= pending_[m].radius &&
-                                    std::abs(q.y() - centres[m].y()) <= pending_[m].radius)
-                                    return true;
-                        }
-                    return false;
-                },
-                nullptr);
+            const ReachIndex reach(std::move(centres), std::move(radii), grid_.size());
+            ReferencePart part = streamReference([&](const Eigen::Vector3d& q) { return reach.touches(q.head<2>(), q.head<2>()); });
             const bool wholeReference = part.positions.size() == totalReference_;
             std::vector<Eigen::Vector3f> queries;
             for (const Pending& w : pending_)

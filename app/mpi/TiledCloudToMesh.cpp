@@ -12,9 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <limits>
-#include <unordered_map>
 
 namespace scandiff::mpi {
 
@@ -199,40 +197,17 @@ private:
             return;
         report_.widenings = 1;
         const Mesh whole = readCheckedMesh(formats_, job_.reference);
-        bool all = false;
-        double largest = 0;
-        std::vector<Eigen::Vector3d> centres(pending_.size());
-        for (std::size_t m = 0; m < pending_.size(); ++m) {
-            Pending& w = pending_[m];
+        std::vector<Eigen::Vector2d> centres;
+        std::vector<double> radii;
+        for (Pending& w : pending_) {
             w.radius += margin(w.index, w.radius);
-            all = all || !std::isfinite(w.radius);
-            largest = std::max(largest, w.radius);
-            centres[m] = comparedCloud_.globalPosition(w.index);
+            centres.push_back(comparedCloud_.globalPosition(w.index).head<2>());
+            radii.push_back(w.radius);
         }
-        // Pending points by cells as large as the largest radius: a triangle
-        // looks at the cells its box spans, and one around.
-        const TileGrid cells(all ? 1.0 : std::max(largest, grid_.size()));
-        std::unordered_map<TileKey, std::vector<std::size_t>, TileKeyHash> byCell;
-        for (std::size_t m = 0; m < pending_.size(); ++m)
-            byCell[cells.tileOf(centres[m].x(), centres[m].y())].push_back(m);
+        const ReachIndex reach(std::move(centres), std::move(radii), grid_.size());
         const Mesh part = partOf(whole, [&](const Triangle& t) {
-            if (all)
-                return true;
             const auto [lo, hi] = worldBox(whole, t);
-            const TileKey first = cells.tileOf(lo.x(), lo.y()), last = cells.tileOf(hi.x(), hi.y());
-            for (std::int64_t x = first.x - 1; x <= last.x + 1; ++x)
-                for (std::int64_t y = first.y - 1; y <= last.y + 1; ++y) {
-                    const auto found = byCell.find({x, y});
-                    if (found == byCell.end())
-                        continue;
-                    for (const std::size_t m : found->second) {
-                        const double r = pending_[m].radius;
-                        if (lo.x() <= centres[m].x() + r && hi.x() >= centres[m].x() - r && lo.y() <= centres[m].y() + r &&
-                            hi.y() >= centres[m].y() - r)
-                            return true;
-                    }
-                }
-            return false;
+            return reach.touches(lo, hi);
         });
         std::vector<Eigen::Vector3f> queries;
         for (const Pending& w : pending_)

@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <limits>
 #include <sstream>
 
@@ -44,11 +43,7 @@ EpochPart collectEpoch(const Communicator& c, const ChunkedCloud& epoch, const T
     ReceivedPoints received = distributePoints(c, epoch, {}, router);
     EpochPart part;
     part.total = received.chunkStarts.back();
-    const HaloRegion own(grid, ownTiles, 0.0);
-    for (const Eigen::Vector3f& q : received.positions) {
-        const Eigen::Vector3d p = epoch.origin() + q.cast<double>();
-        part.inOwnTiles += own.owns(grid.tileOf(p.x(), p.y()));
-    }
+    part.inOwnTiles = countInTiles(received.positions, epoch.origin(), grid, ownTiles);
     part.positions = std::move(received.positions);
     return part;
 }

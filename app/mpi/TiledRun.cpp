@@ -218,6 +218,18 @@ ReceivedPoints distributePoints(const Communicator& c, const ChunkedCloud& cloud
     return received;
 }
 
+std::uint64_t countInTiles(const std::vector<Eigen::Vector3f>& positions, const Eigen::Vector3d& origin, const TileGrid& grid,
+                           const std::vector<TileKey>& tiles)
+{
+    const HaloRegion own(grid, tiles, 0.0);
+    std::uint64_t count = 0;
+    for (const Eigen::Vector3f& q : positions) {
+        const Eigen::Vector3d p = origin + q.cast<double>();
+        count += own.owns(grid.tileOf(p.x(), p.y()));
+    }
+    return count;
+}
+
 RegionRouter::RegionRouter(const TileGrid& grid, const std::map<TileKey, int>& owners, int ranks, double halo)
     : grid_(grid), owner_(owners.begin(), owners.end()), halo_(halo),
       reach_(static_cast<std::int64_t>(std::ceil(halo / grid.size())))

@@ -92,6 +92,11 @@ ReceivedPoints distributePoints(const Communicator& c, const ChunkedCloud& cloud
                                 const Destinations& destinations,
                                 const std::function<void(const Eigen::Vector3d&)>& seen = {});
 
+//! How many of `positions` (in the frame of `origin`) lie in `tiles`: the
+//! report's points held in a rank's own tiles.
+std::uint64_t countInTiles(const std::vector<Eigen::Vector3f>& positions, const Eigen::Vector3d& origin, const TileGrid& grid,
+                           const std::vector<TileKey>& tiles);
+
 //! The ranks whose halo region holds a point, from every rank's tiles: what a
 //! reference point's destinations are.
 class RegionRouter

@@ -103,4 +103,49 @@ bool HaloRegion::intersects(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi
     return false;
 }
 
+namespace {
+
+double largestFinite(const std::vector<double>& values, double floor)
+{
+    double largest = floor;
+    for (const double v : values)
+        if (std::isfinite(v))
+            largest = std::max(largest, v);
+    return largest;
+}
+
+} // namespace
+
+ReachIndex::ReachIndex(std::vector<Eigen::Vector2d> centres, std::vector<double> halfSides, double minimumCell)
+    : centres_(std::move(centres)), halfSides_(std::move(halfSides)),
+      everywhere_(std::any_of(halfSides_.begin(), halfSides_.end(), [](double r) { return !std::isfinite(r); })),
+      cells_(largestFinite(halfSides_, minimumCell))
+{
+    if (everywhere_)
+        return;
+    for (std::size_t m = 0; m < centres_.size(); ++m)
+        byCell_[cells_.tileOf(centres_[m].x(), centres_[m].y())].push_back(m);
+}
+
+bool ReachIndex::touches(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const
+{
+    if (everywhere_)
+        return true;
+    // A square reaches at most one cell beyond its own.
+    const TileKey first = cells_.tileOf(lo.x(), lo.y()), last = cells_.tileOf(hi.x(), hi.y());
+    for (std::int64_t x = first.x - 1; x <= last.x + 1; ++x)
+        for (std::int64_t y = first.y - 1; y <= last.y + 1; ++y) {
+            const auto found = byCell_.find({x, y});
+            if (found == byCell_.end())
+                continue;
+            for (const std::size_t m : found->second) {
+                const Eigen::Vector2d& c = centres_[m];
+                const double r = halfSides_[m];
+                if (lo.x() <= c.x() + r && hi.x() >= c.x() - r && lo.y() <= c.y() + r && hi.y() >= c.y() - r)
+                    return true;
+            }
+        }
+    return false;
+}
+
 } // namespace scandiff::mpi

@@ -13,6 +13,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <unordered_map>
 #include <unordered_set>
 #include <utility>
 #include <vector>
@@ -83,6 +84,25 @@ private:
     std::int64_t reach_; //!< tiles a halo spans beyond a tile's edge
     mutable TileKey lastKey_{std::numeric_limits<std::int64_t>::min(), 0};
     mutable Status lastStatus_ = Far;
+};
+
+//! Squares of the XY plane, each a centre and a half-side (the reach of a
+//! point whose search must be widened), indexed by cells as large as the
+//! largest: which of them an XY box touches, looking only at the cells the box
+//! spans and one around. An infinite half-side reaches everywhere.
+class ReachIndex
+{
+public:
+    ReachIndex(std::vector<Eigen::Vector2d> centres, std::vector<double> halfSides, double minimumCell);
+    //! Whether the box [lo, hi] (a point when lo = hi) touches one of the squares.
+    bool touches(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const;
+
+private:
+    std::vector<Eigen::Vector2d> centres_;
+    std::vector<double> halfSides_;
+    bool everywhere_ = false;
+    TileGrid cells_;
+    std::unordered_map<TileKey, std::vector<std::size_t>, TileKeyHash> byCell_;
 };
 
 } // namespace scandiff::mpi

@@ -7,6 +7,7 @@
 //! Under `make sanitize` the same test runs with AddressSanitizer and
 //! UndefinedBehaviorSanitizer.
 
+#include "BuiltinFormats.h"
 #include "TestSupport.h"
 
 #include <scandiff/core/Error.h>
@@ -22,13 +23,6 @@ using namespace scandiff;
 namespace fs = std::filesystem;
 
 namespace {
-
-io::FormatRegistry formats()
-{
-    io::FormatRegistry registry;
-    io::registerBuiltinFormats(registry);
-    return registry;
-}
 
 //! Reads `file` as a file of extension `extension` (corpus files are named by
 //! their hash): a copy with that extension in the test's folder.
@@ -61,7 +55,7 @@ void readOrRefuse(const io::FormatRegistry& registry, const fs::path& file, cons
 
 TEST(FuzzCorpus, EveryFileIsReadOrRefusedCleanly)
 {
-    const io::FormatRegistry registry = formats();
+    const io::FormatRegistry registry = test::builtinFormats();
     const fs::path scratch = test::tempDir();
     std::set<std::string> extensions;
     std::size_t files = 0;
@@ -84,7 +78,7 @@ TEST(FuzzCorpus, EveryFileIsReadOrRefusedCleanly)
 
 TEST(FuzzCorpus, EveryReproducerIsRefusedOrReadCleanly)
 {
-    const io::FormatRegistry registry = formats();
+    const io::FormatRegistry registry = test::builtinFormats();
     const fs::path scratch = test::tempDir();
     std::size_t files = 0;
     for (const auto& entry : fs::directory_iterator(test::dataPath("fuzz-found")))

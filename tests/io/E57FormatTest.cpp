@@ -12,6 +12,8 @@
 
 #include "../support/TestSupport.h"
 
+#include "BuiltinFormats.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -27,13 +29,6 @@ using namespace scandiff;
 using namespace scandiff::test;
 
 const fs::path kE57Dir = fs::path(SCANDIFF_SAMPLE_DATA_DIR) / "e57";
-
-io::FormatRegistry formats()
-{
-    io::FormatRegistry registry;
-    io::registerBuiltinFormats(registry);
-    return registry;
-}
 
 std::string errorOf(const std::function<void()>& f)
 {
@@ -96,7 +91,7 @@ TEST(E57Format, ReadsTheReferenceBunnyWithinItsDeclaredBounds)
 
 TEST(E57Format, ReadsFloatCoordinatesAndColoursOfTheCube)
 {
-    const PointCloud cube = io::readPointCloud(formats(), kE57Dir / "ColouredCubeFloat.e57");
+    const PointCloud cube = io::readPointCloud(builtinFormats(), kE57Dir / "ColouredCubeFloat.e57");
     ASSERT_EQ(cube.size(), 7680u);
     ASSERT_TRUE(cube.hasColors());
     std::size_t onFace = 0, coloured = 0;
@@ -113,7 +108,7 @@ TEST(E57Format, DecodesBitPackedScaledIntegersAndColourLimits)
 {
     // las2e57's file: coordinates as 10-bit scaled integers (millimetres in
     // -0.5..0.5), 16-bit colours, 1-bit return fields, a LAS extension field.
-    const PointCloud cloud = io::readPointCloud(formats(), kE57Dir / "ColourRepresentation.e57");
+    const PointCloud cloud = io::readPointCloud(builtinFormats(), kE57Dir / "ColourRepresentation.e57");
     ASSERT_EQ(cloud.size(), 153u);
     for (std::size_t i = 0; i < cloud.size(); ++i)
         for (int k = 0; k < 3; ++k) {
@@ -148,7 +143,7 @@ TEST(E57Format, ListsAndExtractsImages)
         EXPECT_EQ(static_cast<unsigned char>(jpeg[1]), 0xD8);
     }
     // A file of images only is not a cloud: a clear error rather than an empty one.
-    EXPECT_NE(errorOf([&] { io::readFile(formats(), kE57Dir / "PinholeImageWithDistortionParameters.e57"); }).find("no 3D scan"),
+    EXPECT_NE(errorOf([&] { io::readFile(builtinFormats(), kE57Dir / "PinholeImageWithDistortionParameters.e57"); }).find("no 3D scan"),
               std::string::npos);
 }
 
@@ -157,9 +152,9 @@ TEST(E57Format, EmptyAndBrokenSamplesGiveClearAnswers)
     const std::vector<PointCloud> zero = io::readE57Scans(kE57Dir / "ZeroPoints.e57");
     ASSERT_EQ(zero.size(), 1u);
     EXPECT_EQ(zero.front().size(), 0u);
-    EXPECT_NE(errorOf([&] { io::readFile(formats(), kE57Dir / "empty.e57"); }).find("holds no 3D scan"), std::string::npos);
-    EXPECT_NE(errorOf([&] { io::readFile(formats(), kE57Dir / "bad-crc.e57"); }).find("checksum of page 0"), std::string::npos);
-    EXPECT_NE(errorOf([&] { io::readFile(formats(), kE57Dir / "InvalidCVHeader.e57"); }).find("not a compressed vector"),
+    EXPECT_NE(errorOf([&] { io::readFile(builtinFormats(), kE57Dir / "empty.e57"); }).find("holds no 3D scan"), std::string::npos);
+    EXPECT_NE(errorOf([&] { io::readFile(builtinFormats(), kE57Dir / "bad-crc.e57"); }).find("checksum of page 0"), std::string::npos);
+    EXPECT_NE(errorOf([&] { io::readFile(builtinFormats(), kE57Dir / "InvalidCVHeader.e57"); }).find("not a compressed vector"),
               std::string::npos);
 }
 
@@ -259,13 +254,13 @@ TEST(E57Format, RoundTripKeepsEveryValueOfSeveralScans)
         EXPECT_EQ(b.globalPosition(i), plain.globalPosition(i));
 
     // One cloud for the tools, with the scan each point came from.
-    const PointCloud merged = io::readPointCloud(formats(), path, options);
+    const PointCloud merged = io::readPointCloud(builtinFormats(), path, options);
     ASSERT_EQ(merged.size(), 20003u);
     ASSERT_NE(merged.field("scan_index"), nullptr);
     EXPECT_EQ(merged.field("scan_index")->value(0), 0.0);
     EXPECT_EQ(merged.field("scan_index")->value(20002), 1.0);
     EXPECT_EQ(merged.sensors().size(), 1u);
-    const std::vector<Entity> parts = io::readEntities(formats(), path, options);
+    const std::vector<Entity> parts = io::readEntities(builtinFormats(), path, options);
     ASSERT_EQ(parts.size(), 2u);
     EXPECT_EQ(std::get<PointCloud>(parts[1]).name, "plain");
 }
@@ -413,7 +408,7 @@ TEST(E57Format, SphericalCoordinatesAreConvertedAndMakeASensor)
 
 TEST(E57Format, ConvertsBetweenE57AndPly)
 {
-    const io::FormatRegistry registry = formats();
+    const io::FormatRegistry registry = builtinFormats();
     const PointCloud cube = io::readPointCloud(registry, kE57Dir / "ColouredCubeFloat.e57");
     const fs::path e57 = tempDir() / "cube.e57", ply = tempDir() / "cube.ply";
     io::writePointCloud(registry, cube, e57);

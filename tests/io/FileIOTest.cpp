@@ -2,6 +2,7 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/io/FileIO.h>
 
+#include "BuiltinFormats.h"
 #include "TestSupport.h"
 
 #include <csignal>
@@ -23,25 +24,18 @@ ErrorCode readError(const io::FormatRegistry& registry, const std::filesystem::p
     return ErrorCode::Internal;
 }
 
-io::FormatRegistry builtins()
-{
-    io::FormatRegistry registry;
-    io::registerBuiltinFormats(registry);
-    return registry;
-}
-
 } // namespace
 
 TEST(FileIO, ExtensionsAreCaseInsensitive)
 {
-    const auto registry = builtins();
+    const auto registry = test::builtinFormats();
     EXPECT_EQ(registry.forPath("scan.PLY").name, registry.forPath("scan.ply").name);
     EXPECT_EQ(io::lowerExtension("a/b/C.LaS"), "las");
 }
 
 TEST(FileIO, UnknownExtensionIsUnsupportedAndBrokenLazAndE57Invalid)
 {
-    const auto registry = builtins();
+    const auto registry = test::builtinFormats();
     const auto dir = test::tempDir();
     test::writeText(dir / "scan.fls", "x");
     test::writeText(dir / "scan.e57", "x");
@@ -57,7 +51,7 @@ TEST(FileIO, UnknownExtensionIsUnsupportedAndBrokenLazAndE57Invalid)
 
 TEST(FileIO, MissingAndEmptyFilesNameTheFile)
 {
-    const auto registry = builtins();
+    const auto registry = test::builtinFormats();
     const auto dir = test::tempDir();
     std::string message;
     for (const char* name : {"missing.ply", "missing.las", "missing.xyz", "missing.obj"}) {
@@ -74,7 +68,7 @@ TEST(FileIO, MissingAndEmptyFilesNameTheFile)
 
 TEST(FileIO, WritingAPointCloudToAMeshOnlyFormatIsRefused)
 {
-    const auto registry = builtins();
+    const auto registry = test::builtinFormats();
     PointCloud cloud;
     cloud.resize(2);
     EXPECT_THROW(io::writePointCloud(registry, cloud, test::tempDir() / "cloud.obj"), Error);
@@ -82,7 +76,7 @@ TEST(FileIO, WritingAPointCloudToAMeshOnlyFormatIsRefused)
 
 TEST(FileIO, EveryBuiltinFormatIsRegistered)
 {
-    const auto registry = builtins();
+    const auto registry = test::builtinFormats();
     for (const char* ext : {"ply", "xyz", "txt", "csv", "pts", "asc", "las", "laz", "obj", "stl", "off", "dxf"})
         EXPECT_NO_THROW(registry.forPath(std::string("a.") + ext)) << ext;
 }

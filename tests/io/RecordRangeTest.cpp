@@ -5,6 +5,7 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/io/FileIO.h>
 
+#include "BuiltinFormats.h"
 #include "TestSupport.h"
 
 #include <cmath>
@@ -16,13 +17,6 @@ namespace scandiff::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-io::FormatRegistry formats()
-{
-    io::FormatRegistry registry;
-    io::registerBuiltinFormats(registry);
-    return registry;
-}
 
 //! UTM-sized coordinates (so the origin matters), colours, a float field, a
 //! double field, and a point with a NaN coordinate the readers drop.
@@ -96,7 +90,7 @@ PointCloud readByRanges(const io::FormatRegistry& registry, const fs::path& path
 
 TEST(RecordRanges, BinaryPlyRangesPutTogetherAreTheWholeRead)
 {
-    const auto registry = formats();
+    const auto registry = builtinFormats();
     const fs::path dir = tempDir();
     io::writePointCloud(registry, sampleCloud(10007), dir / "cloud.ply");
     EXPECT_EQ(io::pointRecordCount(registry, dir / "cloud.ply"), 10007u);
@@ -111,7 +105,7 @@ TEST(RecordRanges, BinaryPlyRangesPutTogetherAreTheWholeRead)
 
 TEST(RecordRanges, GeometryOnlySkipsColoursAndFields)
 {
-    const auto registry = formats();
+    const auto registry = builtinFormats();
     const fs::path dir = tempDir();
     io::writePointCloud(registry, sampleCloud(500), dir / "cloud.ply");
     io::ReadOptions options;
@@ -127,7 +121,7 @@ TEST(RecordRanges, GeometryOnlySkipsColoursAndFields)
 
 TEST(RecordRanges, LasRangesPutTogetherAreTheWholeRead)
 {
-    const auto registry = formats();
+    const auto registry = builtinFormats();
     const fs::path dir = tempDir();
     PointCloud cloud = sampleCloud(3001);
     cloud.positions()[1500].x() = 0; // LAS cannot hold a NaN coordinate
@@ -153,7 +147,7 @@ TEST(RecordRanges, LasRangesPutTogetherAreTheWholeRead)
 
 TEST(RecordRanges, FormatsThatCannotSeekSaySo)
 {
-    const auto registry = formats();
+    const auto registry = builtinFormats();
     const fs::path dir = tempDir();
     io::writePointCloud(registry, sampleCloud(50), dir / "cloud.xyz");
     EXPECT_FALSE(io::canReadRecordRanges(registry, dir / "cloud.xyz"));
@@ -168,7 +162,7 @@ TEST(RecordRanges, FormatsThatCannotSeekSaySo)
 
 TEST(RecordRanges, ChunkWriterChecksWhatItIsGiven)
 {
-    const auto registry = formats();
+    const auto registry = builtinFormats();
     const fs::path dir = tempDir();
     const PointCloud cloud = sampleCloud(100);
     {

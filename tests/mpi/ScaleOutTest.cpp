@@ -7,6 +7,7 @@
 #include <scandiff/core/Mesh.h>
 #include <scandiff/io/FileIO.h>
 
+#include "BuiltinFormats.h"
 #include "TestSupport.h"
 
 #include <gtest/gtest.h>
@@ -20,13 +21,6 @@ namespace scandiff::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-io::FormatRegistry formats()
-{
-    io::FormatRegistry registry;
-    io::registerBuiltinFormats(registry);
-    return registry;
-}
 
 double surface(double x, double y)
 {
@@ -116,7 +110,7 @@ protected:
     void SetUp() override
     {
         dir_ = tempDir();
-        const auto registry = formats();
+        const auto registry = builtinFormats();
         const PointCloud reference = sampleSite(1, 4.0, true, false);
         io::writePointCloud(registry, reference, dir_ / "reference.ply");
         io::writePointCloud(registry, sampleSite(2, 3.0, false, true), dir_ / "compared.ply");
@@ -138,7 +132,7 @@ protected:
         const std::string arguments = " " + command + " " + inputs + " " + options;
         const CommandOutcome cli = run(std::string(SCANDIFF_CLI_PATH) + arguments + " -o " + file("cli.ply"));
         ASSERT_EQ(cli.status, 0) << cli.output;
-        const auto registry = formats();
+        const auto registry = builtinFormats();
         const PointCloud expected = io::readPointCloud(registry, dir_ / "cli.ply");
         fields.push_back("intensity");
         for (const int ranks : {1, 2, 4}) {

@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <random>
+
 namespace scandiff::mpi {
 namespace {
 
@@ -47,6 +50,36 @@ TEST(Tiling, HaloRegionHoldsWhatLiesWithinTheHaloOfAnOwnedTile)
     const HaloRegion wide(grid, {{0, 0}}, 15.0);
     EXPECT_TRUE(wide.contains(24.9, 0));
     EXPECT_FALSE(wide.contains(25.1, 0));
+}
+
+TEST(Tiling, ReachIndexFindsTheSquaresABoxTouchesAsBruteForceDoes)
+{
+    std::mt19937 random(5);
+    std::uniform_real_distribution<double> along(-100.0, 100.0), side(0.0, 12.0);
+    std::vector<Eigen::Vector2d> centres;
+    std::vector<double> halfSides;
+    for (int m = 0; m < 60; ++m) {
+        centres.emplace_back(along(random), along(random));
+        halfSides.push_back(side(random));
+    }
+    const ReachIndex index(centres, halfSides, 10.0);
+    int touched = 0;
+    for (int k = 0; k < 4000; ++k) {
+        const Eigen::Vector2d a(along(random), along(random));
+        // Points (the reference points c2c widens on) and boxes (c2m's triangles).
+        const Eigen::Vector2d b = k % 2 ? a : a + Eigen::Vector2d(side(random), side(random) / 4);
+        bool expected = false;
+        for (std::size_t m = 0; m < centres.size(); ++m)
+            expected = expected || (a.x() <= centres[m].x() + halfSides[m] && b.x() >= centres[m].x() - halfSides[m] &&
+                                    a.y() <= centres[m].y() + halfSides[m] && b.y() >= centres[m].y() - halfSides[m]);
+        ASSERT_EQ(index.touches(a, b), expected) << k;
+        touched += expected;
+    }
+    EXPECT_GT(touched, 400);
+    EXPECT_LT(touched, 3600);
+    // An unknown reach (infinite) reaches everywhere.
+    halfSides.back() = std::numeric_limits<double>::infinity();
+    EXPECT_TRUE(ReachIndex(centres, halfSides, 10.0).touches({1e6, 1e6}, {1e6, 1e6}));
 }
 
 } // namespace

@@ -217,33 +217,7 @@ std::vector<CylinderStats> cylinderStats(const octree::Octree& epoch, const std:
     return stats;
 }
 
-} // namespace
-
-namespace {
-
-M3c2Result m3c2Measure(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints,
-                       const M3c2Params& params, ProgressObserver* progress);
-
-} // namespace
-
-M3c2Result m3c2(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints, const M3c2Params& params,
-                ProgressObserver* progress)
-{
-    checkParams(params);
-    checkCloud(reference, "reference");
-    checkCloud(compared, "compared");
-    return m3c2Measure(reference, compared, corePoints, params, progress);
-}
-
-M3c2Result m3c2OnParts(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints,
-                       const M3c2Params& params, ProgressObserver* progress)
-{
-    checkParams(params);
-    return m3c2Measure(reference, compared, corePoints, params, progress);
-}
-
-namespace {
-
+//! What m3c2 and m3c2OnParts share once their inputs are checked.
 M3c2Result m3c2Measure(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints,
                        const M3c2Params& params, ProgressObserver* progress)
 {
@@ -324,5 +298,21 @@ M3c2Result m3c2Measure(const PointCloud& reference, const PointCloud& compared, 
 }
 
 } // namespace
+
+M3c2Result m3c2(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints, const M3c2Params& params,
+                ProgressObserver* progress)
+{
+    checkParams(params);
+    checkCloud(reference, "reference");
+    checkCloud(compared, "compared");
+    return m3c2Measure(reference, compared, corePoints, params, progress);
+}
+
+M3c2Result m3c2OnParts(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints,
+                       const M3c2Params& params, ProgressObserver* progress)
+{
+    checkParams(params);
+    return m3c2Measure(reference, compared, corePoints, params, progress);
+}
 
 } // namespace scandiff
