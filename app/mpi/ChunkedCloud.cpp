@@ -3,12 +3,13 @@
 
 #include <scandiff/core/Error.h>
 
+#include <limits>
 #include <numeric>
 
 namespace scandiff::mpi {
 
-ChunkedCloud::ChunkedCloud(const io::FormatRegistry& formats, std::filesystem::path path, std::uint64_t chunkPoints,
-                           io::ReadOptions options)
+ChunkedCloud::ChunkedCloud(const Communicator& c, const io::FormatRegistry& formats, std::filesystem::path path,
+                           std::uint64_t chunkPoints, io::ReadOptions options)
     : formats_(formats), path_(std::move(path)), chunkPoints_(std::max<std::uint64_t>(chunkPoints, 1)),
       options_(std::move(options))
 {
@@ -16,12 +17,8 @@ ChunkedCloud::ChunkedCloud(const io::FormatRegistry& formats, std::filesystem::p
     if (io::canReadRecordRanges(formats_, path_)) {
         try {
             records_ = io::pointRecordCount(formats_, path_);
-            // The first range fixes the origin a whole read would choose; every
-            // later range is read in that frame.
-            io::ReadOptions firstOptions = options_;
-            firstOptions.geometryOnly = true;
-            const PointCloud first = io::readPointRecords(formats_, path_, {0, 1}, firstOptions);
-            origin_ = first.origin();
+            // Every range is read in the frame a whole read would choose.
+            origin_ = chooseOrigin(c);
             options_.origin = origin_;
             return;
         } catch (const Error& e) {
@@ -32,6 +29,39 @@ ChunkedCloud::ChunkedCloud(const io::FormatRegistry& formats, std::filesystem::p
     whole_ = io::readPointCloud(formats_, path_, options_);
     records_ = whole_->size();
     origin_ = whole_->origin();
+}
+
+Eigen::Vector3d ChunkedCloud::chooseOrigin(const Communicator& c) const
+{
+    // The whole file's box is the union of the ranks' shares' boxes; whether
+    // one is needed depends on the header alone, so every rank agrees.
+    std::optional<BoundingBox> box;
+    if (!options_.origin) {
+        const auto ranks = static_cast<std::uint64_t>(c.size()), rank = static_cast<std::uint64_t>(c.rank());
+        const std::uint64_t begin = records_ * rank / ranks, end = records_ * (rank + 1) / ranks;
+        box = io::pointRecordBounds(formats_, path_, {begin, end - begin});
+    }
+    if (!box) { // given, or fixed by the header: the first record tells it
+        io::ReadOptions firstOptions = options_;
+        firstOptions.geometryOnly = true;
+        return io::readPointRecords(formats_, path_, {0, 1}, firstOptions).origin();
+    }
+    const double infinity = std::numeric_limits<double>::infinity();
+    double lo[3] = {infinity, infinity, infinity}, hi[3] = {-infinity, -infinity, -infinity};
+    if (!box->empty)
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = box->min[a];
+            hi[a] = box->max[a];
+        }
+    MPI_Allreduce(MPI_IN_PLACE, lo, 3, MPI_DOUBLE, MPI_MIN, c.comm);
+    MPI_Allreduce(MPI_IN_PLACE, hi, 3, MPI_DOUBLE, MPI_MAX, c.comm);
+    BoundingBox whole;
+    whole.empty = !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]);
+    if (!whole.empty) {
+        whole.min = Eigen::Vector3d(lo[0], lo[1], lo[2]);
+        whole.max = Eigen::Vector3d(hi[0], hi[1], hi[2]);
+    }
+    return suggestOrigin(whole);
 }
 
 std::size_t ChunkedCloud::chunkCount() const

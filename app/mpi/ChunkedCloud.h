@@ -5,6 +5,8 @@
 //! PLY, LAS) are streamed; any other is read whole once and served from memory
 //! (said by streamed(), and in the run's report).
 
+#include "Mpi.h"
+
 #include <scandiff/core/PointCloud.h>
 #include <scandiff/io/FileIO.h>
 
@@ -16,10 +18,11 @@ namespace scandiff::mpi {
 class ChunkedCloud
 {
 public:
-    //! Reads the header (and, when the origin must be chosen from every
-    //! point's coordinates, one pass over them). Throws Error like the readers.
-    ChunkedCloud(const io::FormatRegistry& formats, std::filesystem::path path, std::uint64_t chunkPoints,
-                 io::ReadOptions options);
+    //! Collective. Reads the header and, when the origin must be chosen from
+    //! every point's coordinates, their box (each rank a share of the records).
+    //! Throws Error like the readers, on every rank alike.
+    ChunkedCloud(const Communicator& c, const io::FormatRegistry& formats, std::filesystem::path path,
+                 std::uint64_t chunkPoints, io::ReadOptions options);
 
     const std::filesystem::path& path() const { return path_; }
     std::size_t chunkCount() const;
@@ -31,6 +34,8 @@ public:
     bool streamed() const { return !whole_; }
 
 private:
+    Eigen::Vector3d chooseOrigin(const Communicator& c) const;
+
     const io::FormatRegistry& formats_;
     std::filesystem::path path_;
     std::uint64_t chunkPoints_;

@@ -99,8 +99,8 @@ class CloudToCloudRun
 public:
     CloudToCloudRun(const Communicator& c, const io::FormatRegistry& formats, const CloudToCloudJob& job)
         : c_(c), formats_(formats), job_(job),
-          compared_(formats, job.compared, job.tiling.chunkPoints, job.read),
-          reference_(formats, job.reference, job.tiling.chunkPoints, job.read),
+          compared_(c, formats, job.compared, job.tiling.chunkPoints, job.read),
+          reference_(c, formats, job.reference, job.tiling.chunkPoints, job.read),
           grid_(job.tiling.tileSize)
     {
         // The settings, and their errors, are scandiff-cli's.

@@ -87,7 +87,7 @@ public:
         : c_(c), formats_(formats), job_(job),
           // scandiff-cli's order: the settings, the mesh, the cloud (so its errors come first alike).
           params_(cloudToMeshSettings(job.values)), mesh_(readCheckedMesh(formats, job.reference)),
-          compared_(formats, job.compared, job.tiling.chunkPoints, job.read), grid_(job.tiling.tileSize)
+          compared_(c, formats, job.compared, job.tiling.chunkPoints, job.read), grid_(job.tiling.tileSize)
     {
         halo_ = job.tiling.halo ? *job.tiling.halo : params_.maxDistance ? *params_.maxDistance : job.tiling.tileSize / 10;
         checkChunkedOutput(formats, job.output);

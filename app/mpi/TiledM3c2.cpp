@@ -53,9 +53,9 @@ class M3c2Run
 public:
     M3c2Run(const Communicator& c, const io::FormatRegistry& formats, const M3c2Job& job)
         : c_(c), formats_(formats), job_(job), params_(m3c2Settings(job.values)),
-          reference_(formats, job.reference, job.tiling.chunkPoints, job.read),
-          compared_(formats, job.compared, job.tiling.chunkPoints, job.read),
-          cores_(formats, job.corePoints.empty() ? job.reference : job.corePoints, job.tiling.chunkPoints, job.read),
+          reference_(c, formats, job.reference, job.tiling.chunkPoints, job.read),
+          compared_(c, formats, job.compared, job.tiling.chunkPoints, job.read),
+          cores_(c, formats, job.corePoints.empty() ? job.reference : job.corePoints, job.tiling.chunkPoints, job.read),
           grid_(job.tiling.tileSize)
     {
         if (job.values.has("core-spacing"))

@@ -63,12 +63,19 @@ namespace {
 //! chunks, summed over the ranks.
 std::map<TileKey, std::uint64_t> countTilePoints(const Communicator& c, const ChunkedCloud& cloud, const TileGrid& grid)
 {
-    std::map<TileKey, std::uint64_t> mine;
+    std::unordered_map<TileKey, std::uint64_t, TileKeyHash> mine;
+    std::uint64_t* current = nullptr; // consecutive points mostly share a tile
+    TileKey last;
     for (std::size_t k = static_cast<std::size_t>(c.rank()); k < cloud.chunkCount(); k += static_cast<std::size_t>(c.size())) {
         const PointCloud chunk = cloud.read(k, true);
         for (std::size_t i = 0; i < chunk.size(); ++i) {
             const Eigen::Vector3d p = chunk.globalPosition(i);
-            ++mine[grid.tileOf(p.x(), p.y())];
+            const TileKey key = grid.tileOf(p.x(), p.y());
+            if (!current || !(key == last)) {
+                current = &mine[key]; // the map's values stay in place
+                last = key;
+            }
+            ++*current;
         }
     }
     struct Entry
@@ -102,8 +109,15 @@ OwnedPoints collectOwnedPoints(const Communicator& c, const ChunkedCloud& cloud,
     options.withIndex = true;
     for (const TileKey& key : owned.tiles)
         options.expected += static_cast<std::size_t>(counts.at(key));
+    TileKey lastKey;
+    int lastOwner = -1; // consecutive points mostly share a tile
     ReceivedPoints mine = distributePoints(c, cloud, options, [&](const Eigen::Vector3d& p, std::vector<int>& ranks) {
-        ranks.push_back(owner.at(grid.tileOf(p.x(), p.y())));
+        const TileKey key = grid.tileOf(p.x(), p.y());
+        if (lastOwner < 0 || !(key == lastKey)) {
+            lastOwner = owner.at(key);
+            lastKey = key;
+        }
+        ranks.push_back(lastOwner);
     });
     owned.positions = std::move(mine.positions);
     owned.index = std::move(mine.index);
@@ -260,10 +274,14 @@ const std::vector<int>& RegionRouter::candidatesOf(const TileKey& key) const
 void RegionRouter::operator()(const Eigen::Vector3d& world, std::vector<int>& ranks) const
 {
     const TileKey key = grid_.tileOf(world.x(), world.y());
-    const auto owner = owner_.find(key);
+    if (!(key == lastKey_)) { // consecutive points mostly share a tile
+        const auto owner = owner_.find(key);
+        lastKey_ = key;
+        lastOwner_ = owner != owner_.end() ? owner->second : -1;
+    }
     // Most points lie deeper than the halo inside their tile: only its rank's.
-    if (owner != owner_.end() && grid_.depthInGrownTile(key, -halo_, world.x(), world.y()) > 0) {
-        ranks.push_back(owner->second);
+    if (lastOwner_ >= 0 && grid_.depthInGrownTile(key, -halo_, world.x(), world.y()) > 0) {
+        ranks.push_back(lastOwner_);
         return;
     }
     for (const int r : candidatesOf(key))
@@ -312,11 +330,131 @@ void checkChunkedOutput(const io::FormatRegistry& formats, const std::filesystem
                                                 formats.forPath(output).name + " files cannot be yet (use .ply)");
 }
 
+namespace {
+
+//! The values this rank owns in the chunk [begin, end) of input indices, from
+//! `next` on (owned indices increase): its offset in the chunk, then one float
+//! per plane, each as 4 bytes.
+void packChunkValues(const OwnedPoints& owned, const std::vector<const std::vector<float>*>& planes, std::uint64_t begin,
+                     std::uint64_t end, std::size_t& next, std::vector<std::uint32_t>& words)
+{
+    for (; next < owned.index.size() && owned.index[next] < end; ++next) {
+        words.push_back(static_cast<std::uint32_t>(owned.index[next] - begin));
+        for (const std::vector<float>* plane : planes) {
+            std::uint32_t bits = 0;
+            std::memcpy(&bits, &(*plane)[next], sizeof bits);
+            words.push_back(bits);
+        }
+    }
+}
+
+//! One chunk's planes from the packed values every rank sent for it; throws
+//! unless every point of the chunk got its values.
+std::vector<std::vector<float>> unpackChunkValues(const std::vector<std::uint32_t>& words, std::size_t planeCount,
+                                                  std::size_t points, const ChunkedCloud& cloud, std::size_t k)
+{
+    const std::size_t stride = 1 + planeCount;
+    if (words.size() != points * stride)
+        throw Error(ErrorCode::Internal, "chunk " + std::to_string(k) + " of " + cloud.path().string() + ": " +
+                                             std::to_string(words.size() / stride) + " values for " + std::to_string(points) +
+                                             " points");
+    std::vector<std::vector<float>> chunkPlanes(planeCount, std::vector<float>(points, std::numeric_limits<float>::quiet_NaN()));
+    for (std::size_t at = 0; at < words.size(); at += stride) {
+        const std::uint32_t offset = words[at];
+        if (offset >= points)
+            throw Error(ErrorCode::Internal, "chunk " + std::to_string(k) + ": a value beyond its points");
+        for (std::size_t f = 0; f < planeCount; ++f)
+            std::memcpy(&chunkPlanes[f][offset], &words[at + 1 + f], sizeof(float));
+    }
+    return chunkPlanes;
+}
+
+//! Collective. Every rank writes the chunks it decodes in distributePoints's
+//! rounds (chunk qN + r on rank r) at their place in one file, its values
+//! sent to it by their owners (MPI_Alltoallv): the output is written on every
+//! rank at once. False, with nothing written, where the output's format or
+//! encoding cannot be written so (text).
+bool writeInPlace(const Communicator& c, const io::FormatRegistry& formats, const ChunkedCloud& cloud, const OwnedPoints& owned,
+                  const std::vector<const std::vector<float>*>& planes, const AttachValues& attach,
+                  const std::filesystem::path& output, const io::WriteOptions& write)
+{
+    const std::size_t chunks = owned.chunkStarts.size() - 1, planeCount = planes.size();
+    const auto ranks = static_cast<std::size_t>(c.size()), rank = static_cast<std::size_t>(c.rank());
+    std::unique_ptr<io::PlacedChunkWriter> writer;
+    std::vector<int> sendCounts(ranks), sendOffsets(ranks), receiveCounts(ranks), receiveOffsets(ranks);
+    std::vector<std::uint32_t> sendWords, receiveWords;
+    std::size_t next = 0;
+    for (std::size_t round = 0; round * ranks < chunks; ++round) {
+        // Every rank's values for chunk qN + s, to rank s.
+        sendWords.clear();
+        for (std::size_t s = 0; s < ranks; ++s) {
+            const std::size_t k = round * ranks + s;
+            const std::size_t before = sendWords.size();
+            if (k < chunks)
+                packChunkValues(owned, planes, owned.chunkStarts[k], owned.chunkStarts[k + 1], next, sendWords);
+            sendOffsets[s] = static_cast<int>(before * sizeof(std::uint32_t));
+            sendCounts[s] = static_cast<int>((sendWords.size() - before) * sizeof(std::uint32_t));
+        }
+        MPI_Alltoall(sendCounts.data(), 1, MPI_INT, receiveCounts.data(), 1, MPI_INT, c.comm);
+        std::size_t total = 0;
+        for (std::size_t r = 0; r < ranks; ++r) {
+            receiveOffsets[r] = static_cast<int>(total);
+            total += static_cast<std::size_t>(receiveCounts[r]);
+        }
+        receiveWords.resize(total / sizeof(std::uint32_t));
+        MPI_Alltoallv(sendWords.data(), sendCounts.data(), sendOffsets.data(), MPI_BYTE, receiveWords.data(),
+                      receiveCounts.data(), receiveOffsets.data(), MPI_BYTE, c.comm);
+
+        const std::size_t k = round * ranks + rank;
+        PointCloud chunk = k < chunks ? cloud.read(k, false) : PointCloud();
+        if (k < chunks)
+            attach(chunk, unpackChunkValues(receiveWords, planeCount, chunk.size(), cloud, k));
+        if (round == 0) {
+            // Rank 0 creates the file (or finds its encoding cannot be placed) and tells the others where it is.
+            std::string path;
+            if (rank == 0) {
+                try {
+                    writer = io::openPlacedChunkWriter(formats, output, {}, chunk, owned.total(), write);
+                    path = writer->temporaryPath().string();
+                } catch (const Error& e) {
+                    if (e.code() != ErrorCode::Unsupported)
+                        throw;
+                }
+            }
+            auto length = static_cast<std::uint64_t>(path.size());
+            MPI_Bcast(&length, 1, MPI_UINT64_T, 0, c.comm);
+            if (length == 0)
+                return false;
+            path.resize(static_cast<std::size_t>(length));
+            MPI_Bcast(path.data(), static_cast<int>(length), MPI_CHAR, 0, c.comm);
+            // Every range of a file reads with the same attributes: a rank's own chunk lays its writer out as rank 0's.
+            if (rank != 0 && k < chunks)
+                writer = io::openPlacedChunkWriter(formats, output, path, chunk, owned.total(), write);
+        }
+        if (k < chunks)
+            writer->write(owned.chunkStarts[k], chunk);
+    }
+    if (writer)
+        writer->close();
+    c.barrier(); // every rank's records are in the file
+    if (rank == 0)
+        writer->commit();
+    return true;
+}
+
+} // namespace
+
 void writeInInputOrder(const Communicator& c, const io::FormatRegistry& formats, const ChunkedCloud& cloud,
                        const OwnedPoints& owned, const std::vector<const std::vector<float>*>& planes,
                        const AttachValues& attach, const std::filesystem::path& output, const io::WriteOptions& write,
                        std::ostream& out)
 {
+    if (owned.total() > 0 && writeInPlace(c, formats, cloud, owned, planes, attach, output, write)) {
+        if (c.rank() == 0)
+            out << "wrote " << output.string() << '\n';
+        return;
+    }
+
     const std::size_t planeCount = planes.size();
     std::unique_ptr<io::PointChunkWriter> writer;
     std::size_t next = 0; // this rank's first value not sent yet (its indices are increasing)

@@ -127,6 +127,25 @@ std::unique_ptr<PointChunkWriter> openPointChunkWriter(const FormatRegistry& reg
     return handler.openChunkWriter(path, layout, total, options);
 }
 
+std::optional<BoundingBox> pointRecordBounds(const FormatRegistry& registry, const fs::path& path, RecordRange range)
+{
+    const FormatHandler& handler = readerFor(registry, path);
+    if (!handler.recordBounds)
+        return std::nullopt;
+    return handler.recordBounds(path, range);
+}
+
+std::unique_ptr<PlacedChunkWriter> openPlacedChunkWriter(const FormatRegistry& registry, const fs::path& path,
+                                                         const fs::path& join, const PointCloud& layout,
+                                                         std::uint64_t total, const WriteOptions& options)
+{
+    const FormatHandler& handler = registry.forPath(path);
+    if (!handler.openPlacedWriter)
+        throw Error(ErrorCode::Unsupported, path.string() + ": " + handler.name +
+                                                " files cannot be written by several processes at once");
+    return handler.openPlacedWriter(path, join, layout, total, options);
+}
+
 PointCloud readPointCloud(const FormatRegistry& registry, const fs::path& path, const ReadOptions& options)
 {
     Entity entity = readFile(registry, path, options);

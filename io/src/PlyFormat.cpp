@@ -32,7 +32,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -1051,12 +1053,7 @@ public:
 
     Entity read()
     {
-        const PlyElement* vertexElement = nullptr;
-        for (const auto& e : header_.elements)
-            if (isVertexElement(e) && !vertexElement)
-                vertexElement = &e;
-        if (!vertexElement)
-            ctx_.fail("no vertex element in the PLY header");
+        const PlyElement* vertexElement = &findVertexElement();
         layout_ = makeVertexLayout(*vertexElement, ctx_);
         if (options_.geometryOnly)
             keepGeometryOnly(layout_);
@@ -1125,12 +1122,7 @@ private:
     //! (a pass over every record's coordinates) unless the options give one.
     Entity readRecordRange(const PlyElement& vertexElement)
     {
-        if (header_.encoding == PlyEncoding::Ascii || !vertexElement.fixedSize())
-            throw Error(ErrorCode::Unsupported, path_.string() +
-                                                    ": a range of records can only be read from a binary PLY whose vertex "
-                                                    "records have a fixed size");
-        const bool swap = (header_.encoding == PlyEncoding::BinaryBigEndian) == kHostLittleEndian;
-        if (swap)
+        if (swapsBytes(vertexElement))
             readBinaryRange<true>(vertexElement);
         else
             readBinaryRange<false>(vertexElement);
@@ -1138,11 +1130,22 @@ private:
         return finish();
     }
 
+    //! Throws Error(Unsupported) unless records can be read by ranges; then
+    //! whether their bytes must be swapped.
+    bool swapsBytes(const PlyElement& vertexElement) const
+    {
+        if (header_.encoding == PlyEncoding::Ascii || !vertexElement.fixedSize())
+            throw Error(ErrorCode::Unsupported, path_.string() +
+                                                    ": a range of records can only be read from a binary PLY whose vertex "
+                                                    "records have a fixed size");
+        return (header_.encoding == PlyEncoding::BinaryBigEndian) == kHostLittleEndian;
+    }
+
+    //! Where the vertex records start; throws when the file holds fewer than announced.
     template <bool Swap>
-    void readBinaryRange(const PlyElement& vertexElement)
+    const char* vertexRecords(const PlyElement& vertexElement, const char* end)
     {
         const char* ptr = file_.data() + header_.dataOffset;
-        const char* end = file_.data() + file_.size();
         for (const auto& e : header_.elements) {
             if (&e == &vertexElement)
                 break;
@@ -1151,33 +1154,90 @@ private:
         const std::size_t recordSize = vertexElement.minRecordSize();
         if (recordSize == 0 || static_cast<std::uint64_t>(end - ptr) / recordSize < vertexElement.count)
             ctx_.truncated(vertexElement, recordSize == 0 ? 0 : static_cast<std::uint64_t>(end - ptr) / recordSize);
-        const std::uint64_t first = std::min(range_->first, vertexElement.count);
+        return ptr;
+    }
+
+    //! The records [first, first + count) of `vertexElement` (cut at its end) as an element of their own.
+    static PlyElement recordsOf(const PlyElement& vertexElement, RecordRange range, std::uint64_t& first)
+    {
+        first = std::min(range.first, vertexElement.count);
         PlyElement part = vertexElement;
-        part.count = std::min(range_->count, vertexElement.count - first);
+        part.count = std::min(range.count, vertexElement.count - first);
+        return part;
+    }
+
+    //! The box of the coordinates of `part`'s records, which start at `ptr`
+    //! (non-finite values left out, axis by axis, as a whole read does).
+    template <bool Swap>
+    BoundingBox coordinateBox(const PlyElement& part, const char* ptr, const char* end, ProgressTicker& ticker)
+    {
+        VertexLayout coordinates = layout_;
+        coordinates.slots.erase(std::remove_if(coordinates.slots.begin(), coordinates.slots.end(),
+                                               [](const Slot& s) { return s.role < Role::X || s.role > Role::Z; }),
+                                coordinates.slots.end());
+        std::vector<RangeAccumulator> perChunk(static_cast<std::size_t>(part.count / kChunk + 1), RangeAccumulator(0));
+        visitBinaryVertices<Swap>(part, coordinates, ptr, end, ctx_, ticker,
+                                  [&perChunk](std::uint64_t i, const Slot& s, double v) {
+                                      perChunk[static_cast<std::size_t>(i / kChunk)].add(s, v);
+                                  });
+        RangeAccumulator whole(0);
+        for (const RangeAccumulator& chunk : perChunk)
+            whole.merge(chunk);
+        return whole.box();
+    }
+
+    template <bool Swap>
+    void readBinaryRange(const PlyElement& vertexElement)
+    {
+        const char* end = file_.data() + file_.size();
+        const char* ptr = vertexRecords<Swap>(vertexElement, end);
+        std::uint64_t first = 0;
+        const PlyElement part = recordsOf(vertexElement, *range_, first);
+        const std::size_t recordSize = vertexElement.minRecordSize();
 
         std::optional<Eigen::Vector3d> origin = options_.origin;
         ProgressTicker ticker(options_.progress, "Reading " + path_.filename().string(),
                               part.count + (!origin && layout_.coordinatesAreDouble ? vertexElement.count : 0));
-        if (!origin && layout_.coordinatesAreDouble) {
-            VertexLayout coordinates = layout_;
-            coordinates.slots.erase(std::remove_if(coordinates.slots.begin(), coordinates.slots.end(),
-                                                   [](const Slot& s) { return s.role < Role::X || s.role > Role::Z; }),
-                                    coordinates.slots.end());
-            std::vector<RangeAccumulator> perChunk(static_cast<std::size_t>(vertexElement.count / kChunk + 1),
-                                                   RangeAccumulator(0));
-            visitBinaryVertices<Swap>(vertexElement, coordinates, ptr, end, ctx_, ticker,
-                                      [&perChunk](std::uint64_t i, const Slot& s, double v) {
-                                          perChunk[static_cast<std::size_t>(i / kChunk)].add(s, v);
-                                      });
-            RangeAccumulator whole(0);
-            for (const RangeAccumulator& chunk : perChunk)
-                whole.merge(chunk);
-            origin = suggestOrigin(whole.box());
-        }
+        if (!origin && layout_.coordinatesAreDouble)
+            origin = suggestOrigin(coordinateBox<Swap>(vertexElement, ptr, end, ticker));
         const bool wideFields =
             std::find(layout_.fieldIsWide.begin(), layout_.fieldIsWide.end(), true) != layout_.fieldIsWide.end();
         readBinaryVertexElement<Swap>(part, ptr + first * recordSize, end, ticker, wideFields,
                                       origin ? origin : std::optional<Eigen::Vector3d>(Eigen::Vector3d::Zero()));
+    }
+
+public:
+    //! See FormatHandler::recordBounds: the box of the range's coordinates
+    //! when they are doubles (the origin then comes from every point's box),
+    //! else none (the origin is zero, whatever the points).
+    std::optional<BoundingBox> recordBounds()
+    {
+        const PlyElement& vertexElement = findVertexElement();
+        layout_ = makeVertexLayout(vertexElement, ctx_);
+        const bool swap = swapsBytes(vertexElement);
+        if (!layout_.coordinatesAreDouble)
+            return std::nullopt;
+        return swap ? rangeBox<true>(vertexElement) : rangeBox<false>(vertexElement);
+    }
+
+private:
+    template <bool Swap>
+    BoundingBox rangeBox(const PlyElement& vertexElement)
+    {
+        const char* end = file_.data() + file_.size();
+        const char* ptr = vertexRecords<Swap>(vertexElement, end);
+        std::uint64_t first = 0;
+        const PlyElement part = recordsOf(vertexElement, *range_, first);
+        ProgressTicker ticker(nullptr, "", part.count);
+        return coordinateBox<Swap>(part, ptr + first * vertexElement.minRecordSize(), end, ticker);
+    }
+
+    const PlyElement& findVertexElement() const
+    {
+        for (const auto& e : header_.elements)
+            if (isVertexElement(e))
+                return e;
+        ctx_.fail("no vertex element in the PLY header");
     }
 
     std::uint64_t vertexCountFromHeader() const
@@ -1526,8 +1586,19 @@ public:
         return h;
     }
 
+    //! The bytes of one vertex record (binary encodings).
+    std::size_t vertexRecordSize() const
+    {
+        std::size_t size = 0;
+        for (const Column& c : columns_)
+            size += typeSize(c.type);
+        return size;
+    }
+
+    bool isAscii() const { return encoding_ == PlyEncoding::Ascii; }
+
     //! ...then the records of each chunk, a cloud with the same attributes.
-    void writeChunk(std::ofstream& out, const PointCloud& chunk, ProgressTicker& ticker)
+    void writeChunk(std::ostream& out, const PointCloud& chunk, ProgressTicker& ticker)
     {
         const bool sameAttributes = chunk.hasColors() == cloud_->hasColors() &&
                                     chunk.hasNormals() == cloud_->hasNormals() &&
@@ -1548,7 +1619,7 @@ public:
     }
 
 private:
-    void writeRecords(std::ofstream& out, ProgressTicker& ticker)
+    void writeRecords(std::ostream& out, ProgressTicker& ticker)
     {
         if (encoding_ == PlyEncoding::Ascii)
             writeAscii(out, ticker);
@@ -1575,11 +1646,9 @@ private:
     }
 
     template <bool Swap>
-    void writeBinary(std::ofstream& out, ProgressTicker& ticker)
+    void writeBinary(std::ostream& out, ProgressTicker& ticker)
     {
-        std::size_t recordSize = 0;
-        for (const Column& c : columns_)
-            recordSize += typeSize(c.type);
+        const std::size_t recordSize = vertexRecordSize();
         const std::size_t n = cloud_->size();
         std::vector<char> buffer(static_cast<std::size_t>(kChunk) * std::max<std::size_t>(recordSize, 13));
         for (std::size_t start = 0; start < n; start += kChunk) {
@@ -1613,7 +1682,7 @@ private:
         }
     }
 
-    void writeAscii(std::ofstream& out, ProgressTicker& ticker)
+    void writeAscii(std::ostream& out, ProgressTicker& ticker)
     {
         std::string text;
         char number[64];
@@ -1715,6 +1784,90 @@ private:
     ProgressTicker ticker_;
 };
 
+//! A binary PLY filled by several processes: its records have a fixed size,
+//! so each chunk has its place after the header whichever process writes it.
+class PlyPlacedWriter final : public PlacedChunkWriter
+{
+public:
+    PlyPlacedWriter(const fs::path& destination, const fs::path& join, const PointCloud& layout, std::uint64_t total,
+                    const WriteOptions& options)
+        : options_(options), writer_(layout, nullptr, destination, options_), total_(total),
+          header_(writer_.makeHeader(total)), recordSize_(writer_.vertexRecordSize()),
+          ticker_(options_.progress, "Writing " + destination.filename().string(), total)
+    {
+        if (writer_.isAscii())
+            throw Error(ErrorCode::Unsupported,
+                        destination.string() + ": ASCII PLY records vary in size, so they cannot be written at their place");
+        if (join.empty()) {
+            file_.emplace(destination);
+            file_->stream().write(header_.data(), static_cast<std::streamsize>(header_.size()));
+            file_->stream().flush();
+            path_ = file_->tempPath();
+        } else {
+            path_ = join;
+        }
+        // Opened for update, so nothing another process wrote is truncated.
+        stream_.open(path_, std::ios::in | std::ios::out | std::ios::binary);
+        if (!stream_)
+            throw Error(ErrorCode::Io, path_.string() + ": cannot open for writing");
+        if (!join.empty()) {
+            std::string found(header_.size(), '\0');
+            stream_.read(found.data(), static_cast<std::streamsize>(found.size()));
+            if (!stream_ || found != header_)
+                throw Error(ErrorCode::InvalidArgument,
+                            path_.string() + ": its header is not the one this cloud's attributes give");
+        }
+    }
+
+    void write(std::uint64_t first, const PointCloud& chunk) override
+    {
+        if (first > total_ || chunk.size() > total_ - first)
+            throw Error(ErrorCode::InvalidArgument, destination() + ": points " + std::to_string(first) + " to " +
+                                                        std::to_string(first + chunk.size()) + " beyond the " +
+                                                        std::to_string(total_) + " announced");
+        stream_.seekp(static_cast<std::streamoff>(header_.size() + first * recordSize_));
+        writer_.writeChunk(stream_, chunk, ticker_);
+        if (!stream_)
+            throw Error(ErrorCode::Io, path_.string() + ": write failed");
+    }
+
+    void close() override
+    {
+        stream_.close();
+        if (stream_.fail())
+            throw Error(ErrorCode::Io, path_.string() + ": write failed");
+    }
+
+    const fs::path& temporaryPath() const override { return path_; }
+
+    void commit() override
+    {
+        if (!file_)
+            throw Error(ErrorCode::Internal, path_.string() + ": only the process that created it commits it");
+        if (stream_.is_open())
+            close();
+        // Every record must have come: the file then has exactly its size.
+        const std::uint64_t expected = header_.size() + total_ * recordSize_;
+        if (fs::file_size(path_) != expected)
+            throw Error(ErrorCode::InvalidArgument, destination() + ": " + std::to_string(fs::file_size(path_)) +
+                                                        " bytes written of the " + std::to_string(expected) + " expected");
+        file_->commit();
+    }
+
+private:
+    std::string destination() const { return file_ ? file_->destination().string() : path_.string(); }
+
+    WriteOptions options_;
+    PlyWriter writer_;
+    std::uint64_t total_ = 0;
+    std::string header_;
+    std::size_t recordSize_ = 0;
+    ProgressTicker ticker_;
+    std::optional<AtomicFile> file_; //!< the creator's
+    fs::path path_;
+    std::fstream stream_;
+};
+
 } // namespace
 
 FormatHandler plyFormat()
@@ -1739,6 +1892,13 @@ FormatHandler plyFormat()
     handler.openChunkWriter = [](const fs::path& path, const PointCloud& layout, std::uint64_t total,
                                  const WriteOptions& options) -> std::unique_ptr<PointChunkWriter> {
         return std::make_unique<PlyChunkWriter>(path, layout, total, options);
+    };
+    handler.recordBounds = [](const fs::path& path, RecordRange range) {
+        return PlyReader(path, ReadOptions{}, range).recordBounds();
+    };
+    handler.openPlacedWriter = [](const fs::path& destination, const fs::path& join, const PointCloud& layout,
+                                  std::uint64_t total, const WriteOptions& options) -> std::unique_ptr<PlacedChunkWriter> {
+        return std::make_unique<PlyPlacedWriter>(destination, join, layout, total, options);
     };
     return handler;
 }

@@ -179,5 +179,106 @@ TEST(RecordRanges, ChunkWriterChecksWhatItIsGiven)
     EXPECT_EQ(errorCodeOf([&] { io::openPointChunkWriter(registry, dir / "cloud.las", cloud, 100); }), ErrorCode::Unsupported);
 }
 
+TEST(RecordRanges, TheRangesBoxesMakeTheWholeReadsOrigin)
+{
+    const auto registry = builtinFormats();
+    const fs::path dir = tempDir();
+    const PointCloud written = sampleCloud(10007);
+    io::writePointCloud(registry, written, dir / "cloud.ply");
+    const PointCloud whole = io::readPointCloud(registry, dir / "cloud.ply");
+    // Three uneven parts and an empty one, as ranks scan them.
+    BoundingBox joined;
+    for (const io::RecordRange range : {io::RecordRange{0, 10}, io::RecordRange{10, 6000}, io::RecordRange{6010, 5000},
+                                        io::RecordRange{10007, 0}}) {
+        const std::optional<BoundingBox> part = io::pointRecordBounds(registry, dir / "cloud.ply", range);
+        ASSERT_TRUE(part.has_value());
+        if (part->empty)
+            continue;
+        joined.min = joined.empty ? part->min : joined.min.cwiseMin(part->min);
+        joined.max = joined.empty ? part->max : joined.max.cwiseMax(part->max);
+        joined.empty = false;
+    }
+    // Exactly the box of the coordinates in the file (the doubles written),
+    // axis by axis, the NaN left out.
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::size_t i = 0; i < written.size(); ++i)
+        for (int a = 0; a < 3; ++a)
+            if (const double v = written.globalPosition(i)[a]; std::isfinite(v)) {
+                lo[a] = std::min(lo[a], v);
+                hi[a] = std::max(hi[a], v);
+            }
+    EXPECT_EQ(joined.min, lo);
+    EXPECT_EQ(joined.max, hi);
+    EXPECT_EQ(suggestOrigin(joined), whole.origin());
+
+    // Float coordinates and LAS: the header fixes the origin, no box is needed.
+    PointCloud local = sampleCloud(100);
+    local.setOrigin(Eigen::Vector3d::Zero());
+    io::writePointCloud(registry, local, dir / "local.ply");
+    EXPECT_FALSE(io::pointRecordBounds(registry, dir / "local.ply", {0, 100}).has_value());
+    PointCloud las = sampleCloud(100);
+    las.positions()[50].x() = 0;
+    io::writePointCloud(registry, las, dir / "cloud.las");
+    EXPECT_FALSE(io::pointRecordBounds(registry, dir / "cloud.las", {0, 100}).has_value());
+    io::WriteOptions ascii;
+    ascii.encoding = io::Encoding::Ascii;
+    io::writePointCloud(registry, sampleCloud(50), dir / "text.ply", ascii);
+    EXPECT_EQ(errorCodeOf([&] { io::pointRecordBounds(registry, dir / "text.ply", {0, 10}); }), ErrorCode::Unsupported);
+}
+
+TEST(RecordRanges, PlacedWritersFillOneFileAsTheWholeWrite)
+{
+    const auto registry = builtinFormats();
+    const fs::path dir = tempDir();
+    io::writePointCloud(registry, sampleCloud(10007), dir / "cloud.ply");
+    const PointCloud whole = io::readPointCloud(registry, dir / "cloud.ply");
+    io::writePointCloud(registry, whole, dir / "expected.ply");
+    // Two writers (two processes in scandiff-mpi), each its own chunks, out of order.
+    const std::uint64_t step = 3000;
+    std::vector<PointCloud> parts;
+    std::vector<std::uint64_t> starts;
+    for (std::uint64_t first = 0; first < whole.size(); first += step) {
+        std::vector<std::size_t> indices;
+        for (std::uint64_t i = first; i < std::min<std::uint64_t>(whole.size(), first + step); ++i)
+            indices.push_back(static_cast<std::size_t>(i));
+        parts.push_back(whole.subset(indices));
+        starts.push_back(first);
+    }
+    auto creator = io::openPlacedChunkWriter(registry, dir / "placed.ply", {}, parts[1], whole.size());
+    auto joiner = io::openPlacedChunkWriter(registry, dir / "placed.ply", creator->temporaryPath(), parts[0], whole.size());
+    for (std::size_t k = parts.size(); k-- > 0;)
+        (k % 2 ? *creator : *joiner).write(starts[k], parts[k]);
+    EXPECT_FALSE(fs::exists(dir / "placed.ply")); // not before the commit
+    joiner->close();
+    EXPECT_EQ(errorCodeOf([&] { joiner->commit(); }), ErrorCode::Internal); // only the creator commits
+    creator->commit();
+    EXPECT_EQ(readBytes(dir / "placed.ply"), readBytes(dir / "expected.ply"));
+    EXPECT_FALSE(fs::exists(creator->temporaryPath()));
+}
+
+TEST(RecordRanges, PlacedWritersCheckWhatTheyAreGiven)
+{
+    const auto registry = builtinFormats();
+    const fs::path dir = tempDir();
+    const PointCloud cloud = sampleCloud(100);
+    {
+        auto writer = io::openPlacedChunkWriter(registry, dir / "short.ply", {}, cloud, 150);
+        writer->write(0, cloud);
+        EXPECT_EQ(errorCodeOf([&] { writer->write(60, cloud); }), ErrorCode::InvalidArgument); // past 150
+        EXPECT_EQ(errorCodeOf([&] { writer->commit(); }), ErrorCode::InvalidArgument);        // 100 of 150
+        // A process whose cloud has other attributes cannot join.
+        PointCloud other = cloud.clone();
+        other.removeField("intensity");
+        EXPECT_EQ(errorCodeOf([&] { io::openPlacedChunkWriter(registry, dir / "short.ply", writer->temporaryPath(), other, 150); }),
+                  ErrorCode::InvalidArgument);
+    }
+    EXPECT_FALSE(fs::exists(dir / "short.ply")); // never committed: nothing left
+    io::WriteOptions ascii;
+    ascii.encoding = io::Encoding::Ascii;
+    EXPECT_EQ(errorCodeOf([&] { io::openPlacedChunkWriter(registry, dir / "text.ply", {}, cloud, 100, ascii); }),
+              ErrorCode::Unsupported);
+    EXPECT_EQ(errorCodeOf([&] { io::openPlacedChunkWriter(registry, dir / "cloud.las", {}, cloud, 100); }), ErrorCode::Unsupported);
+}
+
 } // namespace
 } // namespace scandiff::test

@@ -205,6 +205,29 @@ TEST_F(ScaleOut, OneTileLeavesRanksWithout)
     EXPECT_NE(lastReport_.find("rank 3: 0 tiles, 0 compared points"), std::string::npos) << lastReport_;
 }
 
+// Binary PLY is written by every rank at once, each chunk at its place;
+// text, whose records vary in size, by rank 0 alone: either way the file is
+// scandiff-cli's, byte for byte (several rounds of chunks on 4 ranks, and a
+// rank past the last chunk).
+TEST_F(ScaleOut, TheOutputIsTheCliFileByteForByte)
+{
+    const std::string arguments = " c2c --reference " + file("reference.ply") + " --compared " + file("compared.ply");
+    for (const std::string encoding : {"binary", "ascii"}) {
+        const std::string written = " --encoding " + encoding + " -o ";
+        const CommandOutcome cli = run(std::string(SCANDIFF_CLI_PATH) + arguments + written + file("cli.ply"));
+        ASSERT_EQ(cli.status, 0) << cli.output;
+        for (const int ranks : {1, 2, 4}) {
+            for (const char* chunk : {"3001", "2000000"}) {
+                const CommandOutcome mpi = run(mpirun(ranks) + arguments + " --tile-size 10 --chunk-points " + chunk +
+                                               written + file("mpi.ply"));
+                ASSERT_EQ(mpi.status, 0) << mpi.output;
+                EXPECT_EQ(readBytes(dir_ / "mpi.ply"), readBytes(dir_ / "cli.ply"))
+                    << encoding << ", " << ranks << " ranks, chunks of " << chunk;
+            }
+        }
+    }
+}
+
 TEST_F(ScaleOut, BadOptionsGiveTheCliErrors)
 {
     const std::string inputs =

@@ -93,6 +93,26 @@ public:
     virtual void commit() = 0;
 };
 
+//! A cloud file several processes fill at once, each writing its own chunks
+//! at their place (formats whose records have a fixed size: binary PLY). One
+//! process creates it, the others join it by its temporary path; once every
+//! writer is closed, the creator commits it (renamed into place; until then
+//! the destination is untouched).
+class PlacedChunkWriter
+{
+public:
+    virtual ~PlacedChunkWriter() = default;
+    //! Points [first, first + chunk.size()) of the file, with the attributes
+    //! of the layout the writer was opened with. Throws Error(InvalidArgument) otherwise.
+    virtual void write(std::uint64_t first, const PointCloud& chunk) = 0;
+    //! Flushes this process's writes. Throws Error(Io) on a write error.
+    virtual void close() = 0;
+    //! The file being filled, for the others to join.
+    virtual const std::filesystem::path& temporaryPath() const = 0;
+    //! The creator's, once every writer is closed. Throws Error(Io).
+    virtual void commit() = 0;
+};
+
 struct FormatHandler
 {
     std::string name;                    //!< "PLY", "LAS"...
@@ -117,6 +137,18 @@ struct FormatHandler
     std::function<std::unique_ptr<PointChunkWriter>(const std::filesystem::path&, const PointCloud& layout,
                                                     std::uint64_t total, const WriteOptions&)>
         openChunkWriter;
+    //! The coordinates' box of a range of records, where the origin a whole
+    //! read chooses is suggestOrigin() of every point's box (so the box of a
+    //! file read by parts is the union of its parts'); std::nullopt where the
+    //! header alone fixes the origin. Null when the header always fixes it.
+    std::function<std::optional<BoundingBox>(const std::filesystem::path&, RecordRange)> recordBounds;
+    //! A placed writer (see PlacedChunkWriter) for `total` points laid out like
+    //! `layout`: created when `join` is empty, else joining the file at `join`.
+    //! May throw Error(Unsupported) for an encoding whose records vary in size.
+    std::function<std::unique_ptr<PlacedChunkWriter>(const std::filesystem::path& destination,
+                                                     const std::filesystem::path& join, const PointCloud& layout,
+                                                     std::uint64_t total, const WriteOptions&)>
+        openPlacedWriter;
 };
 
 class FormatRegistry
@@ -162,6 +194,14 @@ PointCloud readPointRecords(const FormatRegistry& registry, const std::filesyste
 std::unique_ptr<PointChunkWriter> openPointChunkWriter(const FormatRegistry& registry, const std::filesystem::path& path,
                                                        const PointCloud& layout, std::uint64_t total,
                                                        const WriteOptions& options = {});
+//! See FormatHandler::recordBounds (std::nullopt when the format has none).
+std::optional<BoundingBox> pointRecordBounds(const FormatRegistry& registry, const std::filesystem::path& path,
+                                             RecordRange range);
+//! See PlacedChunkWriter: creates the file when `join` is empty, else joins it.
+//! Throws Error(Unsupported) where the format or the encoding cannot.
+std::unique_ptr<PlacedChunkWriter> openPlacedChunkWriter(const FormatRegistry& registry, const std::filesystem::path& path,
+                                                         const std::filesystem::path& join, const PointCloud& layout,
+                                                         std::uint64_t total, const WriteOptions& options = {});
 
 //! Lower-case extension without the dot ("PLY" -> "ply").
 std::string lowerExtension(const std::filesystem::path& path);
