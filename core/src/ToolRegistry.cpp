@@ -388,9 +388,9 @@ const Mesh* ToolInputs::meshOrNull(const std::string& role, std::size_t index) c
     return mesh ? *mesh : nullptr;
 }
 
-ToolResult& ToolResult::add(std::string role, OutputData data)
+ToolResult& ToolResult::add(std::string role, OutputData data, OutputProperties properties)
 {
-    outputs.push_back({std::move(role), std::move(data)});
+    outputs.push_back({std::move(role), std::move(data), std::move(properties)});
     return *this;
 }
 
@@ -490,6 +490,17 @@ void ToolRegistry::add(ToolSpec tool)
 {
     if (find(tool.name))
         throw Error(ErrorCode::Internal, "two tools are named '" + tool.name + "'");
+    for (std::size_t k = 0; k < tool.outputs.size(); ++k) {
+        const OutputSpec& o = tool.outputs[k];
+        if (o.under.empty())
+            continue;
+        // Its entities go under those of an earlier repeated output, one for one.
+        const auto owner = std::find_if(tool.outputs.begin(), tool.outputs.begin() + static_cast<std::ptrdiff_t>(k),
+                                        [&](const OutputSpec& other) { return other.role == o.under; });
+        if (!o.repeated || owner == tool.outputs.begin() + static_cast<std::ptrdiff_t>(k) || !owner->repeated)
+            throw Error(ErrorCode::Internal, tool.name + ": output '" + o.role + "' goes under '" + o.under +
+                                                 "', which must be an earlier repeated output, and be repeated itself");
+    }
     tools_.push_back(std::move(tool));
 }
 

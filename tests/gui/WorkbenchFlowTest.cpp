@@ -5,6 +5,7 @@
 // and restore the session. Answers are checked against core called directly
 // and against brute-force counts.
 #include "MainWindow.h"
+#include "PrimitiveScene.h"
 #include "WallScenes.h"
 
 #include <scandiff/io/DxfReader.h>
@@ -320,6 +321,68 @@ private slots:
                 QVERIFY(window.document().item(window.document().item(id).parent).points().field("stone_id"));
             }
         QCOMPARE(drawings, std::size_t(1));
+    }
+
+    void primitivesListedUnderTheCloudWithTheirSurfacesAndParameters()
+    {
+        // Tools > Primitives on an analytic scene: the cloud gets primitive_id;
+        // each shape's points join the tree under it, its surface (a mesh) under
+        // them, both coloured by the shape's id; selecting either shows the
+        // shape's parameters; a saved session keeps them.
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
+        test::PrimitiveScene scene = test::makePrimitiveScene(test::testSceneShapes(), 40000, 0.005, 0.02, 3, true);
+        const EntityId cloud = window.document().add("scene", std::move(scene.cloud));
+        QVERIFY(window.toolController("primitives")->run(cloud, {{"seed", "5"}}));
+        QVERIFY(window.document().item(cloud).points().field("primitive_id"));
+        std::size_t surfaces = 0, shapes = 0;
+        EntityId firstSurface = gui::kNoEntity;
+        for (EntityId id : window.document().ids()) {
+            const gui::Document::Item& item = window.document().item(id);
+            if (item.parent == cloud && !item.isDrawing()) {
+                ++shapes;
+                QVERIFY(!item.properties.empty());
+                QCOMPARE(item.properties.front().first, QString("Shape"));
+            }
+            if (!item.mesh())
+                continue;
+            ++surfaces;
+            // Under its points, which are under the cloud, with the same parameters.
+            const gui::Document::Item& points = window.document().item(item.parent);
+            QCOMPARE(points.parent, cloud);
+            QVERIFY(item.properties == points.properties);
+            QVERIFY(item.name.endsWith("_surface"));
+            QVERIFY(item.properties.front().second.startsWith(points.name + " "));
+            QCOMPARE(item.display.activeField, std::string("primitive_id"));
+            if (firstSurface == gui::kNoEntity)
+                firstSurface = id;
+        }
+        QVERIFY(surfaces >= 10);
+        QCOMPARE(surfaces, shapes);
+        window.properties()->showEntity(firstSurface);
+        const gui::Document::Item& first = window.document().item(firstSurface);
+        QCOMPARE(window.properties()->value("Shape"), first.properties.front().second);
+        QVERIFY(!window.properties()->value("RMS (m)").isEmpty());
+        QCOMPARE(window.properties()->value("Triangles"), QString::number(first.mesh()->triangles.size()));
+        window.view()->zoomToEntity(cloud);
+        window.view()->render();
+
+        QTemporaryDir dir;
+        const QString session = dir.filePath("primitives.scandiff");
+        QVERIFY(window.sessions()->save(session));
+        const auto before = first.properties;
+        window.document().clear();
+        QVERIFY(window.sessions()->restore(session));
+        std::size_t restored = 0;
+        for (EntityId id : window.document().ids())
+            if (window.document().item(id).mesh()) {
+                ++restored;
+                QVERIFY(!window.document().item(id).properties.empty());
+                if (restored == 1)
+                    QVERIFY(window.document().item(id).properties == before);
+            }
+        QCOMPARE(restored, surfaces);
     }
 
     void multiScanE57OpensAsAGroupOfScansAndExportsBack()

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <set>
 
 using namespace scandiff;
 using namespace scandiff::plugins;
@@ -391,5 +392,81 @@ TEST(Primitives, ThePlanesOutlinesAreADrawingOnALayerPerShape)
         EXPECT_NEAR(n.norm(), 1.0, 1e-12);
         const Eigen::Vector3d point(shape["point"][0], shape["point"][1], shape["point"][2]);
         EXPECT_NEAR(n.dot(point) + shape.at("d").get<double>(), 0.0, 1e-9);
+    }
+}
+
+TEST(Primitives, EachShapeHasItsSurfaceAsAMeshOnTheShapeOverItsPoints)
+{
+    // Through the tool: one surface per shape, in the shapes' order, with the
+    // shape's parameters for the workbench's Properties panel.
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& tool = *registry.tools.find("primitives");
+    ASSERT_EQ(tool.output("surface")->under, "shape");
+    ToolResult result = tool.execute(ToolInputs().add("input", scene().cloud), tool.resolve({{"seed", "5"}}), nullptr);
+    const Table& table = result.table("table");
+    const std::vector<ToolOutput*> surfaces = result.findAll("surface");
+    const std::vector<ToolOutput*> shapes = result.findAll("shape");
+    ASSERT_EQ(surfaces.size(), table.rows.size());
+    ASSERT_EQ(shapes.size(), table.rows.size());
+    const PointCloud& labelled = std::get<PointCloud>(result.find("primitives")->data);
+    std::set<std::string> typesSeen;
+    for (std::size_t k = 0; k < surfaces.size(); ++k) {
+        const Mesh& mesh = std::get<Mesh>(surfaces[k]->data);
+        const std::string type = std::get<std::string>(table.rows[k][1]);
+        typesSeen.insert(type);
+        EXPECT_EQ(mesh.name, type + "_surface");
+        ASSERT_FALSE(surfaces[k]->properties.empty());
+        EXPECT_EQ(surfaces[k]->properties.front().second, type + " " + std::to_string(k));
+        EXPECT_EQ(shapes[k]->properties, surfaces[k]->properties);
+        ASSERT_GT(mesh.triangles.size(), 0u) << type << " " << k;
+        EXPECT_EQ(mesh.countDegenerateTriangles(), 0u);
+        // One colour per shape: its id on every vertex.
+        ASSERT_NE(mesh.vertices.field("primitive_id"), nullptr);
+        EXPECT_EQ(mesh.vertices.field("primitive_id")->value(0), static_cast<double>(k));
+        // Every vertex on the shape (float coordinates around the origin).
+        const Primitive shape = parsePrimitive(std::get<std::string>(table.rows[k].back()));
+        for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+            ASSERT_LT(std::abs(signedDistance(shape, mesh.vertices.globalPosition(v))), 1e-5) << type << " " << k << " vertex " << v;
+        // Every inlier within a cell's diagonal of a vertex (its cell is in the mesh): brute force on a sample.
+        std::vector<std::uint32_t> inliers;
+        for (std::size_t i = 0; i < labelled.size(); ++i)
+            if (labelled.field("primitive_id")->value(i) == static_cast<double>(k))
+                inliers.push_back(static_cast<std::uint32_t>(i));
+        double longestEdge = 0;
+        for (const Triangle& t : mesh.triangles)
+            for (int e = 0; e < 3; ++e)
+                longestEdge = std::max<double>(longestEdge, (mesh.vertices.positions()[t[e]] - mesh.vertices.positions()[t[(e + 1) % 3]]).norm());
+        for (std::size_t s = 0; s < inliers.size(); s += 37) {
+            const Eigen::Vector3d p = labelled.globalPosition(inliers[s]);
+            double nearest = std::numeric_limits<double>::infinity();
+            for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+                nearest = std::min(nearest, (mesh.vertices.globalPosition(v) - p).norm());
+            ASSERT_LE(nearest, longestEdge + 0.02) << type << " " << k << ": inlier " << inliers[s] << " far from the surface's vertices";
+        }
+    }
+    EXPECT_EQ(typesSeen, (std::set<std::string>{"plane", "sphere", "cylinder", "cone", "torus"}));
+
+    // Each true shape's surface covers its sampled area (the part of it its
+    // detected shape holds): the cells its points occupy, less than a cell beyond the edges.
+    for (std::size_t t = 0; t < scene().shapes.size(); ++t) {
+        std::map<int, std::size_t> votes;
+        for (std::size_t i = 0; i < scene().truth.size(); ++i)
+            if (scene().truth[i] == static_cast<int>(t) && labelled.field("primitive_id")->value(i) >= 0)
+                ++votes[static_cast<int>(labelled.field("primitive_id")->value(i))];
+        ASSERT_FALSE(votes.empty()) << scene().shapes[t].label;
+        const auto best = std::max_element(votes.begin(), votes.end(), [](auto& a, auto& b) { return a.second < b.second; });
+        const std::size_t shared = best->second;
+        const Mesh& mesh = std::get<Mesh>(surfaces[static_cast<std::size_t>(best->first)]->data);
+        double area = 0;
+        for (const Triangle& tri : mesh.triangles) {
+            const Eigen::Vector3d a = mesh.vertices.globalPosition(tri[0]), b = mesh.vertices.globalPosition(tri[1]),
+                                  c = mesh.vertices.globalPosition(tri[2]);
+            area += 0.5 * (b - a).cross(c - a).norm();
+        }
+        const double truth = scene().shapes[t].area * static_cast<double>(shared) /
+                             static_cast<double>(std::count(scene().truth.begin(), scene().truth.end(), static_cast<int>(t)));
+        // Seen: 0.985 (the sphere's flat cells) to 1.05 (a 1.2 m box side).
+        EXPECT_GT(area, 0.95 * truth) << scene().shapes[t].label;
+        EXPECT_LT(area, 1.08 * truth) << scene().shapes[t].label;
     }
 }

@@ -139,6 +139,9 @@ bool SessionController::save(const QString& qpath)
             fields[name] = {{"scale", display.scale.toText()},          {"low", bound(display.low)},
                             {"high", bound(display.high)},               {"colourLow", bound(display.colourLow)},
                             {"colourHigh", bound(display.colourHigh)}, {"symmetric", display.symmetric}};
+        json properties = json::array();
+        for (const auto& [key, value] : item.properties)
+            properties.push_back({key.toStdString(), value.toStdString()});
         entities.push_back({{"id", id},
                             {"name", item.name.toStdString()},
                             {"parent", item.parent},
@@ -151,6 +154,7 @@ bool SessionController::save(const QString& qpath)
                             {"outside", item.display.outside == FieldColouring::Outside::Grey ? "grey" : "hide"},
                             {"fields", fields},
                             {"kind", item.isGroup() ? "group" : item.isDrawing() ? "drawing" : "data"},
+                            {"properties", properties},
                             {"provenance", provenanceJson(item.points())}});
     }
     json scales = json::array();
@@ -225,6 +229,7 @@ bool SessionController::restore(const QString& qpath)
         io::Entity entity;
         std::optional<Drawing> drawing;
         bool group = false;
+        Document::Properties properties;
     };
     std::vector<Entry> entries;
     std::vector<ColourScale> scales;
@@ -253,6 +258,9 @@ bool SessionController::restore(const QString& qpath)
                 entry.pointSize = e.value("pointSize", 0.0f);
                 entry.outside = e.value("outside", std::string("hide")) == "grey" ? FieldColouring::Outside::Grey
                                                                                   : FieldColouring::Outside::Hide;
+                for (const json& row : e.value("properties", json::array()))
+                    entry.properties.emplace_back(QString::fromStdString(row.at(0).get<std::string>()),
+                                                  QString::fromStdString(row.at(1).get<std::string>()));
                 const json fields = e.value("fields", json::object()); // items() must not outlive it
                 for (const auto& [name, f] : fields.items()) {
                     FieldDisplay display;
@@ -317,7 +325,7 @@ bool SessionController::restore(const QString& qpath)
         const EntityId parentId = parent == newIds.end() ? kNoEntity : parent->second;
         const EntityId id = e.group     ? document_.addGroup(e.name, parentId, e.source)
                             : e.drawing ? document_.addDrawing(e.name, std::move(*e.drawing), parentId, e.source)
-                                        : document_.add(e.name, std::move(e.entity), parentId, e.source);
+                                        : document_.add(e.name, std::move(e.entity), parentId, e.source, std::move(e.properties));
         newIds[e.id] = id;
         for (const auto& [name, display] : e.fields)
             document_.setFieldDisplay(id, name, display);

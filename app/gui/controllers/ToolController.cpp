@@ -11,6 +11,7 @@
 #include <QElapsedTimer>
 
 #include <algorithm>
+#include <map>
 #include <QMessageBox>
 #include <QTimer>
 
@@ -141,6 +142,7 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
     EntityId last = kNoEntity;
     bool addedEntities = false, updatedInputs = false;
     NamedTables tables;
+    std::map<std::string, std::vector<EntityId>> addedByRole; // for the outputs that go under another's
     for (const OutputSpec& spec : tool_.outputs) {
         std::size_t repeat = 0;
         for (ToolOutput* output : result->findAll(spec.role)) {
@@ -176,7 +178,18 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
             const std::string& dataName = pointsOf(entity).name;
             const auto* mesh = std::get_if<Mesh>(&entity);
             const std::string name = mesh && !mesh->name.empty() ? mesh->name : dataName.empty() ? tool_.name : dataName;
-            last = document_.add(QString::fromStdString(name), std::move(entity), firstInput);
+            Document::Properties properties;
+            for (const auto& [key, value] : output->properties)
+                properties.emplace_back(QString::fromStdString(key), QString::fromStdString(value));
+            // A shape's surface goes under its points: the k-th entity of the output it belongs to.
+            EntityId parent = firstInput;
+            if (!spec.under.empty()) {
+                const std::vector<EntityId>& owners = addedByRole[spec.under];
+                if (k < owners.size())
+                    parent = owners[k];
+            }
+            last = document_.add(QString::fromStdString(name), std::move(entity), parent, {}, std::move(properties));
+            addedByRole[spec.role].push_back(last);
             addedEntities = true;
         }
     }

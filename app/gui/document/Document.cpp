@@ -15,17 +15,20 @@ const PointCloud& Document::Item::points() const
     return std::get<PointCloud>(entity);
 }
 
-EntityId Document::add(QString name, io::Entity entity, EntityId parent, QString sourcePath)
+EntityId Document::add(QString name, io::Entity entity, EntityId parent, QString sourcePath, Properties properties)
 {
     auto item = std::make_unique<Item>();
     item->id = nextId_++;
     item->name = std::move(name);
     item->entity = std::move(entity);
+    item->properties = std::move(properties);
     item->parent = contains(parent) ? parent : kNoEntity;
     item->sourcePath = std::move(sourcePath);
     item->unsaved = item->sourcePath.isEmpty();
-    // A grid (DEM of difference, raster) shows its difference or height, not its column numbers.
-    if (const PointCloud* cloud = item->cloud(); cloud && !cloud->fields().empty()) {
+    // A grid (DEM of difference, raster) shows its difference or height, not
+    // its column numbers. A mesh shows its vertices' first field too (a
+    // shape's surface, coloured by its primitive_id as its points are).
+    if (const PointCloud* cloud = item->hasData() ? &item->points() : nullptr; cloud && !cloud->fields().empty()) {
         const ScalarField* main = mainGridField(*cloud);
         item->display.activeField = main ? main->name() : cloud->fields().front().name();
     }

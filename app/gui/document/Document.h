@@ -77,6 +77,9 @@ public:
         //! A drawing a tool gave (contours, sections): its polylines, drawn
         //! over the clouds; `entity` is then an empty cloud, and cloud() null.
         std::shared_ptr<const Drawing> drawing;
+        //! What the tool that made it said of it (a shape's type, parameters and
+        //! uncertainties), listed in the Properties panel, in order.
+        std::vector<std::pair<QString, QString>> properties;
         //! A folder of the tree holding the parts of one file (the scans of an
         //! E57): no data of its own (`entity` is an empty cloud, cloud() null).
         bool group = false;
@@ -91,8 +94,10 @@ public:
         const PointCloud& points() const;
     };
 
+    using Properties = std::vector<std::pair<QString, QString>>;
     //! Takes ownership; returns the new id. A cloud's first scalar field becomes active.
-    EntityId add(QString name, io::Entity entity, EntityId parent = kNoEntity, QString sourcePath = {});
+    EntityId add(QString name, io::Entity entity, EntityId parent = kNoEntity, QString sourcePath = {},
+                 Properties properties = {});
     //! Takes a drawing (polylines and labels, global coordinates); returns its id.
     EntityId addDrawing(QString name, Drawing drawing, EntityId parent = kNoEntity, QString sourcePath = {});
     //! A group for the parts of one file; its children name it as their parent.

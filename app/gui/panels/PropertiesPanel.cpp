@@ -140,6 +140,13 @@ void PropertiesPanel::rebuild()
         add(nullptr, tr("Type"), item->mesh() ? tr("Mesh") : tr("Point cloud"));
         if (!item->sourcePath.isEmpty())
             add(nullptr, tr("File"), item->sourcePath);
+        if (!item->properties.empty()) {
+            // What the tool that made it said of it: a shape's parameters.
+            QTreeWidgetItem* described = add(nullptr, item->properties.front().first, item->properties.front().second);
+            for (std::size_t k = 1; k < item->properties.size(); ++k)
+                add(described, item->properties[k].first, item->properties[k].second);
+            described->setExpanded(true);
+        }
         add(nullptr, item->mesh() ? tr("Vertices") : tr("Points"), QString::number(points.size()));
         if (const Mesh* mesh = item->mesh())
             add(nullptr, tr("Triangles"), QString::number(mesh->triangles.size()));

@@ -7,8 +7,11 @@
 #include <scandiff/plugins/PluginRegistry.h>
 #include <scandiff/plugins/primitives/PrimitiveDetection.h>
 
+#include "ShapeSurfaces.h"
+
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -113,6 +116,72 @@ std::string primitivesJson(const PrimitiveDetectionResult& result)
     return nlohmann::json({{"primitives", list}}).dump(1) + "\n";
 }
 
+std::string number(double v)
+{
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", v);
+    return text;
+}
+
+//! World coordinates to the millimetre (UTM-sized values keep every digit that matters).
+std::string triple(const Eigen::Vector3d& v)
+{
+    char text[96];
+    std::snprintf(text, sizeof text, "%.4f, %.4f, %.4f", v.x(), v.y(), v.z());
+    return text;
+}
+
+std::string direction(const Eigen::Vector3d& v)
+{
+    char text[96];
+    std::snprintf(text, sizeof text, "%.6f, %.6f, %.6f", v.x(), v.y(), v.z());
+    return text;
+}
+
+//! What the workbench's Properties panel lists for a shape: the same values
+//! as its row of the table and its entry of the JSON document.
+OutputProperties shapeProperties(const DetectedPrimitive& s)
+{
+    const Primitive& p = s.primitive;
+    OutputProperties rows = {{"Shape", std::string(primitiveKindName(p.kind)) + " " + std::to_string(s.id)},
+                             {"Inliers", std::to_string(s.inliers.size())},
+                             {"RMS (m)", number(s.rms)},
+                             {"Area (m²)", number(s.area)}};
+    switch (p.kind) {
+    case PrimitiveKind::Plane:
+        rows.push_back({"Normal", direction(p.direction.normalized())});
+        rows.push_back({"d (n·x + d = 0)", number(-p.direction.normalized().dot(p.point))});
+        rows.push_back({"Point", triple(p.point)});
+        break;
+    case PrimitiveKind::Sphere:
+        rows.push_back({"Centre", triple(p.point)});
+        rows.push_back({"Radius (m)", number(p.radius)});
+        break;
+    case PrimitiveKind::Cylinder:
+        rows.push_back({"Axis point", triple(p.point)});
+        rows.push_back({"Axis direction", direction(p.direction)});
+        rows.push_back({"Radius (m)", number(p.radius)});
+        rows.push_back({"Length (m)", number(s.length)});
+        break;
+    case PrimitiveKind::Cone:
+        rows.push_back({"Apex", triple(p.point)});
+        rows.push_back({"Axis direction", direction(p.direction)});
+        rows.push_back({"Half-angle (°)", number(p.halfAngle * kDegrees)});
+        rows.push_back({"Length (m)", number(s.length)});
+        break;
+    case PrimitiveKind::Torus:
+        rows.push_back({"Centre", triple(p.point)});
+        rows.push_back({"Axis direction", direction(p.direction)});
+        rows.push_back({"Major radius (m)", number(p.radius)});
+        rows.push_back({"Minor radius (m)", number(p.minorRadius)});
+        break;
+    }
+    for (const auto& [name, value] : s.uncertainty)
+        if (std::isfinite(value))
+            rows.push_back({"σ " + name, number(value)});
+    return rows;
+}
+
 //! Each plane's concave outline (and the outlines of its separate parts) in
 //! its own plane, lifted back to 3D, on a layer per shape (PLANE_0003): the
 //! drawing of a façade's or a room's planes for CAD. The outline grid is the
@@ -179,7 +248,7 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
         "region growing (CGAL's), splits each shape into connected parts, merges touching parts of one surface, keeps a curved shape only where it fits its points clearly better than a plane, and "
         "refits every shape by least squares with the uncertainty of its parameters. Adds primitive_id (-1: none), "
         "primitive_type (0 plane, 1 sphere, 2 cylinder, 3 cone, 4 torus) and primitive_distance to the cloud; gives one cloud "
-        "per shape, a table of their parameters and the planes' outlines as a drawing (DXF, a layer per plane). Normals are fitted when the cloud has none (within 10 x the noise).";
+        "per shape with its surface as a mesh (the part its points cover), a table of their parameters and the planes' outlines as a drawing (DXF, a layer per plane). Normals are fitted when the cloud has none (within 10 x the noise).";
     tool.parameters = {
         ParameterSpec::choice("method", "Method",
                               "efficient-ransac: every shape type, from random samples (seeded); region-growing: planes grown from "
@@ -214,9 +283,12 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
                             defaults.orientationToleranceDegrees, 0.01, 44.9, "deg")
             .onlyWith("method=sequential"),
     };
-    // With --out-dir: primitives.ply, TYPE_ID.ply, primitives.csv, primitives.dxf, primitives.json.
+    // With --out-dir: primitives.ply, TYPE_ID.ply, TYPE_surface_ID.ply, primitives.csv, primitives.dxf, primitives.json.
+    OutputSpec surface{"surface", "Shape surface", DataKind::Mesh, false, true};
+    surface.under = "shape";
     tool.outputs = {OutputSpec{"primitives", "Cloud with primitive fields", DataKind::Cloud, true},
                     OutputSpec{"shape", "Shape", DataKind::Cloud, false, true},
+                    surface,
                     OutputSpec{"table", "Primitives", DataKind::Table, false, false, "primitives"},
                     OutputSpec{"outlines", "Plane outlines", DataKind::Drawing, false, false, "primitives"},
                     OutputSpec{"document", "Primitives (JSON)", DataKind::Document, false, false, "primitives"}};
@@ -253,11 +325,22 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
             distance[i] = detected.distance[i];
         }
         result.add("primitives", std::move(labelled));
+        ProgressTicker surfaces(progress, "Primitives: shape surfaces", detected.primitives.size());
         for (const DetectedPrimitive& shape : detected.primitives) {
+            surfaces.checkCancel();
+            surfaces.step();
             std::vector<std::size_t> indices(shape.inliers.begin(), shape.inliers.end());
             PointCloud part = input.subset(indices);
-            part.name = primitiveKindName(shape.primitive.kind); // the CLI adds the shape's id: plane_0.ply
-            result.add("shape", std::move(part));
+            const std::string kind = primitiveKindName(shape.primitive.kind);
+            part.name = kind; // the CLI adds the shape's id: plane_0.ply
+            result.add("shape", std::move(part), shapeProperties(shape));
+            // Its surface, coloured as its points are by primitive_id (one colour per shape).
+            Mesh mesh = shapeSurface(shape.primitive, input, shape.inliers, shapeCellSize(input, shape.inliers));
+            mesh.name = kind + "_surface";
+            mesh.vertices.addField(ScalarField("primitive_id", mesh.vertices.size()));
+            std::fill(mesh.vertices.field("primitive_id")->values().begin(), mesh.vertices.field("primitive_id")->values().end(),
+                      static_cast<float>(shape.id));
+            result.add("surface", std::move(mesh), shapeProperties(shape));
         }
         result.add("table", primitivesTable(detected));
         result.add("outlines", planeOutlines(input, detected, progress));

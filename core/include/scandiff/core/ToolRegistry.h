@@ -20,6 +20,7 @@
 #include <map>
 #include <string>
 #include <variant>
+#include <utility>
 #include <vector>
 
 namespace scandiff {
@@ -183,6 +184,10 @@ struct OutputSpec
     //! role): outputs of different kinds may share one ("stones" gives
     //! stones.ply, stones.dxf and stones.csv).
     std::string fileStem = {};
+    //! A repeated output whose k-th entity belongs to the k-th of another
+    //! repeated output (a shape's surface and its points): the workbench lists
+    //! it under that one instead of under the input. Empty: under the input.
+    std::string under = {};
 };
 
 //! The entities a run gets, by role. It only refers to them: they belong to
@@ -214,10 +219,15 @@ private:
 
 using OutputData = std::variant<PointCloud, Mesh, Table, Eigen::Matrix4d, Drawing, TextDocument>;
 
+//! Named values describing one output (a shape's type, parameters and
+//! uncertainties), in order: the workbench lists them in its Properties panel.
+using OutputProperties = std::vector<std::pair<std::string, std::string>>;
+
 struct ToolOutput
 {
     std::string role;
     OutputData data;
+    OutputProperties properties = {};
 };
 
 //! A value worth seeing on the histogram of an input's field: a threshold
@@ -237,7 +247,7 @@ struct ToolResult
     //! Shown by the workbench on the field's histogram (dashed, labelled); the CLI's summary says them.
     std::vector<FieldMark> marks;
 
-    ToolResult& add(std::string role, OutputData data);
+    ToolResult& add(std::string role, OutputData data, OutputProperties properties = {});
     //! Null when the run produced no output of that role (the first, for a repeated role).
     const ToolOutput* find(const std::string& role) const;
     ToolOutput* find(const std::string& role);
