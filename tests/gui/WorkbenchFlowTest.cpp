@@ -344,6 +344,7 @@ private slots:
                 ++shapes;
                 QVERIFY(!item.properties.empty());
                 QCOMPARE(item.properties.front().first, QString("Shape"));
+                QCOMPARE(item.display.activeField, std::string("primitive_id")); // one colour per shape
             }
             if (!item.mesh())
                 continue;

@@ -418,6 +418,9 @@ TEST(Primitives, EachShapeHasItsSurfaceAsAMeshOnTheShapeOverItsPoints)
         ASSERT_FALSE(surfaces[k]->properties.empty());
         EXPECT_EQ(surfaces[k]->properties.front().second, type + " " + std::to_string(k));
         EXPECT_EQ(shapes[k]->properties, surfaces[k]->properties);
+        const PointCloud& points = std::get<PointCloud>(shapes[k]->data);
+        ASSERT_NE(points.field("primitive_distance"), nullptr); // the shape's points keep every field
+        EXPECT_EQ(points.field("primitive_id")->value(0), static_cast<double>(k));
         ASSERT_GT(mesh.triangles.size(), 0u) << type << " " << k;
         EXPECT_EQ(mesh.countDegenerateTriangles(), 0u);
         // One colour per shape: its id on every vertex.

@@ -189,6 +189,8 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
                     parent = owners[k];
             }
             last = document_.add(QString::fromStdString(name), std::move(entity), parent, {}, std::move(properties));
+            if (!spec.showsField.empty())
+                document_.setActiveField(last, spec.showsField); // ignored when it has no such field
             addedByRole[spec.role].push_back(last);
             addedEntities = true;
         }

@@ -284,11 +284,12 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
             .onlyWith("method=sequential"),
     };
     // With --out-dir: primitives.ply, TYPE_ID.ply, TYPE_surface_ID.ply, primitives.csv, primitives.dxf, primitives.json.
+    OutputSpec shape{"shape", "Shape", DataKind::Cloud, false, true};
+    shape.showsField = "primitive_id";
     OutputSpec surface{"surface", "Shape surface", DataKind::Mesh, false, true};
     surface.under = "shape";
-    tool.outputs = {OutputSpec{"primitives", "Cloud with primitive fields", DataKind::Cloud, true},
-                    OutputSpec{"shape", "Shape", DataKind::Cloud, false, true},
-                    surface,
+    surface.showsField = "primitive_id";
+    tool.outputs = {OutputSpec{"primitives", "Cloud with primitive fields", DataKind::Cloud, true}, shape, surface,
                     OutputSpec{"table", "Primitives", DataKind::Table, false, false, "primitives"},
                     OutputSpec{"outlines", "Plane outlines", DataKind::Drawing, false, false, "primitives"},
                     OutputSpec{"document", "Primitives (JSON)", DataKind::Document, false, false, "primitives"}};
@@ -324,13 +325,18 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
                           : static_cast<float>(detected.primitives[static_cast<std::size_t>(detected.primitiveId[i])].primitive.kind);
             distance[i] = detected.distance[i];
         }
+        // Each shape's points with every field, the primitive ones included.
+        std::vector<PointCloud> parts;
+        for (const DetectedPrimitive& shape : detected.primitives) {
+            std::vector<std::size_t> indices(shape.inliers.begin(), shape.inliers.end());
+            parts.push_back(labelled.subset(indices));
+        }
         result.add("primitives", std::move(labelled));
         ProgressTicker surfaces(progress, "Primitives: shape surfaces", detected.primitives.size());
         for (const DetectedPrimitive& shape : detected.primitives) {
             surfaces.checkCancel();
             surfaces.step();
-            std::vector<std::size_t> indices(shape.inliers.begin(), shape.inliers.end());
-            PointCloud part = input.subset(indices);
+            PointCloud& part = parts[static_cast<std::size_t>(&shape - detected.primitives.data())];
             const std::string kind = primitiveKindName(shape.primitive.kind);
             part.name = kind; // the CLI adds the shape's id: plane_0.ply
             result.add("shape", std::move(part), shapeProperties(shape));

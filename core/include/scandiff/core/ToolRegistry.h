@@ -188,6 +188,10 @@ struct OutputSpec
     //! repeated output (a shape's surface and its points): the workbench lists
     //! it under that one instead of under the input. Empty: under the input.
     std::string under = {};
+    //! The field the workbench shows first on this output's entities (a
+    //! shape's points and surface by primitive_id, one colour per shape),
+    //! when they have it. Empty: their first field.
+    std::string showsField = {};
 };
 
 //! The entities a run gets, by role. It only refers to them: they belong to
