@@ -8,11 +8,12 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/segmentation/RegionReport.h>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
-#include <set>
 #include <utility>
 
 namespace scandiff::plugins {
@@ -21,8 +22,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr std::int64_t kMaxCells = 2048;
-
-using Cell = std::pair<std::int64_t, std::int64_t>;
 
 //! A shape's own coordinates (u, v) and the way back to the surface. u turns
 //! around the axis on every curved shape (periodic); v runs along the axis,
@@ -89,55 +88,91 @@ private:
     Eigen::Vector3d axis_, e1_, e2_;
 };
 
-std::int64_t wrap(std::int64_t i, std::int64_t n)
+//! The cells of the unrolled surface, in a dense array: an axis that turns
+//! (a periodic angle) has `count` cells and wraps; an open axis (a plane's, a
+//! cylinder's height) has its cells plus one empty cell of margin on each
+//! side, so that the closing never leaves the array; a sphere's colatitude
+//! has its cells and ends at the poles.
+class Grid
 {
-    return ((i % n) + n) % n;
-}
+public:
+    enum class Axis { Open, Periodic, Bounded };
 
-//! The cells of a grid with `countU` (`countV`) cells around a periodic axis.
-struct Grid
-{
-    bool periodicU = false, periodicV = false, boundedV = false;
-    std::int64_t countU = 0, countV = 0;
-
-    //! The cell's neighbour (di, dj) away, folded onto the grid; false off a bounded edge.
-    bool neighbour(const Cell& c, int di, int dj, Cell& out) const
+    Grid(Axis u, std::int64_t countU, Axis v, std::int64_t countV) : axis_{u, v}
     {
-        std::int64_t i = c.first + di, j = c.second + dj;
-        if (periodicU)
-            i = wrap(i, countU);
-        if (periodicV)
-            j = wrap(j, countV);
-        else if (boundedV && (j < 0 || j >= countV))
-            return false;
-        out = {i, j};
-        return true;
+        size_[0] = countU + (u == Axis::Open ? 2 : 0);
+        size_[1] = countV + (v == Axis::Open ? 2 : 0);
+        occupied_.assign(static_cast<std::size_t>(size_[0] * size_[1]), 0);
     }
+    //! The margin before cell 0 along an axis.
+    std::int64_t pad(int a) const { return axis_[a] == Axis::Open ? 1 : 0; }
+    std::int64_t size(int a) const { return size_[a]; }
+    bool periodic(int a) const { return axis_[a] == Axis::Periodic; }
+    void occupy(std::int64_t i, std::int64_t j) { occupied_[index(i + pad(0), j + pad(1))] = 1; }
 
     //! Closing with a 3 x 3 square: the one-cell gaps of the sampling filled,
-    //! the outer edge where it was (a missing neighbour off a bounded edge erodes nothing).
-    std::set<Cell> close(const std::set<Cell>& occupied) const
+    //! the outer edge where it was (a missing neighbour past a pole erodes
+    //! nothing). The closed cells in array order, as (i, j) with the margin.
+    std::vector<std::pair<std::int64_t, std::int64_t>> closed() const
     {
-        std::set<Cell> dilated;
-        Cell n;
-        for (const Cell& c : occupied)
-            for (int di = -1; di <= 1; ++di)
-                for (int dj = -1; dj <= 1; ++dj)
-                    if (neighbour(c, di, dj, n))
-                        dilated.insert(n);
-        std::set<Cell> closed;
-        for (const Cell& c : dilated) {
-            bool inside = true;
-            for (int di = -1; di <= 1 && inside; ++di)
-                for (int dj = -1; dj <= 1 && inside; ++dj)
-                    inside = !neighbour(c, di, dj, n) || dilated.count(n) != 0;
-            if (inside)
-                closed.insert(c);
-        }
-        // The erosion never removes an occupied cell: closing only adds.
-        closed.insert(occupied.begin(), occupied.end());
-        return closed;
+        std::vector<std::uint8_t> dilated(occupied_.size(), 0);
+        for (std::int64_t j = 0; j < size_[1]; ++j)
+            for (std::int64_t i = 0; i < size_[0]; ++i)
+                if (occupied_[index(i, j)])
+                    for (int dj = -1; dj <= 1; ++dj)
+                        for (int di = -1; di <= 1; ++di)
+                            if (const auto n = neighbour(i + di, j + dj); n.inside)
+                                dilated[index(n.i, n.j)] = 1;
+        std::vector<std::pair<std::int64_t, std::int64_t>> cells;
+        for (std::int64_t j = 0; j < size_[1]; ++j)
+            for (std::int64_t i = 0; i < size_[0]; ++i) {
+                if (!dilated[index(i, j)])
+                    continue;
+                bool inside = occupied_[index(i, j)] != 0; // closing only adds
+                if (!inside) {
+                    inside = true;
+                    for (int dj = -1; dj <= 1 && inside; ++dj)
+                        for (int di = -1; di <= 1 && inside; ++di) {
+                            const auto n = neighbour(i + di, j + dj);
+                            inside = n.inside ? dilated[index(n.i, n.j)] != 0 : n.pastPole;
+                        }
+                }
+                if (inside)
+                    cells.emplace_back(i, j);
+            }
+        return cells;
     }
+
+    //! (i, j) folded around the periodic axes; `inside` false off the array.
+    struct Place
+    {
+        std::int64_t i = 0, j = 0;
+        bool inside = false, pastPole = false;
+    };
+    Place neighbour(std::int64_t i, std::int64_t j) const
+    {
+        Place p;
+        std::int64_t at[2] = {i, j};
+        for (int a = 0; a < 2; ++a) {
+            if (periodic(a))
+                at[a] = ((at[a] % size_[a]) + size_[a]) % size_[a];
+            else if (at[a] < 0 || at[a] >= size_[a]) {
+                p.pastPole = axis_[a] == Axis::Bounded;
+                return p;
+            }
+        }
+        p.i = at[0];
+        p.j = at[1];
+        p.inside = true;
+        return p;
+    }
+
+private:
+    std::size_t index(std::int64_t i, std::int64_t j) const { return static_cast<std::size_t>(j * size_[0] + i); }
+
+    Axis axis_[2];
+    std::int64_t size_[2];
+    std::vector<std::uint8_t> occupied_;
 };
 
 } // namespace
@@ -166,12 +201,18 @@ Mesh shapeSurface(const Primitive& primitive, const PointCloud& cloud, const std
     if (!(cellSize > 0.0) || !std::isfinite(cellSize))
         throw Error(ErrorCode::InvalidArgument, "shape surface: the cell size must be > 0");
     const Unrolling unrolling(primitive);
+    // Each inlier's coordinates on the shape (both cores; a plane's ground holds most of a scan).
+    std::vector<Eigen::Vector2d> all(inliers.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, inliers.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k)
+            all[k] = unrolling.coordinates(cloud.globalPosition(inliers[k]));
+    });
     std::vector<Eigen::Vector2d> uv;
-    uv.reserve(inliers.size());
+    uv.reserve(all.size());
     Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     std::vector<double> heights;
-    for (const std::uint32_t i : inliers) {
-        const Eigen::Vector2d c = unrolling.coordinates(cloud.globalPosition(i));
+    heights.reserve(all.size());
+    for (const Eigen::Vector2d& c : all) {
         if (!c.allFinite())
             continue;
         uv.push_back(c);
@@ -188,54 +229,58 @@ Mesh shapeSurface(const Primitive& primitive, const PointCloud& cloud, const std
 
     // Steps in u and v: a whole number of cells around a periodic axis; a
     // coarser cell where the grid would pass kMaxCells a side.
-    Grid grid;
-    grid.periodicU = unrolling.periodicU();
-    grid.periodicV = unrolling.periodicV();
-    grid.boundedV = unrolling.boundedV();
-    auto steps = [&](double periodOrExtent, double metresPerUnit, bool periodic, std::int64_t& count) {
-        const double cells = std::clamp(periodOrExtent * std::max(metresPerUnit, 1e-12) / cellSize, 1.0, double(kMaxCells));
-        count = std::max<std::int64_t>(periodic ? 3 : 1, static_cast<std::int64_t>(std::ceil(cells)));
-        return periodic ? periodOrExtent / static_cast<double>(count) : std::max(periodOrExtent / cells, cellSize / metresPerUnit);
+    const Grid::Axis axisU = unrolling.periodicU() ? Grid::Axis::Periodic : Grid::Axis::Open;
+    const Grid::Axis axisV = unrolling.periodicV() ? Grid::Axis::Periodic : unrolling.boundedV() ? Grid::Axis::Bounded : Grid::Axis::Open;
+    auto steps = [&](double span, double metresPerUnit, Grid::Axis axis, std::int64_t& count) {
+        const double cells = std::clamp(span * std::max(metresPerUnit, 1e-12) / cellSize, 1.0, double(kMaxCells));
+        if (axis != Grid::Axis::Open) {
+            count = std::max<std::int64_t>(3, static_cast<std::int64_t>(std::ceil(cells)));
+            return span / static_cast<double>(count);
+        }
+        const double step = std::max(span / cells, cellSize / metresPerUnit);
+        count = static_cast<std::int64_t>(std::floor(span / step)) + 1;
+        return step;
     };
-    const double du = steps(grid.periodicU ? 2 * kPi : hi.x() - lo.x(), metres.x(), grid.periodicU, grid.countU);
-    const double dv = steps(grid.periodicV ? 2 * kPi : grid.boundedV ? kPi : hi.y() - lo.y(), metres.y(),
-                            grid.periodicV || grid.boundedV, grid.countV);
+    std::int64_t countU = 0, countV = 0;
+    const double du = steps(axisU == Grid::Axis::Periodic ? 2 * kPi : hi.x() - lo.x(), metres.x(), axisU, countU);
+    const double dv = steps(axisV == Grid::Axis::Periodic ? 2 * kPi : axisV == Grid::Axis::Bounded ? kPi : hi.y() - lo.y(), metres.y(),
+                            axisV, countV);
     // Where cell (0, 0) starts: -pi on an angle, the inliers' low corner otherwise.
-    const double u0 = grid.periodicU ? -kPi : lo.x();
-    const double v0 = grid.periodicV ? -kPi : grid.boundedV ? 0.0 : lo.y();
+    const double u0 = axisU == Grid::Axis::Periodic ? -kPi : lo.x();
+    const double v0 = axisV == Grid::Axis::Periodic ? -kPi : axisV == Grid::Axis::Bounded ? 0.0 : lo.y();
 
-    std::set<Cell> occupied;
+    Grid grid(axisU, countU, axisV, countV);
     for (const Eigen::Vector2d& c : uv) {
         std::int64_t i = static_cast<std::int64_t>(std::floor((c.x() - u0) / du));
         std::int64_t j = static_cast<std::int64_t>(std::floor((c.y() - v0) / dv));
-        if (grid.periodicU)
-            i = wrap(i, grid.countU);
-        if (grid.periodicV)
-            j = wrap(j, grid.countV);
-        else if (grid.boundedV)
-            j = std::clamp<std::int64_t>(j, 0, grid.countV - 1);
-        occupied.insert({i, j});
+        // Rounding may put the last point one cell out; an angle wraps.
+        i = axisU == Grid::Axis::Periodic ? ((i % countU) + countU) % countU : std::clamp<std::int64_t>(i, 0, countU - 1);
+        j = axisV == Grid::Axis::Periodic ? ((j % countV) + countV) % countV : std::clamp<std::int64_t>(j, 0, countV - 1);
+        grid.occupy(i, j);
     }
-    const std::set<Cell> cells = grid.close(occupied);
+    const auto cells = grid.closed();
 
-    // Corners shared between cells (folded around periodic axes), each made once.
-    std::map<Cell, std::uint32_t> cornerIndex;
+    // Corners shared between cells (folded around periodic axes), each made
+    // once: a dense index over the grid's corners.
+    const std::int64_t cornersU = grid.size(0) + 1, cornersV = grid.size(1) + 1;
+    std::vector<std::uint32_t> cornerIndex(static_cast<std::size_t>(cornersU * cornersV), std::numeric_limits<std::uint32_t>::max());
     std::vector<Eigen::Vector3f> positions;
     auto corner = [&](std::int64_t i, std::int64_t j) {
-        if (grid.periodicU)
-            i = wrap(i, grid.countU);
-        if (grid.periodicV)
-            j = wrap(j, grid.countV);
-        const auto [at, added] = cornerIndex.emplace(Cell{i, j}, static_cast<std::uint32_t>(positions.size()));
-        if (added) {
-            const Eigen::Vector3d p = unrolling.point(u0 + static_cast<double>(i) * du, v0 + static_cast<double>(j) * dv);
+        if (grid.periodic(0))
+            i %= grid.size(0);
+        if (grid.periodic(1))
+            j %= grid.size(1);
+        std::uint32_t& slot = cornerIndex[static_cast<std::size_t>(j * cornersU + i)];
+        if (slot == std::numeric_limits<std::uint32_t>::max()) {
+            slot = static_cast<std::uint32_t>(positions.size());
+            const Eigen::Vector3d p = unrolling.point(u0 + static_cast<double>(i - grid.pad(0)) * du,
+                                                      v0 + static_cast<double>(j - grid.pad(1)) * dv);
             positions.push_back((p - cloud.origin()).cast<float>());
         }
-        return at->second;
+        return slot;
     };
-    for (const Cell& c : cells) {
-        const std::uint32_t a = corner(c.first, c.second), b = corner(c.first + 1, c.second),
-                            d = corner(c.first + 1, c.second + 1), e = corner(c.first, c.second + 1);
+    for (const auto& [i, j] : cells) {
+        const std::uint32_t a = corner(i, j), b = corner(i + 1, j), d = corner(i + 1, j + 1), e = corner(i, j + 1);
         for (const Triangle& t : {Triangle{a, b, d}, Triangle{a, d, e}}) {
             // A sphere's cells at a pole have two corners on it: that triangle has no area.
             const Eigen::Vector3f ab = positions[t[1]] - positions[t[0]], ac = positions[t[2]] - positions[t[0]];
