@@ -1157,13 +1157,27 @@ private:
         return ptr;
     }
 
-    //! The records [first, first + count) of `vertexElement` (cut at its end) as an element of their own.
-    static PlyElement recordsOf(const PlyElement& vertexElement, RecordRange range, std::uint64_t& first)
+    //! Where the range's records lie: the vertex element's records, the
+    //! range's first one, the file's end, and the range (cut at the
+    //! element's end) as an element of its own.
+    struct RangeRecords
     {
-        first = std::min(range.first, vertexElement.count);
-        PlyElement part = vertexElement;
-        part.count = std::min(range.count, vertexElement.count - first);
-        return part;
+        const char* all = nullptr;
+        const char* first = nullptr;
+        const char* end = nullptr;
+        PlyElement part;
+    };
+    template <bool Swap>
+    RangeRecords rangeRecords(const PlyElement& vertexElement)
+    {
+        RangeRecords r;
+        r.end = file_.data() + file_.size();
+        r.all = vertexRecords<Swap>(vertexElement, r.end);
+        const std::uint64_t first = std::min(range_->first, vertexElement.count);
+        r.first = r.all + first * vertexElement.minRecordSize();
+        r.part = vertexElement;
+        r.part.count = std::min(range_->count, vertexElement.count - first);
+        return r;
     }
 
     //! The box of the coordinates of `part`'s records, which start at `ptr`
@@ -1189,20 +1203,15 @@ private:
     template <bool Swap>
     void readBinaryRange(const PlyElement& vertexElement)
     {
-        const char* end = file_.data() + file_.size();
-        const char* ptr = vertexRecords<Swap>(vertexElement, end);
-        std::uint64_t first = 0;
-        const PlyElement part = recordsOf(vertexElement, *range_, first);
-        const std::size_t recordSize = vertexElement.minRecordSize();
-
+        const RangeRecords r = rangeRecords<Swap>(vertexElement);
         std::optional<Eigen::Vector3d> origin = options_.origin;
         ProgressTicker ticker(options_.progress, "Reading " + path_.filename().string(),
-                              part.count + (!origin && layout_.coordinatesAreDouble ? vertexElement.count : 0));
+                              r.part.count + (!origin && layout_.coordinatesAreDouble ? vertexElement.count : 0));
         if (!origin && layout_.coordinatesAreDouble)
-            origin = suggestOrigin(coordinateBox<Swap>(vertexElement, ptr, end, ticker));
+            origin = suggestOrigin(coordinateBox<Swap>(vertexElement, r.all, r.end, ticker));
         const bool wideFields =
             std::find(layout_.fieldIsWide.begin(), layout_.fieldIsWide.end(), true) != layout_.fieldIsWide.end();
-        readBinaryVertexElement<Swap>(part, ptr + first * recordSize, end, ticker, wideFields,
+        readBinaryVertexElement<Swap>(r.part, r.first, r.end, ticker, wideFields,
                                       origin ? origin : std::optional<Eigen::Vector3d>(Eigen::Vector3d::Zero()));
     }
 
@@ -1224,12 +1233,9 @@ private:
     template <bool Swap>
     BoundingBox rangeBox(const PlyElement& vertexElement)
     {
-        const char* end = file_.data() + file_.size();
-        const char* ptr = vertexRecords<Swap>(vertexElement, end);
-        std::uint64_t first = 0;
-        const PlyElement part = recordsOf(vertexElement, *range_, first);
-        ProgressTicker ticker(nullptr, "", part.count);
-        return coordinateBox<Swap>(part, ptr + first * vertexElement.minRecordSize(), end, ticker);
+        const RangeRecords r = rangeRecords<Swap>(vertexElement);
+        ProgressTicker ticker(nullptr, "", r.part.count);
+        return coordinateBox<Swap>(r.part, r.first, r.end, ticker);
     }
 
     const PlyElement& findVertexElement() const
