@@ -3,6 +3,7 @@
 
 #include <scandiff/core/Error.h>
 
+#include <exception>
 #include <limits>
 #include <numeric>
 
@@ -33,26 +34,34 @@ ChunkedCloud::ChunkedCloud(const Communicator& c, const io::FormatRegistry& form
 
 Eigen::Vector3d ChunkedCloud::chooseOrigin(const Communicator& c) const
 {
-    // The whole file's box is the union of the ranks' shares' boxes; whether
+    // The whole file's box is its shares' boxes joined axis by axis; whether
     // one is needed depends on the header alone, so every rank agrees.
     std::optional<BoundingBox> box;
     if (!options_.origin) {
         const auto ranks = static_cast<std::uint64_t>(c.size()), rank = static_cast<std::uint64_t>(c.rank());
         const std::uint64_t begin = records_ * rank / ranks, end = records_ * (rank + 1) / ranks;
-        box = io::pointRecordBounds(formats_, path_, {begin, end - begin});
+        // A failure on some ranks only (their share unreadable) must not leave
+        // the others waiting in the reduction: every rank learns of it.
+        std::exception_ptr failure;
+        try {
+            box = io::pointRecordBounds(formats_, path_, {begin, end - begin});
+        } catch (...) {
+            failure = std::current_exception();
+        }
+        int failed = failure ? 1 : 0;
+        MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, c.comm);
+        if (failure)
+            std::rethrow_exception(failure);
+        if (failed)
+            throw Error(ErrorCode::Io, path_.string() + ": another rank could not read its share of the points");
     }
     if (!box) { // given, or fixed by the header: the first record tells it
         io::ReadOptions firstOptions = options_;
         firstOptions.geometryOnly = true;
         return io::readPointRecords(formats_, path_, {0, 1}, firstOptions).origin();
     }
-    const double infinity = std::numeric_limits<double>::infinity();
-    double lo[3] = {infinity, infinity, infinity}, hi[3] = {-infinity, -infinity, -infinity};
-    if (!box->empty)
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = box->min[a];
-            hi[a] = box->max[a];
-        }
+    // Each axis's range, +inf/-inf where the share has none.
+    double lo[3] = {box->min.x(), box->min.y(), box->min.z()}, hi[3] = {box->max.x(), box->max.y(), box->max.z()};
     MPI_Allreduce(MPI_IN_PLACE, lo, 3, MPI_DOUBLE, MPI_MIN, c.comm);
     MPI_Allreduce(MPI_IN_PLACE, hi, 3, MPI_DOUBLE, MPI_MAX, c.comm);
     BoundingBox whole;

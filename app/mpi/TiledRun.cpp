@@ -380,10 +380,23 @@ bool writeInPlace(const Communicator& c, const io::FormatRegistry& formats, cons
 {
     const std::size_t chunks = owned.chunkStarts.size() - 1, planeCount = planes.size();
     const auto ranks = static_cast<std::size_t>(c.size()), rank = static_cast<std::size_t>(c.rank());
+    // Counted in records (an offset and a value per plane), not bytes: a
+    // round sends up to N chunks of values, which in bytes would pass an
+    // int's range on a large cluster.
+    MPI_Datatype record;
+    MPI_Type_contiguous(static_cast<int>(1 + planeCount), MPI_UINT32_T, &record);
+    MPI_Type_commit(&record);
+    struct FreeType
+    {
+        MPI_Datatype& type;
+        ~FreeType() { MPI_Type_free(&type); }
+    } freeRecord{record};
+    const std::size_t stride = 1 + planeCount;
     std::unique_ptr<io::PlacedChunkWriter> writer;
     std::vector<int> sendCounts(ranks), sendOffsets(ranks), receiveCounts(ranks), receiveOffsets(ranks);
     std::vector<std::uint32_t> sendWords, receiveWords;
     std::size_t next = 0;
+    std::uint64_t written = 0;
     for (std::size_t round = 0; round * ranks < chunks; ++round) {
         // Every rank's values for chunk qN + s, to rank s.
         sendWords.clear();
@@ -392,8 +405,8 @@ bool writeInPlace(const Communicator& c, const io::FormatRegistry& formats, cons
             const std::size_t before = sendWords.size();
             if (k < chunks)
                 packChunkValues(owned, planes, owned.chunkStarts[k], owned.chunkStarts[k + 1], next, sendWords);
-            sendOffsets[s] = static_cast<int>(before * sizeof(std::uint32_t));
-            sendCounts[s] = static_cast<int>((sendWords.size() - before) * sizeof(std::uint32_t));
+            sendOffsets[s] = static_cast<int>(before / stride);
+            sendCounts[s] = static_cast<int>((sendWords.size() - before) / stride);
         }
         MPI_Alltoall(sendCounts.data(), 1, MPI_INT, receiveCounts.data(), 1, MPI_INT, c.comm);
         std::size_t total = 0;
@@ -401,9 +414,9 @@ bool writeInPlace(const Communicator& c, const io::FormatRegistry& formats, cons
             receiveOffsets[r] = static_cast<int>(total);
             total += static_cast<std::size_t>(receiveCounts[r]);
         }
-        receiveWords.resize(total / sizeof(std::uint32_t));
-        MPI_Alltoallv(sendWords.data(), sendCounts.data(), sendOffsets.data(), MPI_BYTE, receiveWords.data(),
-                      receiveCounts.data(), receiveOffsets.data(), MPI_BYTE, c.comm);
+        receiveWords.resize(total * stride);
+        MPI_Alltoallv(sendWords.data(), sendCounts.data(), sendOffsets.data(), record, receiveWords.data(), receiveCounts.data(),
+                      receiveOffsets.data(), record, c.comm);
 
         const std::size_t k = round * ranks + rank;
         PointCloud chunk = k < chunks ? cloud.read(k, false) : PointCloud();
@@ -427,18 +440,35 @@ bool writeInPlace(const Communicator& c, const io::FormatRegistry& formats, cons
                 return false;
             path.resize(static_cast<std::size_t>(length));
             MPI_Bcast(path.data(), static_cast<int>(length), MPI_CHAR, 0, c.comm);
-            // Every range of a file reads with the same attributes: a rank's own chunk lays its writer out as rank 0's.
-            if (rank != 0 && k < chunks)
-                writer = io::openPlacedChunkWriter(formats, output, path, chunk, owned.total(), write);
+            // Every range of a file reads with the same attributes: a rank's
+            // own chunk lays its writer out as rank 0's. A rank that cannot
+            // reach the file (not on a file system the ranks share) sends
+            // every rank back to rank 0 writing alone; rank 0's temporary goes.
+            int joined = 1;
+            if (rank != 0 && k < chunks) {
+                try {
+                    writer = io::openPlacedChunkWriter(formats, output, path, chunk, owned.total(), write);
+                } catch (const Error& e) {
+                    std::cerr << "warning: (rank " << rank << ") " << e.what() << "; rank 0 writes the output alone\n";
+                    joined = 0;
+                }
+            }
+            MPI_Allreduce(MPI_IN_PLACE, &joined, 1, MPI_INT, MPI_MIN, c.comm);
+            if (!joined)
+                return false;
         }
-        if (k < chunks)
+        if (k < chunks) {
             writer->write(owned.chunkStarts[k], chunk);
+            written += chunk.size();
+        }
     }
     if (writer)
         writer->close();
-    c.barrier(); // every rank's records are in the file
+    // Every rank's records are in the file; their count, not the file's size
+    // (which a shared file system may show late), says it is whole.
+    const std::uint64_t all = sumOverRanks(c, written);
     if (rank == 0)
-        writer->commit();
+        writer->commit(all);
     return true;
 }
 

@@ -144,8 +144,10 @@ int run(int argc, char** argv, const mpi::Communicator& world)
     } catch (const CLI::ParseError& e) {
         return world.rank() == 0 ? app.exit(e, std::cout, std::cerr) : e.get_exit_code();
     } catch (const Error& e) {
-        // Option and file errors arise on every rank alike, before any
-        // collective call: rank 0 says it, all return its status.
+        // Option and file errors arise on every rank alike (the one
+        // collective call before the run, the origin's box, tells every rank
+        // of a share one rank alone could not read): rank 0 says it, all
+        // return its status.
         if (world.rank() == 0)
             std::cerr << "error: " << e.what() << '\n';
         return e.exitStatus();

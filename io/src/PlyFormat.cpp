@@ -1185,6 +1185,13 @@ private:
     template <bool Swap>
     BoundingBox coordinateBox(const PlyElement& part, const char* ptr, const char* end, ProgressTicker& ticker)
     {
+        return coordinateRanges<Swap>(part, ptr, end, ticker).box();
+    }
+
+    //! Each axis's range of finite values (+inf/-inf where it has none).
+    template <bool Swap>
+    RangeAccumulator coordinateRanges(const PlyElement& part, const char* ptr, const char* end, ProgressTicker& ticker)
+    {
         VertexLayout coordinates = layout_;
         coordinates.slots.erase(std::remove_if(coordinates.slots.begin(), coordinates.slots.end(),
                                                [](const Slot& s) { return s.role < Role::X || s.role > Role::Z; }),
@@ -1197,7 +1204,7 @@ private:
         RangeAccumulator whole(0);
         for (const RangeAccumulator& chunk : perChunk)
             whole.merge(chunk);
-        return whole.box();
+        return whole;
     }
 
     template <bool Swap>
@@ -1235,7 +1242,13 @@ private:
     {
         const RangeRecords r = rangeRecords<Swap>(vertexElement);
         ProgressTicker ticker(nullptr, "", r.part.count);
-        return coordinateBox<Swap>(r.part, r.first, r.end, ticker);
+        const RangeAccumulator ranges = coordinateRanges<Swap>(r.part, r.first, r.end, ticker);
+        // Every axis's range, even where another has none: the parts of a
+        // file join axis by axis, as a whole read's ranges do.
+        BoundingBox box = ranges.box();
+        box.min = Eigen::Vector3d(ranges.lo[0], ranges.lo[1], ranges.lo[2]);
+        box.max = Eigen::Vector3d(ranges.hi[0], ranges.hi[1], ranges.hi[2]);
+        return box;
     }
 
     const PlyElement& findVertexElement() const
@@ -1534,6 +1547,7 @@ public:
         case Encoding::BinaryCompressed:
             throw Error(ErrorCode::InvalidArgument, path.string() + ": PLY has no compressed encoding");
         }
+        layout_ = {cloud.hasColors(), cloud.hasNormals(), cloud.fields().size(), cloud.origin()};
         const bool globalDoubles = cloud.origin() != Eigen::Vector3d::Zero();
         for (int a = 0; a < 3; ++a)
             columns_.push_back({std::string(1, static_cast<char>('x' + a)),
@@ -1606,10 +1620,10 @@ public:
     //! ...then the records of each chunk, a cloud with the same attributes.
     void writeChunk(std::ostream& out, const PointCloud& chunk, ProgressTicker& ticker)
     {
-        const bool sameAttributes = chunk.hasColors() == cloud_->hasColors() &&
-                                    chunk.hasNormals() == cloud_->hasNormals() &&
-                                    chunk.fields().size() == cloud_->fields().size() &&
-                                    chunk.origin() == cloud_->origin();
+        // Against the layout's attributes, kept as values: the cloud the
+        // writer was made from, or the last chunk, may be gone by now.
+        const bool sameAttributes = chunk.hasColors() == layout_.colours && chunk.hasNormals() == layout_.normals &&
+                                    chunk.fields().size() == layout_.fields && chunk.origin() == layout_.origin;
         if (!sameAttributes)
             throw Error(ErrorCode::InvalidArgument,
                         path_.string() + ": a chunk's colours, normals, fields or origin differ from the first chunk's");
@@ -1744,7 +1758,15 @@ private:
         out.write(text.data(), static_cast<std::streamsize>(text.size()));
     }
 
-    const PointCloud* cloud_;
+    //! The attributes every chunk must have (writeChunk).
+    struct Layout
+    {
+        bool colours = false, normals = false;
+        std::size_t fields = 0;
+        Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    };
+    Layout layout_;
+    const PointCloud* cloud_; //!< what writeRecords writes: the cloud, or the chunk being written
     const std::vector<Triangle>* triangles_;
     fs::path path_;
     const WriteOptions& options_;
@@ -1806,9 +1828,15 @@ public:
                         destination.string() + ": ASCII PLY records vary in size, so they cannot be written at their place");
         if (join.empty()) {
             file_.emplace(destination);
-            file_->stream().write(header_.data(), static_cast<std::streamsize>(header_.size()));
-            file_->stream().flush();
+            file_->stream().flush(); // the temporary exists, empty
             path_ = file_->tempPath();
+            // The header written and the file closed before anyone joins: a
+            // network file system shows other machines what was closed.
+            std::ofstream header(path_, std::ios::in | std::ios::out | std::ios::binary);
+            header.write(header_.data(), static_cast<std::streamsize>(header_.size()));
+            header.close();
+            if (!header)
+                throw Error(ErrorCode::Io, path_.string() + ": cannot write the header");
         } else {
             path_ = join;
         }
@@ -1846,17 +1874,15 @@ public:
 
     const fs::path& temporaryPath() const override { return path_; }
 
-    void commit() override
+    void commit(std::uint64_t pointsWritten) override
     {
         if (!file_)
             throw Error(ErrorCode::Internal, path_.string() + ": only the process that created it commits it");
         if (stream_.is_open())
             close();
-        // Every record must have come: the file then has exactly its size.
-        const std::uint64_t expected = header_.size() + total_ * recordSize_;
-        if (fs::file_size(path_) != expected)
-            throw Error(ErrorCode::InvalidArgument, destination() + ": " + std::to_string(fs::file_size(path_)) +
-                                                        " bytes written of the " + std::to_string(expected) + " expected");
+        if (pointsWritten != total_)
+            throw Error(ErrorCode::InvalidArgument, destination() + ": " + std::to_string(pointsWritten) +
+                                                        " points written of the " + std::to_string(total_) + " announced");
         file_->commit();
     }
 

@@ -226,6 +226,31 @@ TEST(RecordRanges, TheRangesBoxesMakeTheWholeReadsOrigin)
     EXPECT_EQ(errorCodeOf([&] { io::pointRecordBounds(registry, dir / "text.ply", {0, 10}); }), ErrorCode::Unsupported);
 }
 
+TEST(RecordRanges, AnAxisWithNoValueInOnePartStillJoinsAxisByAxis)
+{
+    // The first half's points have no z (dropped by every read) but their x,
+    // 1.5 km west of the rest, still counts for the origin, as in a whole read.
+    const auto registry = builtinFormats();
+    const fs::path dir = tempDir();
+    PointCloud cloud = sampleCloud(2000);
+    for (std::size_t i = 0; i < 1000; ++i) {
+        cloud.positions()[i].x() -= 1500.f;
+        cloud.positions()[i].z() = std::numeric_limits<float>::quiet_NaN();
+    }
+    io::writePointCloud(registry, cloud, dir / "cloud.ply");
+    const PointCloud whole = io::readPointCloud(registry, dir / "cloud.ply");
+    EXPECT_EQ(whole.origin().x(), 498000.0);
+    const std::optional<BoundingBox> west = io::pointRecordBounds(registry, dir / "cloud.ply", {0, 1000});
+    const std::optional<BoundingBox> east = io::pointRecordBounds(registry, dir / "cloud.ply", {1000, 1000});
+    ASSERT_TRUE(west && east);
+    EXPECT_TRUE(west->empty); // no z there
+    BoundingBox joined;
+    joined.min = west->min.cwiseMin(east->min);
+    joined.max = west->max.cwiseMax(east->max);
+    joined.empty = !(joined.min.array() <= joined.max.array()).all();
+    EXPECT_EQ(suggestOrigin(joined), whole.origin());
+}
+
 TEST(RecordRanges, PlacedWritersFillOneFileAsTheWholeWrite)
 {
     const auto registry = builtinFormats();
@@ -250,8 +275,8 @@ TEST(RecordRanges, PlacedWritersFillOneFileAsTheWholeWrite)
         (k % 2 ? *creator : *joiner).write(starts[k], parts[k]);
     EXPECT_FALSE(fs::exists(dir / "placed.ply")); // not before the commit
     joiner->close();
-    EXPECT_EQ(errorCodeOf([&] { joiner->commit(); }), ErrorCode::Internal); // only the creator commits
-    creator->commit();
+    EXPECT_EQ(errorCodeOf([&] { joiner->commit(whole.size()); }), ErrorCode::Internal); // only the creator commits
+    creator->commit(whole.size()); // what both wrote, as scandiff-mpi adds it up
     EXPECT_EQ(readBytes(dir / "placed.ply"), readBytes(dir / "expected.ply"));
     EXPECT_FALSE(fs::exists(creator->temporaryPath()));
 }
@@ -265,7 +290,7 @@ TEST(RecordRanges, PlacedWritersCheckWhatTheyAreGiven)
         auto writer = io::openPlacedChunkWriter(registry, dir / "short.ply", {}, cloud, 150);
         writer->write(0, cloud);
         EXPECT_EQ(errorCodeOf([&] { writer->write(60, cloud); }), ErrorCode::InvalidArgument); // past 150
-        EXPECT_EQ(errorCodeOf([&] { writer->commit(); }), ErrorCode::InvalidArgument);        // 100 of 150
+        EXPECT_EQ(errorCodeOf([&] { writer->commit(100); }), ErrorCode::InvalidArgument);     // 100 of 150
         // A process whose cloud has other attributes cannot join.
         PointCloud other = cloud.clone();
         other.removeField("intensity");

@@ -109,8 +109,11 @@ public:
     virtual void close() = 0;
     //! The file being filled, for the others to join.
     virtual const std::filesystem::path& temporaryPath() const = 0;
-    //! The creator's, once every writer is closed. Throws Error(Io).
-    virtual void commit() = 0;
+    //! The creator's, once every writer is closed: `pointsWritten` is what
+    //! all of them wrote, added up by the caller (a file system shared by
+    //! several machines may show the file's size late). Throws
+    //! Error(InvalidArgument) unless it is the total announced, Error(Io).
+    virtual void commit(std::uint64_t pointsWritten) = 0;
 };
 
 struct FormatHandler
@@ -138,9 +141,12 @@ struct FormatHandler
                                                     std::uint64_t total, const WriteOptions&)>
         openChunkWriter;
     //! The coordinates' box of a range of records, where the origin a whole
-    //! read chooses is suggestOrigin() of every point's box (so the box of a
-    //! file read by parts is the union of its parts'); std::nullopt where the
-    //! header alone fixes the origin. Null when the header always fixes it.
+    //! read chooses is suggestOrigin() of every point's box; std::nullopt
+    //! where the header alone fixes the origin. Null when the header always
+    //! fixes it. `min` and `max` hold each axis's range of finite values
+    //! (+inf and -inf on an axis with none) even when `empty` (an axis has
+    //! none): the box of a file read by parts is then the parts' joined axis
+    //! by axis, empty when an axis has no value in any part.
     std::function<std::optional<BoundingBox>(const std::filesystem::path&, RecordRange)> recordBounds;
     //! A placed writer (see PlacedChunkWriter) for `total` points laid out like
     //! `layout`: created when `join` is empty, else joining the file at `join`.
