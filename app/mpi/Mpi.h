@@ -60,6 +60,32 @@ std::vector<T> gatherToRoot(const Communicator& c, const std::vector<T>& mine)
     return all;
 }
 
+//! Collective. Sends rank r the counts[r] records of `send` that start at
+//! record offsets[r] (a record: `recordElements` values of T), and fills
+//! `received` with the records every rank sent this one, in rank order.
+//! Counted in records, not bytes: an int then counts 2^31 records.
+template <class T>
+void exchangeRecords(const Communicator& c, const std::vector<T>& send, const std::vector<int>& counts,
+                     const std::vector<int>& offsets, std::size_t recordElements, std::vector<T>& received)
+{
+    static_assert(std::is_trivially_copyable_v<T>, "sent as bytes");
+    MPI_Datatype record;
+    MPI_Type_contiguous(static_cast<int>(recordElements * sizeof(T)), MPI_BYTE, &record);
+    MPI_Type_commit(&record);
+    const auto ranks = static_cast<std::size_t>(c.size());
+    std::vector<int> receiveCounts(ranks), receiveOffsets(ranks);
+    MPI_Alltoall(counts.data(), 1, MPI_INT, receiveCounts.data(), 1, MPI_INT, c.comm);
+    std::size_t total = 0;
+    for (std::size_t r = 0; r < ranks; ++r) {
+        receiveOffsets[r] = static_cast<int>(total);
+        total += static_cast<std::size_t>(receiveCounts[r]);
+    }
+    received.resize(total * recordElements);
+    MPI_Alltoallv(send.data(), counts.data(), offsets.data(), record, received.data(), receiveCounts.data(),
+                  receiveOffsets.data(), record, c.comm);
+    MPI_Type_free(&record);
+}
+
 inline std::uint64_t sumOverRanks(const Communicator& c, std::uint64_t mine)
 {
     std::uint64_t total = 0;

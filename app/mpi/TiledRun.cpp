@@ -136,7 +136,7 @@ ReceivedPoints distributePoints(const Communicator& c, const ChunkedCloud& cloud
     if (options.withIndex)
         received.index.reserve(options.expected);
     std::uint64_t base = 0;
-    std::vector<int> targets, sendCounts(ranks), sendOffsets(ranks), receiveCounts(ranks), receiveOffsets(ranks);
+    std::vector<int> targets, sendCounts(ranks), sendOffsets(ranks);
     std::vector<std::uint32_t> destinationsOf; // every point's targets, flattened, for the second pass
     std::vector<std::uint32_t> targetCounts;
     std::vector<float> sendBuffer, receiveBuffer;
@@ -174,10 +174,8 @@ ReceivedPoints distributePoints(const Communicator& c, const ChunkedCloud& cloud
         for (std::size_t r = 1; r < ranks; ++r)
             place[r] = place[r - 1] + static_cast<std::size_t>(sendCounts[r - 1]) * recordFloats;
         const std::size_t sendFloats = place.back() + static_cast<std::size_t>(sendCounts.back()) * recordFloats;
-        for (std::size_t r = 0; r < ranks; ++r) {
-            sendOffsets[r] = static_cast<int>(place[r] * sizeof(float));
-            sendCounts[r] = static_cast<int>(static_cast<std::size_t>(sendCounts[r]) * recordFloats * sizeof(float));
-        }
+        for (std::size_t r = 0; r < ranks; ++r)
+            sendOffsets[r] = static_cast<int>(place[r] / recordFloats);
         sendBuffer.resize(sendFloats);
         const bool normals = options.withNormals && chunk.hasNormals();
         std::size_t next = 0;
@@ -199,15 +197,7 @@ ReceivedPoints distributePoints(const Communicator& c, const ChunkedCloud& cloud
                     std::memcpy(rest, &index, sizeof index);
                 }
             }
-        MPI_Alltoall(sendCounts.data(), 1, MPI_INT, receiveCounts.data(), 1, MPI_INT, c.comm);
-        std::size_t total = 0;
-        for (std::size_t r = 0; r < ranks; ++r) {
-            receiveOffsets[r] = static_cast<int>(total);
-            total += static_cast<std::size_t>(receiveCounts[r]);
-        }
-        receiveBuffer.resize(total / sizeof(float));
-        MPI_Alltoallv(sendBuffer.data(), sendCounts.data(), sendOffsets.data(), MPI_BYTE, receiveBuffer.data(),
-                      receiveCounts.data(), receiveOffsets.data(), MPI_BYTE, c.comm);
+        exchangeRecords(c, sendBuffer, sendCounts, sendOffsets, recordFloats, receiveBuffer);
         // Rank s sent chunk qN + s: in rank order, the records are in input order.
         for (std::size_t at = 0; at < receiveBuffer.size(); at += recordFloats) {
             const float* record = receiveBuffer.data() + at;
@@ -380,20 +370,11 @@ bool writeInPlace(const Communicator& c, const io::FormatRegistry& formats, cons
 {
     const std::size_t chunks = owned.chunkStarts.size() - 1, planeCount = planes.size();
     const auto ranks = static_cast<std::size_t>(c.size()), rank = static_cast<std::size_t>(c.rank());
-    // Counted in records (an offset and a value per plane), not bytes: a
-    // round sends up to N chunks of values, which in bytes would pass an
-    // int's range on a large cluster.
-    MPI_Datatype record;
-    MPI_Type_contiguous(static_cast<int>(1 + planeCount), MPI_UINT32_T, &record);
-    MPI_Type_commit(&record);
-    struct FreeType
-    {
-        MPI_Datatype& type;
-        ~FreeType() { MPI_Type_free(&type); }
-    } freeRecord{record};
+    // A record: an offset and a value per plane. A round sends up to N
+    // chunks of them, which is why the exchange counts records, not bytes.
     const std::size_t stride = 1 + planeCount;
     std::unique_ptr<io::PlacedChunkWriter> writer;
-    std::vector<int> sendCounts(ranks), sendOffsets(ranks), receiveCounts(ranks), receiveOffsets(ranks);
+    std::vector<int> sendCounts(ranks), sendOffsets(ranks);
     std::vector<std::uint32_t> sendWords, receiveWords;
     std::size_t next = 0;
     std::uint64_t written = 0;
@@ -408,15 +389,7 @@ bool writeInPlace(const Communicator& c, const io::FormatRegistry& formats, cons
             sendOffsets[s] = static_cast<int>(before / stride);
             sendCounts[s] = static_cast<int>((sendWords.size() - before) / stride);
         }
-        MPI_Alltoall(sendCounts.data(), 1, MPI_INT, receiveCounts.data(), 1, MPI_INT, c.comm);
-        std::size_t total = 0;
-        for (std::size_t r = 0; r < ranks; ++r) {
-            receiveOffsets[r] = static_cast<int>(total);
-            total += static_cast<std::size_t>(receiveCounts[r]);
-        }
-        receiveWords.resize(total * stride);
-        MPI_Alltoallv(sendWords.data(), sendCounts.data(), sendOffsets.data(), record, receiveWords.data(), receiveCounts.data(),
-                      receiveOffsets.data(), record, c.comm);
+        exchangeRecords(c, sendWords, sendCounts, sendOffsets, stride, receiveWords);
 
         const std::size_t k = round * ranks + rank;
         PointCloud chunk = k < chunks ? cloud.read(k, false) : PointCloud();
