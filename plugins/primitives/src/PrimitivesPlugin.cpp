@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <variant>
 
 namespace scandiff::plugins {
 
@@ -64,47 +65,63 @@ Table primitivesTable(const PrimitiveDetectionResult& result)
     return t;
 }
 
+//! One parameter of a shape: its key in primitives.json, its label in the
+//! workbench's Properties panel, and its value (a number, a point or a unit direction).
+struct ShapeParameter
+{
+    const char* key;
+    const char* label;
+    std::variant<double, Eigen::Vector3d> value;
+    bool isDirection = false;
+};
+
+//! A shape's parameters in world coordinates, by type (plane: unit normal and
+//! d with n.x + d = 0, and a point; sphere: centre, radius; cylinder: axis
+//! point and direction, radius, length; cone: apex, axis, half-angle, length;
+//! torus: centre, axis, both radii): the one list the JSON and the
+//! Properties panel are made from.
+std::vector<ShapeParameter> shapeParameters(const DetectedPrimitive& s)
+{
+    const Primitive& p = s.primitive;
+    switch (p.kind) {
+    case PrimitiveKind::Plane:
+        return {{"normal", "Normal", p.direction.normalized(), true},
+                {"d", "d (n·x + d = 0)", -p.direction.normalized().dot(p.point)},
+                {"point", "Point", p.point}};
+    case PrimitiveKind::Sphere: return {{"center", "Centre", p.point}, {"radius", "Radius (m)", p.radius}};
+    case PrimitiveKind::Cylinder:
+        return {{"axis_point", "Axis point", p.point},
+                {"axis_direction", "Axis direction", p.direction, true},
+                {"radius", "Radius (m)", p.radius},
+                {"length", "Length (m)", s.length}};
+    case PrimitiveKind::Cone:
+        return {{"apex", "Apex", p.point},
+                {"axis_direction", "Axis direction", p.direction, true},
+                {"half_angle_deg", "Half-angle (°)", p.halfAngle * kDegrees},
+                {"length", "Length (m)", s.length}};
+    case PrimitiveKind::Torus:
+        return {{"center", "Centre", p.point},
+                {"axis_direction", "Axis direction", p.direction, true},
+                {"major_radius", "Major radius (m)", p.radius},
+                {"minor_radius", "Minor radius (m)", p.minorRadius}};
+    }
+    return {};
+}
+
 //! The shapes as the JSON document: {"primitives": [{"id", "type",
-//! "inliers", "rms", "area", then the type's parameters in world coordinates
-//! (plane: unit "normal" and "d" with n.x + d = 0; sphere: "center", "radius";
-//! cylinder: "axis_point", "axis_direction", "radius", "length"; cone: "apex",
-//! "axis_direction", "half_angle_deg"; torus: "center", "axis_direction",
-//! "major_radius", "minor_radius"), and "uncertainty" (standard uncertainties by name)}]}.
+//! "inliers", "rms", "area", then the type's parameters (shapeParameters),
+//! and "uncertainty" (standard uncertainties by name)}]}.
 std::string primitivesJson(const PrimitiveDetectionResult& result)
 {
-    auto triple = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
     nlohmann::json list = nlohmann::json::array();
     for (const DetectedPrimitive& s : result.primitives) {
-        const Primitive& p = s.primitive;
-        nlohmann::json shape = {{"id", s.id}, {"type", primitiveKindName(p.kind)}, {"inliers", s.inliers.size()}, {"rms", s.rms}, {"area", s.area}};
-        switch (p.kind) {
-        case PrimitiveKind::Plane:
-            shape["normal"] = triple(p.direction.normalized());
-            shape["d"] = -p.direction.normalized().dot(p.point);
-            shape["point"] = triple(p.point);
-            break;
-        case PrimitiveKind::Sphere:
-            shape["center"] = triple(p.point);
-            shape["radius"] = p.radius;
-            break;
-        case PrimitiveKind::Cylinder:
-            shape["axis_point"] = triple(p.point);
-            shape["axis_direction"] = triple(p.direction);
-            shape["radius"] = p.radius;
-            shape["length"] = s.length;
-            break;
-        case PrimitiveKind::Cone:
-            shape["apex"] = triple(p.point);
-            shape["axis_direction"] = triple(p.direction);
-            shape["half_angle_deg"] = p.halfAngle * kDegrees;
-            shape["length"] = s.length;
-            break;
-        case PrimitiveKind::Torus:
-            shape["center"] = triple(p.point);
-            shape["axis_direction"] = triple(p.direction);
-            shape["major_radius"] = p.radius;
-            shape["minor_radius"] = p.minorRadius;
-            break;
+        nlohmann::json shape = {{"id", s.id}, {"type", primitiveKindName(s.primitive.kind)}, {"inliers", s.inliers.size()},
+                                {"rms", s.rms}, {"area", s.area}};
+        for (const ShapeParameter& parameter : shapeParameters(s)) {
+            if (const auto* v = std::get_if<Eigen::Vector3d>(&parameter.value))
+                shape[parameter.key] = nlohmann::json::array({v->x(), v->y(), v->z()});
+            else
+                shape[parameter.key] = std::get<double>(parameter.value);
         }
         nlohmann::json uncertainty = nlohmann::json::object();
         for (const auto& [name, value] : s.uncertainty)
@@ -123,18 +140,12 @@ std::string number(double v)
     return text;
 }
 
-//! World coordinates to the millimetre (UTM-sized values keep every digit that matters).
-std::string triple(const Eigen::Vector3d& v)
+//! A point to the 0.1 mm (UTM-sized values keep every digit that matters),
+//! a unit direction to 1e-6.
+std::string vectorText(const Eigen::Vector3d& v, bool isDirection)
 {
     char text[96];
-    std::snprintf(text, sizeof text, "%.4f, %.4f, %.4f", v.x(), v.y(), v.z());
-    return text;
-}
-
-std::string direction(const Eigen::Vector3d& v)
-{
-    char text[96];
-    std::snprintf(text, sizeof text, "%.6f, %.6f, %.6f", v.x(), v.y(), v.z());
+    std::snprintf(text, sizeof text, isDirection ? "%.6f, %.6f, %.6f" : "%.4f, %.4f, %.4f", v.x(), v.y(), v.z());
     return text;
 }
 
@@ -142,39 +153,13 @@ std::string direction(const Eigen::Vector3d& v)
 //! as its row of the table and its entry of the JSON document.
 OutputProperties shapeProperties(const DetectedPrimitive& s)
 {
-    const Primitive& p = s.primitive;
-    OutputProperties rows = {{"Shape", std::string(primitiveKindName(p.kind)) + " " + std::to_string(s.id)},
+    OutputProperties rows = {{"Shape", std::string(primitiveKindName(s.primitive.kind)) + " " + std::to_string(s.id)},
                              {"Inliers", std::to_string(s.inliers.size())},
                              {"RMS (m)", number(s.rms)},
                              {"Area (m²)", number(s.area)}};
-    switch (p.kind) {
-    case PrimitiveKind::Plane:
-        rows.push_back({"Normal", direction(p.direction.normalized())});
-        rows.push_back({"d (n·x + d = 0)", number(-p.direction.normalized().dot(p.point))});
-        rows.push_back({"Point", triple(p.point)});
-        break;
-    case PrimitiveKind::Sphere:
-        rows.push_back({"Centre", triple(p.point)});
-        rows.push_back({"Radius (m)", number(p.radius)});
-        break;
-    case PrimitiveKind::Cylinder:
-        rows.push_back({"Axis point", triple(p.point)});
-        rows.push_back({"Axis direction", direction(p.direction)});
-        rows.push_back({"Radius (m)", number(p.radius)});
-        rows.push_back({"Length (m)", number(s.length)});
-        break;
-    case PrimitiveKind::Cone:
-        rows.push_back({"Apex", triple(p.point)});
-        rows.push_back({"Axis direction", direction(p.direction)});
-        rows.push_back({"Half-angle (°)", number(p.halfAngle * kDegrees)});
-        rows.push_back({"Length (m)", number(s.length)});
-        break;
-    case PrimitiveKind::Torus:
-        rows.push_back({"Centre", triple(p.point)});
-        rows.push_back({"Axis direction", direction(p.direction)});
-        rows.push_back({"Major radius (m)", number(p.radius)});
-        rows.push_back({"Minor radius (m)", number(p.minorRadius)});
-        break;
+    for (const ShapeParameter& parameter : shapeParameters(s)) {
+        const auto* v = std::get_if<Eigen::Vector3d>(&parameter.value);
+        rows.push_back({parameter.label, v ? vectorText(*v, parameter.isDirection) : number(std::get<double>(parameter.value))});
     }
     for (const auto& [name, value] : s.uncertainty)
         if (std::isfinite(value))
