@@ -37,13 +37,10 @@ public:
     Representatives(const TileGrid& grid, std::size_t perTile) : grid_(grid), perTile_(perTile) {}
     void offer(const Eigen::Vector3d& p)
     {
-        const TileKey key = grid_.tileOf(p.x(), p.y());
-        if (!last_ || !(key == lastKey_)) { // consecutive points mostly share a tile
-            last_ = &byTile_[key];
-            lastKey_ = key;
-        }
-        if (last_->size() < perTile_)
-            last_->push_back(p);
+        std::vector<Eigen::Vector3d>* list =
+            last_.of(grid_.tileOf(p.x(), p.y()), [&](const TileKey& key) { return &byTile_[key]; });
+        if (list->size() < perTile_)
+            list->push_back(p);
     }
     //! Distance from p to its k-th nearest representative, +inf with fewer.
     double kthDistance(const Eigen::Vector3d& p, std::size_t k) const
@@ -72,7 +69,7 @@ public:
             for (const Eigen::Vector3d& q : list)
                 mine.push_back({key.x, key.y, {q.x(), q.y(), q.z()}});
         byTile_.clear();
-        last_ = nullptr;
+        last_.forget();
         for (const Entry& e : allGather(c, mine)) {
             std::vector<Eigen::Vector3d>& list = byTile_[{e.x, e.y}];
             if (list.size() < perTile_)
@@ -84,8 +81,7 @@ private:
     TileGrid grid_;
     std::size_t perTile_;
     std::unordered_map<TileKey, std::vector<Eigen::Vector3d>, TileKeyHash> byTile_;
-    std::vector<Eigen::Vector3d>* last_ = nullptr; // unordered_map keeps its values in place
-    TileKey lastKey_;
+    LastTile<std::vector<Eigen::Vector3d>*> last_; // unordered_map keeps its values in place
 };
 
 //! How many reference points a compared point's value needs at least.

@@ -64,18 +64,12 @@ namespace {
 std::map<TileKey, std::uint64_t> countTilePoints(const Communicator& c, const ChunkedCloud& cloud, const TileGrid& grid)
 {
     std::unordered_map<TileKey, std::uint64_t, TileKeyHash> mine;
-    std::uint64_t* current = nullptr; // consecutive points mostly share a tile
-    TileKey last;
+    LastTile<std::uint64_t*> count; // the map's values stay in place
     for (std::size_t k = static_cast<std::size_t>(c.rank()); k < cloud.chunkCount(); k += static_cast<std::size_t>(c.size())) {
         const PointCloud chunk = cloud.read(k, true);
         for (std::size_t i = 0; i < chunk.size(); ++i) {
             const Eigen::Vector3d p = chunk.globalPosition(i);
-            const TileKey key = grid.tileOf(p.x(), p.y());
-            if (!current || !(key == last)) {
-                current = &mine[key]; // the map's values stay in place
-                last = key;
-            }
-            ++*current;
+            ++*count.of(grid.tileOf(p.x(), p.y()), [&](const TileKey& key) { return &mine[key]; });
         }
     }
     struct Entry
@@ -109,15 +103,9 @@ OwnedPoints collectOwnedPoints(const Communicator& c, const ChunkedCloud& cloud,
     options.withIndex = true;
     for (const TileKey& key : owned.tiles)
         options.expected += static_cast<std::size_t>(counts.at(key));
-    TileKey lastKey;
-    int lastOwner = -1; // consecutive points mostly share a tile
+    LastTile<int> ownerOf;
     ReceivedPoints mine = distributePoints(c, cloud, options, [&](const Eigen::Vector3d& p, std::vector<int>& ranks) {
-        const TileKey key = grid.tileOf(p.x(), p.y());
-        if (lastOwner < 0 || !(key == lastKey)) {
-            lastOwner = owner.at(key);
-            lastKey = key;
-        }
-        ranks.push_back(lastOwner);
+        ranks.push_back(ownerOf.of(grid.tileOf(p.x(), p.y()), [&](const TileKey& key) { return owner.at(key); }));
     });
     owned.positions = std::move(mine.positions);
     owned.index = std::move(mine.index);
@@ -264,14 +252,13 @@ const std::vector<int>& RegionRouter::candidatesOf(const TileKey& key) const
 void RegionRouter::operator()(const Eigen::Vector3d& world, std::vector<int>& ranks) const
 {
     const TileKey key = grid_.tileOf(world.x(), world.y());
-    if (!(key == lastKey_)) { // consecutive points mostly share a tile
-        const auto owner = owner_.find(key);
-        lastKey_ = key;
-        lastOwner_ = owner != owner_.end() ? owner->second : -1;
-    }
+    const int owner = lastOwner_.of(key, [&](const TileKey& k) {
+        const auto found = owner_.find(k);
+        return found != owner_.end() ? found->second : -1;
+    });
     // Most points lie deeper than the halo inside their tile: only its rank's.
-    if (lastOwner_ >= 0 && grid_.depthInGrownTile(key, -halo_, world.x(), world.y()) > 0) {
-        ranks.push_back(lastOwner_);
+    if (owner >= 0 && grid_.depthInGrownTile(key, -halo_, world.x(), world.y()) > 0) {
+        ranks.push_back(owner);
         return;
     }
     for (const int r : candidatesOf(key))

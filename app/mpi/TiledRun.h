@@ -113,8 +113,7 @@ private:
     double halo_;
     std::int64_t reach_;
     mutable std::unordered_map<TileKey, std::vector<int>, TileKeyHash> candidates_;
-    mutable TileKey lastKey_{std::numeric_limits<std::int64_t>::min(), 0};
-    mutable int lastOwner_ = -1; //!< of lastKey_, -1 for a tile no rank owns
+    mutable LastTile<int> lastOwner_; //!< -1 for a tile no rank owns
 };
 
 //! Collective. scandiff-cli's statistics of the non-NaN values, summed over

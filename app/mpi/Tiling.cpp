@@ -57,12 +57,7 @@ HaloRegion::HaloRegion(const TileGrid& grid, const std::vector<TileKey>& tiles, 
 
 HaloRegion::Status HaloRegion::statusOf(const TileKey& key) const
 {
-    // Scans are coherent: consecutive points mostly share a tile.
-    if (!(key == lastKey_)) {
-        lastKey_ = key;
-        lastStatus_ = owned_.count(key) ? Owned : border_.count(key) ? Border : Far;
-    }
-    return lastStatus_;
+    return lastStatus_.of(key, [&](const TileKey& k) { return owned_.count(k) ? Owned : border_.count(k) ? Border : Far; });
 }
 
 bool HaloRegion::contains(double x, double y) const

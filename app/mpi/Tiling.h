@@ -35,6 +35,32 @@ struct TileKeyHash
     }
 };
 
+//! The value of the tile a point lies in, looked up once per run of points
+//! in one tile: consecutive points of a scan mostly share a tile.
+template <class Value>
+class LastTile
+{
+public:
+    //! `lookup(key)` gives the value when the key is not the last one.
+    template <class Lookup>
+    Value& of(const TileKey& key, Lookup&& lookup)
+    {
+        if (!known_ || !(key == key_)) {
+            value_ = lookup(key);
+            key_ = key;
+            known_ = true;
+        }
+        return value_;
+    }
+    //! After what the values came from changed.
+    void forget() { known_ = false; }
+
+private:
+    TileKey key_;
+    Value value_{};
+    bool known_ = false;
+};
+
 class TileGrid
 {
 public:
@@ -82,8 +108,7 @@ private:
     std::unordered_set<TileKey, TileKeyHash> border_;
     double halo_;
     std::int64_t reach_; //!< tiles a halo spans beyond a tile's edge
-    mutable TileKey lastKey_{std::numeric_limits<std::int64_t>::min(), 0};
-    mutable Status lastStatus_ = Far;
+    mutable LastTile<Status> lastStatus_;
 };
 
 //! Squares of the XY plane, each a centre and a half-side (the reach of a
