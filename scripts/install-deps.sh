@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev libtbb-dev libmuparser-dev
   qtbase5-dev libqt5opengl5-dev
   libvtk9-dev libvtk9-qt-dev libopenmpi-dev openmpi-bin
-  libpcl-dev libflann-dev libcgal-dev liblzf-dev libgdal-dev libxerces-c-dev
+  libpcl-dev libflann-dev libcgal-dev liblzf-dev libgdal-dev libexpat1-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
   python3 python3-ezdxf

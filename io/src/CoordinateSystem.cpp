@@ -4,9 +4,7 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>
 
-#include <cpl_conv.h>
-#include <cpl_error.h>
-#include <ogr_srs_api.h>
+#include "internal/GdalLibrary.h"
 
 #include <memory>
 #include <string>
@@ -15,30 +13,32 @@ namespace scandiff::io {
 
 namespace {
 
+using detail::gdal;
+
 struct SpatialReference
 {
-    OGRSpatialReferenceH handle = OSRNewSpatialReference(nullptr);
-    ~SpatialReference() { OSRDestroySpatialReference(handle); }
+    OGRSpatialReferenceH handle = gdal().OSRNewSpatialReference(nullptr);
+    ~SpatialReference() { gdal().OSRDestroySpatialReference(handle); }
 };
 
 //! GDAL reports failures through its error handler (stderr by default): they
 //! become our messages instead.
 struct QuietGdalErrors
 {
-    QuietGdalErrors() { CPLPushErrorHandler(CPLQuietErrorHandler); }
-    ~QuietGdalErrors() { CPLPopErrorHandler(); }
+    QuietGdalErrors() { gdal().CPLPushErrorHandler(gdal().CPLQuietErrorHandler); }
+    ~QuietGdalErrors() { gdal().CPLPopErrorHandler(); }
 };
 
 std::string exportWkt(OGRSpatialReferenceH srs)
 {
     char* text = nullptr;
     // WKT1 (OGC 01-009) is what LAS 1.4 R15 asks for in its WKT record.
-    if (OSRExportToWkt(srs, &text) != OGRERR_NONE || !text) {
-        CPLFree(text);
+    if (gdal().OSRExportToWkt(srs, &text) != OGRERR_NONE || !text) {
+        gdal().VSIFree(text);
         return {};
     }
     std::string wkt(text);
-    CPLFree(text);
+    gdal().VSIFree(text);
     return wkt;
 }
 
@@ -48,7 +48,7 @@ std::string crsFromUserInput(const std::string& definition)
 {
     const QuietGdalErrors quiet;
     SpatialReference srs;
-    if (definition.empty() || OSRSetFromUserInput(srs.handle, definition.c_str()) != OGRERR_NONE)
+    if (definition.empty() || gdal().OSRSetFromUserInput(srs.handle, definition.c_str()) != OGRERR_NONE)
         throw Error(ErrorCode::InvalidArgument, "unknown coordinate reference system '" + definition +
                                                     "' (give EPSG:CODE, EPSG:CODE+VERTICALCODE, a WKT or a PROJ string)");
     std::string wkt = exportWkt(srs.handle);
@@ -81,13 +81,16 @@ std::string crsName(const std::string& wkt)
 {
     if (wkt.empty())
         return {};
-    const QuietGdalErrors quiet;
-    SpatialReference srs;
-    // Imported as WKT only: text from a file must not make GDAL open a path or a URL.
-    char* text = const_cast<char*>(wkt.c_str());
-    if (OSRImportFromWkt(srs.handle, &text) == OGRERR_NONE) {
-        if (const char* name = OSRGetName(srs.handle))
-            return name;
+    try {
+        const QuietGdalErrors quiet;
+        SpatialReference srs;
+        // Imported as WKT only: text from a file must not make GDAL open a path or a URL.
+        char* text = const_cast<char*>(wkt.c_str());
+        if (gdal().OSRImportFromWkt(srs.handle, &text) == OGRERR_NONE) {
+            if (const char* name = gdal().OSRGetName(srs.handle))
+                return name;
+        }
+    } catch (const Error&) { // no GDAL: the name is the text's start
     }
     return wkt.substr(0, 60) + (wkt.size() > 60 ? "..." : "");
 }

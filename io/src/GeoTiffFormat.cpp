@@ -19,7 +19,6 @@
 #include <scandiff/core/distance/DemOfDifference.h>
 #include <scandiff/io/AtomicFile.h>
 
-#include <gdal.h>
 
 #include <cmath>
 #include <limits>
@@ -56,15 +55,15 @@ void writeGeoTiff(const PointCloud& cloud, const std::filesystem::path& path, co
     const std::string temp = file.tempPath().string();
     char compress[] = "COMPRESS=DEFLATE";
     char* creation[] = {compress, nullptr};
-    GdalDataset owned(GDALCreate(driver, temp.c_str(), static_cast<int>(g.cols), static_cast<int>(g.rows), static_cast<int>(bands.size()),
+    GdalDataset owned(gdal().GDALCreate(driver, temp.c_str(), static_cast<int>(g.cols), static_cast<int>(g.rows), static_cast<int>(bands.size()),
                                  GDT_Float64, creation));
     GDALDatasetH dataset = owned.get();
     if (!dataset)
-        throw Error(ErrorCode::Io, path.string() + ": GDAL cannot create the file: " + CPLGetLastErrorMsg());
+        throw Error(ErrorCode::Io, path.string() + ": GDAL cannot create the file: " + gdal().CPLGetLastErrorMsg());
     // North up: row 0 of the image is the top (the largest y).
     double transform[6] = {g.x0, g.cell, 0.0, g.y0 + static_cast<double>(g.rows) * g.cell, 0.0, -g.cell};
-    GDALSetGeoTransform(dataset, transform);
-    if (!cloud.crsWkt().empty() && GDALSetProjection(dataset, cloud.crsWkt().c_str()) != CE_None)
+    gdal().GDALSetGeoTransform(dataset, transform);
+    if (!cloud.crsWkt().empty() && gdal().GDALSetProjection(dataset, cloud.crsWkt().c_str()) != CE_None)
         logWarning(path.string() + ": GDAL did not take the cloud's coordinate reference system; the GeoTIFF has none");
     ProgressTicker ticker(options.progress, "Writing " + path.filename().string(), bands.size());
     std::vector<double> image(g.cols * g.rows);
@@ -76,16 +75,16 @@ void writeGeoTiff(const PointCloud& cloud, const std::filesystem::path& path, co
             const auto r = static_cast<std::size_t>(row->value(i));
             image[(g.rows - 1 - r) * g.cols + c] = bands[b]->value(i);
         }
-        GDALRasterBandH band = GDALGetRasterBand(dataset, static_cast<int>(b) + 1);
-        GDALSetRasterNoDataValue(band, std::numeric_limits<double>::quiet_NaN());
-        GDALSetDescription(band, bands[b]->name().c_str());
-        status = GDALRasterIO(band, GF_Write, 0, 0, static_cast<int>(g.cols), static_cast<int>(g.rows), image.data(),
+        GDALRasterBandH band = gdal().GDALGetRasterBand(dataset, static_cast<int>(b) + 1);
+        gdal().GDALSetRasterNoDataValue(band, std::numeric_limits<double>::quiet_NaN());
+        gdal().GDALSetDescription(band, bands[b]->name().c_str());
+        status = gdal().GDALRasterIO(band, GF_Write, 0, 0, static_cast<int>(g.cols), static_cast<int>(g.rows), image.data(),
                               static_cast<int>(g.cols), static_cast<int>(g.rows), GDT_Float64, 0, 0);
         ticker.step();
     }
     owned.close();
     if (status != CE_None)
-        throw Error(ErrorCode::Io, path.string() + ": GDAL failed to write: " + CPLGetLastErrorMsg());
+        throw Error(ErrorCode::Io, path.string() + ": GDAL failed to write: " + gdal().CPLGetLastErrorMsg());
     file.commit();
 }
 

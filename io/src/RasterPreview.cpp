@@ -22,7 +22,6 @@
 #include <scandiff/core/distance/M3C2.h>
 #include <scandiff/io/AtomicFile.h>
 
-#include <gdal.h>
 
 #include <algorithm>
 #include <array>
@@ -154,18 +153,18 @@ void writePngPreview(const PointCloud& cloud, const std::filesystem::path& path,
 
     GDALDriverH memory = gdalDriver("MEM", path);
     GDALDriverH png = gdalDriver("PNG", path);
-    const GdalDataset picture(GDALCreate(memory, "", image.width, image.height, 4, GDT_Byte, nullptr));
+    const GdalDataset picture(gdal().GDALCreate(memory, "", image.width, image.height, 4, GDT_Byte, nullptr));
     if (!picture)
-        throw Error(ErrorCode::Io, path.string() + ": GDAL cannot make the picture: " + CPLGetLastErrorMsg());
+        throw Error(ErrorCode::Io, path.string() + ": GDAL cannot make the picture: " + gdal().CPLGetLastErrorMsg());
     std::vector<std::uint8_t>* channels[] = {&image.r, &image.g, &image.b, &image.a};
     for (int b = 0; b < 4; ++b)
-        if (GDALRasterIO(GDALGetRasterBand(picture.get(), b + 1), GF_Write, 0, 0, image.width, image.height, channels[b]->data(),
+        if (gdal().GDALRasterIO(gdal().GDALGetRasterBand(picture.get(), b + 1), GF_Write, 0, 0, image.width, image.height, channels[b]->data(),
                          image.width, image.height, GDT_Byte, 0, 0) != CE_None)
-            throw Error(ErrorCode::Io, path.string() + ": GDAL failed to draw: " + CPLGetLastErrorMsg());
+            throw Error(ErrorCode::Io, path.string() + ": GDAL failed to draw: " + gdal().CPLGetLastErrorMsg());
     AtomicFile file(path);
-    GdalDataset written(GDALCreateCopy(png, file.tempPath().string().c_str(), picture.get(), FALSE, nullptr, nullptr, nullptr));
+    GdalDataset written(gdal().GDALCreateCopy(png, file.tempPath().string().c_str(), picture.get(), FALSE, nullptr, nullptr, nullptr));
     if (!written)
-        throw Error(ErrorCode::Io, path.string() + ": GDAL failed to write the PNG: " + CPLGetLastErrorMsg());
+        throw Error(ErrorCode::Io, path.string() + ": GDAL failed to write the PNG: " + gdal().CPLGetLastErrorMsg());
     written.close();
     // GDAL's PNG driver leaves an .aux.xml beside the file only when asked for
     // georeferencing it cannot store; none is asked here.

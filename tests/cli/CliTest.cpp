@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 
 using namespace scandiff;
@@ -173,6 +175,41 @@ TEST(Cli, TheInstalledBinaryReportsErrorsThroughItsExitStatus)
     const int status = std::system(command.c_str());
     ASSERT_TRUE(WIFEXITED(status));
     EXPECT_EQ(WEXITSTATUS(status), static_cast<int>(ErrorCode::Io));
+}
+
+namespace {
+
+//! What the dynamic loader says of the libraries a command of the installed binary loads.
+std::string librariesLoadedBy(const std::string& arguments, const std::filesystem::path& dir)
+{
+    const std::filesystem::path log = dir / "loader.log";
+    const std::string command = "LD_DEBUG=libs " + std::string(SCANDIFF_CLI_PATH) + " " + arguments + " > /dev/null 2> " + log.string();
+    EXPECT_EQ(std::system(command.c_str()), 0) << command;
+    std::ifstream in(log);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+} // namespace
+
+// GDAL and its hundred dependencies cost 75 ms of a process's start: they are
+// loaded when a coordinate system, a GeoTIFF or a PNG preview needs them.
+TEST(Cli, GdalIsLoadedOnlyByTheCommandsThatNeedIt)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const std::filesystem::path dir = test::tempDir();
+    PointCloud cloud;
+    cloud.resize(3);
+    cloud.positions()[1] = {1, 0, 0};
+    cloud.positions()[2] = {0, 1, 0};
+    io::writePointCloud(registry.formats, cloud, dir / "three.ply");
+    const std::string plain = librariesLoadedBy("convert " + (dir / "three.ply").string() + " " + (dir / "three.las").string(), dir);
+    EXPECT_NE(plain.find("libtbb"), std::string::npos); // the log does list what the process loads
+    EXPECT_EQ(plain.find("libgdal"), std::string::npos);
+    EXPECT_EQ(plain.find("libxerces"), std::string::npos);
+    const std::string withSystem =
+        librariesLoadedBy("convert " + (dir / "three.ply").string() + " " + (dir / "three.las").string() + " --crs EPSG:2056", dir);
+    EXPECT_NE(withSystem.find("libgdal"), std::string::npos);
+    EXPECT_NE(io::readPointCloud(registry.formats, dir / "three.las").crsWkt().find("CH1903+"), std::string::npos);
 }
 
 namespace {

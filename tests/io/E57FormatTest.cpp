@@ -5,6 +5,7 @@
 // problem.
 
 #include "e57/E57Pages.h"
+#include "e57/E57Tree.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/io/E57.h>
@@ -307,6 +308,59 @@ TEST(E57Format, DamagedCopiesOfOurFileAreRefusedByName)
     resealPages(malformed);
     writeBytes(broken, malformed);
     EXPECT_NE(errorOf([&] { io::readE57Scans(broken); }).find("XML section is malformed"), std::string::npos);
+}
+
+TEST(E57Format, TheXmlParserRefusesHostileSectionsAndKeepsNamespacesAndText)
+{
+    auto parse = [](const std::string& text) { return io::e57::parseTree(std::vector<char>(text.begin(), text.end()), "x.e57"); };
+    const std::string open = "<e57Root type=\"Structure\" xmlns=\"http://www.astm.org/COMMIT/E57/2010-e57-v1.0\" "
+                             "xmlns:nor=\"http://www.libe57.org/E57_NOR_surface_normals.txt\">";
+    // Names, namespaces, the type attribute apart from the others, strings
+    // keeping their spaces, numbers trimmed, CDATA as text.
+    const io::e57::Node tree = parse(open + "<guid type=\"String\"> a b </guid><nor:normalX type=\"Float\" minimum=\"-1\"> 0.5 "
+                                            "</nor:normalX><n type=\"Integer\"><![CDATA[42]]></n></e57Root>");
+    ASSERT_EQ(tree.children.size(), 3u);
+    EXPECT_EQ(tree.localName, "e57Root");
+    EXPECT_EQ(tree.namespaceUri, io::e57::kE57Namespace);
+    EXPECT_EQ(tree.children[0].text, " a b ");
+    const io::e57::Node& normal = tree.children[1];
+    EXPECT_EQ(normal.qualifiedName(), "nor:normalX");
+    EXPECT_EQ(normal.namespaceUri, io::e57::kNormalsNamespace);
+    EXPECT_EQ(normal.type, "Float");
+    EXPECT_EQ(normal.text, "0.5");
+    ASSERT_EQ(normal.attributes.size(), 1u);
+    EXPECT_EQ(normal.attributes[0].first, "minimum");
+    EXPECT_EQ(io::e57::integerValue(tree.children[2], "x.e57"), 42);
+
+    // A "billion laughs": ten levels of ten references, 10^10 copies if expanded.
+    std::string laughs = "<?xml version=\"1.0\"?><!DOCTYPE e57Root [<!ENTITY l0 \"ha\">";
+    for (int i = 1; i <= 10; ++i) {
+        laughs += "<!ENTITY l" + std::to_string(i) + " \"";
+        for (int j = 0; j < 10; ++j)
+            laughs += "&l" + std::to_string(i - 1) + ";";
+        laughs += "\">";
+    }
+    laughs += "]>" + open + "<guid type=\"String\">&l10;</guid></e57Root>";
+    EXPECT_NE(errorOf([&] { parse(laughs); }).find("amplification"), std::string::npos) << errorOf([&] { parse(laughs); });
+    // An external entity is never fetched: its reference is refused, not read.
+    const std::string external = "<?xml version=\"1.0\"?><!DOCTYPE e57Root [<!ENTITY secret SYSTEM \"/etc/passwd\">]>" + open +
+                                 "<guid type=\"String\">&secret;</guid></e57Root>";
+    std::string got;
+    try {
+        got = parse(external).children.at(0).text;
+    } catch (const Error&) {
+    }
+    EXPECT_EQ(got.find("root"), std::string::npos);
+    // Nesting deeper than E57 files go.
+    std::string deep = open;
+    for (int i = 0; i < 100; ++i)
+        deep += "<s type=\"Structure\">";
+    for (int i = 0; i < 100; ++i)
+        deep += "</s>";
+    EXPECT_NE(errorOf([&] { parse(deep + "</e57Root>"); }).find("nests deeper than 64 levels"), std::string::npos);
+    // Not XML at all, and no element.
+    EXPECT_NE(errorOf([&] { parse("\x01\x02garbage"); }).find("XML section is malformed (line 1"), std::string::npos);
+    EXPECT_NE(errorOf([&] { parse(""); }).find("XML section"), std::string::npos);
 }
 
 TEST(E57Format, NamesXmlCannotHoldAreMadeSafeAndScansMayNotShareASection)

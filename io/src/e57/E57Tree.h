@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! The XML section of an E57 file as a small tree of our own, so that xerces
+//! The XML section of an E57 file as a small tree of our own, so that expat
 //! (which parses it) stays inside E57Tree.cpp. An E57 element is typed by its
 //! `type` attribute: Structure, Vector, CompressedVector, Integer,
 //! ScaledInteger, Float, String or Blob (ASTM E2807 §7).

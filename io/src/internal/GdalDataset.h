@@ -6,7 +6,7 @@
 
 #include <scandiff/core/Error.h>
 
-#include <gdal.h>
+#include "internal/GdalLibrary.h"
 
 #include <filesystem>
 #include <mutex>
@@ -19,8 +19,8 @@ namespace scandiff::io::detail {
 inline GDALDriverH gdalDriver(const char* name, const std::filesystem::path& path)
 {
     static std::once_flag registered;
-    std::call_once(registered, [] { GDALAllRegister(); });
-    GDALDriverH driver = GDALGetDriverByName(name);
+    std::call_once(registered, [] { gdal().GDALAllRegister(); });
+    GDALDriverH driver = gdal().GDALGetDriverByName(name);
     if (!driver)
         throw Error(ErrorCode::Unsupported, path.string() + ": this GDAL has no " + name + " driver");
     return driver;
@@ -41,7 +41,7 @@ public:
     void close()
     {
         if (handle_)
-            GDALClose(handle_);
+            gdal().GDALClose(handle_);
         handle_ = nullptr;
     }
 
