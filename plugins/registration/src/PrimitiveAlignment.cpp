@@ -403,6 +403,7 @@ PrimitiveAlignment alignOnSpheres(const std::vector<DetectedPrimitive>& movingSh
         PlaneMatch match;
         match.moving = moving[k].id;
         match.reference = reference[r].id;
+        match.kind = PrimitiveKind::Sphere;
         match.offset = (best.rotation * moving[k].centre + best.translation - reference[r].centre).norm();
         sum += match.offset * match.offset;
         result.matches.push_back(match);

@@ -290,22 +290,25 @@ void addPrimitivesTool(ToolRegistry& registry)
 {
     ToolSpec tool;
     tool.name = "register-primitives";
-    tool.title = "Alignment on planes or targets";
+    tool.title = "Alignment on planes, pipes or targets";
     tool.category = "Registration";
     tool.description =
         "Moves the moving cloud onto the reference on the planes both scans hold (thesis 004): planes found in each "
         "(primitives, region growing by default), matched by the angles between them (three planes facing three ways make "
         "a hypothesis, scored by the planes it brings onto planes of the other scan, weighted by area), the motion refined "
-        "on every match; or on sphere targets (--on spheres), matched by their radii and the distances between their centres. "
-        "From any start. Then, unless --refine is off, point-to-plane ICP with a robust kernel finishes it.";
+        "on every match; or on sphere targets (--on spheres), matched by their radii and the distances between their centres; "
+        "or on cylinders (pipes, columns: --on cylinders), or planes, cylinders and spheres together (--on all), three shapes "
+        "that fix the motion making a hypothesis. From any start. Then, unless --refine is off, point-to-plane ICP with a "
+        "robust kernel finishes it.";
     tool.inputs = movingAndReference();
     tool.outputs = registrationOutputs();
     tool.outputs.push_back(OutputSpec{"matches", "Matched shapes", DataKind::Table, false});
     tool.parameters = {
         ParameterSpec::choice("on", "Align on",
                               "planes: the planes both scans hold (walls, floors, roofs); spheres: sphere targets (found by "
-                              "efficient RANSAC), matched by their radii and the distances between them",
-                              {"planes", "spheres"}, "planes"),
+                              "efficient RANSAC), matched by their radii and the distances between them; cylinders: pipes and "
+                              "columns (two that are not parallel fix the motion); all: planes, cylinders and spheres together",
+                              {"planes", "spheres", "cylinders", "all"}, "planes"),
         ParameterSpec::choice("method", "Plane finder", "How the planes of each scan are found (see primitives)",
                               {"region-growing", "efficient-ransac", "sequential"}, "region-growing")
             .onlyWith("on=planes"),
@@ -324,10 +327,18 @@ void addPrimitivesTool(ToolRegistry& registry)
         const PointCloud& moving = inputs.cloud("moving");
         const Mesh* mesh = inputs.meshOrNull("reference");
         const PointCloud& reference = mesh ? mesh->vertices : inputs.cloud("reference");
-        const bool spheres = values.text("on") == "spheres";
+        const std::string on = values.text("on");
+        const bool spheres = on == "spheres", planes = on == "planes";
+        // The kinds matched; planes are sought in every case, so that a wall
+        // is never taken for a huge cylinder or sphere.
+        const std::set<PrimitiveKind> matched = on == "cylinders" ? std::set<PrimitiveKind>{PrimitiveKind::Cylinder}
+                                                : on == "all"     ? std::set<PrimitiveKind>{PrimitiveKind::Plane, PrimitiveKind::Cylinder, PrimitiveKind::Sphere}
+                                                : spheres         ? std::set<PrimitiveKind>{PrimitiveKind::Sphere}
+                                                                  : std::set<PrimitiveKind>{PrimitiveKind::Plane};
         PrimitiveDetectionParams detection;
-        detection.method = spheres ? PrimitiveMethod::EfficientRansac : parsePrimitiveMethod(values.text("method"));
-        detection.kinds = spheres ? std::set<PrimitiveKind>{PrimitiveKind::Plane, PrimitiveKind::Sphere} : std::set<PrimitiveKind>{PrimitiveKind::Plane};
+        detection.method = planes ? parsePrimitiveMethod(values.text("method")) : PrimitiveMethod::EfficientRansac;
+        detection.kinds = matched;
+        detection.kinds.insert(PrimitiveKind::Plane);
         if (values.has("epsilon"))
             detection.epsilon = values.real("epsilon");
         detection.minPoints = static_cast<std::size_t>(values.integer("min-points"));
@@ -338,19 +349,24 @@ void addPrimitivesTool(ToolRegistry& registry)
         align.angleToleranceDegrees = values.real("angle-tolerance");
         align.distanceTolerance = values.real("distance-tolerance");
         const PrimitiveAlignment aligned = spheres ? alignOnSpheres(movingPlanes.primitives, referencePlanes.primitives, align)
-                                                   : alignOnPlanes(movingPlanes.primitives, referencePlanes.primitives, align);
+                                           : planes  ? alignOnPlanes(movingPlanes.primitives, referencePlanes.primitives, align)
+                                                     : alignOnShapes(movingPlanes.primitives, referencePlanes.primitives, matched, align);
 
         RegistrationReport coarse;
-        coarse.method = "alignment on " + std::to_string(aligned.matches.size()) + (spheres ? " spheres" : " planes");
+        coarse.method = "alignment on " + std::to_string(aligned.matches.size()) + (spheres ? " spheres" : planes ? " planes" : " shapes");
         coarse.matrix = aligned.matrix;
+        const BoundingBox movingBox = moving.bounds();
+        coarse.centre = movingBox.empty ? moving.origin() : Eigen::Vector3d((movingBox.min + movingBox.max) / 2);
         coarse.rms = aligned.rmsOffset;
+        // The residuals' spread is the shapes' (listed in `matches`), not the points'.
+        coarse.median = coarse.p90 = coarse.p95 = coarse.p99 = std::numeric_limits<double>::quiet_NaN();
         coarse.overlap = std::numeric_limits<double>::quiet_NaN();
         coarse.converged = true;
         coarse.degeneracy = aligned.degeneracy;
         coarse.notes = aligned.notes;
         coarse.notes.push_back(spheres ? "spheres: RMS distance of the centres " + std::to_string(aligned.rmsOffset) + " m"
-                                       : "planes: RMS angle " + std::to_string(aligned.rmsAngleDegrees) + " deg, RMS offset " +
-                                             std::to_string(aligned.rmsOffset) + " m");
+                                       : std::string(planes ? "planes" : "shapes") + ": RMS angle " + std::to_string(aligned.rmsAngleDegrees) +
+                                             " deg, RMS offset " + std::to_string(aligned.rmsOffset) + " m");
         IcpParams icp;
         icp.kernel = RobustKernel::Cauchy;
         icp.seed = static_cast<std::uint64_t>(values.integer("seed"));
@@ -358,9 +374,10 @@ void addPrimitivesTool(ToolRegistry& registry)
         icp.maxDistance = std::max(movingPlanes.clusterEpsilon, 5.0 * std::max(aligned.rmsOffset, movingPlanes.epsilon));
         ToolResult result = refineAndReport(inputs, icp, &coarse, {}, values.boolean("refine"), progress);
         Table matches;
-        matches.columns = {"moving_shape", "reference_shape", "angle_deg", "offset_m"};
+        matches.columns = {"moving_shape", "reference_shape", "type", "angle_deg", "offset_m"};
         for (const PlaneMatch& m : aligned.matches)
-            matches.rows.push_back({static_cast<double>(m.moving), static_cast<double>(m.reference), m.angleDegrees, m.offset});
+            matches.rows.push_back({static_cast<double>(m.moving), static_cast<double>(m.reference), std::string(primitiveKindName(m.kind)),
+                                    m.angleDegrees, m.offset});
         result.add("matches", std::move(matches));
         return result;
     };

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -26,8 +27,11 @@ struct PrimitiveAlignmentParams
 struct PlaneMatch
 {
     int moving = -1, reference = -1;   //!< ids of the primitives
-    double angleDegrees = 0;           //!< between the reference plane and the moved one
-    double offset = 0;                 //!< distance between them at the moved plane's point (m)
+    PrimitiveKind kind = PrimitiveKind::Plane;
+    double angleDegrees = 0;           //!< between the reference shape's direction and the moved one's (0 for spheres)
+    //! Distance between them at the moved shape's point (m): plane offset,
+    //! axis to axis across the reference's axis, centre to centre.
+    double offset = 0;
 };
 
 struct PrimitiveAlignment
@@ -49,6 +53,19 @@ struct PrimitiveAlignment
 //! bringing three onto three.
 PrimitiveAlignment alignOnSpheres(const std::vector<DetectedPrimitive>& moving, const std::vector<DetectedPrimitive>& reference,
                                   const PrimitiveAlignmentParams& params);
+
+//! Registration on any mix of planes, cylinders (pipes, columns) and spheres
+//! (`kinds`, a subset of those three): every three shapes of the reference
+//! whose constraints fix the six degrees of freedom (a plane its normal and
+//! offset, a cylinder its axis line, a sphere its centre: three planes facing
+//! three ways, two pipes that are not parallel, a column and two walls, three
+//! targets...) and three moving shapes of the same kinds and sizes making the
+//! same angles and distances give a hypothesis, scored by the shapes it brings
+//! onto shapes of the reference (weighted by support), the best refined by
+//! weighted Gauss-Newton on every match. Throws Error(InvalidData) when no
+//! three reference shapes fix the motion or no motion brings three onto three.
+PrimitiveAlignment alignOnShapes(const std::vector<DetectedPrimitive>& moving, const std::vector<DetectedPrimitive>& reference,
+                                 const std::set<PrimitiveKind>& kinds, const PrimitiveAlignmentParams& params);
 
 //! Throws Error(InvalidData) when either scan has fewer than three planes
 //! whose normals span space, or no motion brings three planes onto three.
