@@ -32,7 +32,7 @@ struct RansacShape
 
 //! Shapes found among `points` (local coordinates, unit `normals`), in the
 //! order CGAL found them. Deterministic for a seed and an input order.
-std::vector<RansacShape> efficientRansac(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals,
+std::vector<RansacShape> efficientRansac(const std::vector<Eigen::Vector3d>& points, std::vector<Eigen::Vector3d> normals,
                                          const RansacSettings& settings, const std::function<bool(double)>& keepGoing);
 
 } // namespace scandiff::plugins::detail

@@ -11,9 +11,14 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <unordered_set>
 
 namespace scandiff::plugins {
@@ -222,7 +227,9 @@ bool touching(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Ve
 }
 
 //! The shapes efficient RANSAC finds (in the frame of `points`).
-std::vector<detail::RansacShape> findByRansac(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& unitNormals,
+//! `unitNormals` taken by value: CGAL copies them, and the copy given up
+//! early lowers the run's peak (24 MB a million points).
+std::vector<detail::RansacShape> findByRansac(const std::vector<Eigen::Vector3d>& points, std::vector<Eigen::Vector3d> unitNormals,
                                               const PrimitiveDetectionParams& params, const PrimitiveDetectionResult& result,
                                               ProgressObserver* progress, bool& cancelled)
 {
@@ -234,7 +241,7 @@ std::vector<detail::RansacShape> findByRansac(const std::vector<Eigen::Vector3d>
     settings.minPoints = params.minPoints;
     settings.probability = params.probability;
     settings.seed = params.seed;
-    return detail::efficientRansac(points, unitNormals, settings, [&](double) {
+    return detail::efficientRansac(points, std::move(unitNormals), settings, [&](double) {
         if (progress && progress->cancelRequested()) {
             cancelled = true;
             return false;
@@ -248,9 +255,21 @@ void checkParameters(const PrimitiveDetectionParams& params)
     auto bad = [](const std::string& why) { throw Error(ErrorCode::InvalidArgument, "primitives: " + why); };
     if (params.kinds.empty())
         bad("no shape type asked for");
-    if (params.method != PrimitiveMethod::EfficientRansac && !params.kinds.count(PrimitiveKind::Plane))
-        bad(std::string(params.method == PrimitiveMethod::Sequential ? "sequential RANSAC finds" : "region growing grows") +
+    const bool typedRegions = params.method == PrimitiveMethod::RegionGrowing && params.growOn != GrowOn::Plane;
+    if (typedRegions && !params.kinds.count(PrimitiveKind::Plane) && !params.kinds.count(PrimitiveKind::Sphere) &&
+        !params.kinds.count(PrimitiveKind::Cylinder))
+        bad("grown regions are typed as planes, spheres or cylinders: ask for one of them, or use efficient RANSAC");
+    if (params.method != PrimitiveMethod::EfficientRansac && !typedRegions && !params.kinds.count(PrimitiveKind::Plane))
+        bad(std::string(params.method == PrimitiveMethod::Sequential ? "sequential RANSAC finds" : "region growing on planes grows") +
             " planes: ask for planes, or use efficient RANSAC for curved shapes");
+    if (!(params.smoothnessDegrees > 0 && params.smoothnessDegrees < 90))
+        bad("the smoothness angle must be between 0 and 90 degrees");
+    if (params.curvature && !(*params.curvature >= 0 && *params.curvature <= 1 / 3.0))
+        bad("the curvature (surface variation) threshold must be in [0, 1/3]");
+    if (params.valueTolerance && !(*params.valueTolerance > 0 && std::isfinite(*params.valueTolerance)))
+        bad("the value tolerance (a variance) must be > 0");
+    if (params.valueRadius && !(*params.valueRadius > 0 && std::isfinite(*params.valueRadius)))
+        bad("the growing radius must be > 0");
     if (!(params.orientationToleranceDegrees > 0 && params.orientationToleranceDegrees < 45))
         bad("the orientation tolerance must be between 0 and 45 degrees");
     if (params.epsilon && !(*params.epsilon > 0))
@@ -278,6 +297,17 @@ PrimitiveMethod parsePrimitiveMethod(const std::string& name)
     if (name == "sequential")
         return PrimitiveMethod::Sequential;
     throw Error(ErrorCode::InvalidArgument, "primitives: method '" + name + "': expected efficient-ransac, region-growing or sequential");
+}
+
+GrowOn parseGrowOn(const std::string& name)
+{
+    if (name == "plane")
+        return GrowOn::Plane;
+    if (name == "smoothness")
+        return GrowOn::Smoothness;
+    if (name == "intensity" || name == "value")
+        return GrowOn::Value;
+    throw Error(ErrorCode::InvalidArgument, "primitives: region growing on '" + name + "': give plane, smoothness or intensity");
 }
 
 PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const PrimitiveDetectionParams& params, ProgressObserver* progress)
@@ -328,6 +358,7 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
         const Eigen::Vector3d n = normals->empty() ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : Eigen::Vector3d((*normals)[i].cast<double>());
         unitNormals[i] = n.norm() > 0 ? n.normalized() : Eigen::Vector3d::UnitZ();
     }
+    std::vector<Eigen::Vector3f>().swap(normalsStore); // copied into unitNormals
 
     std::vector<detail::RansacShape> found;
     bool cancelled = false;
@@ -337,16 +368,41 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
                                       : params.method == PrimitiveMethod::Sequential  ? "Primitives: sequential RANSAC"
                                                                                       : "Primitives: efficient RANSAC",
                                       1);
+    auto keepGoing = [&] {
+        cancelled = cancelled || (progress && progress->cancelRequested());
+        return !cancelled;
+    };
     if (params.method == PrimitiveMethod::RegionGrowing) {
         detail::RegionGrowingSettings growing;
         growing.epsilon = result.epsilon;
         growing.normalDegrees = params.normalDeviationDegrees;
         growing.neighbourRadius = result.clusterEpsilon;
         growing.minPoints = params.minPoints;
-        found = detail::growPlanarRegions(points, unitNormals, tree, growing, [&] {
-            cancelled = cancelled || (progress && progress->cancelRequested());
-            return !cancelled;
-        });
+        growing.smoothnessDegrees = params.smoothnessDegrees;
+        growing.curvature = params.curvature;
+        growing.tolerance = params.valueTolerance;
+        if (params.growOn == GrowOn::Plane) {
+            found = detail::growPlanarRegions(points, unitNormals, tree, growing, keepGoing);
+        } else {
+            detail::GrowingOutcome outcome;
+            if (params.growOn == GrowOn::Smoothness) {
+                outcome = detail::growSmoothRegions(points, unitNormals, tree, growing, keepGoing);
+                result.notes.push_back("smooth regions: neighbours' normals within " + std::to_string(params.smoothnessDegrees) +
+                                       " deg, spread by points of surface variation up to " + std::to_string(outcome.curvature));
+            } else {
+                const ScalarField* field = cloud.field(params.valueField);
+                if (!field)
+                    throw Error(ErrorCode::InvalidArgument, "primitives: the cloud '" + cloud.name + "' has no field '" + params.valueField +
+                                                                "' to grow regions on");
+                const double radius = params.valueRadius ? *params.valueRadius : 2.0 * scale.spacing;
+                outcome = detail::growValueRegions(points, field->values(), tree, radius, growing, keepGoing);
+                result.notes.push_back("regions of " + params.valueField + ": variance up to " + std::to_string(outcome.tolerance) +
+                                       ", grown by " + std::to_string(radius) + " m");
+            }
+            for (detail::RansacShape& region : outcome.regions)
+                region.primitive = detail::initialShape(points, unitNormals, region.members);
+            found = std::move(outcome.regions);
+        }
     } else if (params.method == PrimitiveMethod::Sequential) {
         detail::SequentialSettings sequential;
         sequential.distance = result.epsilon;
@@ -363,53 +419,97 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
         result.facadeNormal = outcome.facadeNormal;
         result.notes.insert(result.notes.end(), outcome.notes.begin(), outcome.notes.end());
     } else {
-        found = findByRansac(points, unitNormals, params, result, progress, cancelled);
+        found = findByRansac(points, std::move(unitNormals), params, result, progress, cancelled);
     }
     if (cancelled)
         ticker.checkCancel();
     ticker.step(60);
     // Region growing grows planes: the type check does not turn them into curved shapes.
+    // Regions grown on smoothness or a value are typed as planes, spheres or
+    // cylinders (within the types asked for).
     PrimitiveDetectionParams typeParams = params;
+    const bool typedRegions = params.method == PrimitiveMethod::RegionGrowing && params.growOn != GrowOn::Plane;
     if (params.method != PrimitiveMethod::EfficientRansac) {
         typeParams.kinds = {PrimitiveKind::Plane};
-        if (params.kinds.size() > 1)
-            result.notes.push_back("this method finds planes: the other shape types asked for are left to efficient RANSAC");
+        if (typedRegions) {
+            typeParams.kinds.clear();
+            for (PrimitiveKind kind : {PrimitiveKind::Plane, PrimitiveKind::Sphere, PrimitiveKind::Cylinder})
+                if (params.kinds.count(kind))
+                    typeParams.kinds.insert(kind);
+        }
+        if (params.kinds.size() > typeParams.kinds.size())
+            result.notes.push_back(typedRegions ? "regions are typed as planes, spheres or cylinders: cones and tori are left to efficient RANSAC"
+                                                : "this method finds planes: the other shape types asked for are left to efficient RANSAC");
     }
 
     // Each shape refitted, its type checked; a curved shape that does not fit
     // clearly better than a plane becomes a plane when a plane holds its
     // points within epsilon, and is dropped otherwise.
-    for (const detail::RansacShape& shape : found) {
-        ticker.checkCancel(); // before each shape, kept or not: a refit can take a few tenths of a second
-        std::vector<Eigen::Vector3d> members;
-        members.reserve(shape.members.size());
-        for (std::uint32_t i : shape.members)
-            members.push_back(points[i]);
-        if (members.size() < params.minPoints)
-            continue;
-        Primitive initial = shape.primitive;
-        initial.point += centre; // CGAL's frame -> global
-        std::optional<PrimitiveRefinement> chosen = chooseType(members, centre, initial, typeParams, result.epsilon, result.notes);
-        if (!chosen)
-            continue;
-        const PrimitiveRefinement& refined = *chosen;
-        DetectedPrimitive detected;
-        detected.primitive = refined.primitive;
-        detected.inliers.assign(shape.members.begin(), shape.members.end());
-        std::sort(detected.inliers.begin(), detected.inliers.end());
-        detected.rms = refined.rms;
-        detected.uncertainty = refined.uncertainty;
-        detected.area = footprint(members, std::max(2.0 * scale.spacing, 1e-6));
-        if (detected.primitive.kind == PrimitiveKind::Cylinder || detected.primitive.kind == PrimitiveKind::Cone)
-            detected.length = lengthAlong(detected.primitive, members, centre);
-        result.primitives.push_back(std::move(detected));
+    // The shapes are independent: refitted in parallel (one task each), their
+    // results and notes then taken in the shapes' order, so the outcome never
+    // depends on the threads.
+    std::vector<std::optional<DetectedPrimitive>> refitted(found.size());
+    std::vector<std::vector<std::string>> shapeNotes(found.size());
+    std::atomic<bool> stopped{false};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, found.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t s = range.begin(); s != range.end(); ++s) {
+            // Asked before each shape, kept or not: a refit can take a few tenths of a second.
+            if (stopped || (progress && progress->cancelRequested())) {
+                stopped = true;
+                return;
+            }
+            const detail::RansacShape& shape = found[s];
+            std::vector<Eigen::Vector3d> members;
+            members.reserve(shape.members.size());
+            for (std::uint32_t i : shape.members)
+                members.push_back(points[i]);
+            if (members.size() < params.minPoints)
+                continue;
+            Primitive initial = shape.primitive;
+            if (!typeParams.kinds.count(initial.kind)) { // a region whose normals turn, cylinders not asked for
+                if (typeParams.kinds.count(PrimitiveKind::Sphere)) {
+                    const std::optional<Primitive> sphere = algebraicSphere(members, Eigen::Vector3d::Zero());
+                    if (!sphere)
+                        continue;
+                    initial = *sphere;
+                } else if (typeParams.kinds.count(PrimitiveKind::Plane)) {
+                    initial = pcaPlane(members, Eigen::Vector3d::Zero());
+                } else {
+                    continue; // a flat region, planes not asked for
+                }
+            }
+            initial.point += centre; // CGAL's frame -> global
+            std::optional<PrimitiveRefinement> chosen = chooseType(members, centre, initial, typeParams, result.epsilon, shapeNotes[s]);
+            if (!chosen)
+                continue;
+            const PrimitiveRefinement& refined = *chosen;
+            DetectedPrimitive detected;
+            detected.primitive = refined.primitive;
+            detected.inliers.assign(shape.members.begin(), shape.members.end());
+            std::sort(detected.inliers.begin(), detected.inliers.end());
+            detected.rms = refined.rms;
+            detected.uncertainty = refined.uncertainty;
+            detected.area = footprint(members, std::max(2.0 * scale.spacing, 1e-6));
+            if (detected.primitive.kind == PrimitiveKind::Cylinder || detected.primitive.kind == PrimitiveKind::Cone)
+                detected.length = lengthAlong(detected.primitive, members, centre);
+            refitted[s] = std::move(detected);
+        }
+    }, tbb::simple_partitioner());
+    ticker.checkCancel();
+    for (std::size_t s = 0; s < found.size(); ++s) {
+        result.notes.insert(result.notes.end(), shapeNotes[s].begin(), shapeNotes[s].end());
+        if (refitted[s])
+            result.primitives.push_back(std::move(*refitted[s]));
     }
     ticker.step(20);
 
     // RANSAC may take one surface in two parts (a sphere's cap found apart
     // from the rest): touching shapes of one type whose union fits as well as
     // each part are merged. Disjoint coplanar plates do not touch: they stay apart.
-    for (bool merged = true; merged;) {
+    // Regions grown on a value are not: they are apart by their values (the
+    // stones of one wall plane, the joints between them).
+    const bool mergeTouching = !(params.method == PrimitiveMethod::RegionGrowing && params.growOn == GrowOn::Value);
+    for (bool merged = mergeTouching; merged;) {
         merged = false;
         for (std::size_t a = 0; a < result.primitives.size() && !merged; ++a)
             for (std::size_t b = a + 1; b < result.primitives.size() && !merged; ++b) {

@@ -11,6 +11,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -222,23 +225,23 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
     using namespace scandiff;
     using namespace scandiff::plugins;
     const PrimitiveDetectionParams defaults;
-    registry.plugins.push_back({"primitives", "Planes, spheres, cylinders, cones and tori by efficient RANSAC; planes by region growing", "CGAL"});
+    registry.plugins.push_back({"primitives", "Planes, spheres, cylinders, cones and tori by efficient RANSAC; regions grown on planes, smoothness or intensity", "CGAL"});
 
     ToolSpec tool;
     tool.name = "primitives";
     tool.title = "Primitives";
     tool.category = "Primitives";
     tool.description =
-        "Finds planes, spheres, cylinders, cones and tori (efficient RANSAC, Schnabel et al. 2007, through CGAL), or planes by "
-        "region growing (CGAL's), splits each shape into connected parts, merges touching parts of one surface, keeps a curved shape only where it fits its points clearly better than a plane, and "
+        "Finds planes, spheres, cylinders, cones and tori (efficient RANSAC, Schnabel et al. 2007, through CGAL), or regions grown "
+        "on planes (CGAL's), on smoothness (normals and curvature) or on intensity, splits each shape into connected parts, merges touching parts of one surface, keeps a curved shape only where it fits its points clearly better than a plane, and "
         "refits every shape by least squares with the uncertainty of its parameters. Adds primitive_id (-1: none), "
         "primitive_type (0 plane, 1 sphere, 2 cylinder, 3 cone, 4 torus) and primitive_distance to the cloud; gives one cloud "
         "per shape with its surface as a mesh (the part its points cover), a table of their parameters and the planes' outlines as a drawing (DXF, a layer per plane). Normals are fitted when the cloud has none (within 10 x the noise).";
     tool.parameters = {
         ParameterSpec::choice("method", "Method",
-                              "efficient-ransac: every shape type, from random samples (seeded); region-growing: planes grown from "
-                              "the flattest points, each point joining a neighbour's region within the distance threshold and the "
-                              "normal deviation (no random draw), as thesis 004 compares with RANSAC; sequential: thesis 001's "
+                              "efficient-ransac: every shape type, from random samples (seeded); region-growing: regions grown from "
+                              "the flattest points (no random draw), on planes by default, as thesis 004 compares with RANSAC, or "
+                              "on smoothness or intensity (see Grow on); sequential: thesis 001's "
                               "façade planes, one after the other by classes of orientation (across the façade, horizontal, "
                               "inclined, parallel to it), each the largest connected region of its inliers (connectivity "
                               "pixels of the connectivity distance), refitted by PCA; z must be up",
@@ -267,6 +270,38 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
                             "(the thesis's 1°)",
                             defaults.orientationToleranceDegrees, 0.01, 44.9, "deg")
             .onlyWith("method=sequential"),
+        ParameterSpec::choice("grow-on", "Grow on",
+                              "Region growing: plane: a point joins within the distance threshold of its region's plane, its "
+                              "normal within the normal deviation; smoothness: neighbours' normals within the smoothness angle, "
+                              "edges (points of high surface variation) stopping the region (Rabbani et al. 2006), each region "
+                              "then typed as a plane, a sphere or a cylinder; intensity: neighbours of like values (thesis 003: "
+                              "stones of a wall), each region then typed the same way",
+                              {"plane", "smoothness", "intensity"}, "plane")
+            .onlyWith("method=region-growing"),
+        ParameterSpec::real("smoothness", "Smoothness", "Largest angle between the normals of two neighbours in one region",
+                            defaults.smoothnessDegrees, 0.1, 89.9, "deg")
+            .onlyWith("grow-on=smoothness"),
+        ParameterSpec::real("curvature", "Curvature threshold",
+                            "Points whose surface variation (smallest eigenvalue of their neighbourhood over the sum: 0 on a "
+                            "plane, 1/3 at most) is above this join a region but do not spread it; absent: 3 x the median",
+                            0.05, 0, 1.0 / 3.0)
+            .asOptional()
+            .onlyWith("grow-on=smoothness"),
+        ParameterSpec::text("field", "Value field", "The scalar field the regions share (intensity, a colour channel...)", "intensity")
+            .asFieldOf("input")
+            .onlyWith("grow-on=intensity"),
+        ParameterSpec::real("tolerance", "Value tolerance",
+                            "Largest variance of the values of one region (thesis 003's tau); absent: 4 x the median variance "
+                            "within the radius",
+                            100, 1e-12, 1e18)
+            .asOptional()
+            .onlyWith("grow-on=intensity"),
+        ParameterSpec::real("radius", "Growing radius",
+                            "A region grows to the points within this distance of its points (thesis 003's R); absent: 2 x the "
+                            "median point spacing",
+                            0.05, 1e-9, 1e9, "m")
+            .asOptional()
+            .onlyWith("grow-on=intensity"),
     };
     // With --out-dir: primitives.ply, TYPE_ID.ply, TYPE_surface_ID.ply, primitives.csv, primitives.dxf, primitives.json.
     OutputSpec shape{"shape", "Shape", DataKind::Cloud, false, true};
@@ -292,6 +327,15 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
         params.probability = values.real("probability");
         params.seed = static_cast<std::uint64_t>(values.integer("seed"));
         params.orientationToleranceDegrees = values.real("orientation-tolerance");
+        params.growOn = parseGrowOn(values.text("grow-on"));
+        params.smoothnessDegrees = values.real("smoothness");
+        if (values.has("curvature"))
+            params.curvature = values.real("curvature");
+        params.valueField = values.text("field");
+        if (values.has("tolerance"))
+            params.valueTolerance = values.real("tolerance");
+        if (values.has("radius"))
+            params.valueRadius = values.real("radius");
         const PrimitiveDetectionResult detected = detectPrimitives(input, params, progress);
 
         ToolResult result;
@@ -317,21 +361,28 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
             parts.push_back(labelled.subset(indices));
         }
         result.add("primitives", std::move(labelled));
+        // Each shape's surface, coloured as its points are by primitive_id (one
+        // colour per shape): the shapes in parallel, added in their order.
         ProgressTicker surfaces(progress, "Primitives: shape surfaces", detected.primitives.size());
-        for (const DetectedPrimitive& shape : detected.primitives) {
-            surfaces.checkCancel();
-            surfaces.step();
-            PointCloud& part = parts[static_cast<std::size_t>(&shape - detected.primitives.data())];
-            const std::string kind = primitiveKindName(shape.primitive.kind);
-            part.name = kind; // the CLI adds the shape's id: plane_0.ply
-            result.add("shape", std::move(part), shapeProperties(shape));
-            // Its surface, coloured as its points are by primitive_id (one colour per shape).
-            Mesh mesh = shapeSurface(shape.primitive, input, shape.inliers, shapeCellSize(input, shape.inliers));
-            mesh.name = kind + "_surface";
-            mesh.vertices.addField(ScalarField("primitive_id", mesh.vertices.size()));
-            std::fill(mesh.vertices.field("primitive_id")->values().begin(), mesh.vertices.field("primitive_id")->values().end(),
-                      static_cast<float>(shape.id));
-            result.add("surface", std::move(mesh), shapeProperties(shape));
+        std::vector<Mesh> meshes(detected.primitives.size());
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, meshes.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                surfaces.checkCancel();
+                const DetectedPrimitive& shape = detected.primitives[k];
+                Mesh& mesh = meshes[k];
+                mesh = shapeSurface(shape.primitive, input, shape.inliers, shapeCellSize(input, shape.inliers));
+                mesh.name = std::string(primitiveKindName(shape.primitive.kind)) + "_surface";
+                mesh.vertices.addField(ScalarField("primitive_id", mesh.vertices.size()));
+                std::fill(mesh.vertices.field("primitive_id")->values().begin(), mesh.vertices.field("primitive_id")->values().end(),
+                          static_cast<float>(shape.id));
+                surfaces.step();
+            }
+        }, tbb::simple_partitioner());
+        for (std::size_t k = 0; k < meshes.size(); ++k) {
+            const DetectedPrimitive& shape = detected.primitives[k];
+            parts[k].name = primitiveKindName(shape.primitive.kind); // the CLI adds the shape's id: plane_0.ply
+            result.add("shape", std::move(parts[k]), shapeProperties(shape));
+            result.add("surface", std::move(meshes[k]), shapeProperties(shape));
         }
         result.add("table", primitivesTable(detected));
         result.add("outlines", planeOutlines(input, detected, progress));

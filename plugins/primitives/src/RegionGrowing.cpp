@@ -9,7 +9,13 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
 #include <atomic>
 #include <iterator>
 #include <mutex>
@@ -70,6 +76,10 @@ public:
                                    }
                                });
     }
+    //! The neighbours of point i (itself included), at most kMaxNeighbours.
+    const std::uint32_t* begin(std::size_t i) const { return lists_.data() + i * kMaxNeighbours; }
+    const std::uint32_t* end(std::size_t i) const { return begin(i) + counts_[i]; }
+
     void operator()(std::size_t index, std::vector<std::size_t>& neighbours)
     {
         if (++calls_ % 4096 == 0 && !keepGoing_())
@@ -135,6 +145,241 @@ std::vector<RansacShape> growPlanarRegions(const std::vector<Eigen::Vector3d>& p
         shapes.push_back(std::move(shape));
     }
     return shapes;
+}
+
+namespace {
+
+double medianOf(std::vector<double> values)
+{
+    if (values.empty())
+        return 0.0;
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+}
+
+//! Members grouped by region label, regions smaller than minPoints dropped,
+//! in the order of their first seed.
+std::vector<RansacShape> regionsOf(const std::vector<std::int32_t>& label, std::int32_t count, std::size_t minPoints)
+{
+    std::vector<std::vector<std::uint32_t>> members(static_cast<std::size_t>(count));
+    for (std::size_t i = 0; i < label.size(); ++i)
+        if (label[i] >= 0)
+            members[static_cast<std::size_t>(label[i])].push_back(static_cast<std::uint32_t>(i));
+    std::vector<RansacShape> out;
+    for (auto& m : members)
+        if (m.size() >= minPoints) {
+            RansacShape shape;
+            shape.members = std::move(m);
+            out.push_back(std::move(shape));
+        }
+    return out;
+}
+
+} // namespace
+
+GrowingOutcome growSmoothRegions(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals,
+                                 const octree::Octree& tree, const RegionGrowingSettings& settings, const std::function<bool()>& keepGoing)
+{
+    GrowingOutcome outcome;
+    const std::size_t n = points.size();
+    if (n == 0)
+        return outcome;
+    try {
+        // Wide enough for the noise (10 sigma, epsilon being 3 sigma) that a
+        // plane's variation stays well below an edge's: on a dense, noisy scan
+        // the connectivity radius holds too few points for that.
+        const OctreeQuery query(tree, std::max(settings.neighbourRadius, 3.5 * settings.epsilon), keepGoing);
+        // Each point's surface variation over its neighbourhood.
+        std::vector<double> variation(n, 1.0);
+        std::vector<Eigen::Vector3d> local(normals);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                const std::size_t count = static_cast<std::size_t>(query.end(i) - query.begin(i));
+                if (count < 3)
+                    continue;
+                Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+                for (const std::uint32_t* j = query.begin(i); j != query.end(i); ++j)
+                    mean += points[*j];
+                mean /= static_cast<double>(count);
+                Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+                for (const std::uint32_t* j = query.begin(i); j != query.end(i); ++j)
+                    covariance.noalias() += (points[*j] - mean) * (points[*j] - mean).transpose();
+                const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+                const Eigen::Vector3d values = solver.eigenvalues();
+                const double sum = values.sum();
+                variation[i] = sum > 0 ? std::max(values[0], 0.0) / sum : 0.0;
+                local[i] = solver.eigenvectors().col(0).normalized();
+            }
+        });
+        outcome.curvature = settings.curvature ? *settings.curvature : 2.0 * medianOf(variation);
+        std::vector<std::uint32_t> order(n);
+        for (std::size_t i = 0; i < n; ++i)
+            order[i] = static_cast<std::uint32_t>(i);
+        std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+            return variation[a] != variation[b] ? variation[a] < variation[b] : a < b;
+        });
+        const double cosine = std::cos(settings.smoothnessDegrees * M_PI / 180.0);
+        std::vector<std::int32_t> label(n, -1);
+        std::int32_t regions = 0;
+        std::vector<std::uint32_t> front;
+        std::size_t visited = 0;
+        for (std::uint32_t seed : order) {
+            if (label[seed] >= 0)
+                continue;
+            const std::int32_t id = regions++;
+            label[seed] = id;
+            front.assign(1, seed);
+            while (!front.empty()) {
+                const std::uint32_t at = front.back();
+                front.pop_back();
+                if (++visited % 65536 == 0 && !keepGoing())
+                    throw StopTheRun{};
+                for (const std::uint32_t* j = query.begin(at); j != query.end(at); ++j) {
+                    // Its normal close to this point's, and the point itself on this
+                    // point's tangent plane (within epsilon: PCL's residual test), so a
+                    // panel a few centimetres before a wall stays apart.
+                    if (label[*j] >= 0 || std::abs(local[at].dot(local[*j])) < cosine ||
+                        std::abs(local[at].dot(points[*j] - points[at])) > settings.epsilon)
+                        continue;
+                    label[*j] = id;
+                    if (variation[*j] <= outcome.curvature)
+                        front.push_back(*j);
+                }
+            }
+        }
+        outcome.regions = regionsOf(label, regions, settings.minPoints);
+    } catch (const StopTheRun&) {
+        return {};
+    }
+    return outcome;
+}
+
+GrowingOutcome growValueRegions(const std::vector<Eigen::Vector3d>& points, const std::vector<float>& values, const octree::Octree& tree,
+                                double radius, const RegionGrowingSettings& settings, const std::function<bool()>& keepGoing)
+{
+    GrowingOutcome outcome;
+    const std::size_t n = points.size();
+    if (n == 0)
+        return outcome;
+    std::vector<std::int32_t> label(n, -1);
+    std::int32_t regions = 0;
+    try {
+        const OctreeQuery query(tree, radius, keepGoing);
+        // The variance of the finite values in each point's disc (NaN when fewer than 3).
+        std::vector<double> discVariance(n, std::numeric_limits<double>::quiet_NaN());
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                if (!std::isfinite(values[i]))
+                    continue;
+                double sum = 0, sumSquares = 0;
+                std::size_t count = 0;
+                for (const std::uint32_t* j = query.begin(i); j != query.end(i); ++j)
+                    if (std::isfinite(values[*j])) {
+                        sum += values[*j];
+                        sumSquares += static_cast<double>(values[*j]) * values[*j];
+                        ++count;
+                    }
+                if (count >= 3) {
+                    const double mean = sum / static_cast<double>(count);
+                    discVariance[i] = std::max(0.0, sumSquares / static_cast<double>(count) - mean * mean);
+                }
+            }
+        });
+        std::vector<std::uint32_t> seeds;
+        std::vector<double> finite;
+        for (std::size_t i = 0; i < n; ++i)
+            if (std::isfinite(discVariance[i])) {
+                seeds.push_back(static_cast<std::uint32_t>(i));
+                finite.push_back(discVariance[i]);
+            }
+        outcome.tolerance = settings.tolerance ? *settings.tolerance : 4.0 * medianOf(finite);
+        const double tau = outcome.tolerance, band = 3.0 * std::sqrt(tau);
+        std::sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
+            return discVariance[a] != discVariance[b] ? discVariance[a] < discVariance[b] : a < b;
+        });
+        std::deque<std::uint32_t> front;
+        std::size_t visited = 0;
+        for (std::uint32_t seed : seeds) {
+            if (label[seed] >= 0 || !(discVariance[seed] <= tau))
+                continue;
+            const std::int32_t id = regions++;
+            double sum = 0, sumSquares = 0;
+            std::size_t count = 0;
+            auto join = [&](std::uint32_t j) {
+                label[j] = id;
+                sum += values[j];
+                sumSquares += static_cast<double>(values[j]) * values[j];
+                ++count;
+                front.push_back(j);
+            };
+            join(seed);
+            while (!front.empty()) {
+                const std::uint32_t at = front.front();
+                front.pop_front();
+                if (++visited % 65536 == 0 && !keepGoing())
+                    throw StopTheRun{};
+                for (const std::uint32_t* j = query.begin(at); j != query.end(at); ++j) {
+                    if (label[*j] >= 0 || !std::isfinite(values[*j]))
+                        continue;
+                    const double value = values[*j];
+                    const double mean = (sum + value) / static_cast<double>(count + 1);
+                    const double variance = (sumSquares + value * value) / static_cast<double>(count + 1) - mean * mean;
+                    if (variance < tau && std::abs(value - sum / static_cast<double>(count)) <= band)
+                        join(*j);
+                }
+            }
+        }
+    } catch (const StopTheRun&) {
+        return {};
+    }
+    outcome.regions = regionsOf(label, regions, settings.minPoints);
+    return outcome;
+}
+
+Primitive initialShape(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals,
+                       const std::vector<std::uint32_t>& members)
+{
+    Primitive shape;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (std::uint32_t i : members)
+        mean += points[i];
+    mean /= static_cast<double>(std::max<std::size_t>(members.size(), 1));
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero(), spread = Eigen::Matrix3d::Zero();
+    for (std::uint32_t i : members) {
+        covariance.noalias() += (points[i] - mean) * (points[i] - mean).transpose();
+        spread.noalias() += normals[i] * normals[i].transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> turning(spread);
+    if (turning.eigenvalues()[1] > 0.05 * turning.eigenvalues().sum()) {
+        // The normals turn: a cylinder across them, its section the Kasa circle
+        // of the points projected along the axis.
+        const Eigen::Vector3d axis = turning.eigenvectors().col(0).normalized();
+        const Eigen::Vector3d u = turning.eigenvectors().col(1).normalized(), v = axis.cross(u);
+        Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+        Eigen::Vector3d b = Eigen::Vector3d::Zero();
+        for (std::uint32_t i : members) {
+            const Eigen::Vector3d d = points[i] - mean;
+            const Eigen::Vector2d q(d.dot(u), d.dot(v));
+            const Eigen::Vector3d row(2 * q.x(), 2 * q.y(), 1);
+            a.noalias() += row * row.transpose();
+            b += row * q.squaredNorm();
+        }
+        const Eigen::Vector3d circle = a.ldlt().solve(b);
+        const double radius = std::sqrt(circle[2] + circle.head<2>().squaredNorm());
+        if (circle.allFinite() && std::isfinite(radius) && radius > 0) {
+            shape.kind = PrimitiveKind::Cylinder;
+            shape.direction = axis;
+            shape.point = mean + circle[0] * u + circle[1] * v;
+            shape.radius = radius;
+            return shape;
+        }
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> flat(covariance);
+    shape.kind = PrimitiveKind::Plane;
+    shape.point = mean;
+    shape.direction = flat.eigenvectors().col(0).normalized();
+    return shape;
 }
 
 } // namespace scandiff::plugins::detail

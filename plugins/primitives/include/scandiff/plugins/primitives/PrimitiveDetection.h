@@ -35,6 +35,16 @@ enum class PrimitiveMethod { EfficientRansac, RegionGrowing, Sequential };
 //! "efficient-ransac", "region-growing", "sequential"; throws Error(InvalidArgument) otherwise.
 PrimitiveMethod parsePrimitiveMethod(const std::string& name);
 
+//! What region growing grows on: planes (a point joins within epsilon of the
+//! region's plane, its normal within the deviation); smooth surfaces (normals
+//! of neighbours within the smoothness angle, edges stopping it: planes,
+//! pipes, spheres); or a value such as intensity (thesis 003 §3.2: stones of
+//! a wall, painted marks).
+enum class GrowOn { Plane, Smoothness, Value };
+
+//! "plane", "smoothness", "intensity"; throws Error(InvalidArgument) otherwise.
+GrowOn parseGrowOn(const std::string& name);
+
 struct PrimitiveDetectionParams
 {
     PrimitiveMethod method = PrimitiveMethod::EfficientRansac;
@@ -53,6 +63,19 @@ struct PrimitiveDetectionParams
     double typeTolerance = 0.2;
     //! Sequential: a plane's normal within this angle of its class's axis (thesis 001: 1°).
     double orientationToleranceDegrees = 1.0;
+    //! Region growing: on what (see GrowOn).
+    GrowOn growOn = GrowOn::Plane;
+    //! Smoothness: largest angle between the normals of two neighbours in a region (deg).
+    double smoothnessDegrees = 20;
+    //! Smoothness: a point whose surface variation is above this stops the region
+    //! (it joins, it does not spread it); absent: 3 x the median variation.
+    std::optional<double> curvature;
+    //! Value: the scalar field grown on, the largest variance of a region's
+    //! values (absent: 4 x the median variance within the radius) and the
+    //! radius a region grows by (absent: 2 x the median spacing, thesis 003).
+    std::string valueField = "intensity";
+    std::optional<double> valueTolerance;
+    std::optional<double> valueRadius;
     std::uint64_t seed = 0;
 };
 
