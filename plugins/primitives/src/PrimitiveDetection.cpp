@@ -158,10 +158,12 @@ Primitive pcaPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vect
 //! (fewer parameters: plane 3, sphere 4, cylinder 5, cone 6, torus 7). So a
 //! box side is a plane even when a huge cylinder fits it as well, and a
 //! sphere stays a sphere when a spindle torus fits it too. Empty when no
-//! candidate holds the points within epsilon.
+//! candidate holds the points within epsilon. `foundIsAGuess`: the shape is
+//! a grown region's first guess, not a type a detector claimed, and a change
+//! of type is not worth a note.
 std::optional<PrimitiveRefinement> chooseType(const std::vector<Eigen::Vector3d>& members, const Eigen::Vector3d& centre,
                                               const Primitive& found, const PrimitiveDetectionParams& params, double epsilon,
-                                              std::vector<std::string>& notes)
+                                              std::vector<std::string>& notes, bool foundIsAGuess = false)
 {
     std::vector<Primitive> candidates{found};
     if (params.kinds.count(PrimitiveKind::Plane) && found.kind != PrimitiveKind::Plane)
@@ -193,7 +195,7 @@ std::optional<PrimitiveRefinement> chooseType(const std::vector<Eigen::Vector3d>
         }
     }
     if (fits.empty()) {
-        notes.push_back(std::string("a ") + primitiveKindName(found.kind) + " of " + std::to_string(members.size()) +
+        notes.push_back(std::string("a ") + (foundIsAGuess ? "region" : primitiveKindName(found.kind)) + " of " + std::to_string(members.size()) +
                         " points was left out: no shape type holds them within epsilon");
         return std::nullopt;
     }
@@ -204,7 +206,7 @@ std::optional<PrimitiveRefinement> chooseType(const std::vector<Eigen::Vector3d>
     for (const auto& fit : fits)
         if (fit.rms <= (1 + params.typeTolerance) * best && (!chosen || fit.primitive.kind < chosen->primitive.kind))
             chosen = &fit;
-    if (chosen->primitive.kind != found.kind)
+    if (chosen->primitive.kind != found.kind && !foundIsAGuess)
         notes.push_back(std::string("a ") + primitiveKindName(found.kind) + " of " + std::to_string(members.size()) + " points is a " +
                         primitiveKindName(chosen->primitive.kind) + " (it fits them as well, with fewer parameters)");
     return *chosen;
@@ -479,7 +481,7 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
                 }
             }
             initial.point += centre; // CGAL's frame -> global
-            std::optional<PrimitiveRefinement> chosen = chooseType(members, centre, initial, typeParams, result.epsilon, shapeNotes[s]);
+            std::optional<PrimitiveRefinement> chosen = chooseType(members, centre, initial, typeParams, result.epsilon, shapeNotes[s], typedRegions);
             if (!chosen)
                 continue;
             const PrimitiveRefinement& refined = *chosen;
