@@ -62,7 +62,11 @@ std::string crsFromEpsg(int horizontalEpsg, int verticalEpsg, const std::string&
     const std::string code = "EPSG:" + std::to_string(horizontalEpsg) + (verticalEpsg > 0 ? "+" + std::to_string(verticalEpsg) : "");
     try {
         return crsFromUserInput(code);
-    } catch (const Error&) {
+    } catch (const Error& e) {
+        if (e.code() == ErrorCode::Unsupported) { // no GDAL: say so, rather than blame the code
+            logWarning(where + ": " + e.what() + "; the coordinate reference system " + code + " is not read, the cloud gets none");
+            return {};
+        }
     }
     if (verticalEpsg > 0) { // keep the horizontal system when only the vertical one is unknown
         try {

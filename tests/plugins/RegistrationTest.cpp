@@ -539,6 +539,25 @@ TEST(PrimitiveAlignment, PipesAloneRegisterTwoScansOfAPipeRackFromAnyStart)
     for (const auto& row : matches.rows)
         EXPECT_EQ(std::get<std::string>(row[2]), "cylinder"); // cylinders only
 
+    // The moving scan seeing only part of the rack (x < 5.5 m: the pipes along
+    // y and the column cut off or absent, its box centre metres from the
+    // reference's): the shapes are matched where their points are.
+    {
+        test::PrimitiveScene part = test::makePrimitiveScene(shapes, 120000, 0.002, 0.0, 45, false);
+        std::vector<std::size_t> kept;
+        for (std::size_t i = 0; i < part.cloud.size(); ++i)
+            if (part.cloud.positions()[i].x() < 5.5f)
+                kept.push_back(i);
+        PointCloud cropped = part.cloud.subset(kept);
+        cropped.setOrigin(origin);
+        const PointCloud movedPart = transformCloud(cropped, scene.truth.inverse(), "the truth's inverse");
+        ToolResult partial = tool.execute(ToolInputs().add("moving", movedPart).add("reference", scene.reference),
+                                          tool.resolve({{"on", "cylinders"}, {"refine", "false"}, {"min-points", "300"}}), nullptr);
+        const MotionError p = errorOf(std::get<Eigen::Matrix4d>(partial.find("matrix")->data), scene.truth, origin);
+        EXPECT_LT(p.degrees, 0.05) << partial.summary;
+        EXPECT_LT(p.metres, 0.01) << partial.summary;
+    }
+
     // Pipes all parallel leave the shift along them free: a clear error.
     const Scene parallel = twoSamplings({shapes[0], shapes[1], shapes[2]}, 60000, 0.002, 0.0, 43, origin);
     EXPECT_EQ(test::errorCodeOf([&] {
@@ -546,6 +565,28 @@ TEST(PrimitiveAlignment, PipesAloneRegisterTwoScansOfAPipeRackFromAnyStart)
                                tool.resolve({{"on", "cylinders"}, {"refine", "false"}, {"min-points", "300"}}), nullptr);
               }),
               ErrorCode::InvalidData);
+}
+
+TEST(PrimitiveAlignment, TwoParallelColumnsAndTheFloorFixTheHeading)
+{
+    // Two vertical columns and a floor: every direction is vertical, and only
+    // the vector across the columns' axes holds the rotation about it. From a
+    // 140° turn about a tilted axis, within 0.05° and 1 cm.
+    const Eigen::Vector3d origin(512300.0, 5401200.0, 150.0);
+    using V = Eigen::Vector3d;
+    const std::vector<test::SceneShape> shapes = {
+        test::scene::rectangle("floor", V(-1, -1, 0), V(10, 0, 0), V(0, 10, 0)),
+        test::scene::cylinder("column A", V(2, 2, 0), V(0, 0, 1), 0.25, 3),
+        test::scene::cylinder("column B", V(6, 4.5, 0), V(0, 0, 1), 0.20, 3),
+    };
+    const Scene scene = twoSamplings(shapes, 80000, 0.002, 0.0, 61, origin);
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& tool = *registry.tools.find("register-primitives");
+    ToolResult result = tool.execute(ToolInputs().add("moving", scene.moving).add("reference", scene.reference),
+                                     tool.resolve({{"on", "all"}, {"refine", "false"}, {"min-points", "300"}}), nullptr);
+    const MotionError e = errorOf(std::get<Eigen::Matrix4d>(result.find("matrix")->data), scene.truth, origin);
+    EXPECT_LT(e.degrees, 0.05) << result.summary;
+    EXPECT_LT(e.metres, 0.01) << result.summary;
 }
 
 TEST(PrimitiveAlignment, PlanesCylindersAndSpheresTogetherRegisterTheTestScene)

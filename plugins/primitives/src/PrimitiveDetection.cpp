@@ -492,6 +492,9 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
             detected.rms = refined.rms;
             detected.uncertainty = refined.uncertainty;
             detected.area = footprint(members, std::max(2.0 * scale.spacing, 1e-6));
+            for (const Eigen::Vector3d& m : members)
+                detected.centroid += m;
+            detected.centroid = centre + detected.centroid / static_cast<double>(members.size());
             if (detected.primitive.kind == PrimitiveKind::Cylinder || detected.primitive.kind == PrimitiveKind::Cone)
                 detected.length = lengthAlong(detected.primitive, members, centre);
             refitted[s] = std::move(detected);
@@ -550,6 +553,8 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
                 first.rms = joint.rms;
                 first.uncertainty = joint.uncertainty;
                 first.area += second.area;
+                const double firstShare = static_cast<double>(pa.size()) / static_cast<double>(both.size());
+                first.centroid = firstShare * first.centroid + (1.0 - firstShare) * second.centroid;
                 if (first.primitive.kind == PrimitiveKind::Cylinder || first.primitive.kind == PrimitiveKind::Cone)
                     first.length = lengthAlong(first.primitive, both, centre);
                 result.notes.push_back(std::string("two touching parts of one ") + primitiveKindName(first.primitive.kind) + " merged");

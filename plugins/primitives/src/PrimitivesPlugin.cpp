@@ -291,7 +291,7 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
             .onlyWith("grow-on=smoothness"),
         ParameterSpec::real("curvature", "Curvature threshold",
                             "Points whose surface variation (smallest eigenvalue of their neighbourhood over the sum: 0 on a "
-                            "plane, 1/3 at most) is above this join a region but do not spread it; absent: 3 x the median",
+                            "plane, 1/3 at most) is above this join a region but do not spread it; absent: 2 x the median",
                             0.05, 0, 1.0 / 3.0)
             .asOptional()
             .onlyWith("grow-on=smoothness"),

@@ -295,13 +295,18 @@ GrowingOutcome growValueRegions(const std::vector<Eigen::Vector3d>& points, cons
             }
         outcome.tolerance = settings.tolerance ? *settings.tolerance : 4.0 * medianOf(finite);
         const double tau = outcome.tolerance, band = 3.0 * std::sqrt(tau);
+        // Variances from sums carry rounding (identical values may give 1e-13
+        // rather than 0): a value joins at the tolerance, within that rounding,
+        // so a tolerance of 0 (a quantised or uniform field) still grows regions
+        // of equal values.
+        auto within = [](double variance, double limit, double mean) { return variance <= limit + 1e-12 * (1.0 + mean * mean); };
         std::sort(seeds.begin(), seeds.end(), [&](std::uint32_t a, std::uint32_t b) {
             return discVariance[a] != discVariance[b] ? discVariance[a] < discVariance[b] : a < b;
         });
         std::deque<std::uint32_t> front;
         std::size_t visited = 0;
         for (std::uint32_t seed : seeds) {
-            if (label[seed] >= 0 || !(discVariance[seed] <= tau))
+            if (label[seed] >= 0 || !within(discVariance[seed], tau, values[seed]))
                 continue;
             const std::int32_t id = regions++;
             double sum = 0, sumSquares = 0;
@@ -325,7 +330,7 @@ GrowingOutcome growValueRegions(const std::vector<Eigen::Vector3d>& points, cons
                     const double value = values[*j];
                     const double mean = (sum + value) / static_cast<double>(count + 1);
                     const double variance = (sumSquares + value * value) / static_cast<double>(count + 1) - mean * mean;
-                    if (variance < tau && std::abs(value - sum / static_cast<double>(count)) <= band)
+                    if (within(variance, tau, mean) && std::abs(value - sum / static_cast<double>(count)) <= band + 1e-9 * std::abs(value))
                         join(*j);
                 }
             }

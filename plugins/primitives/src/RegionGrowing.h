@@ -21,7 +21,7 @@ struct RegionGrowingSettings
     //! Smooth regions: largest angle between the normals of two neighbours of a region (deg).
     double smoothnessDegrees = 20;
     //! Smooth regions: a point whose surface variation is above this joins a
-    //! region but does not spread it (an edge stops it); absent: 3 x the median.
+    //! region but does not spread it (an edge stops it); absent: 2 x the median.
     std::optional<double> curvature;
     //! Regions on a value (intensity): largest variance of a region's values; absent: 4 x the median of the discs'.
     std::optional<double> tolerance;

@@ -45,14 +45,20 @@ std::vector<Plane> planesOf(const std::vector<DetectedPrimitive>& shapes, std::s
     std::stable_sort(planes.begin(), planes.end(), [](const DetectedPrimitive* a, const DetectedPrimitive* b) { return a->area > b->area; });
     if (planes.size() > maxPlanes)
         planes.resize(maxPlanes);
+    // Each plane's point where its inliers are (the centroid on the plane): the
+    // point a plane carries may lie anywhere on it, and the matching compares places.
+    auto placeOf = [](const DetectedPrimitive& p) -> Eigen::Vector3d {
+        const Eigen::Vector3d n = p.primitive.direction.normalized();
+        return p.centroid - n * n.dot(p.centroid - p.primitive.point);
+    };
     centre = Eigen::Vector3d::Zero();
     for (const DetectedPrimitive* p : planes)
-        centre += p->primitive.point;
+        centre += placeOf(*p);
     if (!planes.empty())
         centre /= static_cast<double>(planes.size());
     std::vector<Plane> out;
     for (const DetectedPrimitive* p : planes)
-        out.push_back(Plane{p->id, p->primitive.direction.normalized(), p->primitive.point - centre, std::max(p->area, 1e-9)});
+        out.push_back(Plane{p->id, p->primitive.direction.normalized(), placeOf(*p) - centre, std::max(p->area, 1e-9)});
     return out;
 }
 

@@ -350,7 +350,7 @@ void addPrimitivesTool(ToolRegistry& registry)
         align.distanceTolerance = values.real("distance-tolerance");
         const PrimitiveAlignment aligned = spheres ? alignOnSpheres(movingPlanes.primitives, referencePlanes.primitives, align)
                                            : planes  ? alignOnPlanes(movingPlanes.primitives, referencePlanes.primitives, align)
-                                                     : alignOnShapes(movingPlanes.primitives, referencePlanes.primitives, matched, align);
+                                                     : alignOnShapes(movingPlanes.primitives, referencePlanes.primitives, matched, align, progress);
 
         RegistrationReport coarse;
         coarse.method = "alignment on " + std::to_string(aligned.matches.size()) + (spheres ? " spheres" : planes ? " planes" : " shapes");

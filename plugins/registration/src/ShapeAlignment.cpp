@@ -11,6 +11,7 @@
 #include <scandiff/plugins/registration/PrimitiveAlignment.h>
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/Progress.h>
 
 #include <Eigen/Dense>
 
@@ -67,9 +68,21 @@ std::vector<Shape> shapesOf(const std::vector<DetectedPrimitive>& detected, cons
             ofKind.resize(keep);
         chosen.insert(chosen.end(), ofKind.begin(), ofKind.end());
     }
+    // Each shape's point where its inliers are: the centroid on the plane, its
+    // foot on the axis, the sphere's centre (a plane's or an axis's own point
+    // may lie anywhere on it, and the matching compares places).
+    auto placeOf = [](const DetectedPrimitive& s) -> Eigen::Vector3d {
+        const Primitive& p = s.primitive;
+        const Eigen::Vector3d d = p.direction.normalized();
+        switch (p.kind) {
+        case PrimitiveKind::Plane: return s.centroid - d * d.dot(s.centroid - p.point);
+        case PrimitiveKind::Cylinder: return p.point + d * d.dot(s.centroid - p.point);
+        default: return p.point;
+        }
+    };
     centre = Eigen::Vector3d::Zero();
     for (const DetectedPrimitive* s : chosen)
-        centre += s->primitive.point;
+        centre += placeOf(*s);
     if (!chosen.empty())
         centre /= static_cast<double>(chosen.size());
     std::vector<Shape> out;
@@ -79,7 +92,7 @@ std::vector<Shape> shapesOf(const std::vector<DetectedPrimitive>& detected, cons
         shape.kind = s->primitive.kind;
         if (shape.directed())
             shape.direction = s->primitive.direction.normalized();
-        shape.point = s->primitive.point - centre;
+        shape.point = placeOf(*s) - centre;
         shape.radius = s->primitive.radius;
         shape.area = std::max(s->area, 1e-9);
         shape.extent = std::sqrt(shape.area);
@@ -337,6 +350,23 @@ std::optional<Motion> hypothesis(const std::array<const Shape*, 3>& m, const std
             }
         }
     }
+    // Vectors across parallel axes, and from an axis to a sphere's centre:
+    // they turn with the scan, and fix the rotation about the axes where the
+    // directions alone (two columns and a floor) leave it free.
+    for (int q = 0; q < 3; ++q)
+        for (int w = 0; w < 3; ++w) {
+            if (q == w || m[q]->kind != PrimitiveKind::Cylinder || (m[w]->kind == PrimitiveKind::Cylinder && w < q) ||
+                m[w]->kind == PrimitiveKind::Plane)
+                continue;
+            if (m[w]->kind == PrimitiveKind::Cylinder && lineAngle(m[q]->direction, m[w]->direction) > 4 * angleTol)
+                continue; // not parallel: the two directions already hold the rotation
+            const Eigen::Vector3d a = across(m[q]->direction, m[w]->point - m[q]->point);
+            const Eigen::Vector3d b = across(r[q]->direction, r[w]->point - r[q]->point);
+            if (a.norm() > distanceTol && b.norm() > distanceTol) {
+                from.push_back(a.normalized());
+                to.push_back(b.normalized());
+            }
+        }
     if (from.size() < 2)
         return std::nullopt;
     Motion motion;
@@ -377,7 +407,7 @@ std::string counted(std::size_t count, PrimitiveKind kind)
 } // namespace
 
 PrimitiveAlignment alignOnShapes(const std::vector<DetectedPrimitive>& movingShapes, const std::vector<DetectedPrimitive>& referenceShapes,
-                                 const std::set<PrimitiveKind>& kinds, const PrimitiveAlignmentParams& params)
+                                 const std::set<PrimitiveKind>& kinds, const PrimitiveAlignmentParams& params, ProgressObserver* progress)
 {
     for (PrimitiveKind kind : kinds)
         if (kind != PrimitiveKind::Plane && kind != PrimitiveKind::Cylinder && kind != PrimitiveKind::Sphere)
@@ -397,9 +427,11 @@ PrimitiveAlignment alignOnShapes(const std::vector<DetectedPrimitive>& movingSha
     Scored bestScore;
     std::size_t usableTriples = 0;
     const std::size_t nr = reference.size(), nm = moving.size();
-    for (std::size_t i = 0; i < nr; ++i)
+    ProgressTicker ticker(progress, "Registration: matching shapes", nr);
+    for (std::size_t i = 0; i < nr; ++i, ticker.step())
         for (std::size_t j = i + 1; j < nr; ++j)
             for (std::size_t k = j + 1; k < nr; ++k) {
+                ticker.checkCancel();
                 const std::array<const Shape*, 3> r = {&reference[i], &reference[j], &reference[k]};
                 if (!fixesTheMotion({r[0], r[1], r[2]}, length))
                     continue;

@@ -68,7 +68,7 @@ struct PrimitiveDetectionParams
     //! Smoothness: largest angle between the normals of two neighbours in a region (deg).
     double smoothnessDegrees = 20;
     //! Smoothness: a point whose surface variation is above this stops the region
-    //! (it joins, it does not spread it); absent: 3 x the median variation.
+    //! (it joins, it does not spread it); absent: 2 x the median variation.
     std::optional<double> curvature;
     //! Value: the scalar field grown on, the largest variance of a region's
     //! values (absent: 4 x the median variance within the radius) and the
@@ -87,6 +87,9 @@ struct DetectedPrimitive
     double rms = 0;                   //!< of the inliers' distances
     double area = 0;                  //!< of the inliers' footprint on the surface (m², cells of the cluster epsilon)
     double length = 0;                //!< cylinder, cone: the inliers' extent along the axis (m)
+    //! The inliers' centroid (global): where the shape is, whatever point of
+    //! it `primitive` carries (a plane's or an axis's point may lie far off).
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     std::vector<std::pair<std::string, double>> uncertainty; //!< see refinePrimitive()
 };
 

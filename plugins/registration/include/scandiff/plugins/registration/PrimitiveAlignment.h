@@ -64,8 +64,10 @@ PrimitiveAlignment alignOnSpheres(const std::vector<DetectedPrimitive>& moving, 
 //! onto shapes of the reference (weighted by support), the best refined by
 //! weighted Gauss-Newton on every match. Throws Error(InvalidData) when no
 //! three reference shapes fix the motion or no motion brings three onto three.
+//! Cancel (`progress`) is heard between hypotheses.
 PrimitiveAlignment alignOnShapes(const std::vector<DetectedPrimitive>& moving, const std::vector<DetectedPrimitive>& reference,
-                                 const std::set<PrimitiveKind>& kinds, const PrimitiveAlignmentParams& params);
+                                 const std::set<PrimitiveKind>& kinds, const PrimitiveAlignmentParams& params,
+                                 ProgressObserver* progress = nullptr);
 
 //! Throws Error(InvalidData) when either scan has fewer than three planes
 //! whose normals span space, or no motion brings three planes onto three.
