@@ -271,8 +271,10 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
         ParameterSpec::integer("min-points", "Minimum support", "Smallest number of points of a shape",
                                static_cast<std::int64_t>(defaults.minPoints), 10, 1000000000, "points"),
         ParameterSpec::real("probability", "Miss probability", "RANSAC's chance of overlooking the largest remaining shape",
-                            defaults.probability, 1e-6, 0.5),
-        ParameterSpec::integer("seed", "Seed", "Random sampling seed (the same seed, the same shapes)", 0, 0, 4294967295LL),
+                            defaults.probability, 1e-6, 0.5)
+            .onlyWith("!method=region-growing"),
+        ParameterSpec::integer("seed", "Seed", "Random sampling seed (the same seed, the same shapes)", 0, 0, 4294967295LL)
+            .onlyWith("!method=region-growing"),
         ParameterSpec::real("orientation-tolerance", "Orientation tolerance",
                             "Sequential: a plane belongs to a class when its normal is within this angle of the class's axis "
                             "(the thesis's 1°)",
