@@ -6,6 +6,8 @@
 // double, so UTM coordinates lose nothing.
 #include <scandiff/plugins/registration/PrimitiveAlignment.h>
 
+#include "ShapeGeometry.h"
+
 #include <scandiff/core/Error.h>
 
 #include <Eigen/Dense>
@@ -19,6 +21,9 @@
 namespace scandiff::plugins {
 
 namespace {
+
+using detail::lineAngle;
+using detail::rotationBetween;
 
 constexpr double kDegree = M_PI / 180.0;
 
@@ -62,22 +67,7 @@ std::vector<Plane> planesOf(const std::vector<DetectedPrimitive>& shapes, std::s
     return out;
 }
 
-double lineAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
-{
-    return std::acos(std::min(1.0, std::abs(a.dot(b))));
-}
 
-//! The rotation taking the `from` directions onto the `to` ones, weighted (Kabsch), proper.
-Eigen::Matrix3d rotationBetween(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to, const std::vector<double>& w)
-{
-    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-    for (std::size_t k = 0; k < from.size(); ++k)
-        h += w[k] * from[k] * to[k].transpose();
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-    d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
-    return svd.matrixV() * d * svd.matrixU().transpose();
-}
 
 struct Scored
 {

@@ -10,6 +10,8 @@
 // Every computation is in frames centred on each scan's shapes, in double.
 #include <scandiff/plugins/registration/PrimitiveAlignment.h>
 
+#include "ShapeGeometry.h"
+
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Progress.h>
 
@@ -26,6 +28,9 @@
 namespace scandiff::plugins {
 
 namespace {
+
+using detail::lineAngle;
+using detail::rotationBetween;
 
 constexpr double kDegree = M_PI / 180.0;
 
@@ -102,10 +107,6 @@ std::vector<Shape> shapesOf(const std::vector<DetectedPrimitive>& detected, cons
     return out;
 }
 
-double lineAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
-{
-    return std::acos(std::min(1.0, std::abs(a.dot(b))));
-}
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v)
 {
@@ -313,17 +314,6 @@ Scored score(const Motion& m, const std::vector<Shape>& moving, const std::vecto
     return out;
 }
 
-//! The rotation taking the `from` directions onto the `to` ones (Kabsch), proper.
-Eigen::Matrix3d rotationBetween(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to)
-{
-    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-    for (std::size_t k = 0; k < from.size(); ++k)
-        h += from[k] * to[k].transpose();
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-    d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
-    return svd.matrixV() * d * svd.matrixU().transpose();
-}
 
 //! The motion that brings three moving shapes onto three reference shapes,
 //! for one choice of the directions' signs, or nothing when it does not fit
