@@ -293,13 +293,12 @@ void addPrimitivesTool(ToolRegistry& registry)
     tool.title = "Alignment on planes, pipes or targets";
     tool.category = "Registration";
     tool.description =
-        "Moves the moving cloud onto the reference on the planes both scans hold (thesis 004): planes found in each "
-        "(primitives, region growing by default), matched by the angles between them (three planes facing three ways make "
-        "a hypothesis, scored by the planes it brings onto planes of the other scan, weighted by area), the motion refined "
-        "on every match; or on sphere targets (--on spheres), matched by their radii and the distances between their centres; "
-        "or on cylinders (pipes, columns: --on cylinders), or planes, cylinders and spheres together (--on all), three shapes "
-        "that fix the motion making a hypothesis. From any start. Then, unless --refine is off, point-to-plane ICP with a "
-        "robust kernel finishes it.";
+        "Moves the moving cloud onto the reference on the shapes both scans hold (thesis 004): the planes (region growing by "
+        "default), the sphere targets (--on spheres), the pipes and columns (--on cylinders) or all three (--on all) found in "
+        "each; three reference shapes that fix the motion and three moving ones of the same kinds and sizes making the same "
+        "angles and distances give a hypothesis, scored by the shapes it brings onto shapes of the other scan, the best "
+        "refined on every match. From any start. Then, unless --refine is off, point-to-plane ICP with a robust kernel "
+        "finishes it.";
     tool.inputs = movingAndReference();
     tool.outputs = registrationOutputs();
     tool.outputs.push_back(OutputSpec{"matches", "Matched shapes", DataKind::Table, false});
@@ -348,9 +347,7 @@ void addPrimitivesTool(ToolRegistry& registry)
         PrimitiveAlignmentParams align;
         align.angleToleranceDegrees = values.real("angle-tolerance");
         align.distanceTolerance = values.real("distance-tolerance");
-        const PrimitiveAlignment aligned = spheres ? alignOnSpheres(movingPlanes.primitives, referencePlanes.primitives, align)
-                                           : planes  ? alignOnPlanes(movingPlanes.primitives, referencePlanes.primitives, align)
-                                                     : alignOnShapes(movingPlanes.primitives, referencePlanes.primitives, matched, align, progress);
+        const PrimitiveAlignment aligned = alignOnShapes(movingPlanes.primitives, referencePlanes.primitives, matched, align, progress);
 
         RegistrationReport coarse;
         coarse.method = "alignment on " + std::to_string(aligned.matches.size()) + (spheres ? " spheres" : planes ? " planes" : " shapes");

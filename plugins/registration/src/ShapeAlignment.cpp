@@ -10,8 +10,6 @@
 // Every computation is in frames centred on each scan's shapes, in double.
 #include <scandiff/plugins/registration/PrimitiveAlignment.h>
 
-#include "ShapeGeometry.h"
-
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Progress.h>
 
@@ -29,10 +27,27 @@ namespace scandiff::plugins {
 
 namespace {
 
-using detail::lineAngle;
-using detail::rotationBetween;
-
 constexpr double kDegree = M_PI / 180.0;
+
+//! The angle between two lines (radians, 0 to pi/2): a direction's sign does not count.
+double lineAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+    return std::acos(std::min(1.0, std::abs(a.dot(b))));
+}
+
+//! The proper rotation taking the `from` directions onto the `to` ones, each
+//! weighted by `w` (all 1 when empty): Kabsch's SVD solution.
+Eigen::Matrix3d rotationBetween(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to,
+                                       const std::vector<double>& w = {})
+{
+    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+    for (std::size_t k = 0; k < from.size(); ++k)
+        h += (w.empty() ? 1.0 : w[k]) * from[k] * to[k].transpose();
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+    d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+    return svd.matrixV() * d * svd.matrixU().transpose();
+}
 
 struct Shape
 {

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 //! Registration on primitives (thesis 004: scans of a building consolidated
-//! on the planes they share): the planes found in each scan are matched, and
-//! the motion is the one that brings the moving scan's planes onto the
-//! reference's. Works from any start, since planes are matched by the angles
-//! between them, not by position; needs three planes that are not parallel to
-//! one line (two walls and a floor) in both scans.
+//! on the planes they share, and here on pipes and targets too): the shapes
+//! found in each scan are matched, and the motion is the one that brings the
+//! moving scan's shapes onto the reference's. Works from any start, since
+//! shapes are matched by the angles and distances between them, not by
+//! position (src/ShapeAlignment.cpp).
 
 #include <scandiff/plugins/primitives/PrimitiveDetection.h>
 
@@ -44,16 +44,6 @@ struct PrimitiveAlignment
     std::vector<std::string> notes;
 };
 
-//! Registration on sphere targets (the surveyor's way): the spheres of both
-//! scans matched by their radii and the distances between their centres,
-//! three at a time, the motion from the centres (Kabsch), refitted on every
-//! sphere it brings onto a sphere of the same radius. `matches` then hold
-//! spheres (angle 0, offset the centres' distance). Throws Error(InvalidData)
-//! with fewer than three spheres not on a line in either scan, or no motion
-//! bringing three onto three.
-PrimitiveAlignment alignOnSpheres(const std::vector<DetectedPrimitive>& moving, const std::vector<DetectedPrimitive>& reference,
-                                  const PrimitiveAlignmentParams& params);
-
 //! Registration on any mix of planes, cylinders (pipes, columns) and spheres
 //! (`kinds`, a subset of those three): every three shapes of the reference
 //! whose constraints fix the six degrees of freedom (a plane its normal and
@@ -68,10 +58,5 @@ PrimitiveAlignment alignOnSpheres(const std::vector<DetectedPrimitive>& moving, 
 PrimitiveAlignment alignOnShapes(const std::vector<DetectedPrimitive>& moving, const std::vector<DetectedPrimitive>& reference,
                                  const std::set<PrimitiveKind>& kinds, const PrimitiveAlignmentParams& params,
                                  ProgressObserver* progress = nullptr);
-
-//! Throws Error(InvalidData) when either scan has fewer than three planes
-//! whose normals span space, or no motion brings three planes onto three.
-PrimitiveAlignment alignOnPlanes(const std::vector<DetectedPrimitive>& moving, const std::vector<DetectedPrimitive>& reference,
-                                 const PrimitiveAlignmentParams& params);
 
 } // namespace scandiff::plugins
