@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 //! libFuzzer harness of one reader: the input bytes are written to a file of
 //! the reader's extension (SCANDIFF_FUZZ_EXTENSION, one executable per reader)
-//! and read through the registry, as the CLI and the workbench read files. A
+//! and read through the registry, as the CLI and the workbench read files
+//! (and by ranges of records, as scandiff-mpi's ranks read them). A
 //! scandiff::Error is the expected answer to a broken file; a crash, a leak, a
 //! timeout or an allocation past -rss_limit_mb is a bug. Built with
 //! -DSCANDIFF_FUZZ=ON (clang); see docs/reliability.md for how to run it.
@@ -59,6 +60,26 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     } catch (const scandiff::Error&) {
         // A clean refusal: what a broken file must give.
     }
+    // Formats read by ranges of records (what scandiff-mpi's ranks do): the
+    // count, two halves and their boxes, and a range past the end, each a
+    // clean answer or a clean refusal.
+    auto refusedOrRead = [](auto&& read) {
+        try {
+            read();
+        } catch (const scandiff::Error&) {
+        }
+    };
+    refusedOrRead([&] {
+        namespace io = scandiff::io;
+        if (!io::canReadRecordRanges(formats(), inputPath()))
+            return;
+        const std::uint64_t n = io::pointRecordCount(formats(), inputPath());
+        for (const io::RecordRange range : {io::RecordRange{0, n / 2}, io::RecordRange{n / 2, n - n / 2}}) {
+            refusedOrRead([&] { io::pointRecordBounds(formats(), inputPath(), range); });
+            refusedOrRead([&] { io::readPointRecords(formats(), inputPath(), range); });
+        }
+        refusedOrRead([&] { io::readPointRecords(formats(), inputPath(), io::RecordRange{n, 1}); });
+    });
     if (std::string(SCANDIFF_FUZZ_EXTENSION) == "e57") {
         try {
             scandiff::io::inspectE57(inputPath()); // scans and images as the XML lists them
