@@ -118,21 +118,6 @@ void refine(const std::vector<Eigen::Vector3d>& points, Eigen::VectorXd& x,
     refineWithCovariance(points, x, std::move(residual), kind);
 }
 
-//! Kasa's algebraic circle through 2D points: centre and radius.
-bool fitCircle(const std::vector<Eigen::Vector2d>& p, Eigen::Vector2d& centre, double& radius)
-{
-    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d b = Eigen::Vector3d::Zero();
-    for (const auto& q : p) {
-        const Eigen::Vector3d row(2 * q.x(), 2 * q.y(), 1);
-        a.noalias() += row * row.transpose();
-        b += row * q.squaredNorm();
-    }
-    const Eigen::Vector3d s = a.ldlt().solve(b);
-    centre = s.head<2>();
-    radius = std::sqrt(s[2] + centre.squaredNorm());
-    return s.allFinite() && radius > 0;
-}
 
 //! The fitted points that have a normal, with it: the cloud's normals, or
 //! normals estimated on the whole cloud (plane, 12 neighbours).
@@ -477,6 +462,22 @@ Table primitiveTable(const Primitive& s, std::optional<double> rms)
 } // namespace scandiff
 
 namespace scandiff {
+
+bool fitCircle(const std::vector<Eigen::Vector2d>& p, Eigen::Vector2d& centre, double& radius)
+{
+    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    for (const auto& q : p) {
+        const Eigen::Vector3d row(2 * q.x(), 2 * q.y(), 1);
+        a.noalias() += row * row.transpose();
+        b += row * q.squaredNorm();
+    }
+    const Eigen::Vector3d s = a.ldlt().solve(b);
+    centre = s.head<2>();
+    radius = std::sqrt(s[2] + centre.squaredNorm());
+    return s.allFinite() && radius > 0;
+}
+
 
 std::optional<Primitive> algebraicSphere(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre)
 {

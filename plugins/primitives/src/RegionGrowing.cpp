@@ -100,6 +100,28 @@ using Growing = CGAL::Shape_detection::Region_growing<Items, OctreeQuery, PlaneR
 
 } // namespace
 
+namespace {
+
+//! The least-squares plane of the members (a first shape the caller refits).
+Primitive leastSquaresPlane(const std::vector<Eigen::Vector3d>& points, const std::vector<std::uint32_t>& members)
+{
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (std::uint32_t i : members)
+        mean += points[i];
+    mean /= static_cast<double>(std::max<std::size_t>(members.size(), 1));
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (std::uint32_t i : members)
+        covariance.noalias() += (points[i] - mean) * (points[i] - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+    Primitive plane;
+    plane.kind = PrimitiveKind::Plane;
+    plane.point = mean;
+    plane.direction = solver.eigenvectors().col(0).normalized();
+    return plane;
+}
+
+} // namespace
+
 std::vector<RansacShape> growPlanarRegions(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals,
                                            const octree::Octree& tree, const RegionGrowingSettings& settings,
                                            const std::function<bool()>& keepGoing)
@@ -127,21 +149,11 @@ std::vector<RansacShape> growPlanarRegions(const std::vector<Eigen::Vector3d>& p
     shapes.reserve(regions.size());
     for (const std::vector<std::size_t>& members : regions) {
         RansacShape shape;
-        shape.primitive.kind = PrimitiveKind::Plane;
-        // The plane is fitted again by the caller; a first one from the members.
-        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-        for (std::size_t i : members)
-            mean += points[i];
-        mean /= static_cast<double>(members.size());
-        Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-        for (std::size_t i : members)
-            covariance.noalias() += (points[i] - mean) * (points[i] - mean).transpose();
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
-        shape.primitive.point = mean;
-        shape.primitive.direction = solver.eigenvectors().col(0).normalized();
         shape.members.reserve(members.size());
         for (std::size_t i : members)
             shape.members.push_back(static_cast<std::uint32_t>(i));
+        // The plane is fitted again by the caller; a first one from the members.
+        shape.primitive = leastSquaresPlane(points, shape.members);
         shapes.push_back(std::move(shape));
     }
     return shapes;
@@ -345,46 +357,37 @@ GrowingOutcome growValueRegions(const std::vector<Eigen::Vector3d>& points, cons
 Primitive initialShape(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals,
                        const std::vector<std::uint32_t>& members)
 {
-    Primitive shape;
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (std::uint32_t i : members)
         mean += points[i];
     mean /= static_cast<double>(std::max<std::size_t>(members.size(), 1));
-    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero(), spread = Eigen::Matrix3d::Zero();
-    for (std::uint32_t i : members) {
-        covariance.noalias() += (points[i] - mean) * (points[i] - mean).transpose();
+    Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+    for (std::uint32_t i : members)
         spread.noalias() += normals[i] * normals[i].transpose();
-    }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> turning(spread);
     if (turning.eigenvalues()[1] > 0.05 * turning.eigenvalues().sum()) {
         // The normals turn: a cylinder across them, its section the Kasa circle
         // of the points projected along the axis.
         const Eigen::Vector3d axis = turning.eigenvectors().col(0).normalized();
         const Eigen::Vector3d u = turning.eigenvectors().col(1).normalized(), v = axis.cross(u);
-        Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
-        Eigen::Vector3d b = Eigen::Vector3d::Zero();
+        std::vector<Eigen::Vector2d> section;
+        section.reserve(members.size());
         for (std::uint32_t i : members) {
             const Eigen::Vector3d d = points[i] - mean;
-            const Eigen::Vector2d q(d.dot(u), d.dot(v));
-            const Eigen::Vector3d row(2 * q.x(), 2 * q.y(), 1);
-            a.noalias() += row * row.transpose();
-            b += row * q.squaredNorm();
+            section.emplace_back(d.dot(u), d.dot(v));
         }
-        const Eigen::Vector3d circle = a.ldlt().solve(b);
-        const double radius = std::sqrt(circle[2] + circle.head<2>().squaredNorm());
-        if (circle.allFinite() && std::isfinite(radius) && radius > 0) {
+        Eigen::Vector2d circle;
+        double radius = 0;
+        if (fitCircle(section, circle, radius)) {
+            Primitive shape;
             shape.kind = PrimitiveKind::Cylinder;
             shape.direction = axis;
-            shape.point = mean + circle[0] * u + circle[1] * v;
+            shape.point = mean + circle.x() * u + circle.y() * v;
             shape.radius = radius;
             return shape;
         }
     }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> flat(covariance);
-    shape.kind = PrimitiveKind::Plane;
-    shape.point = mean;
-    shape.direction = flat.eigenvectors().col(0).normalized();
-    return shape;
+    return leastSquaresPlane(points, members);
 }
 
 } // namespace scandiff::plugins::detail

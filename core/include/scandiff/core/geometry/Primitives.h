@@ -59,6 +59,10 @@ PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressO
 //! `centre`; empty when they determine none. A start for refinePrimitive().
 std::optional<Primitive> algebraicSphere(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre);
 
+//! Kasa's algebraic circle through 2D points: its centre and radius; false
+//! when they determine none. A start for a cylinder's section.
+bool fitCircle(const std::vector<Eigen::Vector2d>& points, Eigen::Vector2d& centre, double& radius);
+
 //! A refined primitive and the standard uncertainty of its parameters.
 struct PrimitiveRefinement
 {
