@@ -32,6 +32,24 @@ ChunkedCloud::ChunkedCloud(const Communicator& c, const io::FormatRegistry& form
     origin_ = whole_->origin();
 }
 
+void ChunkedCloud::readShareTogether(const Communicator& c, const std::function<void()>& readShare) const
+{
+    // A failure on some ranks only (their share unreadable) must not leave
+    // the others waiting in the reduction that follows: every rank learns of it.
+    std::exception_ptr failure;
+    try {
+        readShare();
+    } catch (...) {
+        failure = std::current_exception();
+    }
+    int failed = failure ? 1 : 0;
+    MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, c.comm);
+    if (failure)
+        std::rethrow_exception(failure);
+    if (failed)
+        throw Error(ErrorCode::Io, path_.string() + ": another rank could not read its share of the points");
+}
+
 Eigen::Vector3d ChunkedCloud::chooseOrigin(const Communicator& c) const
 {
     // The whole file's box is its shares' boxes joined axis by axis; whether
@@ -40,20 +58,7 @@ Eigen::Vector3d ChunkedCloud::chooseOrigin(const Communicator& c) const
     if (!options_.origin) {
         const auto ranks = static_cast<std::uint64_t>(c.size()), rank = static_cast<std::uint64_t>(c.rank());
         const std::uint64_t begin = records_ * rank / ranks, end = records_ * (rank + 1) / ranks;
-        // A failure on some ranks only (their share unreadable) must not leave
-        // the others waiting in the reduction: every rank learns of it.
-        std::exception_ptr failure;
-        try {
-            box = io::pointRecordBounds(formats_, path_, {begin, end - begin});
-        } catch (...) {
-            failure = std::current_exception();
-        }
-        int failed = failure ? 1 : 0;
-        MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, c.comm);
-        if (failure)
-            std::rethrow_exception(failure);
-        if (failed)
-            throw Error(ErrorCode::Io, path_.string() + ": another rank could not read its share of the points");
+        readShareTogether(c, [&] { box = io::pointRecordBounds(formats_, path_, {begin, end - begin}); });
     }
     if (!box) { // given, or fixed by the header: the first record tells it
         io::ReadOptions firstOptions = options_;
@@ -78,6 +83,37 @@ std::size_t ChunkedCloud::chunkCount() const
     return static_cast<std::size_t>((records_ + chunkPoints_ - 1) / chunkPoints_);
 }
 
+void ChunkedCloud::settleFieldsLeftOut(const Communicator& c)
+{
+    if (whole_) // the whole read has left them out already
+        return;
+    const std::vector<std::string> candidates = io::fieldsLeftOutWhenZero(formats_, path_);
+    if (candidates.empty())
+        return;
+    // 1 where a field has a value other than 0 in this rank's share, or is missing.
+    std::vector<int> kept(candidates.size(), 0);
+    const auto ranks = static_cast<std::size_t>(c.size());
+    readShareTogether(c, [&] {
+        for (std::size_t k = static_cast<std::size_t>(c.rank()); k < chunkCount(); k += ranks) {
+            const PointCloud chunk = read(k, false);
+            for (std::size_t f = 0; f < candidates.size(); ++f) {
+                const ScalarField* field = chunk.field(candidates[f]);
+                if (!field) {
+                    kept[f] = 1;
+                    continue;
+                }
+                const ValueRange r = field->range();
+                if (!(r.validCount == field->size() && r.min == 0.0 && r.max == 0.0))
+                    kept[f] = 1;
+            }
+        }
+    });
+    MPI_Allreduce(MPI_IN_PLACE, kept.data(), static_cast<int>(kept.size()), MPI_INT, MPI_MAX, c.comm);
+    for (std::size_t f = 0; f < candidates.size(); ++f)
+        if (!kept[f])
+            leftOut_.push_back(candidates[f]);
+}
+
 PointCloud ChunkedCloud::read(std::size_t chunk, bool geometryOnly) const
 {
     const io::RecordRange range{static_cast<std::uint64_t>(chunk) * chunkPoints_, chunkPoints_};
@@ -89,7 +125,10 @@ PointCloud ChunkedCloud::read(std::size_t chunk, bool geometryOnly) const
     }
     io::ReadOptions options = options_;
     options.geometryOnly = geometryOnly;
-    return io::readPointRecords(formats_, path_, range, options);
+    PointCloud cloud = io::readPointRecords(formats_, path_, range, options);
+    for (const std::string& name : leftOut_)
+        cloud.removeField(name);
+    return cloud;
 }
 
 } // namespace scandiff::mpi

@@ -11,7 +11,10 @@
 #include <scandiff/io/FileIO.h>
 
 #include <filesystem>
+#include <functional>
 #include <optional>
+#include <string>
+#include <vector>
 
 namespace scandiff::mpi {
 
@@ -31,10 +34,19 @@ public:
     //! Geometry only: positions and normals.
     PointCloud read(std::size_t chunk, bool geometryOnly) const;
     const Eigen::Vector3d& origin() const { return origin_; }
+    //! Collective, for the cloud whose attributes go to the output. Finds the
+    //! fields a whole read leaves out because they are 0 in the whole file
+    //! (LAS's standard attributes), which every range keeps: each rank reads
+    //! its share of the chunks, the ranks agree, and read() leaves them out
+    //! too, so that the output has scandiff-cli's fields.
+    void settleFieldsLeftOut(const Communicator& c);
     bool streamed() const { return !whole_; }
 
 private:
     Eigen::Vector3d chooseOrigin(const Communicator& c) const;
+    //! Collective: runs `readShare` (this rank's share of the file), then
+    //! rethrows its failure on this rank and fails the others too.
+    void readShareTogether(const Communicator& c, const std::function<void()>& readShare) const;
 
     const io::FormatRegistry& formats_;
     std::filesystem::path path_;
@@ -43,6 +55,7 @@ private:
     std::uint64_t records_ = 0;
     Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
     std::optional<PointCloud> whole_;
+    std::vector<std::string> leftOut_; //!< fields read() removes (settleFieldsLeftOut)
 };
 
 } // namespace scandiff::mpi

@@ -118,6 +118,7 @@ public:
     void run(std::ostream& out)
     {
         const auto start = Clock::now();
+        compared_.settleFieldsLeftOut(c_);
         owned_ = collectOwnedPoints(c_, compared_, grid_);
         report_.tiles = owned_.tiles.size();
         report_.points = owned_.index.size();

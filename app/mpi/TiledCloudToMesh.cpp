@@ -96,6 +96,7 @@ public:
     void run(std::ostream& out)
     {
         const auto start = Clock::now();
+        compared_.settleFieldsLeftOut(c_);
         owned_ = collectOwnedPoints(c_, compared_, grid_);
         if (owned_.total() == 0)
             throw Error(ErrorCode::InvalidData, "cloud-to-mesh: the compared cloud '" + job_.compared.stem().string() + "' is empty");

@@ -84,6 +84,7 @@ public:
     void run(std::ostream& out)
     {
         const auto start = Clock::now();
+        cores_.settleFieldsLeftOut(c_);
         owned_ = collectOwnedPoints(c_, cores_, grid_);
         report_.tiles = owned_.tiles.size();
         report_.points = owned_.index.size();

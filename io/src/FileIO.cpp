@@ -99,6 +99,12 @@ bool canReadRecordRanges(const FormatRegistry& registry, const fs::path& path)
     return handler.countRecords && handler.readRecords;
 }
 
+std::vector<std::string> fieldsLeftOutWhenZero(const FormatRegistry& registry, const fs::path& path)
+{
+    const FormatHandler& handler = readerFor(registry, path);
+    return handler.fieldsLeftOutWhenZero ? handler.fieldsLeftOutWhenZero(path) : std::vector<std::string>();
+}
+
 std::uint64_t pointRecordCount(const FormatRegistry& registry, const fs::path& path)
 {
     const FormatHandler& handler = readerFor(registry, path);

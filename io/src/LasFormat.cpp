@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 //! LAS: reads LAS 1.0-1.4 (point data record formats 0-10) straight from a
-//! memory map, or from the records LazDecoder.cpp decompresses when the points
-//! are LAZ, and writes LAS 1.4 with point format 6, 7 or 8.
+//! memory map, or, when the points are LAZ, from each chunk's records as
+//! LazDecoder.cpp's workers decompress them, and writes LAS 1.4 with point
+//! format 6, 7 or 8.
 //!
 //! Layout facts quoted below come from the ASPRS LAS 1.4 specification, R15
 //! ("LAS 1.4 R15"), which also describes the older versions this reader accepts.
@@ -19,6 +20,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -26,6 +28,7 @@
 #include <ctime>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <optional>
 #include <stdexcept>
@@ -459,14 +462,19 @@ struct PointOutputs
     float* userData = nullptr;
     float* pointSourceId = nullptr;
     float* gpsTime = nullptr;
-    //! The times' exact form: float residuals, and a flag raised by a time
-    //! they cannot give back (the reader then reads the times as doubles).
+    //! The times' exact form: float residuals beside the floats.
     float* gpsTimeResidual = nullptr;
-    bool* gpsTimeResidualFailed = nullptr;
     double gpsTimeOffset = 0.0;
     float* nir = nullptr;
+};
+
+//! What a run of records tells about the whole file.
+struct DecodedFacts
+{
     //! Bitwise OR of every colour channel: tells whether any exceeds 255.
     unsigned colorBits = 0;
+    //! A time the residuals cannot give back (the reader then reads the times as doubles).
+    bool gpsTimeResidualFailed = false;
 };
 
 struct CoordinateTransform
@@ -479,18 +487,20 @@ struct CoordinateTransform
 // branches on the format and all field offsets are constants.
 //   Extended: formats 6-10; otherwise the legacy formats 0-5 (LAS 1.4 R15,
 //   "Point Data Record Format 0" to "10").
+//! Decodes `count` records into the outputs' points [at, at + count).
 template <bool Extended, bool HasGpsTime, bool HasRgb, bool HasNir>
-unsigned decodeRange(const char* records, std::size_t recordLength, std::size_t begin, std::size_t end,
-                     const CoordinateTransform& transform, const PointOutputs& out)
+DecodedFacts decodeRange(const char* records, std::size_t recordLength, std::size_t count, std::size_t at,
+                         const CoordinateTransform& transform, const PointOutputs& out)
 {
     constexpr std::size_t gpsOffset = Extended ? 22 : 20;
     constexpr std::size_t rgbOffset = Extended ? 30 : (HasGpsTime ? 28 : 20);
     constexpr std::size_t nirOffset = 36;
     const double sx = transform.scale.x(), sy = transform.scale.y(), sz = transform.scale.z();
     const double tx = transform.shift.x(), ty = transform.shift.y(), tz = transform.shift.z();
+    DecodedFacts facts;
     unsigned colorBits = 0;
-    const char* p = records + begin * recordLength;
-    for (std::size_t i = begin; i < end; ++i, p += recordLength) {
+    const char* p = records;
+    for (std::size_t i = at; i < at + count; ++i, p += recordLength) {
         out.positions[i] = Eigen::Vector3f(static_cast<float>(load<std::int32_t>(p) * sx + tx),
                                            static_cast<float>(load<std::int32_t>(p + 4) * sy + ty),
                                            static_cast<float>(load<std::int32_t>(p + 8) * sz + tz));
@@ -535,7 +545,7 @@ unsigned decodeRange(const char* records, std::size_t recordLength, std::size_t 
             out.gpsTime[i] = f;
             out.gpsTimeResidual[i] = ScalarField::residualOf(time, out.gpsTimeOffset, f);
             if (!ScalarField::residualHolds(time, out.gpsTimeOffset))
-                *out.gpsTimeResidualFailed = true;
+                facts.gpsTimeResidualFailed = true;
         }
         if constexpr (HasRgb) {
             const unsigned r = load<std::uint16_t>(p + rgbOffset);
@@ -549,11 +559,12 @@ unsigned decodeRange(const char* records, std::size_t recordLength, std::size_t 
         if constexpr (HasNir)
             out.nir[i] = load<std::uint16_t>(p + nirOffset);
     }
-    return colorBits;
+    facts.colorBits = colorBits;
+    return facts;
 }
 
-using DecodeFunction = unsigned (*)(const char*, std::size_t, std::size_t, std::size_t, const CoordinateTransform&,
-                                    const PointOutputs&);
+using DecodeFunction = DecodedFacts (*)(const char*, std::size_t, std::size_t, std::size_t, const CoordinateTransform&,
+                                        const PointOutputs&);
 
 DecodeFunction decoderFor(int format)
 {
@@ -649,7 +660,7 @@ void decodeExtra(const char* records, std::size_t recordLength, std::size_t coun
 // The cloud origin: the caller's, else the header offset (the "global shift"
 // the producer chose) unless the data lie far from it, where float32 would
 // lose millimetres (e.g. an offset of 0 for UTM coordinates).
-Eigen::Vector3d chooseOrigin(const LasHeader& h, const char* records, const ReadOptions& options)
+Eigen::Vector3d chooseOrigin(const LasHeader& h, const char* firstRecord, const ReadOptions& options)
 {
     if (options.origin)
         return *options.origin;
@@ -660,11 +671,11 @@ Eigen::Vector3d chooseOrigin(const LasHeader& h, const char* records, const Read
         box.min = h.min;
         box.max = h.max;
         box.empty = false;
-    } else if (h.pointCount > 0) {
+    } else if (h.pointCount > 0 && firstRecord) {
         // Bounds missing: the first point stands for the data.
         Eigen::Vector3d first;
         for (int a = 0; a < 3; ++a)
-            first[a] = load<std::int32_t>(records + 4 * a) * h.scale[a] + h.offset[a];
+            first[a] = load<std::int32_t>(firstRecord + 4 * a) * h.scale[a] + h.offset[a];
         box.min = box.max = first;
         box.empty = false;
     }
@@ -691,8 +702,36 @@ std::string uniqueFieldName(const PointCloud& cloud, std::string name)
     }
 }
 
-//! The uncompressed point records of a LAZ file.
-std::unique_ptr<char[]> decompressRecords(const MappedFile& file, const LasHeader& h, const ReadOptions& options)
+//! Whether every value of `field` is 0. A value other than 0 is usually
+//! among the first: only fields that are 0 are scanned to their end.
+bool isZeroEverywhere(const ScalarField& field)
+{
+    if (field.offset() == 0.0) {
+        const std::vector<float>& values = field.values();
+        if (std::any_of(values.begin(), values.end(), [](float v) { return v != 0.0f; }))
+            return false;
+    }
+    const ValueRange r = field.range();
+    return r.validCount == field.size() && r.min == 0.0 && r.max == 0.0;
+}
+
+//! The fields of a point format's standard attributes, in the cloud's order.
+std::vector<std::string> standardFieldNames(int format)
+{
+    std::vector<std::string> names = {"intensity",           "return_number", "number_of_returns", "classification",
+                                      "classification_flags", "scan_direction_flag", "edge_of_flight_line", "scan_angle",
+                                      "user_data",           "point_source_id"};
+    if (format >= 6)
+        names.emplace_back("scanner_channel");
+    if (formatHasGpsTime(format))
+        names.emplace_back("gps_time");
+    if (formatHasNir(format))
+        names.emplace_back("nir");
+    return names;
+}
+
+//! The LASzip record of a LAZ file.
+LazLayout findLazLayout(const MappedFile& file, const LasHeader& h)
 {
     const fs::path& path = file.path();
     std::optional<LazLayout> layout;
@@ -705,61 +744,166 @@ std::unique_ptr<char[]> decompressRecords(const MappedFile& file, const LasHeade
     if (!layout)
         invalid(path, "the point format (byte 104) says the points are compressed (LAZ), but there is no LASzip record "
                       "(user id 'laszip encoded', record 22204)");
-    ProgressTicker ticker(options.progress, "Decompressing " + path.filename().string(), h.pointCount);
-    std::unique_ptr<char[]> records = decompressLaz(path, file.data(), file.size(), h.offsetToPoints, *layout, h.recordLength,
-                                                    h.pointCount, [&](std::size_t points) { ticker.step(points); });
-    return records;
+    return *layout;
 }
 
-//! The whole file, or with `range` the records of that range (uncompressed
-//! LAS only: a LAZ chunk cannot be decoded without those before it in its
-//! chunk, and its range reading is not written yet).
+//! Offset of a format's GPS time in its records.
+std::size_t gpsTimeOffsetOf(int format) { return format >= 6 ? 22 : 20; }
+
+//! Colours of 8-bit files: LAS 1.4 R15 says colours are normalised to 16
+//! bits, but several tools write 8-bit values unscaled. If no channel exceeds
+//! 255 the file is of that kind (genuine 16-bit colours that low would all be
+//! black), so its colours are taken as they are.
+void takeColorsUnscaled(const char* records, std::size_t recordLength, int format, std::size_t count, Rgb8* colors)
+{
+    const char* p = records + rgbOffsetOf(format);
+    for (std::size_t i = 0; i < count; ++i, p += recordLength)
+        colors[i] = Rgb8{static_cast<std::uint8_t>(p[0]), static_cast<std::uint8_t>(p[2]), static_cast<std::uint8_t>(p[4])};
+}
+
+//! The points of records held in memory (LAS's mapped file, or a LAZ file's
+//! records decompressed together because Extra Bytes need them all).
+void parseRecordsInMemory(const LasHeader& h, const char* records, std::size_t count,
+                          const CoordinateTransform& transform, const PointOutputs& out, PointCloud& cloud,
+                          ProgressTicker& ticker)
+{
+    const DecodeFunction decode = decoderFor(h.pointFormat);
+    DecodedFacts facts;
+    for (std::size_t begin = 0; begin < count; begin += kChunkPoints) {
+        const std::size_t end = std::min(count, begin + kChunkPoints);
+        const DecodedFacts some = decode(records + begin * h.recordLength, h.recordLength, end - begin, begin, transform, out);
+        facts.colorBits |= some.colorBits;
+        facts.gpsTimeResidualFailed |= some.gpsTimeResidualFailed;
+        if (!h.compressed) // a heap buffer's pages would come back as zeros
+            MappedFile::releaseConsumed(records + begin * h.recordLength, records + end * h.recordLength);
+        ticker.step(end - begin);
+    }
+    if (facts.gpsTimeResidualFailed) {
+        // Times the residuals cannot hold (far from the offset, or not times at
+        // all): read again as doubles.
+        ScalarField& time = *cloud.field("gps_time");
+        time.keepDoubles();
+        const char* p = records + gpsTimeOffsetOf(h.pointFormat);
+        for (std::size_t i = 0; i < count; ++i, p += h.recordLength)
+            time.doubles()[i] = load<double>(p);
+    }
+    if (out.colors && facts.colorBits <= 255)
+        takeColorsUnscaled(records, h.recordLength, h.pointFormat, count, out.colors);
+}
+
+//! The points of the LAZ records [first, first + count), parsed by the
+//! workers as they decode each chunk: no buffer of every record (a file of
+//! 10 M points in format 7 would need 360 MB more) and both cores parse.
+void parseLazRecords(const MappedFile& file, const LasHeader& h, const LazLayout& layout,
+                     const std::vector<LazChunk>& chunks, std::uint64_t first, std::size_t count, const CoordinateTransform& transform, const PointOutputs& out, PointCloud& cloud,
+                     ProgressTicker& ticker)
+{
+    const DecodeFunction decode = decoderFor(h.pointFormat);
+    std::atomic<unsigned> colorBits{0};
+    std::atomic<bool> gpsTimeResidualFailed{false};
+    // Runs of points whose colours were taken as 8-bit values because none of
+    // their channels exceeds 255; scaled back if another chunk has a channel
+    // above 255. Exact: a run's 8-bit value c is its 16-bit value.
+    std::mutex runsMutex;
+    std::vector<std::pair<std::size_t, std::size_t>> unscaledRuns;
+    decompressLazRecords(
+        file.path(), file.data(), file.size(), chunks, layout, h.recordLength, first, count,
+        [&](std::uint64_t firstPoint, const char* records, std::size_t n) {
+            const auto at = static_cast<std::size_t>(firstPoint - first);
+            const DecodedFacts facts = decode(records, h.recordLength, n, at, transform, out);
+            colorBits.fetch_or(facts.colorBits, std::memory_order_relaxed);
+            if (facts.gpsTimeResidualFailed)
+                gpsTimeResidualFailed = true;
+            if (out.colors && facts.colorBits <= 255) {
+                takeColorsUnscaled(records, h.recordLength, h.pointFormat, n, out.colors + at);
+                const std::lock_guard<std::mutex> lock(runsMutex);
+                unscaledRuns.emplace_back(at, n);
+            }
+        },
+        [&](std::size_t points) { ticker.step(points); });
+    if (out.colors && colorBits.load() > 255) {
+        // 65535 / 257 = 255: the exact inverse of the x257 scaling of the writer.
+        auto scaled = [](std::uint8_t c) { return static_cast<std::uint8_t>((c + 128) / 257); };
+        for (const auto& [at, n] : unscaledRuns)
+            for (std::size_t i = at; i < at + n; ++i)
+                out.colors[i] = Rgb8{scaled(out.colors[i].r), scaled(out.colors[i].g), scaled(out.colors[i].b)};
+    }
+    if (gpsTimeResidualFailed) {
+        // Times the residuals cannot hold: decoded again, kept as doubles.
+        ScalarField& time = *cloud.field("gps_time");
+        time.keepDoubles();
+        double* doubles = time.doubles().data();
+        const std::size_t offset = gpsTimeOffsetOf(h.pointFormat);
+        decompressLazRecords(
+            file.path(), file.data(), file.size(), chunks, layout, h.recordLength, first, count,
+            [&](std::uint64_t firstPoint, const char* records, std::size_t n) {
+                for (std::size_t i = 0; i < n; ++i)
+                    doubles[firstPoint - first + i] = load<double>(records + i * h.recordLength + offset);
+            },
+            [](std::size_t) {});
+    }
+}
+
+//! The whole file, or with `range` the records of that range (a LAZ file's
+//! chunks that hold them are decoded whole).
 Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<RecordRange> range = std::nullopt)
 {
     MappedFile file(path);
     const LasHeader h = parseHeader(file);
-    if (range && h.compressed)
-        throw Error(ErrorCode::Unsupported, path.string() + ": a range of records cannot be read from a LAZ file yet");
     const std::uint64_t first = range ? std::min(range->first, h.pointCount) : 0;
     const std::size_t count = static_cast<std::size_t>(range ? std::min(range->count, h.pointCount - first) : h.pointCount);
-    // LAZ: the records decompressed into memory (freed at the end of the read).
-    const std::unique_ptr<char[]> decompressed = h.compressed ? decompressRecords(file, h, options) : nullptr;
-    const char* allRecords = h.compressed ? decompressed.get() : file.data() + h.offsetToPoints;
-    const char* records = allRecords + first * h.recordLength;
     const int format = h.pointFormat;
     std::vector<ExtraDimension> extras = findExtraDimensions(file, h);
+    const std::optional<LazLayout> layout = h.compressed ? std::optional<LazLayout>(findLazLayout(file, h)) : std::nullopt;
+    // LAZ: parsed chunk by chunk as the workers decode them, unless Extra
+    // Bytes need every record at once (each field's offset comes from its
+    // first value); then decompressed whole first (freed at the end of the read).
+    const bool streamed = h.compressed && extras.empty();
+    // The chunk table vouches for the header's count before the cloud is allocated.
+    const std::vector<LazChunk> chunks =
+        streamed ? readLazChunks(path, file.data(), file.size(), h.offsetToPoints, *layout, h.recordLength, h.pointCount)
+                 : std::vector<LazChunk>();
+    std::unique_ptr<char[]> decompressed;
+    if (h.compressed && !streamed) {
+        ProgressTicker ticker(options.progress, "Decompressing " + path.filename().string(), h.pointCount);
+        decompressed = decompressLaz(path, file.data(), file.size(), h.offsetToPoints, *layout, h.recordLength, h.pointCount,
+                                     [&](std::size_t points) { ticker.step(points); });
+    }
+    const char* allRecords = !h.compressed ? file.data() + h.offsetToPoints : decompressed.get();
+    const char* records = allRecords ? allRecords + first * h.recordLength : nullptr;
+    const char* firstRecordOfFile = allRecords;
+    if (streamed) {
+        const std::uint64_t at = lazFirstRecordOffset(*layout, h.offsetToPoints, h.recordLength, file.size());
+        firstRecordOfFile = at ? file.data() + at : nullptr;
+    }
 
     PointCloud cloud;
-    cloud.setOrigin(chooseOrigin(h, allRecords, options));
+    cloud.setOrigin(chooseOrigin(h, firstRecordOfFile, options));
     cloud.setSourceGrid(CoordinateGrid{h.offset, h.scale});
     cloud.setCrsWkt(findCrs(file, h));
     double gpsTimeOffset = 0.0;
-    if (formatHasGpsTime(format) && count > 0) {
+    // A LAZ range's own first record is not at hand before decoding: its
+    // times are kept relative to the file's first.
+    const char* timeRecord = streamed ? firstRecordOfFile : records;
+    if (formatHasGpsTime(format) && count > 0 && timeRecord) {
         // Relative to the first time, float32 keeps 1 µs over ±8 s and 61 µs over
         // ±17 minutes of a ~1e9 s GPS time, which on its own would keep only 64 s.
-        gpsTimeOffset = std::floor(load<double>(records + (format >= 6 ? 22 : 20)));
+        gpsTimeOffset = std::floor(load<double>(timeRecord + gpsTimeOffsetOf(format)));
         if (!std::isfinite(gpsTimeOffset))
             gpsTimeOffset = 0.0;
     }
     std::vector<std::string> extraNames;
     try {
         cloud.resize(count);
-        for (const char* name : {"intensity", "return_number", "number_of_returns", "classification",
-                                 "classification_flags", "scan_direction_flag", "edge_of_flight_line", "scan_angle",
-                                 "user_data", "point_source_id"})
+        for (const std::string& name : standardFieldNames(format))
             cloud.addField(ScalarField(name, count));
-        if (format >= 6)
-            cloud.addField(ScalarField("scanner_channel", count));
-        if (formatHasGpsTime(format)) {
-            ScalarField& time = cloud.addField(ScalarField("gps_time", count));
-            time.setOffset(gpsTimeOffset);
+        if (ScalarField* time = cloud.field("gps_time")) {
+            time->setOffset(gpsTimeOffset);
             // A double in the file, given back to the bit: float residuals
             // beside the float view (4 bytes a point) hold real GPS times
             // (hours from the offset, in microseconds); doubles otherwise.
-            time.keepResiduals();
+            time->keepResiduals();
         }
-        if (formatHasNir(format))
-            cloud.addField(ScalarField("nir", count));
         for (const ExtraDimension& dim : extras) {
             extraNames.push_back(uniqueFieldName(cloud, dim.name));
             cloud.addField(ScalarField(extraNames.back(), count));
@@ -792,45 +936,18 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     out.userData = values("user_data");
     out.pointSourceId = values("point_source_id");
     out.gpsTime = values("gps_time");
-    bool gpsResidualsFailed = false;
     if (ScalarField* time = cloud.field("gps_time"))
         out.gpsTimeResidual = time->residuals().data();
-    out.gpsTimeResidualFailed = &gpsResidualsFailed;
     out.gpsTimeOffset = gpsTimeOffset;
     out.nir = values("nir");
 
     const CoordinateTransform transform{h.scale, h.offset - cloud.origin()};
-    const DecodeFunction decode = decoderFor(format);
     const std::size_t extraSteps = extras.size() * count;
     ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), count + extraSteps);
-    unsigned colorBits = 0;
-    for (std::size_t begin = 0; begin < count; begin += kChunkPoints) {
-        const std::size_t end = std::min(count, begin + kChunkPoints);
-        colorBits |= decode(records, h.recordLength, begin, end, transform, out);
-        if (!h.compressed) // a heap buffer's pages would come back as zeros
-            MappedFile::releaseConsumed(records + begin * h.recordLength, records + end * h.recordLength);
-        ticker.step(end - begin);
-    }
-    if (gpsResidualsFailed) {
-        // Times the residuals cannot hold (far from the offset, or not times at
-        // all): read again as doubles.
-        ScalarField& time = *cloud.field("gps_time");
-        time.keepDoubles();
-        const char* p = records + (format >= 6 ? 22 : 20);
-        for (std::size_t i = 0; i < count; ++i, p += h.recordLength)
-            time.doubles()[i] = load<double>(p);
-    }
-
-    // LAS 1.4 R15 says colours are normalised to 16 bits, but several tools write
-    // 8-bit values unscaled. If no channel exceeds 255 the file is of that kind
-    // (genuine 16-bit colours that low would all be black), so take them as is.
-    if (out.colors && colorBits <= 255) {
-        const std::size_t rgb = rgbOffsetOf(format);
-        const char* p = records + rgb;
-        for (std::size_t i = 0; i < count; ++i, p += h.recordLength)
-            out.colors[i] = Rgb8{static_cast<std::uint8_t>(p[0]), static_cast<std::uint8_t>(p[2]),
-                                 static_cast<std::uint8_t>(p[4])};
-    }
+    if (streamed)
+        parseLazRecords(file, h, *layout, chunks, first, count, transform, out, cloud, ticker);
+    else
+        parseRecordsInMemory(h, records, count, transform, out, cloud, ticker);
 
     for (std::size_t d = 0; d < extras.size(); ++d) {
         decodeExtra(records, h.recordLength, count, extras[d], *cloud.field(extraNames[d]));
@@ -846,8 +963,7 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     for (const ScalarField& f : cloud.fields()) {
         if (range || std::find(extraNames.begin(), extraNames.end(), f.name()) != extraNames.end())
             continue;
-        const ValueRange r = f.range();
-        if (r.validCount == f.size() && r.min == 0.0 && r.max == 0.0)
+        if (isZeroEverywhere(f))
             emptyStandardFields.push_back(f.name());
     }
     for (const std::string& name : emptyStandardFields)
@@ -1249,11 +1365,15 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
 
 } // namespace
 
-FormatHandler lasFormat()
+namespace {
+
+//! LAS and LAZ alike: the same reader, by ranges too; only the writer's
+//! compression differs.
+FormatHandler lasFamilyHandler(const char* name, const char* extension, bool compressed)
 {
     FormatHandler handler;
-    handler.name = "LAS";
-    handler.extensions = {"las"};
+    handler.name = name;
+    handler.extensions = {extension};
     handler.read = [](const fs::path& path, const ReadOptions& options) { return readLas(path, options); };
     handler.countRecords = [](const fs::path& path) {
         const MappedFile file(path);
@@ -1262,22 +1382,20 @@ FormatHandler lasFormat()
     handler.readRecords = [](const fs::path& path, RecordRange range, const ReadOptions& options) -> PointCloud {
         return std::get<PointCloud>(readLas(path, options, range));
     };
-    handler.writeCloud = [](const PointCloud& cloud, const fs::path& path, const WriteOptions& options) {
-        writeLas(cloud, path, options, false);
+    handler.fieldsLeftOutWhenZero = [](const fs::path& path) {
+        const MappedFile file(path);
+        return standardFieldNames(parseHeader(file).pointFormat);
+    };
+    handler.writeCloud = [compressed](const PointCloud& cloud, const fs::path& path, const WriteOptions& options) {
+        writeLas(cloud, path, options, compressed);
     };
     return handler;
 }
 
-FormatHandler lazFormat()
-{
-    FormatHandler handler;
-    handler.name = "LAZ";
-    handler.extensions = {"laz"};
-    handler.read = [](const fs::path& path, const ReadOptions& options) { return readLas(path, options); };
-    handler.writeCloud = [](const PointCloud& cloud, const fs::path& path, const WriteOptions& options) {
-        writeLas(cloud, path, options, true);
-    };
-    return handler;
-}
+} // namespace
+
+FormatHandler lasFormat() { return lasFamilyHandler("LAS", "las", false); }
+
+FormatHandler lazFormat() { return lasFamilyHandler("LAZ", "laz", true); }
 
 } // namespace scandiff::io::detail

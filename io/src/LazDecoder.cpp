@@ -15,6 +15,7 @@
 #include <scandiff/core/Error.h>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -38,13 +39,7 @@ using laz::load;
     throw Error(ErrorCode::InvalidData, path.string() + ": " + what);
 }
 
-struct Chunk
-{
-    std::uint64_t offset = 0; //!< of its first byte in the file
-    std::uint64_t bytes = 0;  //!< 0 when unknown (no chunk table)
-    std::uint64_t firstPoint = 0;
-    std::uint64_t points = 0;
-};
+using Chunk = LazChunk;
 
 //! Points between two checks of a stream for damage while decoding.
 constexpr std::uint64_t kCheckEvery = 1024;
@@ -288,53 +283,102 @@ LazLayout parseLazLayout(const fs::path& path, const char* payload, std::size_t 
     return layout;
 }
 
+std::uint64_t lazFirstRecordOffset(const LazLayout& layout, std::uint64_t pointsStart, std::size_t recordLength,
+                                   std::size_t fileSize)
+{
+    // Chunked files put the chunk table's offset (8 bytes) before the first chunk.
+    const std::uint64_t at = pointsStart + (layout.compressor == 1 ? 0 : 8);
+    return at <= fileSize && fileSize - at >= recordLength ? at : 0;
+}
+
+std::vector<LazChunk> readLazChunks(const fs::path& path, const char* data, std::size_t size, std::uint64_t pointsStart,
+                                    const LazLayout& layout, std::size_t recordLength, std::uint64_t count)
+{
+    const auto* file = reinterpret_cast<const unsigned char*>(data);
+    if (count == 0)
+        return {};
+    if (layout.compressor == 1) {
+        if (pointsStart > size || count / kMaxPointsPerByte > size - pointsStart)
+            invalid(path, "the header claims " + std::to_string(count) + " points, more than the " +
+                              std::to_string(pointsStart > size ? 0 : size - pointsStart) + " bytes of compressed points can hold");
+        return {Chunk{pointsStart, 0, 0, count}};
+    }
+    return readChunkTable(path, file, size, pointsStart, layout, recordLength, count);
+}
+
+void decompressLazRecords(const fs::path& path, const char* data, std::size_t size, const std::vector<LazChunk>& chunks,
+                          const LazLayout& layout, std::size_t recordLength, std::uint64_t first, std::uint64_t wanted,
+                          const LazRecordsConsumer& consume, const std::function<void(std::size_t)>& progress)
+{
+    const auto* file = reinterpret_cast<const unsigned char*>(data);
+    const std::uint64_t count = chunks.empty() ? 0 : chunks.back().firstPoint + chunks.back().points;
+    first = std::min(first, count);
+    const std::uint64_t last = first + std::min(wanted, count - first);
+    // Only the chunks that hold records of the range.
+    const auto from = std::partition_point(chunks.begin(), chunks.end(),
+                                           [&](const Chunk& c) { return c.firstPoint + c.points <= first; });
+    const auto to = std::partition_point(from, chunks.end(), [&](const Chunk& c) { return c.firstPoint < last; });
+    const std::size_t begin = static_cast<std::size_t>(from - chunks.begin());
+    const std::size_t end = static_cast<std::size_t>(to - chunks.begin());
+    // Each worker decodes into its own buffer of a chunk's records (about 2 MB
+    // for LASzip's 50,000 points), which stays in its cache while the
+    // consumer takes the records from it: no buffer of the whole file.
+    tbb::enumerable_thread_specific<std::vector<char>> buffers;
+    // A few chunks per worker between two calls of `progress`: Cancel is heard
+    // within a few chunks' time (about 10 ms each for 50,000 points).
+    const std::size_t batch = 8;
+    for (std::size_t b = begin; b < end; b += batch) {
+        const std::size_t e = std::min(end, b + batch);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(b, e, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+            std::vector<char>& buffer = buffers.local();
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const Chunk& chunk = chunks[i];
+                if (chunk.points == 0)
+                    continue;
+                if (chunk.points > std::numeric_limits<std::size_t>::max() / recordLength)
+                    invalid(path, chunkName(i, chunk) + " holds more points than memory can");
+                try {
+                    buffer.resize(static_cast<std::size_t>(chunk.points) * recordLength);
+                } catch (const std::bad_alloc&) {
+                    throw Error(ErrorCode::Io, path.string() + ": not enough memory to decompress " + chunkName(i, chunk));
+                }
+                const std::uint64_t used = decodeChunk(path, layout, file, size, chunk, recordLength, i, buffer.data());
+                if (chunk.bytes != 0 && chunk.points > 1 && used != chunk.bytes)
+                    invalid(path, chunkName(i, chunk) + " is corrupt: its " + std::to_string(chunk.points) + " points use " +
+                                      std::to_string(used) + " of its " + std::to_string(chunk.bytes) + " bytes");
+                const std::uint64_t lo = std::max(first, chunk.firstPoint);
+                const std::uint64_t hi = std::min(last, chunk.firstPoint + chunk.points);
+                consume(lo, buffer.data() + (lo - chunk.firstPoint) * recordLength, static_cast<std::size_t>(hi - lo));
+            }
+        });
+        std::uint64_t points = 0;
+        for (std::size_t i = b; i < e; ++i)
+            points += std::min(last, chunks[i].firstPoint + chunks[i].points) - std::max(first, chunks[i].firstPoint);
+        progress(static_cast<std::size_t>(points));
+    }
+}
+
 std::unique_ptr<char[]> decompressLaz(const fs::path& path, const char* data, std::size_t size, std::uint64_t pointsStart,
                                       const LazLayout& layout, std::size_t recordLength, std::uint64_t count,
                                       const std::function<void(std::size_t)>& progress)
 {
-    const auto* file = reinterpret_cast<const unsigned char*>(data);
-    std::vector<Chunk> chunks;
-    if (count == 0) {
-        // nothing to decode
-    } else if (layout.compressor == 1) {
-        if (pointsStart > size || count / kMaxPointsPerByte > size - pointsStart)
-            invalid(path, "the header claims " + std::to_string(count) + " points, more than the " +
-                              std::to_string(pointsStart > size ? 0 : size - pointsStart) + " bytes of compressed points can hold");
-        chunks.push_back(Chunk{pointsStart, 0, 0, count});
-    } else {
-        chunks = readChunkTable(path, file, size, pointsStart, layout, recordLength, count);
-    }
-    // Allocated once the chunk table has vouched for the count. Not zeroed:
-    // the decoder writes every byte (zeroing them first costs a quarter of
-    // the decoding time on this kind of machine).
-    std::unique_ptr<char[]> out;
     if (count > std::numeric_limits<std::size_t>::max() / recordLength)
         invalid(path, std::to_string(count) + " points of " + std::to_string(recordLength) + " bytes do not fit in memory");
+    const std::vector<LazChunk> chunks = readLazChunks(path, data, size, pointsStart, layout, recordLength, count);
+    // Allocated once the chunk table has vouched for the count. Not zeroed:
+    // every byte is written (zeroing costs a quarter of the decoding time).
+    std::unique_ptr<char[]> out;
     try {
         out.reset(new char[std::max<std::size_t>(1, static_cast<std::size_t>(count) * recordLength)]);
     } catch (const std::bad_alloc&) {
         throw Error(ErrorCode::Io, path.string() + ": not enough memory to decompress " + std::to_string(count) + " points");
     }
-    // A few chunks per worker between two calls of `progress`: Cancel is heard
-    // within a few chunks' time (about 10 ms each for 50,000 points).
-    const std::size_t batch = 8;
-    for (std::size_t begin = 0; begin < chunks.size(); begin += batch) {
-        const std::size_t end = std::min(chunks.size(), begin + batch);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const Chunk& chunk = chunks[i];
-                const std::uint64_t used =
-                    decodeChunk(path, layout, file, size, chunk, recordLength, i, out.get() + chunk.firstPoint * recordLength);
-                if (chunk.bytes != 0 && chunk.points > 1 && used != chunk.bytes)
-                    invalid(path, chunkName(i, chunk) + " is corrupt: its " + std::to_string(chunk.points) + " points use " +
-                                      std::to_string(used) + " of its " + std::to_string(chunk.bytes) + " bytes");
-            }
-        });
-        std::size_t points = 0;
-        for (std::size_t i = begin; i < end; ++i)
-            points += chunks[i].points;
-        progress(points);
-    }
+    decompressLazRecords(
+        path, data, size, chunks, layout, recordLength, 0, count,
+        [&](std::uint64_t firstPoint, const char* records, std::size_t n) {
+            std::memcpy(out.get() + firstPoint * recordLength, records, n * recordLength);
+        },
+        progress);
     return out;
 }
 

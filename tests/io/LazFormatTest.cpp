@@ -311,6 +311,126 @@ TEST(LazFormat, WrittenLazReadsBackAsTheSameCloudAsLas)
     EXPECT_EQ(io::readPointCloud(registry(), dir / "none.laz").size(), 0u);
 }
 
+namespace {
+
+//! The records of `las` (a LAS file scandiff wrote, its records patched since)
+//! compressed as `lazTemplate` (the same cloud written as LAZ by scandiff,
+//! whose header and records only differ in the compression) lays them out.
+std::string compressLikeTemplate(const std::string& las, const std::string& lazTemplate)
+{
+    const auto length = at<std::uint16_t>(las, kRecordLength);
+    const auto count = at<std::uint64_t>(las, 247);
+    const std::size_t payload = laszipPayload(lazTemplate);
+    const io::detail::LazLayout layout =
+        io::detail::parseLazLayout("template.laz", lazTemplate.data() + payload, at<std::uint16_t>(lazTemplate, payload - 54 + 20),
+                                   length);
+    std::ostringstream out;
+    out.write(lazTemplate.data(), at<std::uint32_t>(lazTemplate, kOffsetToPoints));
+    io::detail::LazPointWriter writer(out, layout, length);
+    writer.add(las.data() + at<std::uint32_t>(las, kOffsetToPoints), static_cast<std::size_t>(count));
+    writer.finish();
+    return out.str();
+}
+
+//! varyingCloud() without its two Extra Bytes dimensions: a LAZ file of it is
+//! parsed chunk by chunk as the workers decode it.
+PointCloud standardCloud(std::size_t count, bool colours, bool nir, unsigned seed)
+{
+    PointCloud cloud = varyingCloud(count, colours, nir, seed);
+    cloud.removeField("height_above_ground");
+    cloud.removeField("amplitude");
+    return cloud;
+}
+
+} // namespace
+
+TEST(LazFormat, ChunkByChunkParsingGivesTheLasTwinsCloud)
+{
+    // 120,000 points: chunks of 50,000, parsed by the workers as they decode them.
+    const fs::path dir = test::tempDir();
+    for (const bool colours : {false, true}) {
+        for (const bool nir : {false, true}) {
+            if (nir && !colours)
+                continue;
+            const std::string name = std::string("standard") + (colours ? "_rgb" : "") + (nir ? "_nir" : "");
+            const PointCloud cloud = standardCloud(120000, colours, nir, 8);
+            io::writePointCloud(registry(), cloud, dir / (name + ".las"));
+            io::writePointCloud(registry(), cloud, dir / (name + ".laz"));
+            expectSameClouds(io::readPointCloud(registry(), dir / (name + ".las")),
+                             io::readPointCloud(registry(), dir / (name + ".laz")), name);
+        }
+    }
+
+    // Colours: each chunk decides alone whether its channels fit in 8 bits,
+    // the file as a whole whether they are 8-bit values. The first chunk's
+    // fit, the others' do not: the file's colours are 16-bit, the first
+    // chunk's too (LAS 1.4 R15), as the LAS reader reads them.
+    const PointCloud cloud = standardCloud(120000, true, false, 9);
+    io::writePointCloud(registry(), cloud, dir / "colours.las");
+    io::writePointCloud(registry(), cloud, dir / "colours.laz");
+    const std::string lazTemplate = fileBytes(dir / "colours.laz");
+    std::string las = fileBytes(dir / "colours.las");
+    const std::size_t start = at<std::uint32_t>(las, kOffsetToPoints), length = at<std::uint16_t>(las, kRecordLength);
+    ASSERT_EQ(length, 36u);
+    auto setColour = [&](std::size_t i, std::uint16_t r, std::uint16_t g, std::uint16_t b) {
+        put<std::uint16_t>(las, start + i * length + 30, r);
+        put<std::uint16_t>(las, start + i * length + 32, g);
+        put<std::uint16_t>(las, start + i * length + 34, b);
+    };
+    for (std::size_t i = 0; i < 50000; ++i)
+        setColour(i, static_cast<std::uint16_t>(i % 256), static_cast<std::uint16_t>((i / 7) % 256), 200);
+    auto expectTwins = [&](const std::string& name) -> PointCloud {
+        test::writeText(dir / (name + ".las"), las);
+        test::writeText(dir / (name + ".laz"), compressLikeTemplate(las, lazTemplate));
+        PointCloud fromLas = io::readPointCloud(registry(), dir / (name + ".las"));
+        expectSameClouds(fromLas, io::readPointCloud(registry(), dir / (name + ".laz")), name);
+        return fromLas;
+    };
+    const PointCloud mixed = expectTwins("mixed_colours");
+    EXPECT_EQ(mixed.colors()[255], (Rgb8{1, 0, 1})) << "200 of 65535 is 1 of 255";
+    // Every chunk fits: 8-bit colours, taken as they are.
+    for (std::size_t i = 50000; i < 120000; ++i)
+        setColour(i, 17, 99, static_cast<std::uint16_t>(i % 256));
+    const PointCloud eightBit = expectTwins("eight_bit_colours");
+    EXPECT_EQ(eightBit.colors()[255], (Rgb8{255, 36, 200}));
+
+    // A time the float residuals cannot hold, in the third chunk: every time
+    // is then decoded again and kept as a double.
+    put<double>(las, start + 110000 * length + 22, 4.0e15);
+    const PointCloud farTime = expectTwins("far_time");
+    EXPECT_EQ(farTime.field("gps_time")->value(110000), 4.0e15);
+    EXPECT_EQ(farTime.field("gps_time")->value(0), cloud.field("gps_time")->value(0));
+}
+
+TEST(LazFormat, RangesOfRecordsReadAsTheLasTwinsRanges)
+{
+    // Only the chunks holding a range are decoded; a range may start or end
+    // inside a chunk, span a border, run past the end or start beyond it.
+    const fs::path dir = test::tempDir();
+    const auto formats = registry();
+    for (const bool extras : {false, true}) {
+        const PointCloud cloud = extras ? varyingCloud(120000, true, false, 10) : standardCloud(120000, true, false, 10);
+        const std::string name = extras ? "with_extras" : "standard";
+        io::writePointCloud(formats, cloud, dir / (name + ".las"));
+        io::writePointCloud(formats, cloud, dir / (name + ".laz"));
+        ASSERT_TRUE(io::canReadRecordRanges(formats, dir / (name + ".laz")));
+        const PointCloud whole = io::readPointCloud(formats, dir / (name + ".las"));
+        for (const io::RecordRange range : {io::RecordRange{0, 10}, io::RecordRange{49990, 20}, io::RecordRange{60000, 50000},
+                                            io::RecordRange{119990, 100}, io::RecordRange{200000, 5}}) {
+            const std::string what = name + " from " + std::to_string(range.first);
+            const PointCloud laz = io::readPointRecords(formats, dir / (name + ".laz"), range);
+            const PointCloud las = io::readPointRecords(formats, dir / (name + ".las"), range);
+            expectSameClouds(las, laz, what);
+            // And the same points as the whole read's.
+            ASSERT_EQ(laz.size(), std::min<std::uint64_t>(range.count, 120000 - std::min<std::uint64_t>(range.first, 120000))) << what;
+            for (std::size_t i = 0; i < laz.size(); ++i) {
+                ASSERT_EQ(laz.positions()[i], whole.positions()[range.first + i]) << what << " " << i;
+                ASSERT_EQ(laz.field("gps_time")->value(i), whole.field("gps_time")->value(range.first + i)) << what << " " << i;
+            }
+        }
+    }
+}
+
 TEST(LazFormat, DamagedFilesAreClearErrors)
 {
     const std::string good = fileBytes(kLazDir / "simple.laz");

@@ -199,6 +199,19 @@ TEST_F(ScaleOut, QuadricModelWithinARadius)
     expectSameAsCli("--model quadric --radius 0.8", "--tile-size 7.5", {"c2c_distance"});
 }
 
+// LAZ is read by ranges too: each rank decodes the LASzip chunks holding its
+// ranges (5,000 records, so ranges begin and end inside chunks of 50,000).
+TEST_F(ScaleOut, LazInputsAreStreamedByRanges)
+{
+    const auto registry = builtinFormats();
+    for (const char* name : {"reference", "compared"})
+        io::writePointCloud(registry, io::readPointCloud(registry, dir_ / (std::string(name) + ".ply")),
+                            dir_ / (std::string(name) + ".laz"));
+    expectSameAsCli("c2c", "--reference " + file("reference.laz") + " --compared " + file("compared.laz"), "",
+                    "--tile-size 10 --chunk-points 5000", {"c2c_distance"});
+    EXPECT_EQ(lastReport_.find("read whole"), std::string::npos) << lastReport_;
+}
+
 TEST_F(ScaleOut, OneTileLeavesRanksWithout)
 {
     expectSameAsCli("", "--tile-size 1000", {"c2c_distance"});

@@ -40,14 +40,49 @@ constexpr std::uint16_t kLaszipRecordId = 22204;
 //! have, each naming the file.
 LazLayout parseLazLayout(const std::filesystem::path& path, const char* payload, std::size_t length, std::size_t recordLength);
 
-//! Decompresses the `count` records of `recordLength` bytes whose compressed
-//! data starts at byte `pointsStart` of the file (`data`, `size` bytes), into
-//! memory allocated once the chunk table has vouched for the count. Chunks are
-//! decoded in parallel; `progress(points)` is called between batches of
-//! chunks with the points decoded since the last call (it may throw to
-//! cancel). Throws Error(InvalidData) naming the file for a chunk table or
-//! chunk that does not fit the file or the header's count, or that does not
-//! decode (a damaged stream is given up within a thousand points or so).
+//! Receives decoded records: `count` records of the layout's length, the
+//! first of them record `firstPoint` of the file. Called on worker threads,
+//! for several chunks at once; `records` lives only during the call.
+using LazRecordsConsumer = std::function<void(std::uint64_t firstPoint, const char* records, std::size_t count)>;
+
+//! Where the first record of the compressed points lies (stored as is, the
+//! first record of the first chunk), or 0 when the file is too short for it.
+std::uint64_t lazFirstRecordOffset(const LazLayout& layout, std::uint64_t pointsStart, std::size_t recordLength,
+                                   std::size_t fileSize);
+
+//! A chunk of compressed points: each is decoded on its own.
+struct LazChunk
+{
+    std::uint64_t offset = 0; //!< of its first byte in the file
+    std::uint64_t bytes = 0;  //!< 0 when unknown (no chunk table)
+    std::uint64_t firstPoint = 0;
+    std::uint64_t points = 0;
+};
+
+//! The chunks of the `count` records of `recordLength` bytes whose compressed
+//! data starts at byte `pointsStart` of the file (`data`, `size` bytes), from
+//! the chunk table: what vouches for the header's count before anything is
+//! allocated for it. Throws Error(InvalidData) naming the file for a chunk
+//! table that does not fit the file or the count.
+std::vector<LazChunk> readLazChunks(const std::filesystem::path& path, const char* data, std::size_t size,
+                                    std::uint64_t pointsStart, const LazLayout& layout, std::size_t recordLength,
+                                    std::uint64_t count);
+
+//! Decompresses the records [first, first + wanted) of `chunks` (of the file
+//! `data`, `size` bytes) chunk by chunk: only the chunks holding those
+//! records are decoded, each into a buffer of its worker, and handed to
+//! `consume` clipped to the range. Chunks are decoded in parallel;
+//! `progress(points)` is called between batches of chunks with the records
+//! handed over since the last call (it may throw to cancel). Throws
+//! Error(InvalidData) naming the file for a chunk that does not decode (a
+//! damaged stream is given up within a thousand points or so).
+void decompressLazRecords(const std::filesystem::path& path, const char* data, std::size_t size,
+                          const std::vector<LazChunk>& chunks, const LazLayout& layout, std::size_t recordLength,
+                          std::uint64_t first, std::uint64_t wanted, const LazRecordsConsumer& consume,
+                          const std::function<void(std::size_t)>& progress);
+
+//! Every record decompressed into one buffer (count × recordLength bytes),
+//! allocated once the chunk table has vouched for the count.
 std::unique_ptr<char[]> decompressLaz(const std::filesystem::path& path, const char* data, std::size_t size,
                                       std::uint64_t pointsStart, const LazLayout& layout, std::size_t recordLength,
                                       std::uint64_t count, const std::function<void(std::size_t)>& progress);

@@ -148,6 +148,11 @@ struct FormatHandler
     //! none): the box of a file read by parts is then the parts' joined axis
     //! by axis, empty when an axis has no value in any part.
     std::function<std::optional<BoundingBox>(const std::filesystem::path&, RecordRange)> recordBounds;
+    //! The fields a whole read leaves out when every value in the file is 0
+    //! (LAS's standard attributes, which most files leave at 0); a range of
+    //! records keeps them all, so that every range has the same fields. Null
+    //! where a whole read keeps every field.
+    std::function<std::vector<std::string>(const std::filesystem::path&)> fieldsLeftOutWhenZero;
     //! A placed writer (see PlacedChunkWriter) for `total` points laid out like
     //! `layout`: created when `join` is empty, else joining the file at `join`.
     //! May throw Error(Unsupported) for an encoding whose records vary in size.
@@ -203,6 +208,8 @@ std::unique_ptr<PointChunkWriter> openPointChunkWriter(const FormatRegistry& reg
 //! See FormatHandler::recordBounds (std::nullopt when the format has none).
 std::optional<BoundingBox> pointRecordBounds(const FormatRegistry& registry, const std::filesystem::path& path,
                                              RecordRange range);
+//! See FormatHandler::fieldsLeftOutWhenZero (empty when the format has none).
+std::vector<std::string> fieldsLeftOutWhenZero(const FormatRegistry& registry, const std::filesystem::path& path);
 //! See PlacedChunkWriter: creates the file when `join` is empty, else joins it.
 //! Throws Error(Unsupported) where the format or the encoding cannot.
 std::unique_ptr<PlacedChunkWriter> openPlacedChunkWriter(const FormatRegistry& registry, const std::filesystem::path& path,
