@@ -5,10 +5,14 @@
 //! Usage: scandiff-make-scan POINTS OUTPUT [SEED]
 //!        scandiff-make-scan --mesh N OUTPUT   (the terrain as an N x N vertex grid:
 //!                                              2 (N-1)^2 triangles, 300 -> 178,802)
-//!        scandiff-make-scan --terrain POINTS SIZE OUTPUT [SEED]
+//!        scandiff-make-scan --terrain POINTS SIZE OUTPUT [SEED] [--scan-order]
 //!                                             (terrain only, SIZE x SIZE m: the
 //!                                              processing benchmarks' 1 M points
-//!                                              over 100 x 100 m)
+//!                                              over 100 x 100 m; points in random
+//!                                              order, or with --scan-order in an
+//!                                              airborne sweep's: along scan lines
+//!                                              10 cm apart, back and forth, with
+//!                                              a gps_time of 500,000 points a second)
 //!        scandiff-make-scan --site POINTS OUTPUT SEED [--changed]
 //!                           [--motion YAW,PITCH,ROLL,TX,TY,TZ] [--x-range LOW,HIGH]
 //!                                             (the registration tests' site of
@@ -43,11 +47,14 @@
 #include <scandiff/io/FileIO.h>
 #include <scandiff/io/ResultFiles.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <numeric>
 #include <random>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -80,9 +87,34 @@ int writeTerrainMesh(int n, const char* output)
     return 0;
 }
 
+//! Puts the points in the order an airborne scanner takes them: along scan
+//! lines 10 cm apart, back and forth, timed at 500,000 points a second. Real
+//! LAZ files keep that order (or a spatial one), which their compression
+//! relies on; the random order of the other benchmarks is LAZ's worst case.
+void putInScanOrder(scandiff::PointCloud& cloud)
+{
+    const std::size_t n = cloud.size();
+    auto lineOf = [&](std::size_t i) { return static_cast<long>(std::floor(cloud.positions()[i].y() / 0.1f)); };
+    std::vector<std::size_t> order(n);
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        const long la = lineOf(a), lb = lineOf(b);
+        if (la != lb)
+            return la < lb;
+        const float xa = cloud.positions()[a].x(), xb = cloud.positions()[b].x();
+        return la % 2 == 0 ? xa < xb : xa > xb;
+    });
+    scandiff::PointCloud sorted = cloud.subset(order);
+    auto& time = sorted.addField("gps_time");
+    time.setOffset(400000.0);
+    for (std::size_t i = 0; i < n; ++i)
+        time.values()[i] = static_cast<float>(static_cast<double>(i) * 2e-6);
+    cloud = std::move(sorted);
+}
+
 //! A terrain scan without the wall: uniform over size x size metres, 3 mm of
 //! noise, colours and intensity.
-int writeTerrainScan(std::size_t n, float size, const char* output, unsigned seed)
+int writeTerrainScan(std::size_t n, float size, const char* output, unsigned seed, bool scanOrder)
 {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> u(0.0f, size);
@@ -99,6 +131,8 @@ int writeTerrainScan(std::size_t n, float size, const char* output, unsigned see
         colours[i] = {static_cast<std::uint8_t>(2.5f * x), static_cast<std::uint8_t>(2.5f * y), static_cast<std::uint8_t>(128 + 50 * z)};
         intensity.values()[i] = static_cast<float>(i % 4096);
     }
+    if (scanOrder)
+        putInScanOrder(cloud);
     scandiff::io::FormatRegistry registry;
     scandiff::io::registerBuiltinFormats(registry);
     scandiff::io::writePointCloud(registry, cloud, output);
@@ -196,9 +230,12 @@ int main(int argc, char** argv)
             return 1;
         }
     }
-    if ((argc == 5 || argc == 6) && std::string(argv[1]) == "--terrain") {
+    if (argc >= 5 && argc <= 7 && std::string(argv[1]) == "--terrain") {
         try {
-            return writeTerrainScan(std::stoull(argv[2]), std::stof(argv[3]), argv[4], argc == 6 ? static_cast<unsigned>(std::stoul(argv[5])) : 1u);
+            const bool scanOrder = std::string(argv[argc - 1]) == "--scan-order";
+            const int positional = argc - (scanOrder ? 1 : 0);
+            const unsigned seed = positional == 6 ? static_cast<unsigned>(std::stoul(argv[5])) : 1u;
+            return writeTerrainScan(std::stoull(argv[2]), std::stof(argv[3]), argv[4], seed, scanOrder);
         } catch (const std::exception& e) {
             std::cerr << "error: " << e.what() << '\n';
             return 1;
