@@ -844,6 +844,31 @@ void parseLazRecords(const MappedFile& file, const LasHeader& h, const LazLayout
     }
 }
 
+//! The LAZ records [first, first + count) decompressed into one buffer.
+std::unique_ptr<char[]> decompressLazRange(const MappedFile& file, const LasHeader& h, const LazLayout& layout,
+                                           const std::vector<LazChunk>& chunks, std::uint64_t first, std::size_t count,
+                                           const ReadOptions& options)
+{
+    const fs::path& path = file.path();
+    if (count > std::numeric_limits<std::size_t>::max() / h.recordLength)
+        invalid(path, std::to_string(count) + " points of " + std::to_string(h.recordLength) + " bytes do not fit in memory");
+    // Not zeroed: every byte is written (zeroing costs a quarter of the decoding time).
+    std::unique_ptr<char[]> records;
+    try {
+        records.reset(new char[std::max<std::size_t>(1, count * h.recordLength)]);
+    } catch (const std::bad_alloc&) {
+        throw Error(ErrorCode::Io, path.string() + ": not enough memory to decompress " + std::to_string(count) + " points");
+    }
+    ProgressTicker ticker(options.progress, "Decompressing " + path.filename().string(), count);
+    decompressLazRecords(
+        path, file.data(), file.size(), chunks, layout, h.recordLength, first, count,
+        [&](std::uint64_t firstPoint, const char* decoded, std::size_t n) {
+            std::memcpy(records.get() + (firstPoint - first) * h.recordLength, decoded, n * h.recordLength);
+        },
+        [&](std::size_t points) { ticker.step(points); });
+    return records;
+}
+
 //! The whole file, or with `range` the records of that range (a LAZ file's
 //! chunks that hold them are decoded whole).
 Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<RecordRange> range = std::nullopt)
@@ -855,24 +880,21 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     const int format = h.pointFormat;
     std::vector<ExtraDimension> extras = findExtraDimensions(file, h);
     const std::optional<LazLayout> layout = h.compressed ? std::optional<LazLayout>(findLazLayout(file, h)) : std::nullopt;
-    // LAZ: parsed chunk by chunk as the workers decode them, unless Extra
-    // Bytes need every record at once (each field's offset comes from its
-    // first value); then decompressed whole first (freed at the end of the read).
-    const bool streamed = h.compressed && extras.empty();
-    // The chunk table vouches for the header's count before the cloud is allocated.
+    // The chunk table vouches for the header's count before anything is allocated for it.
     const std::vector<LazChunk> chunks =
-        streamed ? readLazChunks(path, file.data(), file.size(), h.offsetToPoints, *layout, h.recordLength, h.pointCount)
-                 : std::vector<LazChunk>();
-    std::unique_ptr<char[]> decompressed;
-    if (h.compressed && !streamed) {
-        ProgressTicker ticker(options.progress, "Decompressing " + path.filename().string(), h.pointCount);
-        decompressed = decompressLaz(path, file.data(), file.size(), h.offsetToPoints, *layout, h.recordLength, h.pointCount,
-                                     [&](std::size_t points) { ticker.step(points); });
-    }
-    const char* allRecords = !h.compressed ? file.data() + h.offsetToPoints : decompressed.get();
-    const char* records = allRecords ? allRecords + first * h.recordLength : nullptr;
-    const char* firstRecordOfFile = allRecords;
-    if (streamed) {
+        h.compressed ? readLazChunks(path, file.data(), file.size(), h.offsetToPoints, *layout, h.recordLength, h.pointCount)
+                     : std::vector<LazChunk>();
+    // LAZ: parsed chunk by chunk as the workers decode them, unless Extra
+    // Bytes need the records of the read at once (each field's offset comes
+    // from its first value); then those are decompressed first (freed at the
+    // end of the read).
+    const bool streamed = h.compressed && extras.empty();
+    const std::unique_ptr<char[]> decompressed =
+        h.compressed && !streamed ? decompressLazRange(file, h, *layout, chunks, first, count, options) : nullptr;
+    const char* records = !h.compressed ? file.data() + h.offsetToPoints + first * h.recordLength : decompressed.get();
+    const char* firstRecordOfFile = file.data() + h.offsetToPoints;
+    if (h.compressed) {
+        // The first record of the first chunk is stored as is.
         const std::uint64_t at = lazFirstRecordOffset(*layout, h.offsetToPoints, h.recordLength, file.size());
         firstRecordOfFile = at ? file.data() + at : nullptr;
     }

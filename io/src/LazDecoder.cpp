@@ -147,6 +147,10 @@ std::uint64_t decodeLayered(const fs::path& path, const LazLayout& layout, const
     }
     if (corrupt())
         refuse();
+    // Each layer is a stream of its own, finished by its encoder: a damaged
+    // one seldom ends on its last byte.
+    if (!std::all_of(items.begin(), items.end(), [](const auto& item) { return item->endedExactly(); }))
+        invalid(path, chunkName(index, chunk) + " is corrupt: a layer does not end where its size says");
     return static_cast<std::uint64_t>(p - first);
 }
 

@@ -428,6 +428,24 @@ TEST(LazFormat, RangesOfRecordsReadAsTheLasTwinsRanges)
                 ASSERT_EQ(laz.field("gps_time")->value(i), whole.field("gps_time")->value(range.first + i)) << what << " " << i;
             }
         }
+
+        // Only the chunks holding a range are decoded: with the last of the
+        // three chunks damaged, the first two still read, the last does not.
+        std::string bytes = fileBytes(dir / (name + ".laz"));
+        const std::size_t payload = laszipPayload(bytes);
+        const auto length = at<std::uint16_t>(bytes, kRecordLength);
+        const io::detail::LazLayout layout =
+            io::detail::parseLazLayout(name, bytes.data() + payload, at<std::uint16_t>(bytes, payload - 54 + 20), length);
+        const std::vector<io::detail::LazChunk> chunks = io::detail::readLazChunks(
+            name, bytes.data(), bytes.size(), at<std::uint32_t>(bytes, kOffsetToPoints), layout, length, 120000);
+        ASSERT_EQ(chunks.size(), 3u);
+        const std::size_t middle = static_cast<std::size_t>(chunks[2].offset + chunks[2].bytes / 2);
+        std::fill(bytes.begin() + static_cast<std::ptrdiff_t>(middle), bytes.begin() + static_cast<std::ptrdiff_t>(middle + 2000), '\xFF');
+        const fs::path damaged = dir / (name + "_damaged.laz");
+        test::writeText(damaged, bytes);
+        EXPECT_EQ(io::readPointRecords(formats, damaged, {0, 100000}).size(), 100000u) << name;
+        test::expectError([&] { io::readPointRecords(formats, damaged, {99990, 20}); }, ErrorCode::InvalidData, damaged,
+                          "LAZ chunk 2");
     }
 }
 

@@ -139,6 +139,9 @@ public:
     //! Where the next byte would be read (past `end` when it ran out).
     const unsigned char* position() const { return next_; }
     std::size_t bytesPastEnd() const { return pastEnd_; }
+    //! Whether the stream was read to its last byte exactly, as every stream
+    //! an encoder finished is (it writes the bytes the decoder reads ahead).
+    bool endedExactly() const { return next_ == end_; }
     //! Whether the stream cannot come from an encoder: it ran past its end,
     //! left the coding interval, or a coder saw an impossible sequence.
     bool corrupt() const { return pastEnd_ > 0 || corrupt_ || value_ >= length_; }

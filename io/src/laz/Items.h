@@ -151,6 +151,9 @@ public:
     virtual void decode(unsigned char* item, std::uint32_t& context) = 0;
     //! Whether a layer's stream cannot come from an encoder (see ArithmeticDecoder::corrupt).
     virtual bool corrupt() const = 0;
+    //! Once the chunk is decoded: whether every layer was read to its last
+    //! byte (see ArithmeticDecoder::endedExactly).
+    virtual bool endedExactly() const = 0;
 };
 
 //! The coder of a layered item (point14, rgb14, rgbnir14 or byte14, version

@@ -30,6 +30,7 @@ public:
     bool changes() const { return decoder_.has_value(); }
     ArithmeticDecoder& operator*() { return *decoder_; }
     bool corrupt() const { return decoder_ && decoder_->corrupt(); }
+    bool endedExactly() const { return !decoder_ || decoder_->endedExactly(); }
 
 private:
     std::optional<ArithmeticDecoder> decoder_;
@@ -57,6 +58,10 @@ public:
     bool corrupt() const override
     {
         return std::any_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.corrupt(); });
+    }
+    bool endedExactly() const override
+    {
+        return std::all_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.endedExactly(); });
     }
 
     void decode(unsigned char* item, std::uint32_t& context) override
@@ -176,6 +181,7 @@ public:
     }
 
     bool corrupt() const override { return rgb_.corrupt() || nir_.corrupt(); }
+    bool endedExactly() const override { return rgb_.endedExactly() && nir_.endedExactly(); }
 
     void decode(unsigned char* item, std::uint32_t& context) override
     {
@@ -228,6 +234,10 @@ public:
     bool corrupt() const override
     {
         return std::any_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.corrupt(); });
+    }
+    bool endedExactly() const override
+    {
+        return std::all_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.endedExactly(); });
     }
 
     void decode(unsigned char* item, std::uint32_t& context) override
