@@ -29,6 +29,8 @@ public:
 
     const std::filesystem::path& path() const { return path_; }
     std::size_t chunkCount() const;
+    //! The records of the file (points, non-finite ones included).
+    std::uint64_t recordCount() const { return records_; }
     //! The points of one chunk, in file order, in the frame a whole read gives
     //! (same origin); non-finite points dropped as a whole read drops them.
     //! Geometry only: positions and normals.

@@ -170,8 +170,14 @@ private:
     ReferencePart collectReference(Representatives& representatives)
     {
         const RegionRouter router(grid_, owned_.owners, c_.size(), halo_);
+        // Room for this rank's part of the reference, estimated from its share
+        // of the compared points with a margin for the halo: room never
+        // touched costs no memory, while growing the vector copied it into
+        // fresh pages again and again.
+        const double share = owned_.total() ? static_cast<double>(owned_.index.size()) / static_cast<double>(owned_.total()) : 0.0;
+        const auto expected = static_cast<std::size_t>(share * static_cast<double>(reference_.recordCount()) * 1.3);
         ReceivedPoints received =
-            distributePoints(c_, reference_, {needNormals_, false, 0}, router,
+            distributePoints(c_, reference_, {needNormals_, false, expected}, router,
                              [&](const Eigen::Vector3d& p) { representatives.offer(p); });
         representatives.mergeOverRanks(c_);
         totalReference_ = received.chunkStarts.back();
