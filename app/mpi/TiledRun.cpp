@@ -60,17 +60,25 @@ PointCloud makeCloud(const Eigen::Vector3d& origin, std::vector<Eigen::Vector3f>
 namespace {
 
 //! Pass 1: the points of every tile, counted by each rank on its share of the
-//! chunks, summed over the ranks.
-std::map<TileKey, std::uint64_t> countTilePoints(const Communicator& c, const ChunkedCloud& cloud, const TileGrid& grid)
+//! chunks, summed over the ranks. The positions of the chunks read are kept
+//! in `positions` (chunk qN + r at q), for pass 2.
+std::map<TileKey, std::uint64_t> countTilePoints(const Communicator& c, const ChunkedCloud& cloud, const TileGrid& grid,
+                                                 std::vector<PointCloud>& positions)
 {
     std::unordered_map<TileKey, std::uint64_t, TileKeyHash> mine;
     LastTile<std::uint64_t*> count; // the map's values stay in place
     for (std::size_t k = static_cast<std::size_t>(c.rank()); k < cloud.chunkCount(); k += static_cast<std::size_t>(c.size())) {
-        const PointCloud chunk = cloud.read(k, true);
+        PointCloud chunk = cloud.read(k, true);
         for (std::size_t i = 0; i < chunk.size(); ++i) {
             const Eigen::Vector3d p = chunk.globalPosition(i);
             ++*count.of(grid.tileOf(p.x(), p.y()), [&](const TileKey& key) { return &mine[key]; });
         }
+        // Positions only (12 bytes a point, this rank's share): reading the
+        // chunk again in pass 2 cost more than keeping them.
+        PointCloud kept;
+        kept.setOrigin(chunk.origin());
+        kept.positions() = std::move(chunk.positions());
+        positions.push_back(std::move(kept));
     }
     struct Entry
     {
@@ -90,7 +98,8 @@ std::map<TileKey, std::uint64_t> countTilePoints(const Communicator& c, const Ch
 
 OwnedPoints collectOwnedPoints(const Communicator& c, const ChunkedCloud& cloud, const TileGrid& grid)
 {
-    const std::map<TileKey, std::uint64_t> counts = countTilePoints(c, cloud, grid);
+    std::vector<PointCloud> positions;
+    const std::map<TileKey, std::uint64_t> counts = countTilePoints(c, cloud, grid, positions);
     OwnedPoints owned;
     owned.owners = assignTiles(counts, c.size());
     std::unordered_map<TileKey, int, TileKeyHash> owner(owned.owners.begin(), owned.owners.end());
@@ -101,6 +110,7 @@ OwnedPoints collectOwnedPoints(const Communicator& c, const ChunkedCloud& cloud,
     // Pass 2: every point to its tile's rank.
     DistributeOptions options;
     options.withIndex = true;
+    options.alreadyRead = &positions;
     for (const TileKey& key : owned.tiles)
         options.expected += static_cast<std::size_t>(counts.at(key));
     LastTile<int> ownerOf;
@@ -130,7 +140,9 @@ ReceivedPoints distributePoints(const Communicator& c, const ChunkedCloud& cloud
     std::vector<float> sendBuffer, receiveBuffer;
     for (std::size_t round = 0; round * ranks < cloud.chunkCount(); ++round) {
         const std::size_t chunkIndex = round * ranks + static_cast<std::size_t>(c.rank());
-        const PointCloud chunk = chunkIndex < cloud.chunkCount() ? cloud.read(chunkIndex, true) : PointCloud();
+        PointCloud chunk;
+        if (chunkIndex < cloud.chunkCount())
+            chunk = options.alreadyRead ? std::move((*options.alreadyRead)[round]) : cloud.read(chunkIndex, true);
         // The round's chunk sizes give every point its input index.
         const std::vector<std::uint64_t> sizes = allGather(c, std::vector<std::uint64_t>{chunk.size()});
         std::uint64_t first = base;

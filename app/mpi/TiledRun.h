@@ -81,6 +81,9 @@ struct DistributeOptions
     bool withNormals = false; //!< send the normals (when the file has them)
     bool withIndex = false;   //!< send the input indices
     std::size_t expected = 0; //!< points this rank will receive, when known (room made at once)
+    //! This rank's chunks (chunk qN + r at q) when an earlier pass read them
+    //! already; taken from here instead of read again.
+    std::vector<PointCloud>* alreadyRead = nullptr;
 };
 
 //! Collective. Reads `cloud` once across the ranks, one round of N chunks at a
