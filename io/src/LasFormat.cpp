@@ -795,7 +795,8 @@ void parseRecordsInMemory(const LasHeader& h, const char* records, std::size_t c
 //! workers as they decode each chunk: no buffer of every record (a file of
 //! 10 M points in format 7 would need 360 MB more) and both cores parse.
 void parseLazRecords(const MappedFile& file, const LasHeader& h, const LazLayout& layout,
-                     const std::vector<LazChunk>& chunks, std::uint64_t first, std::size_t count, const CoordinateTransform& transform, const PointOutputs& out, PointCloud& cloud,
+                     const std::vector<LazChunk>& chunks, std::uint64_t first, std::size_t count,
+                     const CoordinateTransform& transform, const PointOutputs& out, PointCloud& cloud,
                      ProgressTicker& ticker)
 {
     const DecodeFunction decode = decoderFor(h.pointFormat);
