@@ -57,11 +57,12 @@ class SymbolModel
 public:
     //! The table is only the decoder's search aid: the stream does not depend
     //! on it. LASzip's has a quarter as many entries as symbols, and the
-    //! bisection that ends each search then took a third of the decoding time
-    //! (its branches follow the coded data, so they are mispredicted); this
-    //! one has four entries per symbol, so a search mostly ends at the table.
-    //! Rebuilding it when the model adapts costs well under one store per
-    //! symbol decoded (updates come every (symbols + 6) × 8 symbols at most).
+    //! bisection that ends each search then took a third of the integer
+    //! decoding's time (its branches follow the coded data, so they are
+    //! mispredicted); this one has four entries per symbol, so a search mostly
+    //! ends at the table. Once a model has settled (an update every
+    //! (symbols + 6) × 8 symbols), rebuilding the table costs under one store
+    //! per symbol decoded.
     static constexpr std::uint32_t kTableFinerBits = 2;
     static constexpr std::uint32_t kTableFrom = 4;
 
