@@ -845,31 +845,6 @@ void parseLazRecords(const MappedFile& file, const LasHeader& h, const LazLayout
     }
 }
 
-//! The LAZ records [first, first + count) decompressed into one buffer.
-std::unique_ptr<char[]> decompressLazRange(const MappedFile& file, const LasHeader& h, const LazLayout& layout,
-                                           const std::vector<LazChunk>& chunks, std::uint64_t first, std::size_t count,
-                                           const ReadOptions& options)
-{
-    const fs::path& path = file.path();
-    if (count > std::numeric_limits<std::size_t>::max() / h.recordLength)
-        invalid(path, std::to_string(count) + " points of " + std::to_string(h.recordLength) + " bytes do not fit in memory");
-    // Not zeroed: every byte is written (zeroing costs a quarter of the decoding time).
-    std::unique_ptr<char[]> records;
-    try {
-        records.reset(new char[std::max<std::size_t>(1, count * h.recordLength)]);
-    } catch (const std::bad_alloc&) {
-        throw Error(ErrorCode::Io, path.string() + ": not enough memory to decompress " + std::to_string(count) + " points");
-    }
-    ProgressTicker ticker(options.progress, "Decompressing " + path.filename().string(), count);
-    decompressLazRecords(
-        path, file.data(), file.size(), chunks, layout, h.recordLength, first, count,
-        [&](std::uint64_t firstPoint, const char* decoded, std::size_t n) {
-            std::memcpy(records.get() + (firstPoint - first) * h.recordLength, decoded, n * h.recordLength);
-        },
-        [&](std::size_t points) { ticker.step(points); });
-    return records;
-}
-
 //! The whole file, or with `range` the records of that range (a LAZ file's
 //! chunks that hold them are decoded whole).
 Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<RecordRange> range = std::nullopt)
@@ -890,8 +865,12 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     // from its first value); then those are decompressed first (freed at the
     // end of the read).
     const bool streamed = h.compressed && extras.empty();
-    const std::unique_ptr<char[]> decompressed =
-        h.compressed && !streamed ? decompressLazRange(file, h, *layout, chunks, first, count, options) : nullptr;
+    std::unique_ptr<char[]> decompressed;
+    if (h.compressed && !streamed) {
+        ProgressTicker ticker(options.progress, "Decompressing " + path.filename().string(), count);
+        decompressed = decompressLazRange(path, file.data(), file.size(), chunks, *layout, h.recordLength, first, count,
+                                          [&](std::size_t points) { ticker.step(points); });
+    }
     const char* records = !h.compressed ? file.data() + h.offsetToPoints + first * h.recordLength : decompressed.get();
     const char* firstRecordOfFile = file.data() + h.offsetToPoints;
     if (h.compressed) {
