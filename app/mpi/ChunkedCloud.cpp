@@ -98,12 +98,7 @@ void ChunkedCloud::settleFieldsLeftOut(const Communicator& c)
             const PointCloud chunk = read(k, false);
             for (std::size_t f = 0; f < candidates.size(); ++f) {
                 const ScalarField* field = chunk.field(candidates[f]);
-                if (!field) {
-                    kept[f] = 1;
-                    continue;
-                }
-                const ValueRange r = field->range();
-                if (!(r.validCount == field->size() && r.min == 0.0 && r.max == 0.0))
+                if (!field || !field->isZeroEverywhere())
                     kept[f] = 1;
             }
         }

@@ -133,6 +133,14 @@ bool ScalarField::compact(bool stayExact)
     return true;
 }
 
+bool ScalarField::isZeroEverywhere() const
+{
+    if (offset_ == 0.0 && std::any_of(values_.begin(), values_.end(), [](float v) { return v != 0.0f; }))
+        return false;
+    const ValueRange r = range();
+    return r.validCount == size() && r.min == 0.0 && r.max == 0.0;
+}
+
 ValueRange ScalarField::range() const
 {
     ValueRange r;

@@ -702,19 +702,6 @@ std::string uniqueFieldName(const PointCloud& cloud, std::string name)
     }
 }
 
-//! Whether every value of `field` is 0. A value other than 0 is usually
-//! among the first: only fields that are 0 are scanned to their end.
-bool isZeroEverywhere(const ScalarField& field)
-{
-    if (field.offset() == 0.0) {
-        const std::vector<float>& values = field.values();
-        if (std::any_of(values.begin(), values.end(), [](float v) { return v != 0.0f; }))
-            return false;
-    }
-    const ValueRange r = field.range();
-    return r.validCount == field.size() && r.min == 0.0 && r.max == 0.0;
-}
-
 //! The fields of a point format's standard attributes, in the cloud's order.
 std::vector<std::string> standardFieldNames(int format)
 {
@@ -965,7 +952,7 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     for (const ScalarField& f : cloud.fields()) {
         if (range || std::find(extraNames.begin(), extraNames.end(), f.name()) != extraNames.end())
             continue;
-        if (isZeroEverywhere(f))
+        if (f.isZeroEverywhere())
             emptyStandardFields.push_back(f.name());
     }
     for (const std::string& name : emptyStandardFields)

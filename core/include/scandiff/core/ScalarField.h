@@ -110,6 +110,10 @@ public:
 
     //! Min/max of the valid values (NaN when there is none).
     ValueRange range() const;
+    //! Whether every value is valid and 0 (what LAS readers leave out). A
+    //! value other than 0 is usually among the first: only a field of zeros
+    //! is scanned to its end.
+    bool isZeroEverywhere() const;
 
 private:
     std::string name_;
