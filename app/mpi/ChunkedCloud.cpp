@@ -2,7 +2,9 @@
 #include "ChunkedCloud.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/Log.h>
 
+#include <cmath>
 #include <exception>
 #include <limits>
 #include <numeric>
@@ -21,6 +23,13 @@ ChunkedCloud::ChunkedCloud(const Communicator& c, const io::FormatRegistry& form
             // Every range is read in the frame a whole read would choose.
             origin_ = chooseOrigin(c);
             options_.origin = origin_;
+            io::ReadOptions firstOptions = options_;
+            firstOptions.geometryOnly = true;
+            const PointCloud first = io::readPointRecords(formats_, path_, {0, 1}, firstOptions);
+            layout_ = first.subset({});
+            // Kept coordinates stand for a geometry read only where it has no normals.
+            if (first.hasNormals())
+                kept_.clear();
             return;
         } catch (const Error& e) {
             if (e.code() != ErrorCode::Unsupported)
@@ -30,6 +39,7 @@ ChunkedCloud::ChunkedCloud(const Communicator& c, const io::FormatRegistry& form
     whole_ = io::readPointCloud(formats_, path_, options_);
     records_ = whole_->size();
     origin_ = whole_->origin();
+    layout_ = whole_->subset({});
 }
 
 void ChunkedCloud::readShareTogether(const Communicator& c, const std::function<void()>& readShare) const
@@ -50,16 +60,52 @@ void ChunkedCloud::readShareTogether(const Communicator& c, const std::function<
         throw Error(ErrorCode::Io, path_.string() + ": another rank could not read its share of the points");
 }
 
-Eigen::Vector3d ChunkedCloud::chooseOrigin(const Communicator& c) const
+std::optional<BoundingBox> ChunkedCloud::shareBounds(const Communicator& c)
+{
+    const auto ranks = static_cast<std::size_t>(c.size()), rank = static_cast<std::size_t>(c.rank());
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = std::numeric_limits<double>::infinity();
+        hi[a] = -lo[a];
+    }
+    bool kept = rank < chunkCount();
+    for (std::size_t k = rank; kept && k < chunkCount(); k += ranks) {
+        std::optional<std::vector<Eigen::Vector3d>> coordinates =
+            io::pointRecordPositions(formats_, path_, {static_cast<std::uint64_t>(k) * chunkPoints_, chunkPoints_});
+        if (!coordinates) {
+            kept = false;
+            break;
+        }
+        // Each axis's range of finite values, as the readers' box is.
+        for (const Eigen::Vector3d& p : *coordinates)
+            for (int a = 0; a < 3; ++a)
+                if (std::isfinite(p[a])) {
+                    lo[a] = std::min(lo[a], p[a]);
+                    hi[a] = std::max(hi[a], p[a]);
+                }
+        kept_[k] = std::move(*coordinates);
+    }
+    if (!kept) {
+        // The format has no such reader, or the header fixes the origin (the
+        // same on every rank), or this rank has no chunk: its contiguous share.
+        kept_.clear();
+        const std::uint64_t begin = records_ * rank / ranks, end = records_ * (rank + 1) / ranks;
+        return io::pointRecordBounds(formats_, path_, {begin, end - begin});
+    }
+    BoundingBox box;
+    box.min = Eigen::Vector3d(lo[0], lo[1], lo[2]);
+    box.max = Eigen::Vector3d(hi[0], hi[1], hi[2]);
+    box.empty = !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]);
+    return box;
+}
+
+Eigen::Vector3d ChunkedCloud::chooseOrigin(const Communicator& c)
 {
     // The whole file's box is its shares' boxes joined axis by axis; whether
     // one is needed depends on the header alone, so every rank agrees.
     std::optional<BoundingBox> box;
-    if (!options_.origin) {
-        const auto ranks = static_cast<std::uint64_t>(c.size()), rank = static_cast<std::uint64_t>(c.rank());
-        const std::uint64_t begin = records_ * rank / ranks, end = records_ * (rank + 1) / ranks;
-        readShareTogether(c, [&] { box = io::pointRecordBounds(formats_, path_, {begin, end - begin}); });
-    }
+    if (!options_.origin)
+        readShareTogether(c, [&] { box = shareBounds(c); });
     if (!box) { // given, or fixed by the header: the first record tells it
         io::ReadOptions firstOptions = options_;
         firstOptions.geometryOnly = true;
@@ -109,8 +155,30 @@ void ChunkedCloud::settleFieldsLeftOut(const Communicator& c)
             leftOut_.push_back(candidates[f]);
 }
 
+PointCloud ChunkedCloud::fromKeptCoordinates(std::vector<Eigen::Vector3d>&& coordinates) const
+{
+    // As a geometry read of the range makes it: the same conversion to the
+    // origin's frame, the same points dropped.
+    PointCloud cloud = layout_.subset({});
+    cloud.setOrigin(origin_);
+    cloud.resize(coordinates.size());
+    std::vector<Eigen::Vector3f>& positions = cloud.positions();
+    for (std::size_t i = 0; i < coordinates.size(); ++i)
+        for (int a = 0; a < 3; ++a)
+            positions[i][a] = static_cast<float>(coordinates[i][a] - origin_[a]);
+    coordinates = {};
+    if (const std::size_t dropped = cloud.removeNonFinitePoints(); dropped > 0)
+        logWarning(path_.string() + ": " + std::to_string(dropped) + " points with non-finite coordinates were skipped");
+    return cloud;
+}
+
 PointCloud ChunkedCloud::read(std::size_t chunk, bool geometryOnly) const
 {
+    if (const auto found = kept_.find(chunk); geometryOnly && found != kept_.end()) {
+        std::vector<Eigen::Vector3d> coordinates = std::move(found->second);
+        kept_.erase(found);
+        return fromKeptCoordinates(std::move(coordinates));
+    }
     const io::RecordRange range{static_cast<std::uint64_t>(chunk) * chunkPoints_, chunkPoints_};
     if (whole_) {
         const std::uint64_t end = std::min(records_, range.first + range.count);

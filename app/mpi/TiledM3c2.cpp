@@ -67,7 +67,7 @@ public:
         using Kind = NormalOrientation::Kind;
         if (params_.orientation.kind == Kind::MinimumSpanningTree || params_.orientation.kind == Kind::None)
             throw Error(ErrorCode::InvalidArgument, "m3c2: orient the normals by a direction, the sensor or the centroid");
-        referenceLayout_ = reference_.read(0, true);
+        referenceLayout_ = reference_.layout().subset({});
         reach_ = searchReach(params_);
         if (job.tiling.halo && *job.tiling.halo < reach_)
         {

@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdlib>
+#include <malloc.h>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -164,6 +165,12 @@ int run(int argc, char** argv, const mpi::Communicator& world)
 
 int main(int argc, char** argv)
 {
+    // Buffers from 4 MiB up are mapped on their own and go back to the system
+    // when freed. glibc otherwise raises this threshold to the size of the
+    // largest buffer freed so far (the chunks of coordinates a rank reads,
+    // 25 MB each), and the buffers that follow come from a heap that keeps
+    // its holes: a rank's peak was 15 % higher.
+    mallopt(M_MMAP_THRESHOLD, 4 << 20);
     // A rank waiting in a collective call gives its core away instead of
     // polling: with more ranks than cores (a workstation, a shared node) the
     // ranks still computing get it. OpenMPI reads this before MPI_Init; a value

@@ -141,6 +141,15 @@ std::optional<BoundingBox> pointRecordBounds(const FormatRegistry& registry, con
     return handler.recordBounds(path, range);
 }
 
+std::optional<std::vector<Eigen::Vector3d>> pointRecordPositions(const FormatRegistry& registry, const fs::path& path,
+                                                                 RecordRange range)
+{
+    const FormatHandler& handler = readerFor(registry, path);
+    if (!handler.recordPositions)
+        return std::nullopt;
+    return handler.recordPositions(path, range);
+}
+
 std::unique_ptr<PlacedChunkWriter> openPlacedChunkWriter(const FormatRegistry& registry, const fs::path& path,
                                                          const fs::path& join, const PointCloud& layout,
                                                          std::uint64_t total, const WriteOptions& options)

@@ -753,6 +753,64 @@ const char* visitBinaryVertices(const PlyElement& e, const VertexLayout& layout,
     return ptr;
 }
 
+//! Where a record's x, y and z lie when they are three values of one
+//! floating type: the layout every common writer uses (scandiff, CloudCompare,
+//! PDAL). Coordinates-only passes (the box, a geometry-only read) then load
+//! them directly instead of dispatching on every value's type and role.
+struct PlainCoordinates
+{
+    PlyType type = PlyType::Float32;
+    std::size_t offset[3] = {0, 0, 0};
+};
+
+std::optional<PlainCoordinates> plainCoordinates(const VertexLayout& layout)
+{
+    PlainCoordinates plain;
+    int found = 0;
+    for (const Slot& s : layout.slots)
+        if (s.role >= Role::X && s.role <= Role::Z) {
+            if (found > 0 && s.type != plain.type)
+                return std::nullopt;
+            plain.type = s.type;
+            plain.offset[static_cast<int>(s.role) - static_cast<int>(Role::X)] = s.offset;
+            ++found;
+        }
+    if (found != 3 || (plain.type != PlyType::Float32 && plain.type != PlyType::Float64))
+        return std::nullopt;
+    return plain;
+}
+
+//! Calls visit(i, x, y, z) for every record of a fixed-size element in
+//! native byte order whose coordinates are plain, by chunks on several
+//! threads as visitBinaryVertices does.
+template <class T, class Visit>
+void visitPlainCoordinates(const PlyElement& e, const PlainCoordinates& plain, const char* ptr, const char* end,
+                           const Context& ctx, ProgressTicker& ticker, Visit&& visit)
+{
+    const std::uint64_t n = e.count;
+    const std::size_t recordSize = e.minRecordSize();
+    if (static_cast<std::uint64_t>(end - ptr) / recordSize < n)
+        ctx.truncated(e, static_cast<std::uint64_t>(end - ptr) / recordSize);
+    const std::size_t ox = plain.offset[0], oy = plain.offset[1], oz = plain.offset[2];
+    const std::uint64_t chunks = (n + kChunk - 1) / kChunk;
+    tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, chunks, 1), [&](const tbb::blocked_range<std::uint64_t>& range) {
+        for (std::uint64_t chunk = range.begin(); chunk != range.end(); ++chunk) {
+            const std::uint64_t start = chunk * kChunk, stop = std::min(n, start + kChunk);
+            const char* record = ptr + start * recordSize;
+            const char* chunkBegin = record;
+            for (std::uint64_t i = start; i < stop; ++i, record += recordSize) {
+                T x, y, z;
+                std::memcpy(&x, record + ox, sizeof x);
+                std::memcpy(&y, record + oy, sizeof y);
+                std::memcpy(&z, record + oz, sizeof z);
+                visit(i, static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
+            }
+            MappedFile::releaseConsumed(chunkBegin, record);
+            ticker.step(stop - start);
+        }
+    });
+}
+
 template <bool Swap>
 const char* skipBinaryElement(const PlyElement& e, const char* ptr, const char* end, const Context& ctx)
 {
@@ -1192,19 +1250,43 @@ private:
     template <bool Swap>
     RangeAccumulator coordinateRanges(const PlyElement& part, const char* ptr, const char* end, ProgressTicker& ticker)
     {
-        VertexLayout coordinates = layout_;
-        coordinates.slots.erase(std::remove_if(coordinates.slots.begin(), coordinates.slots.end(),
-                                               [](const Slot& s) { return s.role < Role::X || s.role > Role::Z; }),
-                                coordinates.slots.end());
         std::vector<RangeAccumulator> perChunk(static_cast<std::size_t>(part.count / kChunk + 1), RangeAccumulator(0));
-        visitBinaryVertices<Swap>(part, coordinates, ptr, end, ctx_, ticker,
-                                  [&perChunk](std::uint64_t i, const Slot& s, double v) {
-                                      perChunk[static_cast<std::size_t>(i / kChunk)].add(s, v);
-                                  });
+        const std::optional<PlainCoordinates> plain = plainCoordinates(layout_);
+        if (!Swap && plain && part.fixedSize()) {
+            const auto add = [&perChunk](std::uint64_t i, double x, double y, double z) {
+                RangeAccumulator& r = perChunk[static_cast<std::size_t>(i / kChunk)];
+                const double v[3] = {x, y, z};
+                for (int a = 0; a < 3; ++a)
+                    if (std::isfinite(v[a])) {
+                        r.lo[a] = std::min(r.lo[a], v[a]);
+                        r.hi[a] = std::max(r.hi[a], v[a]);
+                    }
+            };
+            if (plain->type == PlyType::Float64)
+                visitPlainCoordinates<double>(part, *plain, ptr, end, ctx_, ticker, add);
+            else
+                visitPlainCoordinates<float>(part, *plain, ptr, end, ctx_, ticker, add);
+        } else {
+            visitCoordinates<Swap>(part, ptr, end, ticker, perChunk);
+        }
         RangeAccumulator whole(0);
         for (const RangeAccumulator& chunk : perChunk)
             whole.merge(chunk);
         return whole;
+    }
+
+    template <bool Swap>
+    void visitCoordinates(const PlyElement& part, const char* ptr, const char* end, ProgressTicker& ticker,
+                          std::vector<RangeAccumulator>& perChunk)
+    {
+        VertexLayout coordinates = layout_;
+        coordinates.slots.erase(std::remove_if(coordinates.slots.begin(), coordinates.slots.end(),
+                                               [](const Slot& s) { return s.role < Role::X || s.role > Role::Z; }),
+                                coordinates.slots.end());
+        visitBinaryVertices<Swap>(part, coordinates, ptr, end, ctx_, ticker,
+                                  [&perChunk](std::uint64_t i, const Slot& s, double v) {
+                                      perChunk[static_cast<std::size_t>(i / kChunk)].add(s, v);
+                                  });
     }
 
     template <bool Swap>
@@ -1236,7 +1318,46 @@ public:
         return swap ? rangeBox<true>(vertexElement) : rangeBox<false>(vertexElement);
     }
 
+    //! See FormatHandler::recordPositions: the range's coordinates as the
+    //! file holds them, when they are doubles; else none.
+    std::optional<std::vector<Eigen::Vector3d>> recordPositions()
+    {
+        const PlyElement& vertexElement = findVertexElement();
+        layout_ = makeVertexLayout(vertexElement, ctx_);
+        const bool swap = swapsBytes(vertexElement);
+        if (!layout_.coordinatesAreDouble)
+            return std::nullopt;
+        return swap ? rangePositions<true>(vertexElement) : rangePositions<false>(vertexElement);
+    }
+
 private:
+    template <bool Swap>
+    std::vector<Eigen::Vector3d> rangePositions(const PlyElement& vertexElement)
+    {
+        // rangeRecords has checked that the file holds every record.
+        const RangeRecords r = rangeRecords<Swap>(vertexElement);
+        std::vector<Eigen::Vector3d> positions(static_cast<std::size_t>(r.part.count));
+        ProgressTicker ticker(nullptr, "", r.part.count);
+        const std::optional<PlainCoordinates> plain = plainCoordinates(layout_);
+        if (!Swap && plain) {
+            const auto store = [&positions](std::uint64_t i, double x, double y, double z) { positions[i] = {x, y, z}; };
+            if (plain->type == PlyType::Float64)
+                visitPlainCoordinates<double>(r.part, *plain, r.first, r.end, ctx_, ticker, store);
+            else
+                visitPlainCoordinates<float>(r.part, *plain, r.first, r.end, ctx_, ticker, store);
+            return positions;
+        }
+        VertexLayout coordinates = layout_;
+        coordinates.slots.erase(std::remove_if(coordinates.slots.begin(), coordinates.slots.end(),
+                                               [](const Slot& s) { return s.role < Role::X || s.role > Role::Z; }),
+                                coordinates.slots.end());
+        visitBinaryVertices<Swap>(r.part, coordinates, r.first, r.end, ctx_, ticker,
+                                  [&positions](std::uint64_t i, const Slot& s, double v) {
+                                      positions[i][static_cast<int>(s.role) - static_cast<int>(Role::X)] = v;
+                                  });
+        return positions;
+    }
+
     template <bool Swap>
     BoundingBox rangeBox(const PlyElement& vertexElement)
     {
@@ -1308,7 +1429,9 @@ private:
                       std::to_string(end - ptr) + " bytes of data remain");
         }
         RangeAccumulator ranges(layout_.fieldNames.size());
-        if (needsRanges) {
+        if (needsRanges && layout_.fieldNames.empty()) {
+            ranges = coordinateRanges<Swap>(e, ptr, end, ticker);
+        } else if (needsRanges) {
             // One accumulator per chunk (the decoding is parallel by chunk), merged after.
             std::vector<RangeAccumulator> perChunk(static_cast<std::size_t>(e.count / kChunk + 1), ranges);
             visitBinaryVertices<Swap>(e, layout_, ptr, end, ctx_, ticker, [&perChunk](std::uint64_t i, const Slot& s, double v) {
@@ -1340,8 +1463,25 @@ private:
         }
         applyFieldOffsets(sink);
         sink.compile(layout_);
-        const char* next = visitBinaryVertices<Swap>(
-            e, layout_, ptr, end, ctx_, ticker, [&sink](std::uint64_t i, const Slot& s, double v) { sink.put(i, s, v); });
+        const char* next = nullptr;
+        const std::optional<PlainCoordinates> plain = plainCoordinates(layout_);
+        if (!Swap && plain && layout_.slots.size() == 3 && e.fixedSize() && e.count > 0) {
+            // Coordinates only (a geometry-only read): each one as put() would store it.
+            Eigen::Vector3f* positions = sink.positions;
+            const Eigen::Vector3d origin = sink.origin;
+            const auto store = [positions, origin](std::uint64_t i, double x, double y, double z) {
+                positions[i] = Eigen::Vector3f(static_cast<float>(x - origin.x()), static_cast<float>(y - origin.y()),
+                                               static_cast<float>(z - origin.z()));
+            };
+            if (plain->type == PlyType::Float64)
+                visitPlainCoordinates<double>(e, *plain, ptr, end, ctx_, ticker, store);
+            else
+                visitPlainCoordinates<float>(e, *plain, ptr, end, ctx_, ticker, store);
+            next = ptr + e.count * e.minRecordSize();
+        } else {
+            next = visitBinaryVertices<Swap>(
+                e, layout_, ptr, end, ctx_, ticker, [&sink](std::uint64_t i, const Slot& s, double v) { sink.put(i, s, v); });
+        }
         for (std::size_t f = 0; f < layout_.fieldNames.size(); ++f) {
             if (!failed[f].load())
                 continue;
@@ -1927,6 +2067,9 @@ FormatHandler plyFormat()
     };
     handler.recordBounds = [](const fs::path& path, RecordRange range) {
         return PlyReader(path, ReadOptions{}, range).recordBounds();
+    };
+    handler.recordPositions = [](const fs::path& path, RecordRange range) {
+        return PlyReader(path, ReadOptions{}, range).recordPositions();
     };
     handler.openPlacedWriter = [](const fs::path& destination, const fs::path& join, const PointCloud& layout,
                                   std::uint64_t total, const WriteOptions& options) -> std::unique_ptr<PlacedChunkWriter> {

@@ -225,6 +225,64 @@ TEST(RecordRanges, TheRangesBoxesMakeTheWholeReadsOrigin)
     EXPECT_EQ(errorCodeOf([&] { io::pointRecordBounds(registry, dir / "text.ply", {0, 10}); }), ErrorCode::Unsupported);
 }
 
+// scandiff-mpi reads a chunk's coordinates once, in double, to choose the
+// origin, then takes its geometry from them: they must be the file's values
+// to the bit, in either byte order, and make the range's geometry read.
+TEST(RecordRanges, PositionsOfARangeAreTheFilesDoubles)
+{
+    const auto registry = builtinFormats();
+    const fs::path dir = tempDir();
+    const PointCloud written = sampleCloud(10007);
+    io::WriteOptions bigEndian;
+    bigEndian.encoding = io::Encoding::BinaryBigEndian;
+    io::writePointCloud(registry, written, dir / "little.ply");
+    io::writePointCloud(registry, written, dir / "big.ply", bigEndian);
+    const PointCloud whole = io::readPointCloud(registry, dir / "little.ply");
+    for (const char* name : {"little.ply", "big.ply"}) {
+        std::size_t next = 0;
+        for (const io::RecordRange range : {io::RecordRange{0, 10}, io::RecordRange{10, 6000}, io::RecordRange{6010, 5000},
+                                            io::RecordRange{10007, 0}}) {
+            const std::optional<std::vector<Eigen::Vector3d>> positions =
+                io::pointRecordPositions(registry, dir / name, range);
+            ASSERT_TRUE(positions.has_value()) << name;
+            ASSERT_EQ(positions->size(), std::min<std::uint64_t>(range.count, written.size() - range.first)) << name;
+            for (const Eigen::Vector3d& p : *positions) {
+                for (int a = 0; a < 3; ++a)
+                    ASSERT_TRUE(sameBits(p[a], written.globalPosition(next)[a])) << name << ", record " << next;
+                ++next;
+            }
+            // In the whole read's frame, non-finite points left out: the
+            // range's geometry read.
+            io::ReadOptions geometry;
+            geometry.geometryOnly = true;
+            geometry.origin = whole.origin();
+            const PointCloud read = io::readPointRecords(registry, dir / name, range, geometry);
+            std::vector<Eigen::Vector3f> converted;
+            for (const Eigen::Vector3d& p : *positions) {
+                const Eigen::Vector3f f = (p - whole.origin()).cast<float>();
+                if (f.allFinite())
+                    converted.push_back(f);
+            }
+            EXPECT_EQ(converted, read.positions()) << name;
+        }
+        EXPECT_EQ(next, written.size());
+    }
+    // Float coordinates: the origin is zero, nothing to choose; LAS has no
+    // such reader; text cannot be read by ranges.
+    PointCloud local = sampleCloud(100);
+    local.setOrigin(Eigen::Vector3d::Zero());
+    io::writePointCloud(registry, local, dir / "local.ply");
+    EXPECT_FALSE(io::pointRecordPositions(registry, dir / "local.ply", {0, 100}).has_value());
+    PointCloud las = sampleCloud(100);
+    las.positions()[50].x() = 0;
+    io::writePointCloud(registry, las, dir / "cloud.las");
+    EXPECT_FALSE(io::pointRecordPositions(registry, dir / "cloud.las", {0, 100}).has_value());
+    io::WriteOptions ascii;
+    ascii.encoding = io::Encoding::Ascii;
+    io::writePointCloud(registry, sampleCloud(50), dir / "text.ply", ascii);
+    EXPECT_EQ(errorCodeOf([&] { io::pointRecordPositions(registry, dir / "text.ply", {0, 10}); }), ErrorCode::Unsupported);
+}
+
 TEST(RecordRanges, AnAxisWithNoValueInOnePartStillJoinsAxisByAxis)
 {
     // The first half's points have no z (dropped by every read) but their x,

@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -210,6 +211,25 @@ TEST_F(ScaleOut, LazInputsAreStreamedByRanges)
     expectSameAsCli("c2c", "--reference " + file("reference.laz") + " --compared " + file("compared.laz"), "",
                     "--tile-size 10 --chunk-points 5000", {"c2c_distance"});
     EXPECT_EQ(lastReport_.find("read whole"), std::string::npos) << lastReport_;
+}
+
+// A rank takes a chunk's geometry from the coordinates it read to choose the
+// origin, except where the file has normals (a reference for signed
+// distances): both must read as scandiff-cli reads, non-finite points dropped.
+TEST_F(ScaleOut, NonFinitePointsAndReferenceNormalsReadAsTheCliReadsThem)
+{
+    const auto registry = builtinFormats();
+    PointCloud reference = sampleSite(1, 4.0, true, false);
+    auto& normals = reference.enableNormals();
+    for (std::size_t i = 0; i < reference.size(); ++i)
+        normals[i] = Eigen::Vector3f(0.1f * static_cast<float>(i % 3), 0.05f, 1.0f).normalized();
+    PointCloud compared = sampleSite(2, 3.0, false, true);
+    for (std::size_t i = 0; i < compared.size(); i += 997)
+        compared.positions()[i].y() = std::numeric_limits<float>::quiet_NaN();
+    io::writePointCloud(registry, reference, dir_ / "reference_normals.ply");
+    io::writePointCloud(registry, compared, dir_ / "compared_nan.ply");
+    expectSameAsCli("c2c", "--reference " + file("reference_normals.ply") + " --compared " + file("compared_nan.ply"),
+                    "--signed", "--tile-size 10 --chunk-points 5000", {"c2c_distance"});
 }
 
 TEST_F(ScaleOut, OneTileLeavesRanksWithout)

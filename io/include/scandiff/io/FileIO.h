@@ -148,6 +148,12 @@ struct FormatHandler
     //! none): the box of a file read by parts is then the parts' joined axis
     //! by axis, empty when an axis has no value in any part.
     std::function<std::optional<BoundingBox>(const std::filesystem::path&, RecordRange)> recordBounds;
+    //! The global coordinates of a range of records, in double, exactly as
+    //! the file holds them, where recordBounds gives a box: a caller that
+    //! chooses the origin from every part's box reads each record once
+    //! instead of a box pass, then a read. std::nullopt where recordBounds
+    //! gives none. Null where the format has no such reader.
+    std::function<std::optional<std::vector<Eigen::Vector3d>>(const std::filesystem::path&, RecordRange)> recordPositions;
     //! The fields a whole read leaves out when every value in the file is 0
     //! (LAS's standard attributes, which most files leave at 0); a range of
     //! records keeps them all, so that every range has the same fields. Null
@@ -208,6 +214,9 @@ std::unique_ptr<PointChunkWriter> openPointChunkWriter(const FormatRegistry& reg
 //! See FormatHandler::recordBounds (std::nullopt when the format has none).
 std::optional<BoundingBox> pointRecordBounds(const FormatRegistry& registry, const std::filesystem::path& path,
                                              RecordRange range);
+//! See FormatHandler::recordPositions (std::nullopt when the format has none).
+std::optional<std::vector<Eigen::Vector3d>> pointRecordPositions(const FormatRegistry& registry,
+                                                                 const std::filesystem::path& path, RecordRange range);
 //! See FormatHandler::fieldsLeftOutWhenZero (empty when the format has none).
 std::vector<std::string> fieldsLeftOutWhenZero(const FormatRegistry& registry, const std::filesystem::path& path);
 //! See PlacedChunkWriter: creates the file when `join` is empty, else joins it.
