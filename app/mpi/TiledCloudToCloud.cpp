@@ -102,7 +102,6 @@ public:
         memoryNote("origins chosen");
         // The settings, and their errors, are scandiff-cli's.
         referenceLayout_ = reference_.layout().subset({});
-        memoryNote("layout read");
         params_ = cloudToCloudSettings(job.values, referenceLayout_);
         if (cloudToCloudBothWays(job.values))
             throw Error(ErrorCode::Unsupported, "scandiff-mpi c2c: --both-ways is not supported yet (run it again with the clouds swapped)");
