@@ -14,6 +14,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 namespace scandiff::io::detail::laz {
@@ -159,8 +160,7 @@ public:
             value_ -= x;
             length_ -= x;
         }
-        if (length_ < kMinLength)
-            renormalise();
+        renormalise();
         if (--m.bitsUntilUpdate == 0)
             m.update();
         return bit;
@@ -212,8 +212,7 @@ public:
         }
         value_ -= x;
         length_ = y - x;
-        if (length_ < kMinLength)
-            renormalise();
+        renormalise();
         ++m.counts_[symbol];
         if (--m.symbolsUntilUpdate_ == 0)
             m.update();
@@ -231,8 +230,7 @@ public:
         length_ >>= bits;
         const std::uint32_t value = value_ / length_;
         value_ -= length_ * value;
-        if (length_ < kMinLength)
-            renormalise();
+        renormalise();
         return value;
     }
 
@@ -254,11 +252,27 @@ private:
         ++pastEnd_;
         return 0;
     }
+    //! Shifts `length` back to at least kMinLength, a byte of the stream
+    //! into `value` for each 8 bits. Whether it is needed after a symbol is
+    //! the coded data itself: a branch on it was mispredicted often, so the
+    //! shift (0, 8, 16 or 24 bits: `length` is never 0) is computed and
+    //! applied without one, up to 4 bytes before the end of the stream.
     void renormalise()
     {
-        do
-            value_ = (value_ << 8) | byte();
-        while ((length_ <<= 8) < kMinLength);
+        if (end_ - next_ < 4) {
+            while (length_ < kMinLength) {
+                value_ = (value_ << 8) | byte();
+                length_ <<= 8;
+            }
+            return;
+        }
+        const unsigned shift = static_cast<unsigned>(__builtin_clz(length_)) & ~7u;
+        std::uint32_t word;
+        std::memcpy(&word, next_, sizeof word);
+        word = __builtin_bswap32(word); // the stream is big-endian
+        value_ = static_cast<std::uint32_t>(((std::uint64_t(value_) << 32) | word) >> (32 - shift));
+        length_ <<= shift;
+        next_ += shift >> 3;
     }
 
     const unsigned char* next_;
@@ -452,11 +466,10 @@ private:
             const std::uint32_t lowBits = k_ - bitsHigh_;
             c = (c << lowBits) | decoder.readBits(lowBits);
         }
-        // [0, 2^(k-1)) stands for [-(2^k - 1), -2^(k-1)], [2^(k-1), 2^k) for [2^(k-1) + 1, 2^k].
-        if (c >= (std::int64_t(1) << (k_ - 1)))
-            c += 1;
-        else
-            c -= (std::int64_t(1) << k_) - 1;
+        // [0, 2^(k-1)) stands for [-(2^k - 1), -2^(k-1)], [2^(k-1), 2^k) for
+        // [2^(k-1) + 1, 2^k]. Without a branch: the sign is the data itself.
+        const std::int64_t below = -static_cast<std::int64_t>(c < (std::int64_t(1) << (k_ - 1)));
+        c += 1 - (below & (std::int64_t(1) << k_));
         return static_cast<std::int32_t>(static_cast<std::uint32_t>(c));
     }
     void writeCorrection(ArithmeticEncoder& encoder, std::int32_t c, SymbolModel& sizeModel)

@@ -6,6 +6,8 @@
 
 #include "Items.h"
 
+#include <algorithm>
+
 namespace scandiff::io::detail::laz {
 
 std::string itemName(std::uint16_t type)
@@ -27,53 +29,21 @@ std::string itemName(std::uint16_t type)
 
 void StreamingMedian5::add(std::int32_t x)
 {
-    if (high) {
-        if (x < v[2]) {
-            v[4] = v[3];
-            v[3] = v[2];
-            if (x < v[0]) {
-                v[2] = v[1];
-                v[1] = v[0];
-                v[0] = x;
-            } else if (x < v[1]) {
-                v[2] = v[1];
-                v[1] = x;
-            } else {
-                v[2] = x;
-            }
-        } else {
-            if (x < v[3]) {
-                v[4] = v[3];
-                v[3] = x;
-            } else {
-                v[4] = x;
-            }
-            high = false;
-        }
-    } else {
-        if (v[2] < x) {
-            v[0] = v[1];
-            v[1] = v[2];
-            if (v[4] < x) {
-                v[2] = v[3];
-                v[3] = v[4];
-                v[4] = x;
-            } else if (v[3] < x) {
-                v[2] = v[3];
-                v[3] = x;
-            } else {
-                v[2] = x;
-            }
-        } else {
-            if (v[1] < x) {
-                v[0] = v[1];
-                v[1] = x;
-            } else {
-                v[0] = x;
-            }
-            high = true;
-        }
-    }
+    // LASzip's rule: while `high`, the largest of the five goes, else the
+    // smallest, and x takes its place in order; `high` then stays or becomes
+    // true if x fell below the old median (or, after the smallest went, at
+    // it). Written with min and max rather than LASzip's branches: which way
+    // each goes is the coded data, and they were mispredicted. Equal values
+    // are interchangeable, so the order among them does not matter.
+    const bool dropSmallest = !high;
+    const std::int32_t a0 = dropSmallest ? v[1] : v[0], a1 = dropSmallest ? v[2] : v[1];
+    const std::int32_t a2 = dropSmallest ? v[3] : v[2], a3 = dropSmallest ? v[4] : v[3];
+    high = high ? x < v[2] : !(v[2] < x);
+    v[0] = std::min(a0, x);
+    v[1] = std::min(a1, std::max(a0, x));
+    v[2] = std::min(a2, std::max(a1, x));
+    v[3] = std::min(a3, std::max(a2, x));
+    v[4] = std::max(a3, x);
 }
 
 std::array<std::uint16_t, 3> decodeRgb(ArithmeticDecoder& d, RgbModels& models, const std::array<std::uint16_t, 3>& last)
