@@ -61,7 +61,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         // A clean refusal: what a broken file must give.
     }
     // Formats read by ranges of records (what scandiff-mpi's ranks do): the
-    // count, two halves and their boxes, and a range past the end, each a
+    // count, two halves, their boxes and coordinates, and a range past the end, each a
     // clean answer or a clean refusal.
     auto refusedOrRead = [](auto&& read) {
         try {
@@ -76,6 +76,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const std::uint64_t n = io::pointRecordCount(formats(), inputPath());
         for (const io::RecordRange range : {io::RecordRange{0, n / 2}, io::RecordRange{n / 2, n - n / 2}}) {
             refusedOrRead([&] { io::pointRecordBounds(formats(), inputPath(), range); });
+            refusedOrRead([&] { io::pointRecordPositions(formats(), inputPath(), range); });
             refusedOrRead([&] { io::readPointRecords(formats(), inputPath(), range); });
         }
         refusedOrRead([&] { io::readPointRecords(formats(), inputPath(), io::RecordRange{n, 1}); });
