@@ -20,22 +20,27 @@ ChunkedCloud::ChunkedCloud(const Communicator& c, const io::FormatRegistry& form
     if (io::canReadRecordRanges(formats_, path_)) {
         try {
             records_ = io::pointRecordCount(formats_, path_);
+            // The first record, in any frame, tells the attributes (sensor
+            // poses, CRS) and whether the geometry has normals, which kept
+            // coordinates cannot give: then, or when it tells nothing (no
+            // record, or one dropped as non-finite), none are kept.
+            io::ReadOptions probe = options_;
+            probe.geometryOnly = true;
+            if (!probe.origin)
+                probe.origin = Eigen::Vector3d::Zero();
+            const PointCloud first = io::readPointRecords(formats_, path_, {0, 1}, probe);
+            layout_ = first.subset({});
+            keepCoordinates_ = !first.empty() && !first.hasNormals();
             // Every range is read in the frame a whole read would choose.
             origin_ = chooseOrigin(c);
             options_.origin = origin_;
-            io::ReadOptions firstOptions = options_;
-            firstOptions.geometryOnly = true;
-            const PointCloud first = io::readPointRecords(formats_, path_, {0, 1}, firstOptions);
-            layout_ = first.subset({});
-            // Kept coordinates stand for a geometry read only where it has no normals.
-            if (first.hasNormals())
-                kept_.clear();
             return;
         } catch (const Error& e) {
             if (e.code() != ErrorCode::Unsupported)
                 throw;
         }
     }
+    kept_.clear();
     whole_ = io::readPointCloud(formats_, path_, options_);
     records_ = whole_->size();
     origin_ = whole_->origin();
@@ -68,14 +73,18 @@ std::optional<BoundingBox> ChunkedCloud::shareBounds(const Communicator& c)
         lo[a] = std::numeric_limits<double>::infinity();
         hi[a] = -lo[a];
     }
-    bool kept = rank < chunkCount();
-    for (std::size_t k = rank; kept && k < chunkCount(); k += ranks) {
+    // Whether the format reads coordinates in double depends on its header
+    // alone: every rank, with chunks or without, answers alike.
+    if (!keepCoordinates_ || !io::pointRecordPositions(formats_, path_, {0, 0})) {
+        // Its contiguous share of the records, for the box only.
+        const std::uint64_t begin = records_ * rank / ranks, end = records_ * (rank + 1) / ranks;
+        return io::pointRecordBounds(formats_, path_, {begin, end - begin});
+    }
+    for (std::size_t k = rank; k < chunkCount(); k += ranks) {
         std::optional<std::vector<Eigen::Vector3d>> coordinates =
             io::pointRecordPositions(formats_, path_, {static_cast<std::uint64_t>(k) * chunkPoints_, chunkPoints_});
-        if (!coordinates) {
-            kept = false;
-            break;
-        }
+        if (!coordinates)
+            throw Error(ErrorCode::Internal, path_.string() + ": the coordinates of a range could not be read in double");
         // Each axis's range of finite values, as the readers' box is.
         for (const Eigen::Vector3d& p : *coordinates)
             for (int a = 0; a < 3; ++a)
@@ -85,13 +94,7 @@ std::optional<BoundingBox> ChunkedCloud::shareBounds(const Communicator& c)
                 }
         kept_[k] = std::move(*coordinates);
     }
-    if (!kept) {
-        // The format has no such reader, or the header fixes the origin (the
-        // same on every rank), or this rank has no chunk: its contiguous share.
-        kept_.clear();
-        const std::uint64_t begin = records_ * rank / ranks, end = records_ * (rank + 1) / ranks;
-        return io::pointRecordBounds(formats_, path_, {begin, end - begin});
-    }
+    // A rank without a chunk gives an empty box: the others' chunks cover the file.
     BoundingBox box;
     box.min = Eigen::Vector3d(lo[0], lo[1], lo[2]);
     box.max = Eigen::Vector3d(hi[0], hi[1], hi[2]);

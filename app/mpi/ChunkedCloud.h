@@ -53,7 +53,9 @@ private:
     Eigen::Vector3d chooseOrigin(const Communicator& c);
     //! This rank's part of the box of the whole file, std::nullopt where the
     //! header fixes the origin. Where the format gives the coordinates in
-    //! double, this rank's chunks are read so and kept for their first read.
+    //! double and the geometry has no normals, this rank's chunks are read so
+    //! and kept for their first geometry read (one thread: read() is not
+    //! safe to call from several).
     std::optional<BoundingBox> shareBounds(const Communicator& c);
     PointCloud fromKeptCoordinates(std::vector<Eigen::Vector3d>&& coordinates) const;
     //! Collective: runs `readShare` (this rank's share of the file), then
@@ -69,6 +71,7 @@ private:
     std::optional<PointCloud> whole_;
     std::vector<std::string> leftOut_; //!< fields read() removes (settleFieldsLeftOut)
     PointCloud layout_;
+    bool keepCoordinates_ = false; //!< the file's geometry is positions only (see the constructor)
     //! Per chunk of this rank, its coordinates as the file holds them, read
     //! while choosing the origin: the geometry pass that follows needs them
     //! and reading the chunk again cost a third of the time before counting.

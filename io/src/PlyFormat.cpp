@@ -479,14 +479,15 @@ VertexLayout makeVertexLayout(const PlyElement& e, const Context& ctx)
     return layout;
 }
 
-//! Drops colours and scalar fields from a layout (ReadOptions::geometryOnly):
-//! their values are then never decoded.
-void keepGeometryOnly(VertexLayout& layout)
+//! Keeps the slots `keep` accepts, renumbered, and the map from properties
+//! to slots with them (records of variable size are visited through it).
+template <class Keep>
+void keepSlots(VertexLayout& layout, Keep&& keep)
 {
     std::vector<int> newIndex(layout.slots.size(), -1);
     std::vector<Slot> kept;
     for (const Slot& s : layout.slots)
-        if ((s.role >= Role::X && s.role <= Role::Z) || (s.role >= Role::Nx && s.role <= Role::Nz)) {
+        if (keep(s)) {
             newIndex[s.index] = static_cast<int>(kept.size());
             kept.push_back(s);
             kept.back().index = static_cast<std::uint32_t>(newIndex[s.index]);
@@ -498,6 +499,24 @@ void keepGeometryOnly(VertexLayout& layout)
     layout.fieldNames.clear();
     layout.fieldIsWide.clear();
     layout.hasColors = false;
+}
+
+bool isCoordinate(const Slot& s) { return s.role >= Role::X && s.role <= Role::Z; }
+
+//! Drops colours and scalar fields from a layout (ReadOptions::geometryOnly):
+//! their values are then never decoded.
+void keepGeometryOnly(VertexLayout& layout)
+{
+    keepSlots(layout, [](const Slot& s) { return isCoordinate(s) || (s.role >= Role::Nx && s.role <= Role::Nz); });
+}
+
+//! The layout's x, y and z alone (the passes over coordinates).
+VertexLayout coordinatesOnly(const VertexLayout& layout)
+{
+    VertexLayout coordinates = layout;
+    keepSlots(coordinates, isCoordinate);
+    coordinates.hasNormals = false;
+    return coordinates;
 }
 
 //! Where decoded vertex values go. Coordinates and wide fields go to double
@@ -1279,11 +1298,7 @@ private:
     void visitCoordinates(const PlyElement& part, const char* ptr, const char* end, ProgressTicker& ticker,
                           std::vector<RangeAccumulator>& perChunk)
     {
-        VertexLayout coordinates = layout_;
-        coordinates.slots.erase(std::remove_if(coordinates.slots.begin(), coordinates.slots.end(),
-                                               [](const Slot& s) { return s.role < Role::X || s.role > Role::Z; }),
-                                coordinates.slots.end());
-        visitBinaryVertices<Swap>(part, coordinates, ptr, end, ctx_, ticker,
+        visitBinaryVertices<Swap>(part, coordinatesOnly(layout_), ptr, end, ctx_, ticker,
                                   [&perChunk](std::uint64_t i, const Slot& s, double v) {
                                       perChunk[static_cast<std::size_t>(i / kChunk)].add(s, v);
                                   });
@@ -1347,11 +1362,7 @@ private:
                 visitPlainCoordinates<float>(r.part, *plain, r.first, r.end, ctx_, ticker, store);
             return positions;
         }
-        VertexLayout coordinates = layout_;
-        coordinates.slots.erase(std::remove_if(coordinates.slots.begin(), coordinates.slots.end(),
-                                               [](const Slot& s) { return s.role < Role::X || s.role > Role::Z; }),
-                                coordinates.slots.end());
-        visitBinaryVertices<Swap>(r.part, coordinates, r.first, r.end, ctx_, ticker,
+        visitBinaryVertices<Swap>(r.part, coordinatesOnly(layout_), r.first, r.end, ctx_, ticker,
                                   [&positions](std::uint64_t i, const Slot& s, double v) {
                                       positions[i][static_cast<int>(s.role) - static_cast<int>(Role::X)] = v;
                                   });

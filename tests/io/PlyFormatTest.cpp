@@ -452,6 +452,35 @@ TEST(PlyFormat, TypeAliasesListOnVertexAndCrlfHeader)
     EXPECT_EQ(cloud.field("Label")->value(1), 4.0);
 }
 
+// Records of variable size (a list on the vertex) with colours and normals
+// before double coordinates: the pass that finds the origin must see x, y, z
+// only, whatever comes before them, in a whole read as in a geometry-only one.
+TEST(PlyFormat, OriginOfVariableRecordsComesFromTheCoordinatesAlone)
+{
+    const auto registry = plyRegistry();
+    const fs::path path = tempDir() / "variable.ply";
+    const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty uchar red\n"
+                               "property uchar green\nproperty uchar blue\nproperty float nx\nproperty float ny\n"
+                               "property float nz\nproperty double x\nproperty double y\nproperty double z\n"
+                               "property list uchar int neighbours\nend_header\n";
+    Bytes b(false);
+    b.put<std::uint8_t>(255).put<std::uint8_t>(7).put<std::uint8_t>(9).put(0.0f).put(0.0f).put(1.0f);
+    b.put(512345.25).put(5401234.5).put(101.125).put<std::uint8_t>(1).put<std::int32_t>(1);
+    b.put<std::uint8_t>(3).put<std::uint8_t>(4).put<std::uint8_t>(5).put(1.0f).put(0.0f).put(0.0f);
+    b.put(512346.75).put(5401236.0).put(102.5).put<std::uint8_t>(0);
+    writeText(path, header + b.str());
+    for (const bool geometryOnly : {false, true}) {
+        io::ReadOptions options;
+        options.geometryOnly = geometryOnly;
+        const PointCloud cloud = io::readPointCloud(registry, path, options);
+        ASSERT_EQ(cloud.size(), 2u);
+        EXPECT_EQ(cloud.origin(), Eigen::Vector3d(512000.0, 5401000.0, 0.0)) << geometryOnly;
+        EXPECT_EQ(cloud.globalPosition(0), Eigen::Vector3d(512345.25, 5401234.5, 101.125)) << geometryOnly;
+        EXPECT_EQ(cloud.globalPosition(1), Eigen::Vector3d(512346.75, 5401236.0, 102.5)) << geometryOnly;
+        EXPECT_EQ(cloud.normals()[1], Eigen::Vector3f(1, 0, 0));
+    }
+}
+
 TEST(PlyFormat, CrlfAsciiFile)
 {
     const auto registry = plyRegistry();

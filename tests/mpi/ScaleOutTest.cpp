@@ -223,6 +223,8 @@ TEST_F(ScaleOut, NonFinitePointsAndReferenceNormalsReadAsTheCliReadsThem)
     auto& normals = reference.enableNormals();
     for (std::size_t i = 0; i < reference.size(); ++i)
         normals[i] = Eigen::Vector3f(0.1f * static_cast<float>(i % 3), 0.05f, 1.0f).normalized();
+    // Its first record non-finite: the normals must be seen all the same.
+    reference.positions()[0].x() = std::numeric_limits<float>::quiet_NaN();
     PointCloud compared = sampleSite(2, 3.0, false, true);
     for (std::size_t i = 0; i < compared.size(); i += 997)
         compared.positions()[i].y() = std::numeric_limits<float>::quiet_NaN();
