@@ -659,14 +659,19 @@ struct RangeAccumulator
     {
     }
 
+    //! Each axis's range keeps its finite values only.
+    void addCoordinate(int axis, double v)
+    {
+        if (std::isfinite(v)) {
+            lo[axis] = std::min(lo[axis], v);
+            hi[axis] = std::max(hi[axis], v);
+        }
+    }
+
     void add(const Slot& s, double v)
     {
         if (s.role >= Role::X && s.role <= Role::Z) {
-            if (std::isfinite(v)) {
-                const int axis = static_cast<int>(s.role) - static_cast<int>(Role::X);
-                lo[axis] = std::min(lo[axis], v);
-                hi[axis] = std::max(hi[axis], v);
-            }
+            addCoordinate(static_cast<int>(s.role) - static_cast<int>(Role::X), v);
         } else if (s.role == Role::Field && std::isfinite(v)) {
             fieldLo[s.field] = std::min(fieldLo[s.field], v);
             fieldHi[s.field] = std::max(fieldHi[s.field], v);
@@ -717,6 +722,35 @@ const char* skipBinaryList(const PlyElement& e, const PlyProperty& p, std::uint6
     return ptr + static_cast<std::size_t>(count) * itemSize;
 }
 
+//! Calls visit(i, record) for each record of an element of fixed-size
+//! records, after checking the file holds them all; returns the end of the
+//! records. Records are visited in chunks on both cores, from one thread per
+//! chunk, so the visitor must only write what belongs to record i (or to its
+//! chunk, i / kChunk); each chunk's pages are released once read.
+template <class Visit>
+const char* visitFixedRecords(const PlyElement& e, const char* ptr, const char* end, const Context& ctx,
+                              ProgressTicker& ticker, Visit&& visit)
+{
+    const std::uint64_t n = e.count;
+    const std::size_t recordSize = e.minRecordSize();
+    const std::uint64_t available = static_cast<std::uint64_t>(end - ptr) / recordSize;
+    if (available < n)
+        ctx.truncated(e, available);
+    const std::uint64_t chunks = (n + kChunk - 1) / kChunk;
+    tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, chunks, 1), [&](const tbb::blocked_range<std::uint64_t>& range) {
+        for (std::uint64_t chunk = range.begin(); chunk != range.end(); ++chunk) {
+            const std::uint64_t start = chunk * kChunk, stop = std::min(n, start + kChunk);
+            const char* record = ptr + start * recordSize;
+            const char* chunkBegin = record;
+            for (std::uint64_t i = start; i < stop; ++i, record += recordSize)
+                visit(i, record);
+            MappedFile::releaseConsumed(chunkBegin, record);
+            ticker.step(stop - start);
+        }
+    });
+    return ptr + n * recordSize;
+}
+
 //! Calls visit(index, slot, value) for every used vertex property: in file
 //! order for records of variable size, by chunks on several threads for
 //! fixed-size records (see below).
@@ -726,30 +760,12 @@ const char* visitBinaryVertices(const PlyElement& e, const VertexLayout& layout,
 {
     const std::uint64_t n = e.count;
     if (e.fixedSize()) {
-        const std::size_t recordSize = e.minRecordSize();
-        const std::uint64_t available = static_cast<std::uint64_t>(end - ptr) / recordSize;
-        if (available < n)
-            ctx.truncated(e, available);
         const Slot* slotsBegin = layout.slots.data();
         const Slot* slotsEnd = slotsBegin + layout.slots.size();
-        // Records of a fixed size are decoded in chunks on both cores: the
-        // visitor is called for every value of a record, from one thread per
-        // chunk, so it must only write what belongs to record i (or to its
-        // chunk, i / kChunk).
-        const std::uint64_t chunks = (n + kChunk - 1) / kChunk;
-        tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, chunks, 1), [&](const tbb::blocked_range<std::uint64_t>& range) {
-            for (std::uint64_t chunk = range.begin(); chunk != range.end(); ++chunk) {
-                const std::uint64_t start = chunk * kChunk, stop = std::min(n, start + kChunk);
-                const char* record = ptr + start * recordSize;
-                const char* chunkBegin = record;
-                for (std::uint64_t i = start; i < stop; ++i, record += recordSize)
-                    for (const Slot* s = slotsBegin; s != slotsEnd; ++s)
-                        visit(i, *s, loadDouble<Swap>(record + s->offset, s->type));
-                MappedFile::releaseConsumed(chunkBegin, record);
-                ticker.step(stop - start);
-            }
+        return visitFixedRecords(e, ptr, end, ctx, ticker, [&](std::uint64_t i, const char* record) {
+            for (const Slot* s = slotsBegin; s != slotsEnd; ++s)
+                visit(i, *s, loadDouble<Swap>(record + s->offset, s->type));
         });
-        return ptr + n * recordSize;
     }
     for (std::uint64_t i = 0; i < n; ++i) {
         for (std::size_t j = 0; j < e.properties.size(); ++j) {
@@ -800,34 +816,23 @@ std::optional<PlainCoordinates> plainCoordinates(const VertexLayout& layout)
 }
 
 //! Calls visit(i, x, y, z) for every record of a fixed-size element in
-//! native byte order whose coordinates are plain, by chunks on several
-//! threads as visitBinaryVertices does.
-template <class T, class Visit>
-void visitPlainCoordinates(const PlyElement& e, const PlainCoordinates& plain, const char* ptr, const char* end,
-                           const Context& ctx, ProgressTicker& ticker, Visit&& visit)
+//! native byte order whose coordinates are plain (see visitFixedRecords).
+template <class Visit>
+const char* visitPlainCoordinates(const PlyElement& e, const PlainCoordinates& plain, const char* ptr, const char* end,
+                                  const Context& ctx, ProgressTicker& ticker, Visit&& visit)
 {
-    const std::uint64_t n = e.count;
-    const std::size_t recordSize = e.minRecordSize();
-    if (static_cast<std::uint64_t>(end - ptr) / recordSize < n)
-        ctx.truncated(e, static_cast<std::uint64_t>(end - ptr) / recordSize);
     const std::size_t ox = plain.offset[0], oy = plain.offset[1], oz = plain.offset[2];
-    const std::uint64_t chunks = (n + kChunk - 1) / kChunk;
-    tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, chunks, 1), [&](const tbb::blocked_range<std::uint64_t>& range) {
-        for (std::uint64_t chunk = range.begin(); chunk != range.end(); ++chunk) {
-            const std::uint64_t start = chunk * kChunk, stop = std::min(n, start + kChunk);
-            const char* record = ptr + start * recordSize;
-            const char* chunkBegin = record;
-            for (std::uint64_t i = start; i < stop; ++i, record += recordSize) {
-                T x, y, z;
-                std::memcpy(&x, record + ox, sizeof x);
-                std::memcpy(&y, record + oy, sizeof y);
-                std::memcpy(&z, record + oz, sizeof z);
-                visit(i, static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
-            }
-            MappedFile::releaseConsumed(chunkBegin, record);
-            ticker.step(stop - start);
-        }
-    });
+    const auto visitAs = [&](auto type) {
+        using T = decltype(type);
+        return visitFixedRecords(e, ptr, end, ctx, ticker, [&](std::uint64_t i, const char* record) {
+            T x, y, z;
+            std::memcpy(&x, record + ox, sizeof x);
+            std::memcpy(&y, record + oy, sizeof y);
+            std::memcpy(&z, record + oz, sizeof z);
+            visit(i, static_cast<double>(x), static_cast<double>(y), static_cast<double>(z));
+        });
+    };
+    return plain.type == PlyType::Float64 ? visitAs(double()) : visitAs(float());
 }
 
 template <bool Swap>
@@ -1274,17 +1279,11 @@ private:
         if (!Swap && plain && part.fixedSize()) {
             const auto add = [&perChunk](std::uint64_t i, double x, double y, double z) {
                 RangeAccumulator& r = perChunk[static_cast<std::size_t>(i / kChunk)];
-                const double v[3] = {x, y, z};
-                for (int a = 0; a < 3; ++a)
-                    if (std::isfinite(v[a])) {
-                        r.lo[a] = std::min(r.lo[a], v[a]);
-                        r.hi[a] = std::max(r.hi[a], v[a]);
-                    }
+                r.addCoordinate(0, x);
+                r.addCoordinate(1, y);
+                r.addCoordinate(2, z);
             };
-            if (plain->type == PlyType::Float64)
-                visitPlainCoordinates<double>(part, *plain, ptr, end, ctx_, ticker, add);
-            else
-                visitPlainCoordinates<float>(part, *plain, ptr, end, ctx_, ticker, add);
+            visitPlainCoordinates(part, *plain, ptr, end, ctx_, ticker, add);
         } else {
             visitCoordinates<Swap>(part, ptr, end, ticker, perChunk);
         }
@@ -1356,10 +1355,7 @@ private:
         const std::optional<PlainCoordinates> plain = plainCoordinates(layout_);
         if (!Swap && plain) {
             const auto store = [&positions](std::uint64_t i, double x, double y, double z) { positions[i] = {x, y, z}; };
-            if (plain->type == PlyType::Float64)
-                visitPlainCoordinates<double>(r.part, *plain, r.first, r.end, ctx_, ticker, store);
-            else
-                visitPlainCoordinates<float>(r.part, *plain, r.first, r.end, ctx_, ticker, store);
+            visitPlainCoordinates(r.part, *plain, r.first, r.end, ctx_, ticker, store);
             return positions;
         }
         visitBinaryVertices<Swap>(r.part, coordinatesOnly(layout_), r.first, r.end, ctx_, ticker,
@@ -1484,11 +1480,7 @@ private:
                 positions[i] = Eigen::Vector3f(static_cast<float>(x - origin.x()), static_cast<float>(y - origin.y()),
                                                static_cast<float>(z - origin.z()));
             };
-            if (plain->type == PlyType::Float64)
-                visitPlainCoordinates<double>(e, *plain, ptr, end, ctx_, ticker, store);
-            else
-                visitPlainCoordinates<float>(e, *plain, ptr, end, ctx_, ticker, store);
-            next = ptr + e.count * e.minRecordSize();
+            next = visitPlainCoordinates(e, *plain, ptr, end, ctx_, ticker, store);
         } else {
             next = visitBinaryVertices<Swap>(
                 e, layout_, ptr, end, ctx_, ticker, [&sink](std::uint64_t i, const Slot& s, double v) { sink.put(i, s, v); });
