@@ -138,12 +138,26 @@ std::uint64_t decodeLayered(const fs::path& path, const LazLayout& layout, const
         invalid(path, chunkName(index, chunk) + " is corrupt: a layer does not decode into " + std::to_string(chunk.points) +
                           " points");
     };
-    for (std::uint64_t q = 1; q < chunk.points; ++q) {
-        auto* record = reinterpret_cast<unsigned char*>(out + q * recordLength);
-        for (std::size_t i = 0; i < items.size(); ++i)
-            items[i]->decode(record + offsets[i], context);
-        if (q % kCheckEvery == 0 && corrupt())
-            refuse();
+    // One item at a time over the whole chunk: its layers are streams of
+    // their own, so nothing ties an item's points to the other items' but
+    // the scanner channel the point14 item decodes, kept here per point. A
+    // loop over one item's code and models runs faster (random order 0.92 of
+    // the time, one item after the other per point).
+    std::vector<std::uint8_t> channels(items.size() > 1 ? chunk.points : 0);
+    const std::uint32_t firstContext = context;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        laz::LayeredItem& item = *items[i];
+        unsigned char* field = reinterpret_cast<unsigned char*>(out) + offsets[i];
+        context = firstContext;
+        for (std::uint64_t q = 1; q < chunk.points; ++q) {
+            if (i > 0)
+                context = channels[q];
+            item.decode(field + q * recordLength, context);
+            if (i == 0 && !channels.empty())
+                channels[q] = static_cast<std::uint8_t>(context);
+            if (q % kCheckEvery == 0 && item.corrupt())
+                refuse();
+        }
     }
     if (corrupt())
         refuse();

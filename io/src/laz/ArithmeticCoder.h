@@ -92,24 +92,24 @@ public:
     {
         if ((totalCount_ += updateCycle_) > kSymbolMaxCount) {
             totalCount_ = 0;
-            for (std::uint32_t& c : counts_)
-                totalCount_ += (c = (c + 1) >> 1);
+            for (std::uint16_t& c : counts_)
+                totalCount_ += (c = static_cast<std::uint16_t>((c + 1) >> 1));
         }
         std::uint32_t sum = 0, s = 0;
         const std::uint32_t scale = 0x80000000u / totalCount_;
         for (std::uint32_t k = 0; k < symbols_; ++k) {
-            distribution_[k] = (scale * sum) >> (31 - kSymbolLengthShift);
+            distribution_[k] = static_cast<std::uint16_t>((scale * sum) >> (31 - kSymbolLengthShift));
             sum += counts_[k];
             if (tableSize_ != 0) {
                 const std::uint32_t w = distribution_[k] >> tableShift_;
                 while (s < w)
-                    decoderTable_[++s] = k - 1;
+                    decoderTable_[++s] = static_cast<std::uint16_t>(k - 1);
             }
         }
         if (tableSize_ != 0) {
             decoderTable_[0] = 0;
             while (s <= tableEnd_)
-                decoderTable_[++s] = symbols_ - 1;
+                decoderTable_[++s] = static_cast<std::uint16_t>(symbols_ - 1);
         }
         updateCycle_ = (5 * updateCycle_) >> 2;
         const std::uint32_t maxCycle = (symbols_ + 6) << 3;
@@ -124,7 +124,11 @@ private:
     std::uint32_t symbols_, lastSymbol_;
     std::uint32_t tableSize_ = 0, tableShift_ = 0, tableEnd_ = 0;
     std::uint32_t totalCount_ = 0, updateCycle_ = 0, symbolsUntilUpdate_ = 0;
-    std::vector<std::uint32_t> distribution_, counts_, decoderTable_;
+    // 16 bits suffice and halve the models' share of the cache: the
+    // distribution is below 2^15, a symbol below 2^11, and a count at most
+    // 2^15 plus one update cycle ((515 + 6) × 8 for the largest alphabet LAZ
+    // uses). They also cannot alias the decoder's 32-bit state.
+    std::vector<std::uint16_t> distribution_, counts_, decoderTable_;
 };
 
 //! Decodes from the bytes [begin, end); beyond `end` it reads zeros and counts
@@ -184,7 +188,7 @@ public:
             std::uint32_t n = m.decoderTable_[t + 1] + 1;
             // Without branches: which half holds the symbol is the coded
             // data itself, so a branch on it would be mispredicted half the time.
-            const std::uint32_t* distribution = m.distribution_.data();
+            const std::uint16_t* distribution = m.distribution_.data();
             while (n > symbol + 1) {
                 const std::uint32_t k = (symbol + n) >> 1;
                 const bool above = distribution[k] > dv;
