@@ -143,19 +143,13 @@ std::uint64_t decodeLayered(const fs::path& path, const LazLayout& layout, const
     // the scanner channel the point14 item decodes, kept here per point. A
     // loop over one item's code and models runs faster (random order 0.92 of
     // the time, one item after the other per point).
-    std::vector<std::uint8_t> channels(items.size() > 1 ? chunk.points : 0);
-    const std::uint32_t firstContext = context;
+    std::vector<std::uint8_t> channels(chunk.points);
     for (std::size_t i = 0; i < items.size(); ++i) {
-        laz::LayeredItem& item = *items[i];
         unsigned char* field = reinterpret_cast<unsigned char*>(out) + offsets[i];
-        context = firstContext;
-        for (std::uint64_t q = 1; q < chunk.points; ++q) {
-            if (i > 0)
-                context = channels[q];
-            item.decode(field + q * recordLength, context);
-            if (i == 0 && !channels.empty())
-                channels[q] = static_cast<std::uint8_t>(context);
-            if (q % kCheckEvery == 0 && item.corrupt())
+        for (std::uint64_t q = 1; q < chunk.points; q += kCheckEvery) {
+            const auto count = static_cast<std::size_t>(std::min<std::uint64_t>(kCheckEvery, chunk.points - q));
+            items[i]->decodeRun(field + q * recordLength, recordLength, count, channels.data() + q);
+            if (items[i]->corrupt())
                 refuse();
         }
     }

@@ -90,11 +90,13 @@ void expectRefused(const std::string& name, const std::string& bytes, ErrorCode 
 
 namespace {
 
-//! Decompresses `name`.laz and compares every record with `name`.las's.
-void expectRecordsOfTheLasTwin(const std::string& name, std::size_t expectedPoints, std::size_t expectedItems)
+//! Decompresses `name`.laz and compares every record with `name`.las's
+//! (in `dir`: the LASzip samples unless told).
+void expectRecordsOfTheLasTwin(const std::string& name, std::size_t expectedPoints, std::size_t expectedItems,
+                               const fs::path& dir = kLazDir)
 {
-    const std::string las = fileBytes(kLazDir / (name + ".las"));
-    const std::string laz = fileBytes(kLazDir / (name + ".laz"));
+    const std::string las = fileBytes(dir / (name + ".las"));
+    const std::string laz = fileBytes(dir / (name + ".laz"));
     // LAS 1.4 keeps the count in a 64-bit field (byte 247), the legacy one is 0 for formats 6-10.
     const bool v14 = laz[25] == 4;
     const std::uint64_t count = v14 ? at<std::uint64_t>(laz, 247) : at<std::uint32_t>(laz, kPointCount);
@@ -274,6 +276,27 @@ void expectSameClouds(const PointCloud& a, const PointCloud& b, const std::strin
 }
 
 } // namespace
+
+TEST(LazFormat, RecordsOfFourInterleavedScannerChannelsDecodeByteForByte)
+{
+    // The layered decoder takes a chunk's x, y layer before its other layers;
+    // a scanner channel used for the first time starts from the last point of
+    // the one before it, every attribute of it.
+    const fs::path dir = test::tempDir();
+    for (const bool colours : {false, true}) {
+        const std::string name = colours ? "channels7" : "channels6";
+        PointCloud cloud = varyingCloud(120000, colours, false, 11);
+        // Times a pulse apart that a 32-bit float keeps, so that the first
+        // point of a channel differs in time from the last of the one before.
+        ScalarField& time = *cloud.field("gps_time");
+        for (std::size_t i = 0; i < cloud.size(); ++i)
+            time.setValue(i, 345678.0 + 0.25 * double(i / 3) + (i / 3 % 7 == 0 ? 0.5 : 0.0));
+        io::writePointCloud(registry(), cloud, dir / (name + ".las"));
+        io::writePointCloud(registry(), cloud, dir / (name + ".laz"));
+        // point14, rgb14 for format 7, and the two Extra Bytes dimensions as byte14.
+        expectRecordsOfTheLasTwin(name, 120000, colours ? 3 : 2, dir);
+    }
+}
 
 TEST(LazFormat, WrittenLazReadsBackAsTheSameCloudAsLas)
 {

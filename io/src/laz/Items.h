@@ -148,7 +148,10 @@ public:
     //! Gives the chunk's layers (layerCount() of them) and the context of the
     //! first point; the point14 item sets it from that point.
     virtual void start(const Layer* layers, std::uint32_t& context) = 0;
-    virtual void decode(unsigned char* item, std::uint32_t& context) = 0;
+    //! Decodes the items of `count` consecutive points, the first at `item`,
+    //! one every `stride` bytes. `channels` holds each point's scanner
+    //! channel: the point14 item writes it, the items after it read it.
+    virtual void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* channels) = 0;
     //! Whether a layer's stream cannot come from an encoder (see ArithmeticDecoder::corrupt).
     virtual bool corrupt() const = 0;
     //! Once the chunk is decoded: whether every layer was read to its last

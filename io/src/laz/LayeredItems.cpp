@@ -50,9 +50,9 @@ public:
     {
         for (std::size_t i = 0; i < kLayers; ++i)
             streams_[i].open(layers[i]);
-        current_ = first_.scannerChannel;
-        context = current_;
-        contexts_[current_] = std::make_unique<Point14Context>(first_);
+        xyChannel_ = first_.scannerChannel;
+        context = xyChannel_;
+        contexts_[xyChannel_] = std::make_unique<Point14Context>(first_);
     }
 
     bool corrupt() const override
@@ -64,9 +64,40 @@ public:
         return std::all_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.endedExactly(); });
     }
 
-    void decode(unsigned char* item, std::uint32_t& context) override
+    //! Two passes over the run: the returns and x, y first, then the other
+    //! layers from what the first left per point. The layers are streams of
+    //! their own; in one pass each, a layer's decoding does not wait behind
+    //! the x, y layer's mispredicted branches.
+    void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* channels) override
     {
-        Point14Context* c = contexts_[current_].get();
+        steps_.resize(count);
+        for (std::size_t k = 0; k < count; ++k) {
+            steps_[k] = decodeReturnsXY(item + k * stride);
+            channels[k] = steps_[k].channel;
+        }
+        for (std::size_t k = 0; k < count; ++k)
+            decodeOthers(item + k * stride, steps_[k]);
+    }
+
+private:
+    enum : std::size_t { kReturnsXY, kZ, kClassification, kFlags, kIntensity, kScanAngle, kUserData, kPointSource, kGpsTime, kLayers };
+
+    //! What the x, y layer tells the others about a point.
+    struct Step
+    {
+        std::uint8_t channel = 0;
+        std::uint8_t startedFrom = kNone; //!< a channel used for the first time starts from this one's last point
+        std::uint8_t position = 0;        //!< single 3, first 2, last 1, intermediate 0
+        std::uint8_t level = 0;           //!< |n - r|, at most 7: the height's context
+        std::uint8_t zSize = 0;           //!< the mean size of the x and y corrections
+        bool single = false, gpsTimeChanged = false, scanAngleChanged = false, pointSourceChanged = false;
+    };
+    static constexpr std::uint8_t kNone = 0xFF;
+
+    Step decodeReturnsXY(unsigned char* item)
+    {
+        Step step;
+        Point14Context* c = contexts_[xyChannel_].get();
         ArithmeticDecoder& xy = *streams_[kReturnsXY];
         // The last point's return (single, first, last or intermediate) and
         // whether its time changed choose the model of what changed now.
@@ -75,18 +106,21 @@ public:
                                            (c->last.gpsTimeChanged ? 4u : 0u);
         const std::uint32_t changed = xy.decodeSymbol(c->changedValues[lastPosition]);
         if (changed & (1u << 6)) {
-            const std::uint32_t channel = (current_ + xy.decodeSymbol(c->scannerChannel) + 1) % 4;
-            if (!contexts_[channel])
+            const std::uint32_t channel = (xyChannel_ + xy.decodeSymbol(c->scannerChannel) + 1) % 4;
+            if (!contexts_[channel]) {
+                // Only the returns and x, y of the last point are known yet:
+                // the second pass sets the rest when it reaches this point.
                 contexts_[channel] = std::make_unique<Point14Context>(c->last);
-            current_ = channel;
-            context = current_;
-            c = contexts_[current_].get();
-            c->last.scannerChannel = channel;
+                step.startedFrom = static_cast<std::uint8_t>(xyChannel_);
+            }
+            xyChannel_ = channel;
+            c = contexts_[xyChannel_].get();
         }
+        step.channel = static_cast<std::uint8_t>(xyChannel_);
         Point14& p = c->last;
-        const bool pointSourceChanged = changed & (1u << 5);
-        const bool gpsTimeChanged = changed & (1u << 4);
-        const bool scanAngleChanged = changed & (1u << 3);
+        step.pointSourceChanged = changed & (1u << 5);
+        step.gpsTimeChanged = changed & (1u << 4);
+        step.scanAngleChanged = changed & (1u << 3);
 
         const std::uint32_t lastN = p.numberOfReturns, lastR = p.returnNumber;
         const std::uint32_t n = (changed & (1u << 2)) ? xy.decodeSymbol(c->numberOfReturns[lastN]) : lastN;
@@ -96,33 +130,48 @@ public:
         case 1: r = (lastR + 1) % 16; break;
         case 2: r = (lastR + 15) % 16; break;
         case 3:
-            r = gpsTimeChanged ? xy.decodeSymbol(c->returnNumber[lastR])
-                               : (lastR + xy.decodeSymbol(c->returnNumberGpsSame) + 2) % 16;
+            r = step.gpsTimeChanged ? xy.decodeSymbol(c->returnNumber[lastR])
+                                    : (lastR + xy.decodeSymbol(c->returnNumberGpsSame) + 2) % 16;
             break;
         default: break;
         }
         p.returnNumber = r;
-        const std::uint32_t m = kReturnMap6[n][r], l = returnLevel8(n, r);
+        step.single = n == 1;
+        step.level = static_cast<std::uint8_t>(returnLevel8(n, r));
         // The return of this point: single 3, first 2, last 1, intermediate 0
         // (the last point's above counts first as 1 and last as 2).
-        const std::uint32_t position = (r == 1 ? 2u : 0u) + (r >= n ? 1u : 0u);
-        const std::uint32_t medianSlot = (m << 1) | (gpsTimeChanged ? 1u : 0u);
+        step.position = static_cast<std::uint8_t>((r == 1 ? 2u : 0u) + (r >= n ? 1u : 0u));
+        const std::uint32_t medianSlot = (std::uint32_t(kReturnMap6[n][r]) << 1) | (step.gpsTimeChanged ? 1u : 0u);
 
         const std::int32_t dx = c->dx.decompress(xy, c->xMedian[medianSlot].median(), n == 1);
         p.x = static_cast<std::int32_t>(static_cast<std::uint32_t>(p.x) + static_cast<std::uint32_t>(dx));
         c->xMedian[medianSlot].add(dx);
-        std::uint32_t k = c->dx.lastSize();
+        const std::uint32_t k = c->dx.lastSize();
         const std::int32_t dy = c->dy.decompress(xy, c->yMedian[medianSlot].median(), (n == 1) + (k < 20 ? k & ~1u : 20));
         p.y = static_cast<std::int32_t>(static_cast<std::uint32_t>(p.y) + static_cast<std::uint32_t>(dy));
         c->yMedian[medianSlot].add(dy);
+        step.zSize = static_cast<std::uint8_t>((c->dx.lastSize() + c->dy.lastSize()) / 2);
+        p.gpsTimeChanged = step.gpsTimeChanged;
+        p.scannerChannel = xyChannel_;
+        store(item, p.x);
+        store(item + 4, p.y);
+        item[14] = static_cast<unsigned char>(r | (n << 4));
+        return step;
+    }
 
+    void decodeOthers(unsigned char* item, const Step& step)
+    {
+        if (step.startedFrom != kNone)
+            contexts_[step.channel]->restartOthers(contexts_[step.startedFrom]->last);
+        Point14Context* c = contexts_[step.channel].get();
+        Point14& p = c->last;
         if (streams_[kZ].changes()) {
-            k = (c->dx.lastSize() + c->dy.lastSize()) / 2;
-            p.z = c->z.decompress(*streams_[kZ], c->lastZ[l], (n == 1) + (k < 18 ? k & ~1u : 18));
-            c->lastZ[l] = p.z;
+            const std::uint32_t k = step.zSize;
+            p.z = c->z.decompress(*streams_[kZ], c->lastZ[step.level], step.single + (k < 18 ? k & ~1u : 18));
+            c->lastZ[step.level] = p.z;
         }
         if (streams_[kClassification].changes()) {
-            const std::uint32_t key = ((p.classification & 0x1F) << 1) + (position == 3 ? 1 : 0);
+            const std::uint32_t key = ((p.classification & 0x1F) << 1) + (step.position == 3 ? 1 : 0);
             p.classification = (*streams_[kClassification]).decodeSymbol(c->classification[key]);
         }
         if (streams_[kFlags].changes()) {
@@ -133,29 +182,27 @@ public:
             p.classificationFlags = f & 0x0F;
         }
         if (streams_[kIntensity].changes()) {
-            const std::uint32_t slot = (position << 1) | (gpsTimeChanged ? 1u : 0u);
-            p.intensity = static_cast<std::uint16_t>(c->intensity.decompress(*streams_[kIntensity], c->lastIntensity[slot], position));
+            const std::uint32_t slot = (std::uint32_t(step.position) << 1) | (step.gpsTimeChanged ? 1u : 0u);
+            p.intensity = static_cast<std::uint16_t>(c->intensity.decompress(*streams_[kIntensity], c->lastIntensity[slot], step.position));
             c->lastIntensity[slot] = p.intensity;
         }
-        if (streams_[kScanAngle].changes() && scanAngleChanged)
-            p.scanAngle = static_cast<std::int16_t>(c->scanAngle.decompress(*streams_[kScanAngle], p.scanAngle, gpsTimeChanged));
+        if (streams_[kScanAngle].changes() && step.scanAngleChanged)
+            p.scanAngle = static_cast<std::int16_t>(c->scanAngle.decompress(*streams_[kScanAngle], p.scanAngle, step.gpsTimeChanged));
         if (streams_[kUserData].changes())
             p.userData = (*streams_[kUserData]).decodeSymbol(c->userData[p.userData / 4]);
-        if (streams_[kPointSource].changes() && pointSourceChanged)
+        if (streams_[kPointSource].changes() && step.pointSourceChanged)
             p.pointSource = static_cast<std::uint16_t>(c->pointSource.decompress(*streams_[kPointSource], p.pointSource));
-        if (streams_[kGpsTime].changes() && gpsTimeChanged)
+        if (streams_[kGpsTime].changes() && step.gpsTimeChanged)
             p.gpsTime = c->gpsTime.decode(*streams_[kGpsTime]);
-        p.write(item);
-        p.gpsTimeChanged = gpsTimeChanged;
+        p.writeOthers(item);
     }
 
-private:
-    enum : std::size_t { kReturnsXY, kZ, kClassification, kFlags, kIntensity, kScanAngle, kUserData, kPointSource, kGpsTime, kLayers };
 
     Point14 first_;
     std::array<LayerStream, kLayers> streams_;
     std::array<std::unique_ptr<Point14Context>, 4> contexts_;
-    std::uint32_t current_ = 0;
+    std::uint32_t xyChannel_ = 0; //!< the scanner channel of the first pass
+    std::vector<Step> steps_;
 };
 
 //! Red, green, blue (uint16 each) in one layer, and near infrared in a
@@ -183,7 +230,14 @@ public:
     bool corrupt() const override { return rgb_.corrupt() || nir_.corrupt(); }
     bool endedExactly() const override { return rgb_.endedExactly() && nir_.endedExactly(); }
 
-    void decode(unsigned char* item, std::uint32_t& context) override
+    void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* channels) override
+    {
+        for (std::size_t k = 0; k < count; ++k)
+            decode(item + k * stride, channels[k]);
+    }
+
+private:
+    void decode(unsigned char* item, std::uint32_t context)
     {
         std::array<std::uint16_t, 4>& last = switchContext(contexts_, current_, context);
         Context& c = *contexts_[current_];
@@ -205,7 +259,6 @@ public:
             store(item + 2 * k, last[k]);
     }
 
-private:
     using Context = RgbContext;
 
     bool withNir_;
@@ -240,7 +293,14 @@ public:
         return std::all_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.endedExactly(); });
     }
 
-    void decode(unsigned char* item, std::uint32_t& context) override
+    void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* channels) override
+    {
+        for (std::size_t k = 0; k < count; ++k)
+            decode(item + k * stride, channels[k]);
+    }
+
+private:
+    void decode(unsigned char* item, std::uint32_t context)
     {
         std::vector<unsigned char>& last = switchContext(contexts_, current_, context);
         Context& c = *contexts_[current_];
@@ -251,7 +311,6 @@ public:
         }
     }
 
-private:
     using Context = BytesContext;
 
     std::vector<unsigned char> first_;

@@ -58,13 +58,12 @@ struct Point14
         return q;
     }
 
-    void write(unsigned char* p) const
+    //! All but x, y and the returns (what the layers after the first give;
+    //! the decoder writes those in its first pass).
+    void writeOthers(unsigned char* p) const
     {
-        store(p, x);
-        store(p + 4, y);
         store(p + 8, z);
         store(p + 12, intensity);
-        p[14] = static_cast<unsigned char>(returnNumber | (numberOfReturns << 4));
         p[15] = static_cast<unsigned char>(classificationFlags | (scannerChannel << 4) | (scanDirection << 6) | (edgeOfFlightLine << 7));
         p[16] = static_cast<unsigned char>(classification);
         p[17] = static_cast<unsigned char>(userData);
@@ -277,6 +276,23 @@ struct Point14Context
         last.gpsTimeChanged = false;
         lastZ.fill(from.z);
         lastIntensity.fill(from.intensity);
+    }
+
+    //! A context the decoder's first pass started from `from` when only its
+    //! returns and x, y were known: the rest of `from`, once decoded.
+    void restartOthers(const Point14& from)
+    {
+        Point14 restarted = from;
+        restarted.x = last.x;
+        restarted.y = last.y;
+        restarted.returnNumber = last.returnNumber;
+        restarted.numberOfReturns = last.numberOfReturns;
+        restarted.scannerChannel = last.scannerChannel;
+        restarted.gpsTimeChanged = last.gpsTimeChanged;
+        last = restarted;
+        lastZ.fill(from.z);
+        lastIntensity.fill(from.intensity);
+        gpsTime = GpsTime14(from.gpsTime);
     }
 
     Point14 last;
