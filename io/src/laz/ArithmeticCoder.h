@@ -187,13 +187,14 @@ public:
             symbol = m.decoderTable_[t];
             std::uint32_t n = m.decoderTable_[t + 1] + 1;
             // Without branches: which half holds the symbol is the coded
-            // data itself, so a branch on it would be mispredicted half the time.
+            // data itself, so a branch on it would be mispredicted half the
+            // time. Masks, because GCC turns the plain selections into one.
             const std::uint16_t* distribution = m.distribution_.data();
             while (n > symbol + 1) {
                 const std::uint32_t k = (symbol + n) >> 1;
-                const bool above = distribution[k] > dv;
-                n = above ? k : n;
-                symbol = above ? symbol : k;
+                const std::uint32_t above = 0u - static_cast<std::uint32_t>(distribution[k] > dv);
+                n = (k & above) | (n & ~above);
+                symbol = (symbol & above) | (k & ~above);
             }
             x = m.distribution_[symbol] * length_;
             if (symbol != m.lastSymbol_)
