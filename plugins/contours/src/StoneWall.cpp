@@ -4,6 +4,7 @@
 #include <scandiff/plugins/contours/StoneWall.h>
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/segmentation/RunningMoments.h>
 #include <scandiff/octree/Octree.h>
 
 #include <algorithm>
@@ -82,26 +83,18 @@ std::vector<std::int32_t> growOnIntensity(const octree::Octree& tree, const std:
         ticker.step();
         if (region[seed] >= 0)
             continue;
-        double sum = intensity[seed], sumSquares = static_cast<double>(intensity[seed]) * intensity[seed];
-        std::size_t count = 1;
-        for (std::uint32_t j : lists[seed]) {
-            if (region[j] >= 0 || !std::isfinite(intensity[j]))
-                continue;
-            sum += intensity[j];
-            sumSquares += static_cast<double>(intensity[j]) * intensity[j];
-            ++count;
-        }
-        const double mean = sum / static_cast<double>(count);
-        if (count < 3 || sumSquares / static_cast<double>(count) - mean * mean > tau)
+        RunningMoments disc;
+        disc.add(intensity[seed]);
+        for (std::uint32_t j : lists[seed])
+            if (region[j] < 0 && std::isfinite(intensity[j]))
+                disc.add(intensity[j]);
+        if (disc.count < 3 || disc.variance() > tau)
             continue; // not a homogeneous seed surface
         const std::int32_t id = next++;
-        sum = sumSquares = 0.0;
-        count = 0;
+        RunningMoments stone;
         auto join = [&](std::uint32_t j) {
             region[j] = id;
-            sum += intensity[j];
-            sumSquares += static_cast<double>(intensity[j]) * intensity[j];
-            ++count;
+            stone.add(intensity[j]);
             front.push_back(j);
         };
         join(seed);
@@ -112,9 +105,7 @@ std::vector<std::int32_t> growOnIntensity(const octree::Octree& tree, const std:
                 if (region[j] >= 0 || !stoneClass[j])
                     continue;
                 const double value = intensity[j];
-                const double m = (sum + value) / static_cast<double>(count + 1);
-                const double variance = (sumSquares + value * value) / static_cast<double>(count + 1) - m * m;
-                if (variance < tau && std::abs(value - sum / static_cast<double>(count)) <= band)
+                if (stone.varianceWith(value) < tau && std::abs(value - stone.mean()) <= band)
                     join(j);
             }
         }

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "RegionGrowing.h"
 
+#include <scandiff/core/segmentation/RunningMoments.h>
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Shape_detection/Region_growing/Region_growing.h>
 #include <CGAL/Shape_detection/Region_growing/Region_growing_on_point_set/Least_squares_plane_fit_region.h>
@@ -284,18 +286,12 @@ GrowingOutcome growValueRegions(const std::vector<Eigen::Vector3d>& points, cons
             for (std::size_t i = range.begin(); i != range.end(); ++i) {
                 if (!std::isfinite(values[i]))
                     continue;
-                double sum = 0, sumSquares = 0;
-                std::size_t count = 0;
+                RunningMoments disc;
                 for (const std::uint32_t* j = query.begin(i); j != query.end(i); ++j)
-                    if (std::isfinite(values[*j])) {
-                        sum += values[*j];
-                        sumSquares += static_cast<double>(values[*j]) * values[*j];
-                        ++count;
-                    }
-                if (count >= 3) {
-                    const double mean = sum / static_cast<double>(count);
-                    discVariance[i] = std::max(0.0, sumSquares / static_cast<double>(count) - mean * mean);
-                }
+                    if (std::isfinite(values[*j]))
+                        disc.add(values[*j]);
+                if (disc.count >= 3)
+                    discVariance[i] = std::max(0.0, disc.variance());
             }
         });
         std::vector<std::uint32_t> seeds;
@@ -321,13 +317,10 @@ GrowingOutcome growValueRegions(const std::vector<Eigen::Vector3d>& points, cons
             if (label[seed] >= 0 || !within(discVariance[seed], tau, values[seed]))
                 continue;
             const std::int32_t id = regions++;
-            double sum = 0, sumSquares = 0;
-            std::size_t count = 0;
+            RunningMoments region;
             auto join = [&](std::uint32_t j) {
                 label[j] = id;
-                sum += values[j];
-                sumSquares += static_cast<double>(values[j]) * values[j];
-                ++count;
+                region.add(values[j]);
                 front.push_back(j);
             };
             join(seed);
@@ -340,9 +333,8 @@ GrowingOutcome growValueRegions(const std::vector<Eigen::Vector3d>& points, cons
                     if (label[*j] >= 0 || !std::isfinite(values[*j]))
                         continue;
                     const double value = values[*j];
-                    const double mean = (sum + value) / static_cast<double>(count + 1);
-                    const double variance = (sumSquares + value * value) / static_cast<double>(count + 1) - mean * mean;
-                    if (within(variance, tau, mean) && std::abs(value - sum / static_cast<double>(count)) <= band + 1e-9 * std::abs(value))
+                    if (within(region.varianceWith(value), tau, region.meanWith(value)) &&
+                        std::abs(value - region.mean()) <= band + 1e-9 * std::abs(value))
                         join(*j);
                 }
             }
