@@ -140,15 +140,16 @@ std::uint64_t decodeLayered(const fs::path& path, const LazLayout& layout, const
     };
     // One item at a time over the whole chunk: its layers are streams of
     // their own, so nothing ties an item's points to the other items' but
-    // the scanner channel the point14 item decodes, kept here per point. A
-    // loop over one item's code and models runs faster (random order 0.92 of
-    // the time, one item after the other per point).
+    // the scanner channel the point14 item decodes, kept here per point.
+    // Decoding an item over all the points and then the next took 0.92 of
+    // the time of decoding every item of a point before the next point.
     std::vector<std::uint8_t> channels(chunk.points);
+    channels[0] = static_cast<std::uint8_t>(context);
     for (std::size_t i = 0; i < items.size(); ++i) {
         unsigned char* field = reinterpret_cast<unsigned char*>(out) + offsets[i];
         for (std::uint64_t q = 1; q < chunk.points; q += kCheckEvery) {
-            const auto count = static_cast<std::size_t>(std::min<std::uint64_t>(kCheckEvery, chunk.points - q));
-            items[i]->decodeRun(field + q * recordLength, recordLength, count, channels.data() + q);
+            const auto run = static_cast<std::size_t>(std::min<std::uint64_t>(kCheckEvery, chunk.points - q));
+            items[i]->decodeRun(field + q * recordLength, recordLength, run, channels.data() + q);
             if (items[i]->corrupt())
                 refuse();
         }
@@ -289,9 +290,14 @@ LazLayout parseLazLayout(const fs::path& path, const char* payload, std::size_t 
                             " cannot be read (version " + std::to_string(version) + ", what LASzip writes" +
                             (layered ? " for LAS 1.4 points, can)" : " since 2011, can)"));
     }
-    // The layered coders begin with the point14 item: it sets the context the others follow.
+    // The layered coders begin with the point14 item: it sets the context the
+    // others follow. It comes once: a second one would find its x, y layer
+    // unchecked (the chunk's first layer is the only one that must not be empty).
     if (layered && (layout.items.empty() || layout.items.front().type != laz::kPoint14))
         invalid(path, "the LASzip record's layered items do not start with point14");
+    if (layered && std::count_if(layout.items.begin(), layout.items.end(),
+                                 [](const LazItem& item) { return item.type == laz::kPoint14; }) > 1)
+        invalid(path, "the LASzip record has more than one point14 item");
     return layout;
 }
 

@@ -279,23 +279,40 @@ void expectSameClouds(const PointCloud& a, const PointCloud& b, const std::strin
 
 TEST(LazFormat, RecordsOfFourInterleavedScannerChannelsDecodeByteForByte)
 {
-    // The layered decoder takes a chunk's x, y layer before its other layers;
-    // a scanner channel used for the first time starts from the last point of
-    // the one before it, every attribute of it.
+    // The layered decoder takes a run of points' x, y layer (1,024 points at
+    // a time) before their other layers; a scanner channel used for the
+    // first time starts from the last point of the one before it, every
+    // attribute of it. Channels interleaved from the start of each chunk of
+    // 50,000 points, and channels that first appear at the chunk's second
+    // point, inside a later run, and at a run's first point.
     const fs::path dir = test::tempDir();
-    for (const bool colours : {false, true}) {
-        const std::string name = colours ? "channels7" : "channels6";
-        PointCloud cloud = varyingCloud(120000, colours, false, 11);
-        // Times a pulse apart that a 32-bit float keeps, so that the first
-        // point of a channel differs in time from the last of the one before.
-        ScalarField& time = *cloud.field("gps_time");
-        for (std::size_t i = 0; i < cloud.size(); ++i)
-            time.setValue(i, 345678.0 + 0.25 * double(i / 3) + (i / 3 % 7 == 0 ? 0.5 : 0.0));
-        io::writePointCloud(registry(), cloud, dir / (name + ".las"));
-        io::writePointCloud(registry(), cloud, dir / (name + ".laz"));
-        // point14, rgb14 for format 7, and the two Extra Bytes dimensions as byte14.
-        expectRecordsOfTheLasTwin(name, 120000, colours ? 3 : 2, dir);
-    }
+    auto lateChannel = [](std::size_t i) -> double {
+        const std::size_t q = i % 50000; // in its chunk
+        if (q == 1)
+            return 3;
+        if (q >= 1500 && q < 1510)
+            return 1;
+        if (q >= 2049 && q < 2060) // 2,049: the first point of the third run
+            return 2;
+        return q >= 3000 ? double(q / 7 % 4) : 0;
+    };
+    for (const bool late : {false, true})
+        for (const bool colours : {false, true}) {
+            const std::string name = std::string(late ? "late" : "interleaved") + (colours ? "7" : "6");
+            PointCloud cloud = varyingCloud(120000, colours, false, 11);
+            // Times a pulse apart that a 32-bit float keeps, so that the first
+            // point of a channel differs in time from the last of the one before.
+            ScalarField& time = *cloud.field("gps_time");
+            for (std::size_t i = 0; i < cloud.size(); ++i)
+                time.setValue(i, 345678.0 + 0.25 * double(i / 3) + (i / 3 % 7 == 0 ? 0.5 : 0.0));
+            if (late)
+                for (std::size_t i = 0; i < cloud.size(); ++i)
+                    cloud.field("scanner_channel")->setValue(i, lateChannel(i));
+            io::writePointCloud(registry(), cloud, dir / (name + ".las"));
+            io::writePointCloud(registry(), cloud, dir / (name + ".laz"));
+            // point14, rgb14 for format 7, and the two Extra Bytes dimensions as byte14.
+            expectRecordsOfTheLasTwin(name, 120000, colours ? 3 : 2, dir);
+        }
 }
 
 TEST(LazFormat, WrittenLazReadsBackAsTheSameCloudAsLas)
@@ -544,6 +561,20 @@ TEST(LazFormat, DamagedFilesAreClearErrors)
     bytes = good;
     put<std::uint32_t>(bytes, payload + 12, 500u); // 500 points a chunk: the table's one chunk holds 500, not 1,065
     expectRefused("chunks.laz", bytes, ErrorCode::InvalidData, "chunk table accounts for 500 points");
+}
+
+TEST(LazFormat, ASecondPoint14ItemIsAClearError)
+{
+    // The chunk's first layer (the first point14's x, y) is the only one that
+    // must not be empty; a second point14 item would decode from an empty one.
+    const std::string good = fileBytes(kLazDir / "1_4_w_evlr.laz");
+    const std::size_t payload = laszipPayload(good);
+    ASSERT_EQ(at<std::uint16_t>(good, payload + 32), 1u); // one item: point14, 30 bytes, version 3
+    std::string twice = good.substr(payload, 34 + 6);
+    put<std::uint16_t>(twice, 32, 2);
+    twice += good.substr(payload + 34, 6);
+    test::expectError([&] { io::detail::parseLazLayout("twice.laz", twice.data(), twice.size(), 60); }, ErrorCode::InvalidData,
+                      "twice.laz", "more than one point14 item");
 }
 
 TEST(LazFormat, DamagedLayeredChunksAreClearErrors)

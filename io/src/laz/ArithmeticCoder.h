@@ -12,6 +12,7 @@
 //! Written by hand because Debian 12 packages no LAZ library (no LASzip, no
 //! laz-perf, no PDAL).
 
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -69,6 +70,7 @@ public:
 
     explicit SymbolModel(std::uint32_t symbols) : symbols_(symbols), lastSymbol_(symbols - 1)
     {
+        assert(symbols >= 2 && symbols <= 2048); // LAZ's alphabets; the 16-bit counts need under 4,000
         if (symbols > kTableFrom) {
             std::uint32_t tableBits = 3;
             while (symbols > (1u << (tableBits - kTableFinerBits)))
@@ -126,8 +128,9 @@ private:
     std::uint32_t totalCount_ = 0, updateCycle_ = 0, symbolsUntilUpdate_ = 0;
     // 16 bits suffice and halve the models' share of the cache: the
     // distribution is below 2^15, a symbol below 2^11, and a count at most
-    // 2^15 plus one update cycle ((515 + 6) × 8 for the largest alphabet LAZ
-    // uses). They also cannot alias the decoder's 32-bit state.
+    // 2^15 plus one update cycle ((516 + 6) × 8 for the largest alphabet LAZ
+    // uses, gpstime11's; under 2^16 up to 4,000 symbols). They also cannot
+    // alias the decoder's 32-bit state.
     std::vector<std::uint16_t> distribution_, counts_, decoderTable_;
 };
 
@@ -188,7 +191,7 @@ public:
             std::uint32_t n = m.decoderTable_[t + 1] + 1;
             // Without branches: which half holds the symbol is the coded
             // data itself, so a branch on it would be mispredicted half the
-            // time. Masks, because GCC turns the plain selections into one.
+            // time. Masks, because GCC turns the plain selections into a branch.
             const std::uint16_t* distribution = m.distribution_.data();
             while (n > symbol + 1) {
                 const std::uint32_t k = (symbol + n) >> 1;
