@@ -65,6 +65,22 @@ void ChunkedCloud::readShareTogether(const Communicator& c, const std::function<
         throw Error(ErrorCode::Io, path_.string() + ": another rank could not read its share of the points");
 }
 
+namespace {
+
+//! Each axis's range of finite values as a box, +inf and -inf kept on an
+//! axis without any (FormatHandler::recordBounds's box): empty when an axis
+//! has none.
+BoundingBox boxOfAxisRanges(const double lo[3], const double hi[3])
+{
+    BoundingBox box;
+    box.min = Eigen::Vector3d(lo[0], lo[1], lo[2]);
+    box.max = Eigen::Vector3d(hi[0], hi[1], hi[2]);
+    box.empty = !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]);
+    return box;
+}
+
+} // namespace
+
 std::optional<BoundingBox> ChunkedCloud::shareBounds(const Communicator& c)
 {
     const auto ranks = static_cast<std::size_t>(c.size()), rank = static_cast<std::size_t>(c.rank());
@@ -95,11 +111,7 @@ std::optional<BoundingBox> ChunkedCloud::shareBounds(const Communicator& c)
         kept_[k] = std::move(*coordinates);
     }
     // A rank without a chunk gives an empty box: the others' chunks cover the file.
-    BoundingBox box;
-    box.min = Eigen::Vector3d(lo[0], lo[1], lo[2]);
-    box.max = Eigen::Vector3d(hi[0], hi[1], hi[2]);
-    box.empty = !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]);
-    return box;
+    return boxOfAxisRanges(lo, hi);
 }
 
 Eigen::Vector3d ChunkedCloud::chooseOrigin(const Communicator& c)
@@ -118,13 +130,7 @@ Eigen::Vector3d ChunkedCloud::chooseOrigin(const Communicator& c)
     double lo[3] = {box->min.x(), box->min.y(), box->min.z()}, hi[3] = {box->max.x(), box->max.y(), box->max.z()};
     MPI_Allreduce(MPI_IN_PLACE, lo, 3, MPI_DOUBLE, MPI_MIN, c.comm);
     MPI_Allreduce(MPI_IN_PLACE, hi, 3, MPI_DOUBLE, MPI_MAX, c.comm);
-    BoundingBox whole;
-    whole.empty = !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]);
-    if (!whole.empty) {
-        whole.min = Eigen::Vector3d(lo[0], lo[1], lo[2]);
-        whole.max = Eigen::Vector3d(hi[0], hi[1], hi[2]);
-    }
-    return suggestOrigin(whole);
+    return suggestOrigin(boxOfAxisRanges(lo, hi));
 }
 
 std::size_t ChunkedCloud::chunkCount() const
