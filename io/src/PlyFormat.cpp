@@ -798,8 +798,13 @@ struct PlainCoordinates
     std::size_t offset[3] = {0, 0, 0};
 };
 
-std::optional<PlainCoordinates> plainCoordinates(const VertexLayout& layout)
+//! The plain coordinates of `e`'s records, where they can be loaded
+//! directly: fixed-size records in the machine's byte order.
+template <bool Swap>
+std::optional<PlainCoordinates> plainCoordinates(const VertexLayout& layout, const PlyElement& e)
 {
+    if (Swap || !e.fixedSize())
+        return std::nullopt;
     PlainCoordinates plain;
     int found = 0;
     for (const Slot& s : layout.slots)
@@ -1275,8 +1280,7 @@ private:
     RangeAccumulator coordinateRanges(const PlyElement& part, const char* ptr, const char* end, ProgressTicker& ticker)
     {
         std::vector<RangeAccumulator> perChunk(static_cast<std::size_t>(part.count / kChunk + 1), RangeAccumulator(0));
-        const std::optional<PlainCoordinates> plain = plainCoordinates(layout_);
-        if (!Swap && plain && part.fixedSize()) {
+        if (const std::optional<PlainCoordinates> plain = plainCoordinates<Swap>(layout_, part)) {
             const auto add = [&perChunk](std::uint64_t i, double x, double y, double z) {
                 RangeAccumulator& r = perChunk[static_cast<std::size_t>(i / kChunk)];
                 r.addCoordinate(0, x);
@@ -1352,8 +1356,7 @@ private:
         const RangeRecords r = rangeRecords<Swap>(vertexElement);
         std::vector<Eigen::Vector3d> positions(static_cast<std::size_t>(r.part.count));
         ProgressTicker ticker(nullptr, "", r.part.count);
-        const std::optional<PlainCoordinates> plain = plainCoordinates(layout_);
-        if (!Swap && plain) {
+        if (const std::optional<PlainCoordinates> plain = plainCoordinates<Swap>(layout_, r.part)) {
             const auto store = [&positions](std::uint64_t i, double x, double y, double z) { positions[i] = {x, y, z}; };
             visitPlainCoordinates(r.part, *plain, r.first, r.end, ctx_, ticker, store);
             return positions;
@@ -1471,8 +1474,8 @@ private:
         applyFieldOffsets(sink);
         sink.compile(layout_);
         const char* next = nullptr;
-        const std::optional<PlainCoordinates> plain = plainCoordinates(layout_);
-        if (!Swap && plain && layout_.slots.size() == 3 && e.fixedSize() && e.count > 0) {
+        const std::optional<PlainCoordinates> plain = plainCoordinates<Swap>(layout_, e);
+        if (plain && layout_.slots.size() == 3 && e.count > 0) {
             // Coordinates only (a geometry-only read): each one as put() would store it.
             Eigen::Vector3f* positions = sink.positions;
             const Eigen::Vector3d origin = sink.origin;
