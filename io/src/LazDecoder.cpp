@@ -140,16 +140,16 @@ std::uint64_t decodeLayered(const fs::path& path, const LazLayout& layout, const
     };
     // One item at a time over the whole chunk: its layers are streams of
     // their own, so nothing ties an item's points to the other items' but
-    // the scanner channel the point14 item decodes, kept here per point.
-    // Decoding an item over all the points and then the next took 0.92 of
-    // the time of decoding every item of a point before the next point.
-    std::vector<std::uint8_t> channels(chunk.points);
-    channels[0] = static_cast<std::uint8_t>(context);
+    // the context the point14 item hands them (laz/Items.h), kept here per
+    // point. Decoding an item over all the points and then the next took
+    // 0.92 of the time of decoding every item of a point before the next.
+    std::vector<std::uint8_t> contexts(chunk.points);
+    contexts[0] = static_cast<std::uint8_t>(context);
     for (std::size_t i = 0; i < items.size(); ++i) {
         unsigned char* field = reinterpret_cast<unsigned char*>(out) + offsets[i];
         for (std::uint64_t q = 1; q < chunk.points; q += kCheckEvery) {
             const auto run = static_cast<std::size_t>(std::min<std::uint64_t>(kCheckEvery, chunk.points - q));
-            items[i]->decodeRun(field + q * recordLength, recordLength, run, channels.data() + q);
+            items[i]->decodeRun(field + q * recordLength, recordLength, run, contexts.data() + q);
             if (items[i]->corrupt())
                 refuse();
         }

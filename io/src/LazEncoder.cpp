@@ -44,9 +44,13 @@ std::vector<unsigned char> compressChunk(const LazLayout& layout, const unsigned
         offsets.push_back(at);
         at += item.size;
     }
-    for (std::size_t p = 1; p < count; ++p)
+    for (std::size_t p = 1; p < count; ++p) {
+        // As in LASzip: each point starts from context 0, and the point14
+        // item sets its channel only where the channel changes (laz/Items.h).
+        context = 0;
         for (std::size_t i = 0; i < items.size(); ++i)
             items[i]->encode(records + p * recordLength + offsets[i], context);
+    }
     std::vector<std::vector<unsigned char>> layers;
     for (auto& item : items)
         item->finish(layers);

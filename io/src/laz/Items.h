@@ -138,8 +138,14 @@ struct Layer
 };
 
 //! A layered item: each of its attributes in a stream of its own. The
-//! point14 item chooses the context (the scanner channel, 0-3) the others
-//! follow: each context keeps its own last values and models.
+//! point14 item chooses the context (0-3) the others follow: each context
+//! keeps its own last values and models. That context is not simply the
+//! point's scanner channel: LASzip hands the items after point14 a context
+//! that starts at 0 for every point and that point14 sets to the new
+//! channel only at a point whose channel changed (LASreadPoint::read and
+//! LASwritePoint::write, LASzip 3.x). Files with one channel do not tell the
+//! difference; files with several are coded that way by every LASzip
+//! writer, and laz-perf reads them so.
 class LayeredItem
 {
 public:
@@ -149,9 +155,10 @@ public:
     //! first point; the point14 item sets it from that point.
     virtual void start(const Layer* layers, std::uint32_t& context) = 0;
     //! Decodes the items of `count` consecutive points, the first at `item`,
-    //! one every `stride` bytes. `channels` holds each point's scanner
-    //! channel: the point14 item writes it, the items after it read it.
-    virtual void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* channels) = 0;
+    //! one every `stride` bytes. `contexts` holds each point's context for
+    //! the items after point14 (see above): the point14 item writes it, the
+    //! others read it.
+    virtual void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* contexts) = 0;
     //! Whether a layer's stream cannot come from an encoder (see ArithmeticDecoder::corrupt).
     virtual bool corrupt() const = 0;
     //! Once the chunk is decoded: whether every layer was read to its last

@@ -68,12 +68,13 @@ public:
     //! layers from what the first left per point. The layers are streams of
     //! their own; in one pass each, a layer's decoding does not wait behind
     //! the x, y layer's mispredicted branches.
-    void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* channels) override
+    void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* contexts) override
     {
         steps_.resize(count);
         for (std::size_t k = 0; k < count; ++k) {
             steps_[k] = decodeReturnsXY(item + k * stride);
-            channels[k] = steps_[k].channel;
+            // The items after this one see the channel where it changed, 0 elsewhere (Items.h).
+            contexts[k] = steps_[k].channelChanged ? steps_[k].channel : 0;
         }
         for (std::size_t k = 0; k < count; ++k)
             decodeOthers(item + k * stride, steps_[k]);
@@ -90,7 +91,8 @@ private:
         std::uint8_t position = 0;        //!< single 3, first 2, last 1, intermediate 0
         std::uint8_t level = 0;           //!< |n - r|, at most 7: the height's context
         std::uint8_t zSize = 0;           //!< the mean size of the x and y corrections
-        bool single = false, gpsTimeChanged = false, scanAngleChanged = false, pointSourceChanged = false;
+        bool channelChanged = false, single = false, gpsTimeChanged = false, scanAngleChanged = false,
+             pointSourceChanged = false;
     };
     static constexpr std::uint8_t kNone = 0xFF;
 
@@ -115,6 +117,7 @@ private:
             }
             xyChannel_ = channel;
             c = contexts_[xyChannel_].get();
+            step.channelChanged = true;
         }
         step.channel = static_cast<std::uint8_t>(xyChannel_);
         Point14& p = c->last;
@@ -230,10 +233,10 @@ public:
     bool corrupt() const override { return rgb_.corrupt() || nir_.corrupt(); }
     bool endedExactly() const override { return rgb_.endedExactly() && nir_.endedExactly(); }
 
-    void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* channels) override
+    void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* contexts) override
     {
         for (std::size_t k = 0; k < count; ++k)
-            decode(item + k * stride, channels[k]);
+            decode(item + k * stride, contexts[k]);
     }
 
 private:
@@ -293,10 +296,10 @@ public:
         return std::all_of(streams_.begin(), streams_.end(), [](const LayerStream& s) { return s.endedExactly(); });
     }
 
-    void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* channels) override
+    void decodeRun(unsigned char* item, std::size_t stride, std::size_t count, std::uint8_t* contexts) override
     {
         for (std::size_t k = 0; k < count; ++k)
-            decode(item + k * stride, channels[k]);
+            decode(item + k * stride, contexts[k]);
     }
 
 private:
