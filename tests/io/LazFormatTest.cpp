@@ -308,6 +308,112 @@ void expectSameClouds(const PointCloud& a, const PointCloud& b, const std::strin
 
 } // namespace
 
+namespace {
+
+//! The points of channels8 laid out as a COPC file lays them out (COPC 1.0,
+//! copc.io): the COPC info VLR right after the header, variable-size chunks
+//! (LASzip's chunk size 2^32 - 1, each chunk's point count in the chunk
+//! table), one chunk per hierarchy node, the hierarchy in an EVLR. The
+//! nodes' points are not in their octants: not a valid COPC, but what a LAZ
+//! reader meets in one.
+std::string copcShapedLaz(const std::vector<std::uint32_t>& chunkPoints)
+{
+    const std::string las = fileBytes(kLazDir / "channels8.las");
+    const std::string laz = fileBytes(kLazDir / "channels8.laz");
+    const auto length = at<std::uint16_t>(las, kRecordLength);
+    const char* records = las.data() + at<std::uint32_t>(las, kOffsetToPoints);
+    // Each chunk alone through our encoder (format 8, the rest Extra Bytes).
+    std::vector<std::string> chunks;
+    std::size_t first = 0;
+    for (const std::uint32_t n : chunkPoints) {
+        std::ostringstream one;
+        io::detail::LazPointWriter writer(one, io::detail::lazLayoutForFormat(8, length - 38u), length);
+        writer.add(records + first * length, n);
+        writer.finish();
+        const std::string bytes = one.str();
+        chunks.push_back(bytes.substr(8, static_cast<std::size_t>(at<std::int64_t>(bytes, 0)) - 8));
+        first += n;
+    }
+    EXPECT_EQ(first, at<std::uint64_t>(las, 247));
+    constexpr std::size_t kVlrHeader = 54, kEvlrHeader = 60, kCopcInfo = 160, kEntry = 32;
+    constexpr std::size_t kEvlrStart = 235, kEvlrCount = 243;
+    std::string info(kVlrHeader + kCopcInfo, '\0');
+    std::memcpy(info.data() + 2, "copc", 4);
+    put<std::uint16_t>(info, 18, 1);
+    put<std::uint16_t>(info, 20, static_cast<std::uint16_t>(kCopcInfo));
+    const auto headerSize = at<std::uint16_t>(laz, kHeaderSize);
+    const std::size_t pointsAt = at<std::uint32_t>(laz, kOffsetToPoints);
+    std::string out = laz.substr(0, headerSize) + info + laz.substr(headerSize, pointsAt - headerSize);
+    put<std::uint32_t>(out, kOffsetToPoints, static_cast<std::uint32_t>(out.size()));
+    put<std::uint32_t>(out, kVlrCount, at<std::uint32_t>(laz, kVlrCount) + 1);
+    put<std::uint32_t>(out, laszipPayload(out) + 12, UINT32_MAX); // variable chunks
+    const std::size_t tableOffsetAt = out.size();
+    out.append(8, '\0');
+    std::vector<std::uint64_t> nodeAt;
+    for (const std::string& chunk : chunks) {
+        nodeAt.push_back(out.size());
+        out += chunk;
+    }
+    put<std::int64_t>(out, tableOffsetAt, static_cast<std::int64_t>(out.size()));
+    // The chunk table: each chunk's point count (context 0) and byte count
+    // (context 1), each coded after the previous chunk's, as LASzip writes it.
+    std::string table(8, '\0');
+    put<std::uint32_t>(table, 4, static_cast<std::uint32_t>(chunks.size()));
+    io::detail::laz::ArithmeticEncoder encoder;
+    io::detail::laz::IntegerCoder sizes(32, 2);
+    for (std::size_t i = 0; i < chunks.size(); ++i) {
+        sizes.compress(encoder, i ? static_cast<std::int32_t>(chunkPoints[i - 1]) : 0, static_cast<std::int32_t>(chunkPoints[i]), 0);
+        sizes.compress(encoder, i ? static_cast<std::int32_t>(chunks[i - 1].size()) : 0, static_cast<std::int32_t>(chunks[i].size()), 1);
+    }
+    const std::vector<unsigned char> coded = encoder.done();
+    out += table + std::string(coded.begin(), coded.end());
+    // The hierarchy: the root and its first children, one chunk each.
+    const std::size_t evlrAt = out.size();
+    std::string evlr(kEvlrHeader + kEntry * chunks.size(), '\0');
+    std::memcpy(evlr.data() + 2, "copc", 4);
+    put<std::uint16_t>(evlr, 18, 1000);
+    put<std::uint64_t>(evlr, 20, kEntry * chunks.size());
+    for (std::size_t i = 0; i < chunks.size(); ++i) {
+        const std::size_t e = kEvlrHeader + kEntry * i;
+        const auto child = static_cast<std::int32_t>(i - 1);
+        const std::int32_t key[4] = {i ? 1 : 0, i ? child & 1 : 0, i ? (child >> 1) & 1 : 0, i ? (child >> 2) & 1 : 0};
+        std::memcpy(evlr.data() + e, key, sizeof key);
+        put<std::uint64_t>(evlr, e + 16, nodeAt[i]);
+        put<std::int32_t>(evlr, e + 24, static_cast<std::int32_t>(chunks[i].size()));
+        put<std::int32_t>(evlr, e + 28, static_cast<std::int32_t>(chunkPoints[i]));
+    }
+    out += evlr;
+    put<std::uint64_t>(out, kEvlrStart, evlrAt);
+    put<std::uint32_t>(out, kEvlrCount, 1);
+    // The info VLR's root hierarchy page (offset 40 and 48 of its payload).
+    put<std::uint64_t>(out, headerSize + kVlrHeader + 40, evlrAt + kEvlrHeader);
+    put<std::uint64_t>(out, headerSize + kVlrHeader + 48, kEntry * chunks.size());
+    return out;
+}
+
+} // namespace
+
+TEST(LazFormat, ACopcLayoutWithVariableChunksReadsAsItsLasTwin)
+{
+    // Chunks of 700, 1, 13, 1,200 and 86 points. laz-perf decodes the file
+    // this builds (data/laz/copc8.laz) into channels8.las's records.
+    const std::string built = copcShapedLaz({700, 1, 13, 1200, 86});
+    EXPECT_TRUE(built == fileBytes(kLazDir / "copc8.laz")) << "the layout changed: check it again with laz-perf (data/laz/README.md)";
+    const fs::path dir = test::tempDir();
+    test::writeText(dir / "copc8.laz", built);
+    fs::copy_file(kLazDir / "channels8.las", dir / "copc8.las");
+    expectRecordsOfTheLasTwin("copc8", 2000, 3, dir);
+    // Through the reader, as a whole and by ranges that cross the chunks.
+    const auto formats = registry();
+    const PointCloud fromLas = io::readPointCloud(formats, kLazDir / "channels8.las");
+    expectSameClouds(fromLas, io::readPointCloud(formats, dir / "copc8.laz"), "copc8");
+    for (const io::RecordRange range : {io::RecordRange{699, 3}, io::RecordRange{701, 1300}, io::RecordRange{1990, 20}}) {
+        const PointCloud part = io::readPointRecords(formats, dir / "copc8.laz", range);
+        expectSameClouds(io::readPointRecords(formats, kLazDir / "channels8.las", range), part,
+                         "copc8 from " + std::to_string(range.first));
+    }
+}
+
 TEST(LazFormat, RecordsOfFourInterleavedScannerChannelsDecodeByteForByte)
 {
     // The layered decoder takes a run of points' x, y layer (1,024 points at
