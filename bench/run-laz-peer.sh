@@ -9,18 +9,22 @@
 #     same points;
 #  2. speed: each given LAZ file read by scandiff (`info`, both cores, and
 #     pinned to one core) and decoded by laz-perf (one thread), in turn.
-# Usage: bench/run-laz-peer.sh [BUILD_DIR] [FILE.laz...]
+# Usage: bench/run-laz-peer.sh BUILD_DIR [FILE.laz...]
 # The package is fetched once with `npm pack` into ${LAZPERF_CACHE:-~/.cache/scandiff/laz-perf}.
+# Needs node and npm (Debian: nodejs, npm), python3 and /usr/bin/time (Debian: time).
 set -euo pipefail
-build=${1:-build}
-shift || true
+build=${1:?usage: bench/run-laz-peer.sh BUILD_DIR [FILE.laz...]}
+shift
 cli="$build/app/cli/scandiff-cli"
 here=$(cd "$(dirname "$0")" && pwd)
+[ -x "$cli" ] || { echo "no $cli: give the build directory first" >&2; exit 1; }
+for tool in node npm python3 /usr/bin/time; do
+  command -v "$tool" > /dev/null || { echo "needs $tool (Debian packages nodejs, npm, python3, time)" >&2; exit 1; }
+done
 cache=${LAZPERF_CACHE:-$HOME/.cache/scandiff/laz-perf}
 version=0.0.7
 export LAZPERF_DIR="$cache/package"
 
-command -v node > /dev/null || { echo "needs Node.js (apt install nodejs npm)" >&2; exit 1; }
 if [ ! -f "$LAZPERF_DIR/lib/node/index.js" ]; then
   mkdir -p "$cache"
   (cd "$cache" && npm pack --silent "laz-perf@$version" > /dev/null && tar xzf "laz-perf-$version.tgz")
@@ -36,8 +40,10 @@ echo "== interoperability: laz-perf $version decodes scandiff's LAZ"
 python3 - "$work" <<'PY'
 import random, sys
 random.seed(5)
-columns = {'f6': 'x,y,z,intensity,gps_time', 'f7': 'x,y,z,r,g,b,intensity,height',
-           'f8': 'x,y,z,r,g,b,nir,classification'}
+# Four scanner channels, point by point: the colour, NIR and Extra Bytes
+# coders then switch context at almost every point (docs/laz.md).
+columns = {'f6': 'x,y,z,intensity,gps_time,scanner_channel', 'f7': 'x,y,z,r,g,b,intensity,height,scanner_channel',
+           'f8': 'x,y,z,r,g,b,nir,classification,amplitude,scanner_channel'}
 for name, cols in columns.items():
     with open(f'{sys.argv[1]}/{name}.txt', 'w') as out:
         x = 651000.0
@@ -50,7 +56,9 @@ for name, cols in columns.items():
                             'intensity': lambda: str(random.randrange(4000)),
                             'gps_time': lambda: f'{300000 + i * 1e-5:.6f}',
                             'classification': lambda: str(random.choice([2, 3, 5, 6])),
-                            'height': lambda: f'{random.uniform(-5, 5):.4f}'}[c]())
+                            'height': lambda: f'{random.uniform(-5, 5):.4f}',
+                            'amplitude': lambda: str(random.randrange(300)),
+                            'scanner_channel': lambda: str(random.randrange(4))}[c]())
             out.write(' '.join(row) + '\n')
     open(f'{sys.argv[1]}/{name}.columns', 'w').write(cols)
 PY

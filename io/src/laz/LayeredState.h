@@ -98,7 +98,10 @@ private:
 //! update. In version 3 a switch to a context already used keeps predicting
 //! from (and updating) the previous context's last item, with the new
 //! context's models: LASzip's encoder does the same, so the format is that
-//! (version 4 corrected it).
+//! (version 4 corrected it). NIR included: the current LASzip reader and
+//! writer, and laz-perf, keep it in that same last item; an earlier LASzip
+//! reader (seen in older copies of its source) kept it in the new context's,
+//! and so decodes the NIR of files with several channels differently.
 template <typename Context>
 auto& switchContext(std::array<std::unique_ptr<Context>, 4>& contexts, std::uint32_t& current, std::uint32_t context)
 {
