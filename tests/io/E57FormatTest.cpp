@@ -243,8 +243,9 @@ TEST(E57Format, RoundTripKeepsEveryValueOfSeveralScans)
         ASSERT_NE(read, nullptr) << name;
         for (std::size_t i = 0; i < a.size(); ++i) {
             ASSERT_EQ(original->hasValue(i), read->hasValue(i)) << name << " " << i;
-            if (original->hasValue(i))
+            if (original->hasValue(i)) {
                 ASSERT_EQ(original->value(i), read->value(i)) << name << " " << i; // a double stays a double
+            }
         }
     }
 

@@ -56,9 +56,10 @@ void expectSameCloud(const PointCloud& a, const PointCloud& b)
         for (int k = 0; k < 3; ++k)
             ASSERT_TRUE(sameBits(a.globalPosition(i)[k], b.globalPosition(i)[k])) << "point " << i;
     ASSERT_EQ(a.hasColors(), b.hasColors());
-    if (a.hasColors())
+    if (a.hasColors()) {
         for (std::size_t i = 0; i < a.size(); ++i)
             ASSERT_TRUE(a.colors()[i].r == b.colors()[i].r && a.colors()[i].g == b.colors()[i].g) << i;
+    }
     ASSERT_EQ(a.fields().size(), b.fields().size());
     for (const ScalarField& f : a.fields()) {
         const ScalarField* g = b.field(f.name());
