@@ -184,6 +184,19 @@ TEST(LazFormat, ExtraBytesAndALargerChunkDecodeExactly)
 
 namespace {
 
+//! `count` records of `length` bytes, point `format` and the rest Extra
+//! Bytes, through our LAZ writer: the chunk table's offset, the chunks, the
+//! chunk table.
+std::string ourCompressedPoints(const char* records, std::uint64_t count, std::uint8_t format, std::size_t length)
+{
+    const std::size_t standard = format == 6 ? 30 : format == 7 ? 36 : 38;
+    std::ostringstream out;
+    io::detail::LazPointWriter writer(out, io::detail::lazLayoutForFormat(format, length - standard), length);
+    writer.add(records, count);
+    writer.finish();
+    return out.str();
+}
+
 //! The records of `name`.las through our layered encoder (point `format`,
 //! the rest of each record Extra Bytes): the chunk and chunk table of
 //! `name`.laz, byte for byte.
@@ -191,14 +204,8 @@ void expectOurEncoderWritesTheLaz(const std::string& name, std::uint8_t format)
 {
     const std::string las = fileBytes(kLazDir / (name + ".las"));
     const std::string laz = fileBytes(kLazDir / (name + ".laz"));
-    const auto count = at<std::uint64_t>(las, 247);
-    const auto length = at<std::uint16_t>(las, kRecordLength);
-    const std::size_t standard = format == 6 ? 30 : format == 7 ? 36 : 38;
-    std::ostringstream out;
-    io::detail::LazPointWriter writer(out, io::detail::lazLayoutForFormat(format, length - standard), length);
-    writer.add(las.data() + at<std::uint32_t>(las, kOffsetToPoints), count);
-    writer.finish();
-    const std::string ours = out.str();
+    const std::string ours = ourCompressedPoints(las.data() + at<std::uint32_t>(las, kOffsetToPoints), at<std::uint64_t>(las, 247),
+                                                 format, at<std::uint16_t>(las, kRecordLength));
     const std::size_t points = at<std::uint32_t>(laz, kOffsetToPoints);
     const auto theirTable = static_cast<std::size_t>(at<std::int64_t>(laz, points));
     const std::string theirChunk = laz.substr(points + 8, theirTable - points - 8);
@@ -326,11 +333,7 @@ std::string copcShapedLaz(const std::vector<std::uint32_t>& chunkPoints)
     std::vector<std::string> chunks;
     std::size_t first = 0;
     for (const std::uint32_t n : chunkPoints) {
-        std::ostringstream one;
-        io::detail::LazPointWriter writer(one, io::detail::lazLayoutForFormat(8, length - 38u), length);
-        writer.add(records + first * length, n);
-        writer.finish();
-        const std::string bytes = one.str();
+        const std::string bytes = ourCompressedPoints(records + first * length, n, 8, length);
         chunks.push_back(bytes.substr(8, static_cast<std::size_t>(at<std::int64_t>(bytes, 0)) - 8));
         first += n;
     }
