@@ -200,7 +200,6 @@ private:
         p.writeOthers(item);
     }
 
-
     Point14 first_;
     std::array<LayerStream, kLayers> streams_;
     std::array<std::unique_ptr<Point14Context>, 4> contexts_;
