@@ -600,65 +600,94 @@ double offsetForValues(double firstValue)
     return std::floor(firstValue);
 }
 
-template <class T>
-void decodeExtraTyped(const char* records, std::size_t recordLength, std::size_t count, const ExtraDimension& dim,
-                      ScalarField& field)
+//! One Extra Bytes value of each of `count` records, as a double (NaN for
+//! the dimension's no_data), or as a float where a float holds each exactly.
+template <class T, class Out>
+void extractExtra(const char* records, std::size_t recordLength, std::size_t count, const ExtraDimension& dim, Out* out)
 {
-    const char* p = records + dim.recordOffset;
     // The no_data value is stored upcast to 8 bytes: double for floats, 64-bit
     // integers otherwise (LAS 1.4 R15, Extra Bytes).
     using Upcast = std::conditional_t<std::is_floating_point_v<T>, double,
                                       std::conditional_t<std::is_signed_v<T>, std::int64_t, std::uint64_t>>;
     Upcast noData{};
     std::memcpy(&noData, &dim.noDataBits, sizeof noData);
-    const bool plain = dim.scale == 1.0 && dim.offset == 0.0;
-    double first = std::numeric_limits<double>::quiet_NaN();
-    for (std::size_t i = 0; i < count && !std::isfinite(first); ++i) {
-        const auto raw = load<T>(p + i * recordLength);
-        if (!(dim.hasNoData && static_cast<Upcast>(raw) == noData))
-            first = static_cast<double>(raw) * dim.scale + dim.offset;
-    }
-    const bool exactInFloat = plain && (sizeof(T) <= 2 || std::is_same_v<T, float>);
-    const double fieldOffset = exactInFloat ? 0.0 : offsetForValues(first);
-    field.setOffset(fieldOffset);
-    float* values = field.values().data();
-    // Anything a float around the offset may not hold is also kept in double;
-    // the doubles go again when, for this file, the floats hold every value.
-    double* exact = nullptr;
-    if (!exactInFloat) {
-        field.keepDoubles();
-        exact = field.doubles().data();
-    }
+    const char* p = records + dim.recordOffset;
     for (std::size_t i = 0; i < count; ++i, p += recordLength) {
         const auto raw = load<T>(p);
-        const double v = dim.hasNoData && static_cast<Upcast>(raw) == noData
-                             ? std::numeric_limits<double>::quiet_NaN()
-                             : static_cast<double>(raw) * dim.scale + dim.offset;
-        values[i] = static_cast<float>(v - fieldOffset);
-        if (exact)
-            exact[i] = v;
+        out[i] = static_cast<Out>(dim.hasNoData && static_cast<Upcast>(raw) == noData
+                                      ? std::numeric_limits<double>::quiet_NaN()
+                                      : static_cast<double>(raw) * dim.scale + dim.offset);
     }
-    if (exact)
-        field.compact(std::is_same_v<T, double>);
 }
 
-void decodeExtra(const char* records, std::size_t recordLength, std::size_t count, const ExtraDimension& dim,
-                 ScalarField& field)
+template <class Out>
+void extractExtraOfType(const char* records, std::size_t recordLength, std::size_t count, const ExtraDimension& dim, Out* out)
 {
     switch (dim.type) {
-    case 1: decodeExtraTyped<std::uint8_t>(records, recordLength, count, dim, field); break;
-    case 2: decodeExtraTyped<std::int8_t>(records, recordLength, count, dim, field); break;
-    case 3: decodeExtraTyped<std::uint16_t>(records, recordLength, count, dim, field); break;
-    case 4: decodeExtraTyped<std::int16_t>(records, recordLength, count, dim, field); break;
-    case 5: decodeExtraTyped<std::uint32_t>(records, recordLength, count, dim, field); break;
-    case 6: decodeExtraTyped<std::int32_t>(records, recordLength, count, dim, field); break;
-    case 7: decodeExtraTyped<std::uint64_t>(records, recordLength, count, dim, field); break;
-    case 8: decodeExtraTyped<std::int64_t>(records, recordLength, count, dim, field); break;
-    case 9: decodeExtraTyped<float>(records, recordLength, count, dim, field); break;
-    case 10: decodeExtraTyped<double>(records, recordLength, count, dim, field); break;
+    case 1: extractExtra<std::uint8_t>(records, recordLength, count, dim, out); break;
+    case 2: extractExtra<std::int8_t>(records, recordLength, count, dim, out); break;
+    case 3: extractExtra<std::uint16_t>(records, recordLength, count, dim, out); break;
+    case 4: extractExtra<std::int16_t>(records, recordLength, count, dim, out); break;
+    case 5: extractExtra<std::uint32_t>(records, recordLength, count, dim, out); break;
+    case 6: extractExtra<std::int32_t>(records, recordLength, count, dim, out); break;
+    case 7: extractExtra<std::uint64_t>(records, recordLength, count, dim, out); break;
+    case 8: extractExtra<std::int64_t>(records, recordLength, count, dim, out); break;
+    case eb::typeFloat: extractExtra<float>(records, recordLength, count, dim, out); break;
+    case eb::typeDouble: extractExtra<double>(records, recordLength, count, dim, out); break;
     default: break;
     }
 }
+
+//! Fills the field of one Extra Bytes dimension from runs of records taken in
+//! any order (a LAZ file's chunks as the workers decode them), each run
+//! once. A value a float holds exactly (a plain integer of up to 16 bits, a
+//! plain float) goes straight to the float view; any other is kept as a
+//! double until finish() has every value: the field's offset comes from the
+//! first value of the read, so that a float around it keeps large values
+//! (times, identifiers) precisely, and the doubles stay only where the floats
+//! do not give every value back.
+class ExtraFieldFiller
+{
+public:
+    ExtraFieldFiller(const ExtraDimension& dim, ScalarField& field) : dim_(dim), field_(field)
+    {
+        const bool plain = dim.scale == 1.0 && dim.offset == 0.0;
+        const bool fitsFloat = plain && (dim.type <= 4 || dim.type == eb::typeFloat);
+        floats_ = field.values().data();
+        if (!fitsFloat) {
+            field.keepDoubles();
+            doubles_ = field.doubles().data();
+        }
+    }
+
+    //! The values of `count` records, for the points from `at`.
+    void fill(const char* records, std::size_t recordLength, std::size_t count, std::size_t at) const
+    {
+        if (doubles_)
+            extractExtraOfType(records, recordLength, count, dim_, doubles_ + at);
+        else
+            extractExtraOfType(records, recordLength, count, dim_, floats_ + at);
+    }
+
+    void finish()
+    {
+        if (!doubles_)
+            return;
+        const std::size_t count = field_.size();
+        const double* first = std::find_if(doubles_, doubles_ + count, [](double v) { return std::isfinite(v); });
+        const double offset = offsetForValues(first == doubles_ + count ? std::numeric_limits<double>::quiet_NaN() : *first);
+        field_.setOffset(offset);
+        for (std::size_t i = 0; i < count; ++i)
+            floats_[i] = static_cast<float>(doubles_[i] - offset);
+        field_.compact(dim_.type == eb::typeDouble);
+    }
+
+private:
+    const ExtraDimension& dim_;
+    ScalarField& field_;
+    float* floats_ = nullptr;
+    double* doubles_ = nullptr;
+};
 
 // The cloud origin: the caller's, else the header offset (the "global shift"
 // the producer chose) unless the data lie far from it, where float32 would
@@ -751,11 +780,10 @@ void takeColorsUnscaled(const char* records, std::size_t recordLength, int forma
         colors[i] = Rgb8{static_cast<std::uint8_t>(p[0]), static_cast<std::uint8_t>(p[2]), static_cast<std::uint8_t>(p[4])};
 }
 
-//! The points of records held in memory (LAS's mapped file, or a LAZ file's
-//! records decompressed together because Extra Bytes need them all).
+//! The points of a LAS file's records, mapped in memory.
 void parseRecordsInMemory(const LasHeader& h, const char* records, std::size_t count,
-                          const CoordinateTransform& transform, const PointOutputs& out, PointCloud& cloud,
-                          ProgressTicker& ticker)
+                          const CoordinateTransform& transform, const PointOutputs& out,
+                          const std::vector<ExtraFieldFiller>& extras, PointCloud& cloud, ProgressTicker& ticker)
 {
     const DecodeFunction decode = decoderFor(h.pointFormat);
     DecodedFacts facts;
@@ -764,8 +792,9 @@ void parseRecordsInMemory(const LasHeader& h, const char* records, std::size_t c
         const DecodedFacts some = decode(records + begin * h.recordLength, h.recordLength, end - begin, begin, transform, out);
         facts.colorBits |= some.colorBits;
         facts.gpsTimeResidualFailed |= some.gpsTimeResidualFailed;
-        if (!h.compressed) // a heap buffer's pages would come back as zeros
-            MappedFile::releaseConsumed(records + begin * h.recordLength, records + end * h.recordLength);
+        for (const ExtraFieldFiller& extra : extras)
+            extra.fill(records + begin * h.recordLength, h.recordLength, end - begin, begin);
+        MappedFile::releaseConsumed(records + begin * h.recordLength, records + end * h.recordLength);
         ticker.step(end - begin);
     }
     if (facts.gpsTimeResidualFailed) {
@@ -782,12 +811,13 @@ void parseRecordsInMemory(const LasHeader& h, const char* records, std::size_t c
 }
 
 //! The points of the LAZ records [first, first + count), parsed by the
-//! workers as they decode each chunk: no buffer of every record (a file of
-//! 10 M points in format 7 would need 360 MB more) and both cores parse.
+//! workers as they decode each chunk, Extra Bytes included: no buffer of
+//! every record (a file of 10 M points in format 7 would need 360 MB more)
+//! and both cores parse.
 void parseLazRecords(const MappedFile& file, const LasHeader& h, const LazLayout& layout,
                      const std::vector<LazChunk>& chunks, std::uint64_t first, std::size_t count,
-                     const CoordinateTransform& transform, const PointOutputs& out, PointCloud& cloud,
-                     ProgressTicker& ticker)
+                     const CoordinateTransform& transform, const PointOutputs& out,
+                     const std::vector<ExtraFieldFiller>& extras, PointCloud& cloud, ProgressTicker& ticker)
 {
     const DecodeFunction decode = decoderFor(h.pointFormat);
     std::atomic<unsigned> colorBits{0};
@@ -802,6 +832,8 @@ void parseLazRecords(const MappedFile& file, const LasHeader& h, const LazLayout
         [&](std::uint64_t firstPoint, const char* records, std::size_t n) {
             const auto at = static_cast<std::size_t>(firstPoint - first);
             const DecodedFacts facts = decode(records, h.recordLength, n, at, transform, out);
+            for (const ExtraFieldFiller& extra : extras)
+                extra.fill(records, h.recordLength, n, at);
             colorBits.fetch_or(facts.colorBits, std::memory_order_relaxed);
             if (facts.gpsTimeResidualFailed)
                 gpsTimeResidualFailed = true;
@@ -850,18 +882,8 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     const std::vector<LazChunk> chunks =
         h.compressed ? readLazChunks(path, file.data(), file.size(), h.offsetToPoints, *layout, h.recordLength, h.pointCount)
                      : std::vector<LazChunk>();
-    // LAZ: parsed chunk by chunk as the workers decode them, unless Extra
-    // Bytes need the records of the read at once (each field's offset comes
-    // from its first value); then those are decompressed first (freed at the
-    // end of the read).
-    const bool streamed = h.compressed && extras.empty();
-    std::unique_ptr<char[]> decompressed;
-    if (h.compressed && !streamed) {
-        ProgressTicker ticker(options.progress, "Decompressing " + path.filename().string(), count);
-        decompressed = decompressLazRange(path, file.data(), file.size(), chunks, *layout, h.recordLength, first, count,
-                                          [&](std::size_t points) { ticker.step(points); });
-    }
-    const char* records = !h.compressed ? file.data() + h.offsetToPoints + first * h.recordLength : decompressed.get();
+    // LAZ is parsed chunk by chunk as the workers decode the chunks.
+    const char* records = h.compressed ? nullptr : file.data() + h.offsetToPoints + first * h.recordLength;
     const char* firstRecordOfFile = file.data() + h.offsetToPoints;
     if (h.compressed) {
         // The first record of the first chunk is stored as is.
@@ -876,7 +898,7 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     double gpsTimeOffset = 0.0;
     // A LAZ range's own first record is not at hand before decoding: its
     // times are kept relative to the file's first.
-    const char* timeRecord = streamed ? firstRecordOfFile : records;
+    const char* timeRecord = h.compressed ? firstRecordOfFile : records;
     if (formatHasGpsTime(format) && count > 0 && timeRecord) {
         // Relative to the first time, float32 keeps 1 µs over ±8 s and 61 µs over
         // ±17 minutes of a ~1e9 s GPS time, which on its own would keep only 64 s.
@@ -885,6 +907,7 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
             gpsTimeOffset = 0.0;
     }
     std::vector<std::string> extraNames;
+    std::vector<ExtraFieldFiller> extraFillers;
     try {
         // A fresh array's pages are zeroed by the kernel as they are first
         // touched, a fifth to a half of a read's time on this machine: the
@@ -916,6 +939,9 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
             extraNames.push_back(uniqueFieldName(cloud, dim.name));
             cloud.addField(ScalarField(extraNames.back(), count));
         }
+        // Once every field exists (adding one moves the others).
+        for (std::size_t d = 0; d < extras.size(); ++d)
+            extraFillers.emplace_back(extras[d], *cloud.field(extraNames[d]));
     } catch (const std::bad_alloc&) {
         throw Error(ErrorCode::Io, path.string() + ": not enough memory to load " + std::to_string(count) + " points");
     } catch (const std::length_error&) {
@@ -948,17 +974,13 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     out.nir = values("nir");
 
     const CoordinateTransform transform{h.scale, h.offset - cloud.origin()};
-    const std::size_t extraSteps = extras.size() * count;
-    ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), count + extraSteps);
-    if (streamed)
-        parseLazRecords(file, h, *layout, chunks, first, count, transform, out, cloud, ticker);
+    ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), count);
+    if (h.compressed)
+        parseLazRecords(file, h, *layout, chunks, first, count, transform, out, extraFillers, cloud, ticker);
     else
-        parseRecordsInMemory(h, records, count, transform, out, cloud, ticker);
-
-    for (std::size_t d = 0; d < extras.size(); ++d) {
-        decodeExtra(records, h.recordLength, count, extras[d], *cloud.field(extraNames[d]));
-        ticker.step(count);
-    }
+        parseRecordsInMemory(h, records, count, transform, out, extraFillers, cloud, ticker);
+    for (ExtraFieldFiller& extra : extraFillers)
+        extra.finish();
 
     // A standard attribute that is 0 for every point (user_data, scanner_channel,
     // flags... in most files) carries nothing: dropping it saves 4 bytes per point

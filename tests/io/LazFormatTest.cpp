@@ -308,8 +308,14 @@ void expectSameClouds(const PointCloud& a, const PointCloud& b, const std::strin
     for (const ScalarField& f : a.fields()) {
         const ScalarField* g = b.field(f.name());
         ASSERT_NE(g, nullptr) << what << " " << f.name();
-        for (std::size_t i = 0; i < f.size(); ++i)
-            ASSERT_EQ(g->value(i), f.value(i)) << what << " " << f.name() << " " << i;
+        for (std::size_t i = 0; i < f.size(); ++i) {
+            if (std::isnan(f.value(i))) {
+                ASSERT_TRUE(std::isnan(g->value(i))) << what << " " << f.name() << " " << i;
+            } else {
+                ASSERT_EQ(g->value(i), f.value(i)) << what << " " << f.name() << " " << i;
+            }
+        }
+        EXPECT_EQ(g->isDouble(), f.isDouble()) << what << " " << f.name();
     }
 }
 
@@ -517,8 +523,7 @@ std::string compressLikeTemplate(const std::string& las, const std::string& lazT
     return out.str();
 }
 
-//! varyingCloud() without its two Extra Bytes dimensions: a LAZ file of it is
-//! parsed chunk by chunk as the workers decode it.
+//! varyingCloud() without its two Extra Bytes dimensions.
 PointCloud standardCloud(std::size_t count, bool colours, bool nir, unsigned seed)
 {
     PointCloud cloud = varyingCloud(count, colours, nir, seed);
@@ -585,6 +590,42 @@ TEST(LazFormat, ChunkByChunkParsingGivesTheLasTwinsCloud)
     const PointCloud farTime = expectTwins("far_time");
     EXPECT_EQ(farTime.field("gps_time")->value(110000), 4.0e15);
     EXPECT_EQ(farTime.field("gps_time")->value(0), cloud.field("gps_time")->value(0));
+}
+
+TEST(LazFormat, ExtraBytesAreTakenChunkByChunkAsTheWorkersDecode)
+{
+    // An extra dimension's offset comes from its first value in the read:
+    // here in the third of three chunks, which either core may decode first.
+    // Its values need doubles in the file (4e9 and more); around the offset
+    // floats hold them all, and the field stays exact only so that it is
+    // written back as doubles, as from the LAS.
+    const fs::path dir = test::tempDir();
+    PointCloud cloud = standardCloud(120000, true, false, 12);
+    ScalarField& pulse = cloud.addField("pulse_id");
+    pulse.keepDoubles();
+    auto pulseOf = [](std::size_t i) { return i < 110000 ? std::nan("") : 4.0e9 + 0.5 * double(i); };
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        pulse.setValue(i, pulseOf(i));
+    io::writePointCloud(registry(), cloud, dir / "pulses.las");
+    io::writePointCloud(registry(), cloud, dir / "pulses.laz");
+    const PointCloud las = io::readPointCloud(registry(), dir / "pulses.las");
+    const PointCloud laz = io::readPointCloud(registry(), dir / "pulses.laz");
+    expectSameClouds(las, laz, "pulses");
+    const ScalarField* read = laz.field("pulse_id");
+    ASSERT_NE(read, nullptr);
+    EXPECT_EQ(read->offset(), 4.0e9 + 55000.0);
+    for (std::size_t i = 0; i < laz.size(); ++i) {
+        if (i < 110000) {
+            ASSERT_TRUE(std::isnan(read->value(i))) << i;
+        } else {
+            ASSERT_EQ(read->value(i), pulseOf(i)) << i;
+        }
+    }
+    // A range from the second chunk on: its offset is its own first value's.
+    const PointCloud part = io::readPointRecords(registry(), dir / "pulses.laz", {109999, 3});
+    EXPECT_TRUE(std::isnan(part.field("pulse_id")->value(0)));
+    EXPECT_EQ(part.field("pulse_id")->value(2), pulseOf(110001));
+    EXPECT_EQ(part.field("pulse_id")->offset(), 4.0e9 + 55000.0);
 }
 
 TEST(LazFormat, RangesOfRecordsReadAsTheLasTwinsRanges)
