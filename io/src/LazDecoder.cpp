@@ -88,12 +88,21 @@ std::uint64_t decodePointwise(const fs::path& path, const LazLayout& layout, con
     return static_cast<std::uint64_t>(decoder.position() - first);
 }
 
-//! Decodes the records after the first of a layered chunk; returns the
-//! bytes the chunk holds (its count, layer sizes and layers).
+//! What a worker decodes a chunk into, kept from one chunk to the next.
+struct ChunkBuffers
+{
+    std::vector<char> records;
+    //! The context the point14 item hands the other items, per point (layered chunks).
+    std::vector<std::uint8_t> contexts;
+};
+
+//! Decodes the records after the first of a layered chunk into `out.records`;
+//! returns the bytes the chunk holds (its count, layer sizes and layers).
 std::uint64_t decodeLayered(const fs::path& path, const LazLayout& layout, const unsigned char* first,
                             const unsigned char* end, const Chunk& chunk, std::size_t index, std::size_t recordLength,
-                            char* out)
+                            ChunkBuffers& buffers)
 {
+    char* out = buffers.records.data();
     std::vector<std::unique_ptr<laz::LayeredItem>> items;
     std::vector<std::size_t> offsets;
     std::size_t at = 0, layerCount = 0;
@@ -144,12 +153,12 @@ std::uint64_t decodeLayered(const fs::path& path, const LazLayout& layout, const
     // point. Decoding an item over all the points and then the next took
     // 0.92 of the time of decoding every item of a point before the next.
     // (The first point's entry is never read: the items start from `context`.)
-    std::vector<std::uint8_t> contexts(chunk.points);
+    std::uint8_t* contexts = buffers.contexts.data();
     for (std::size_t i = 0; i < items.size(); ++i) {
         unsigned char* field = reinterpret_cast<unsigned char*>(out) + offsets[i];
         for (std::uint64_t q = 1; q < chunk.points; q += kCheckEvery) {
             const auto run = static_cast<std::size_t>(std::min<std::uint64_t>(kCheckEvery, chunk.points - q));
-            items[i]->decodeRun(field + q * recordLength, recordLength, run, contexts.data() + q);
+            items[i]->decodeRun(field + q * recordLength, recordLength, run, contexts + q);
             if (items[i]->corrupt())
                 refuse();
         }
@@ -163,10 +172,12 @@ std::uint64_t decodeLayered(const fs::path& path, const LazLayout& layout, const
     return static_cast<std::uint64_t>(p - first);
 }
 
-//! Decodes one chunk's records into `out`; returns the bytes it used.
+//! Decodes one chunk's records into `buffers.records` (sized for them);
+//! returns the bytes it used.
 std::uint64_t decodeChunk(const fs::path& path, const LazLayout& layout, const unsigned char* file, std::size_t fileSize,
-                          const Chunk& chunk, std::size_t recordLength, std::size_t index, char* out)
+                          const Chunk& chunk, std::size_t recordLength, std::size_t index, ChunkBuffers& buffers)
 {
+    char* out = buffers.records.data();
     if (chunk.points == 0)
         return 0;
     if (chunk.offset > fileSize || fileSize - chunk.offset < recordLength)
@@ -176,7 +187,7 @@ std::uint64_t decodeChunk(const fs::path& path, const LazLayout& layout, const u
     const unsigned char* first = file + chunk.offset;
     std::memcpy(out, first, recordLength);
     const unsigned char* end = chunk.bytes ? first + chunk.bytes : file + fileSize;
-    return layout.compressor == 3 ? decodeLayered(path, layout, first, end, chunk, index, recordLength, out)
+    return layout.compressor == 3 ? decodeLayered(path, layout, first, end, chunk, index, recordLength, buffers)
                                   : decodePointwise(path, layout, first, end, chunk, index, recordLength, out);
 }
 
@@ -341,14 +352,14 @@ void decompressLazRecords(const fs::path& path, const char* data, std::size_t si
     // Each worker decodes into its own buffer of a chunk's records (about 2 MB
     // for LASzip's 50,000 points), which stays in its cache while the
     // consumer takes the records from it: no buffer of the whole file.
-    tbb::enumerable_thread_specific<std::vector<char>> buffers;
+    tbb::enumerable_thread_specific<ChunkBuffers> workerBuffers;
     // A few chunks per worker between two calls of `progress`: Cancel is heard
     // within a few chunks' time (about 10 ms each for 50,000 points).
     const std::size_t batch = 8;
     for (std::size_t b = begin; b < end; b += batch) {
         const std::size_t e = std::min(end, b + batch);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(b, e, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-            std::vector<char>& buffer = buffers.local();
+            ChunkBuffers& buffers = workerBuffers.local();
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 const Chunk& chunk = chunks[i];
                 if (chunk.points == 0)
@@ -356,17 +367,19 @@ void decompressLazRecords(const fs::path& path, const char* data, std::size_t si
                 if (chunk.points > std::numeric_limits<std::size_t>::max() / recordLength)
                     invalid(path, chunkName(i, chunk) + " holds more points than memory can");
                 try {
-                    buffer.resize(static_cast<std::size_t>(chunk.points) * recordLength);
+                    buffers.records.resize(static_cast<std::size_t>(chunk.points) * recordLength);
+                    if (layout.compressor == 3)
+                        buffers.contexts.resize(static_cast<std::size_t>(chunk.points));
                 } catch (const std::bad_alloc&) {
                     throw Error(ErrorCode::Io, path.string() + ": not enough memory to decompress " + chunkName(i, chunk));
                 }
-                const std::uint64_t used = decodeChunk(path, layout, file, size, chunk, recordLength, i, buffer.data());
+                const std::uint64_t used = decodeChunk(path, layout, file, size, chunk, recordLength, i, buffers);
                 if (chunk.bytes != 0 && chunk.points > 1 && used != chunk.bytes)
                     invalid(path, chunkName(i, chunk) + " is corrupt: its " + std::to_string(chunk.points) + " points use " +
                                       std::to_string(used) + " of its " + std::to_string(chunk.bytes) + " bytes");
                 const std::uint64_t lo = std::max(first, chunk.firstPoint);
                 const std::uint64_t hi = std::min(last, chunk.firstPoint + chunk.points);
-                consume(lo, buffer.data() + (lo - chunk.firstPoint) * recordLength, static_cast<std::size_t>(hi - lo));
+                consume(lo, buffers.records.data() + (lo - chunk.firstPoint) * recordLength, static_cast<std::size_t>(hi - lo));
             }
         });
         std::uint64_t points = 0;
