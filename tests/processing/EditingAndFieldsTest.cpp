@@ -345,9 +345,20 @@ TEST(FieldOperations, ExpressionsOverFieldsCoordinatesAndColours)
     const ScalarField x = evaluateFieldExpression(cloud, "x - 512000", "dx");
     for (std::size_t i = 0; i < cloud.size(); i += 101)
         EXPECT_NEAR(x.value(i), cloud.positions()[i].x(), 1e-6);
-    // A large result keeps its precision through the offset.
+    // A large result is the double the expression gives, exactly: kept in
+    // float residuals or doubles where the floats around the offset are not.
     const ScalarField big = evaluateFieldExpression(cloud, "y", "y");
-    EXPECT_NEAR(big.value(7), cloud.globalPosition(7).y(), 1e-3);
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        ASSERT_EQ(big.value(i), cloud.globalPosition(i).y()) << i;
+    ScalarField& id = cloud.addField("id");
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        id.setValue(i, static_cast<double>(i));
+    const ScalarField pulse = evaluateFieldExpression(cloud, "id * 1000000 + 4000000000", "pulse");
+    EXPECT_TRUE(pulse.isDouble());
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        ASSERT_EQ(pulse.value(i), 1e6 * static_cast<double>(i) + 4e9) << i;
+    // What floats hold stays float only.
+    EXPECT_FALSE(evaluateFieldExpression(cloud, "id / 4", "quarter").isDouble());
     // Comparisons are not assignments.
     EXPECT_EQ(parseFieldAssignment("a = b >= 2").second, "b >= 2");
     EXPECT_EQ(test::errorCodeOf([&] { parseFieldAssignment("a == b"); }), ErrorCode::InvalidArgument);

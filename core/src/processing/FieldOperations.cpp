@@ -199,8 +199,21 @@ ScalarField evaluateFieldExpression(const PointCloud& cloud, const std::string& 
         }
     const double offset = finite > 0 && std::abs(sum / static_cast<double>(finite)) > 1e4 ? std::floor(sum / static_cast<double>(finite)) : 0.0;
     result.setOffset(offset);
-    for (std::size_t i = 0; i < n; ++i)
-        result.values()[i] = std::isfinite(values[i]) ? static_cast<float>(values[i] - offset) : std::numeric_limits<float>::quiet_NaN();
+    bool floatsHold = true;
+    for (std::size_t i = 0; i < n; ++i) {
+        const float f = std::isfinite(values[i]) ? static_cast<float>(values[i] - offset) : std::numeric_limits<float>::quiet_NaN();
+        result.values()[i] = f;
+        floatsHold = floatsHold && (std::isnan(f) || offset + static_cast<double>(f) == values[i]);
+    }
+    // Results the floats around the offset do not give back (identifiers past
+    // 2^24, a time to the microsecond, a global coordinate) are kept exactly,
+    // in float residuals or doubles, as the readers keep such values.
+    if (!floatsHold) {
+        result.keepDoubles();
+        for (std::size_t i = 0; i < n; ++i)
+            result.doubles()[i] = std::isfinite(values[i]) ? values[i] : std::numeric_limits<double>::quiet_NaN();
+        result.compact();
+    }
     return result;
 }
 
