@@ -313,21 +313,27 @@ std::vector<ExtraDimension> parseExtraBytes(const fs::path& path, const char* pa
                        std::to_string(recordLength) + "-byte point record; it and the ones after it are skipped");
             break;
         }
-        if (type >= 1 && type <= 10) {
-            ExtraDimension dim;
-            dim.name = std::move(name);
-            dim.type = type;
-            dim.recordOffset = position;
-            dim.hasNoData = (options & eb::optNoData) != 0;
-            dim.noDataBits = load<std::uint64_t>(p + eb::noData);
-            if (options & eb::optScale)
-                dim.scale = load<double>(p + eb::scale);
-            if (options & eb::optOffset)
-                dim.offset = load<double>(p + eb::offset);
-            dims.push_back(std::move(dim));
-        } else if (type != 0) {
-            logWarning(path.string() + ": extra bytes dimension '" + name + "' (array type " + std::to_string(type) +
-                       ") is not supported and was skipped");
+        if (type != 0) {
+            // Types 11-20 and 21-30, deprecated since LAS 1.4 R14 but still
+            // written (laspy's samples have them), are arrays of 2 and 3 values
+            // of type 1-10, each element with its own no_data, scale and offset
+            // (the descriptor's three slots): one field per element, named as
+            // PDAL names them (name0, name1, name2).
+            const std::size_t elements = type <= 10 ? 1 : type <= 20 ? 2 : 3;
+            const auto elementType = static_cast<unsigned char>(type - 10 * (elements - 1));
+            for (std::size_t e = 0; e < elements; ++e) {
+                ExtraDimension dim;
+                dim.name = elements == 1 ? name : name + std::to_string(e);
+                dim.type = elementType;
+                dim.recordOffset = position + e * (size / elements);
+                dim.hasNoData = (options & eb::optNoData) != 0;
+                dim.noDataBits = load<std::uint64_t>(p + eb::noData + 8 * e);
+                if (options & eb::optScale)
+                    dim.scale = load<double>(p + eb::scale + 8 * e);
+                if (options & eb::optOffset)
+                    dim.offset = load<double>(p + eb::offset + 8 * e);
+                dims.push_back(std::move(dim));
+            }
         }
         position += size;
     }

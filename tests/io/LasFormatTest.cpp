@@ -174,14 +174,17 @@ std::string extraBytesDescriptor(std::uint8_t type, std::uint8_t options, const 
 //! (ignored) and extra bytes described by an Extra Bytes VLR:
 //!   "temperature": uint16, scale 0.1, offset -40, no_data 65535
 //!   "echo width": float
-//!   "pair": short[2] (deprecated array type, skipped)
-//!   "tail": uchar (after the skipped one, so its position must still be right)
+//!   "pair": short[2] (a deprecated array type), scale 0.5 for its first
+//!           element and 2 for its second: fields pair0 and pair1
+//!   "tail": uchar (after the array, so its position must still be right)
 Bytes makeLas14Format10()
 {
     const std::size_t extraSize = 2 + 4 + 4 + 1;
+    std::string pair = extraBytesDescriptor(14, 8, "pair", 0.5);
+    const double secondScale = 2.0;
+    std::memcpy(&pair[112 + 8], &secondScale, sizeof secondScale); // scale[1]
     std::string descriptors = extraBytesDescriptor(3, 1 | 8 | 16, "temperature", 0.1, -40.0, 65535) +
-                              extraBytesDescriptor(9, 0, "echo width") + extraBytesDescriptor(14, 0, "pair") +
-                              extraBytesDescriptor(1, 0, "tail");
+                              extraBytesDescriptor(9, 0, "echo width") + pair + extraBytesDescriptor(1, 0, "tail");
     HeaderSpec s;
     s.minor = 4;
     s.format = 10;
@@ -220,7 +223,7 @@ Bytes makeLas14Format10()
     b.put<std::uint64_t>(p0 + 39, 0xDEADBEEFull);         // byte offset to waveform data
     b.put<std::uint16_t>(p0 + 67, 650);                   // temperature: 650*0.1-40 = 25
     b.put<float>(p0 + 69, 2.5f);                          // echo width
-    b.put<std::int16_t>(p0 + 73, -1);                     // pair (skipped)
+    b.put<std::int16_t>(p0 + 73, -1);                     // pair
     b.put<std::int16_t>(p0 + 75, -2);
     b.put<std::uint8_t>(p0 + 77, 99);                     // tail
     const std::size_t p1 = p0 + s.recordLength;
@@ -563,15 +566,20 @@ TEST(LasFormat, HandBuiltLas14Format10DecodesAsTheSpecSays)
     EXPECT_NEAR(fieldValue(cloud, "scan_angle", 1), 180.0, 1e-4);
     EXPECT_NEAR(fieldValue(cloud, "gps_time", 1), 312345679.5, 1e-6);
 
-    // Extra bytes: scale and offset applied, no_data -> NaN, arrays skipped.
+    // Extra bytes: scale and offset applied, no_data -> NaN, an array's
+    // elements as fields of their own, each with its scale.
     EXPECT_NEAR(fieldValue(cloud, "temperature", 0), 25.0, 1e-5);
     EXPECT_TRUE(std::isnan(fieldValue(cloud, "temperature", 1)));
     EXPECT_EQ(fieldValue(cloud, "echo width", 0), 2.5);
     EXPECT_TRUE(std::isnan(fieldValue(cloud, "echo width", 1)));
     EXPECT_EQ(cloud.field("pair"), nullptr);
+    EXPECT_EQ(fieldValue(cloud, "pair0", 0), -0.5);
+    EXPECT_EQ(fieldValue(cloud, "pair1", 0), -4.0);
+    EXPECT_EQ(fieldValue(cloud, "pair0", 1), 0.0);
+    EXPECT_EQ(fieldValue(cloud, "pair1", 1), 0.0);
     EXPECT_EQ(fieldValue(cloud, "tail", 0), 99);
     EXPECT_EQ(fieldValue(cloud, "tail", 1), 1);
-    EXPECT_EQ(log.warnings.size(), 1u); // the skipped array dimension
+    EXPECT_TRUE(log.warnings.empty());
 }
 
 TEST(LasFormat, EightBitColoursStoredUnscaledAreTakenAsIs)

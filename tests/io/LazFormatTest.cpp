@@ -148,20 +148,34 @@ TEST(LazFormat, ReadsAsTheSameCloudAsTheLasTwin)
 
 TEST(LazFormat, ExtraBytesAndALargerChunkDecodeExactly)
 {
-    // extra.laz is simple.las with two Extra Bytes dimensions appended (a copy
-    // of the intensity and the GPS time in whole seconds): the byte item.
-    test::CapturedLog quiet; // extra.laz has dimensions the reader skips
+    // extra.laz is simple.las with four Extra Bytes dimensions appended: the
+    // colours again as uint16[3] and the returns as int8[2] (deprecated array
+    // types), a copy of the intensity, and the GPS time in whole seconds. The
+    // byte item; the arrays give a field per element (Colors0, Colors1...).
+    test::CapturedLog log;
     const PointCloud simple = io::readPointCloud(registry(), kLazDir / "simple.las");
     const PointCloud extra = io::readPointCloud(registry(), kLazDir / "extra.laz");
+    EXPECT_TRUE(log.warnings.empty());
     ASSERT_EQ(extra.size(), simple.size());
     EXPECT_EQ(extra.positions(), simple.positions());
     const ScalarField* copy = extra.field("Intensity");
     const ScalarField* seconds = extra.field("Time");
     ASSERT_NE(copy, nullptr);
     ASSERT_NE(seconds, nullptr);
+    const ScalarField* colours[3] = {extra.field("Colors0"), extra.field("Colors1"), extra.field("Colors2")};
+    const ScalarField* returns[2] = {extra.field("Flags0"), extra.field("Flags1")};
+    for (const ScalarField* f : {colours[0], colours[1], colours[2], returns[0], returns[1]})
+        ASSERT_NE(f, nullptr);
+    ASSERT_TRUE(simple.hasColors());
     for (std::size_t i = 0; i < extra.size(); ++i) {
         ASSERT_EQ(copy->value(i), simple.field("intensity")->value(i)) << i;
         ASSERT_EQ(seconds->value(i), std::floor(simple.field("gps_time")->value(i))) << i;
+        const Rgb8 c = simple.colors()[i]; // simple.las keeps 8-bit values in its 16-bit slots
+        ASSERT_EQ(colours[0]->value(i), c.r) << i;
+        ASSERT_EQ(colours[1]->value(i), c.g) << i;
+        ASSERT_EQ(colours[2]->value(i), c.b) << i;
+        ASSERT_EQ(returns[0]->value(i), simple.field("return_number")->value(i)) << i;
+        ASSERT_EQ(returns[1]->value(i), simple.field("number_of_returns")->value(i)) << i;
     }
 
     // plane.laz: 28,185 points in one chunk, no twin. Every point lies within
