@@ -635,7 +635,8 @@ TEST(LazFormat, ExtraBytesAreTakenChunkByChunkAsTheWorkersDecode)
             ASSERT_EQ(read->value(i), pulseOf(i)) << i;
         }
     }
-    // A range from the second chunk on: its offset is its own first value's.
+    // A range inside the third chunk, starting on a point without a value:
+    // its offset is its own first value's.
     const PointCloud part = io::readPointRecords(registry(), dir / "pulses.laz", {109999, 3});
     EXPECT_TRUE(std::isnan(part.field("pulse_id")->value(0)));
     EXPECT_EQ(part.field("pulse_id")->value(2), pulseOf(110001));
