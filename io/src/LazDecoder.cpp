@@ -389,29 +389,6 @@ void decompressLazRecords(const fs::path& path, const char* data, std::size_t si
     }
 }
 
-std::unique_ptr<char[]> decompressLazRange(const fs::path& path, const char* data, std::size_t size,
-                                           const std::vector<LazChunk>& chunks, const LazLayout& layout,
-                                           std::size_t recordLength, std::uint64_t first, std::size_t count,
-                                           const std::function<void(std::size_t)>& progress)
-{
-    if (count > std::numeric_limits<std::size_t>::max() / recordLength)
-        invalid(path, std::to_string(count) + " points of " + std::to_string(recordLength) + " bytes do not fit in memory");
-    // Not zeroed: every byte is written (zeroing costs a quarter of the decoding time).
-    std::unique_ptr<char[]> out;
-    try {
-        out.reset(new char[std::max<std::size_t>(1, count * recordLength)]);
-    } catch (const std::bad_alloc&) {
-        throw Error(ErrorCode::Io, path.string() + ": not enough memory to decompress " + std::to_string(count) + " points");
-    }
-    decompressLazRecords(
-        path, data, size, chunks, layout, recordLength, first, count,
-        [&](std::uint64_t firstPoint, const char* records, std::size_t n) {
-            std::memcpy(out.get() + (firstPoint - first) * recordLength, records, n * recordLength);
-        },
-        progress);
-    return out;
-}
-
 std::unique_ptr<char[]> decompressLaz(const fs::path& path, const char* data, std::size_t size, std::uint64_t pointsStart,
                                       const LazLayout& layout, std::size_t recordLength, std::uint64_t count,
                                       const std::function<void(std::size_t)>& progress)
@@ -420,7 +397,20 @@ std::unique_ptr<char[]> decompressLaz(const fs::path& path, const char* data, st
         invalid(path, std::to_string(count) + " points of " + std::to_string(recordLength) + " bytes do not fit in memory");
     // The chunk table vouches for the count before anything is allocated for it.
     const std::vector<LazChunk> chunks = readLazChunks(path, data, size, pointsStart, layout, recordLength, count);
-    return decompressLazRange(path, data, size, chunks, layout, recordLength, 0, static_cast<std::size_t>(count), progress);
+    // Not zeroed: every byte is written (zeroing costs a quarter of the decoding time).
+    std::unique_ptr<char[]> out;
+    try {
+        out.reset(new char[std::max<std::size_t>(1, static_cast<std::size_t>(count) * recordLength)]);
+    } catch (const std::bad_alloc&) {
+        throw Error(ErrorCode::Io, path.string() + ": not enough memory to decompress " + std::to_string(count) + " points");
+    }
+    decompressLazRecords(
+        path, data, size, chunks, layout, recordLength, 0, count,
+        [&](std::uint64_t firstPoint, const char* records, std::size_t n) {
+            std::memcpy(out.get() + firstPoint * recordLength, records, n * recordLength);
+        },
+        progress);
+    return out;
 }
 
 } // namespace scandiff::io::detail

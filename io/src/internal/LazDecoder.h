@@ -81,15 +81,10 @@ void decompressLazRecords(const std::filesystem::path& path, const char* data, s
                           std::uint64_t first, std::uint64_t wanted, const LazRecordsConsumer& consume,
                           const std::function<void(std::size_t)>& progress);
 
-//! The records [first, first + count) of `chunks` (see
-//! decompressLazRecords) decompressed into one buffer of count × recordLength bytes.
-std::unique_ptr<char[]> decompressLazRange(const std::filesystem::path& path, const char* data, std::size_t size,
-                                           const std::vector<LazChunk>& chunks, const LazLayout& layout,
-                                           std::size_t recordLength, std::uint64_t first, std::size_t count,
-                                           const std::function<void(std::size_t)>& progress);
-
 //! Every record decompressed into one buffer (count × recordLength bytes),
-//! allocated once the chunk table has vouched for the count.
+//! allocated once the chunk table has vouched for the count. The readers
+//! parse chunk by chunk (decompressLazRecords); this is for the tests that
+//! compare every record with its uncompressed twin.
 std::unique_ptr<char[]> decompressLaz(const std::filesystem::path& path, const char* data, std::size_t size,
                                       std::uint64_t pointsStart, const LazLayout& layout, std::size_t recordLength,
                                       std::uint64_t count, const std::function<void(std::size_t)>& progress);
