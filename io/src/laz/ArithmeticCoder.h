@@ -12,10 +12,12 @@
 //! Written by hand because Debian 12 packages no LAZ library (no LASzip, no
 //! laz-perf, no PDAL).
 
+#include <algorithm>
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 namespace scandiff::io::detail::laz {
@@ -34,7 +36,7 @@ struct BitModel
     std::uint32_t bit0Probability = 1u << (kBitLengthShift - 1);
     std::uint32_t bit0Count = 1, bitCount = 2;
 
-    void update()
+    [[gnu::noinline, gnu::cold]] void update()
     {
         // Halve the counts when they reach the maximum, then rescale.
         if ((bitCount += updateCycle) > kBitMaxCount) {
@@ -81,7 +83,8 @@ public:
             // at most, and length >= 2^24: 64 past the end, rounded up to
             // entries, and one more for the end of the last search.
             tableEnd_ = tableSize_ + ((64u + (1u << tableShift_) - 1) >> tableShift_);
-            decoderTable_.resize(tableEnd_ + 2);
+            // Eight entries of room past the end for fillDecoderTable()'s stores.
+            decoderTable_.resize(tableEnd_ + 2 + 8);
         }
         distribution_.resize(symbols);
         counts_.assign(symbols, 1);
@@ -90,29 +93,21 @@ public:
         updateCycle_ = symbolsUntilUpdate_ = (symbols + 6) >> 1;
     }
 
-    void update()
+    [[gnu::noinline, gnu::cold]] void update()
     {
         if ((totalCount_ += updateCycle_) > kSymbolMaxCount) {
             totalCount_ = 0;
             for (std::uint16_t& c : counts_)
                 totalCount_ += (c = static_cast<std::uint16_t>((c + 1) >> 1));
         }
-        std::uint32_t sum = 0, s = 0;
+        std::uint32_t sum = 0;
         const std::uint32_t scale = 0x80000000u / totalCount_;
         for (std::uint32_t k = 0; k < symbols_; ++k) {
             distribution_[k] = static_cast<std::uint16_t>((scale * sum) >> (31 - kSymbolLengthShift));
             sum += counts_[k];
-            if (tableSize_ != 0) {
-                const std::uint32_t w = distribution_[k] >> tableShift_;
-                while (s < w)
-                    decoderTable_[++s] = static_cast<std::uint16_t>(k - 1);
-            }
         }
-        if (tableSize_ != 0) {
-            decoderTable_[0] = 0;
-            while (s <= tableEnd_)
-                decoderTable_[++s] = static_cast<std::uint16_t>(symbols_ - 1);
-        }
+        if (tableSize_ != 0)
+            fillDecoderTable();
         updateCycle_ = (5 * updateCycle_) >> 2;
         const std::uint32_t maxCycle = (symbols_ + 6) << 3;
         if (updateCycle_ > maxCycle)
@@ -121,6 +116,31 @@ public:
     }
 
 private:
+    //! Entry t holds the last symbol whose distribution is below t's share
+    //! of the interval: entries (dist[k - 1] >> shift, dist[k] >> shift]
+    //! are symbol k - 1, the ones past the last symbol's start the last.
+    void fillDecoderTable()
+    {
+        std::uint16_t* table = decoderTable_.data();
+        std::uint32_t s = 0;
+        for (std::uint32_t k = 1; k < symbols_; ++k) {
+            const std::uint32_t w = distribution_[k] >> tableShift_;
+            // Eight entries at once whether the symbol spans that many or
+            // none; the next symbol's overwrite the ones past its own. A
+            // loop entry by entry stopped on a branch mispredicted at every
+            // symbol (the spans follow the counts), and the models of a
+            // chunk are rebuilt often while their update cycle is short.
+            const std::uint64_t pattern = (k - 1) * 0x0001000100010001ull;
+            std::memcpy(table + s + 1, &pattern, sizeof pattern);
+            std::memcpy(table + s + 5, &pattern, sizeof pattern);
+            for (std::uint32_t t = s + 9; t <= w; ++t)
+                table[t] = static_cast<std::uint16_t>(k - 1);
+            s = w;
+        }
+        table[0] = 0;
+        std::fill(table + s + 1, table + tableEnd_ + 2, static_cast<std::uint16_t>(symbols_ - 1));
+    }
+
     friend class ArithmeticDecoder;
     friend class ArithmeticEncoder;
     std::uint32_t symbols_, lastSymbol_;
@@ -424,9 +444,7 @@ public:
         sizeModels_.reserve(contexts);
         for (std::uint32_t c = 0; c < contexts; ++c)
             sizeModels_.emplace_back(correctionBits_ + 1);
-        valueModels_.reserve(correctionBits_);
-        for (std::uint32_t k = 1; k <= correctionBits_; ++k)
-            valueModels_.emplace_back(k <= bitsHigh ? 1u << k : 1u << bitsHigh);
+        valueModels_.resize(correctionBits_);
     }
 
     //! The size k of the last correction: the point coders use it as context.
@@ -462,6 +480,13 @@ public:
     }
 
 private:
+    SymbolModel& valueModel(std::uint32_t k)
+    {
+        std::optional<SymbolModel>& model = valueModels_[k - 1];
+        if (!model)
+            model.emplace(k <= bitsHigh_ ? 1u << k : 1u << bitsHigh_);
+        return *model;
+    }
     std::int32_t readCorrection(ArithmeticDecoder& decoder, SymbolModel& sizeModel)
     {
         k_ = decoder.decodeSymbol(sizeModel);
@@ -469,7 +494,7 @@ private:
             return static_cast<std::int32_t>(decoder.decodeBit(zeroOrOne_));
         if (k_ >= 32)
             return minCorrection_;
-        std::int64_t c = decoder.decodeSymbol(valueModels_[k_ - 1]);
+        std::int64_t c = decoder.decodeSymbol(valueModel(k_));
         if (k_ > bitsHigh_) {
             const std::uint32_t lowBits = k_ - bitsHigh_;
             c = (c << lowBits) | decoder.readBits(lowBits);
@@ -498,11 +523,11 @@ private:
             return; // INT32_MIN: the decoder knows it from k alone
         std::int64_t v = c < 0 ? std::int64_t(c) + ((std::int64_t(1) << k_) - 1) : std::int64_t(c) - 1;
         if (k_ <= bitsHigh_) {
-            encoder.encodeSymbol(valueModels_[k_ - 1], static_cast<std::uint32_t>(v));
+            encoder.encodeSymbol(valueModel(k_), static_cast<std::uint32_t>(v));
         } else {
             const std::uint32_t lowBits = k_ - bitsHigh_;
             const auto low = static_cast<std::uint32_t>(v & ((std::int64_t(1) << lowBits) - 1));
-            encoder.encodeSymbol(valueModels_[k_ - 1], static_cast<std::uint32_t>(v >> lowBits));
+            encoder.encodeSymbol(valueModel(k_), static_cast<std::uint32_t>(v >> lowBits));
             encoder.writeBits(lowBits, low);
         }
     }
@@ -515,7 +540,11 @@ private:
     std::uint32_t k_ = 0;
     std::vector<SymbolModel> sizeModels_;
     BitModel zeroOrOne_;
-    std::vector<SymbolModel> valueModels_; //!< index k - 1
+    //! The model of corrections of k bits, index k - 1, made on first use:
+    //! a chunk of a few dozen thousand points seldom sees more than half of
+    //! the 32 sizes, and a model of 256 symbols takes 3 KB to make (its
+    //! first state does not depend on when it is made).
+    std::vector<std::optional<SymbolModel>> valueModels_;
 };
 
 } // namespace scandiff::io::detail::laz
