@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include <scandiff/core/ScalarField.h>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
+#include <cstdint>
 
 namespace scandiff {
 
@@ -141,39 +145,98 @@ bool ScalarField::isZeroEverywhere() const
     return r.validCount == size() && r.min == 0.0 && r.max == 0.0;
 }
 
+namespace {
+
+//! The extremes and the count of the values that are not NaN, over part of a field.
+struct Extremes
+{
+    double lo = std::numeric_limits<double>::infinity();
+    double hi = -std::numeric_limits<double>::infinity();
+    std::size_t count = 0;
+
+    void merge(const Extremes& other)
+    {
+        lo = std::min(lo, other.lo);
+        hi = std::max(hi, other.hi);
+        count += other.count;
+    }
+};
+
+//! The floats of [begin, end): eight lanes with no branch, so that the
+//! compiler keeps them in vector registers (`v < lo ? v : lo` is the
+//! processors' min instruction, which keeps `lo` when v is NaN).
+Extremes floatExtremes(const float* begin, const float* end)
+{
+    constexpr std::size_t kLanes = 8;
+    float lo[kLanes], hi[kLanes];
+    std::uint32_t count[kLanes] = {};
+    std::fill(lo, lo + kLanes, std::numeric_limits<float>::infinity());
+    std::fill(hi, hi + kLanes, -std::numeric_limits<float>::infinity());
+    const float* v = begin;
+    for (; end - v >= static_cast<std::ptrdiff_t>(kLanes); v += kLanes) {
+        for (std::size_t l = 0; l < kLanes; ++l) {
+            lo[l] = v[l] < lo[l] ? v[l] : lo[l];
+            hi[l] = v[l] > hi[l] ? v[l] : hi[l];
+            count[l] += v[l] == v[l];
+        }
+    }
+    Extremes e;
+    for (std::size_t l = 0; l < kLanes; ++l) {
+        e.lo = std::min(e.lo, static_cast<double>(lo[l]));
+        e.hi = std::max(e.hi, static_cast<double>(hi[l]));
+        e.count += count[l];
+    }
+    for (; v < end; ++v) {
+        if (std::isnan(*v))
+            continue;
+        e.lo = std::min(e.lo, static_cast<double>(*v));
+        e.hi = std::max(e.hi, static_cast<double>(*v));
+        ++e.count;
+    }
+    return e;
+}
+
+} // namespace
+
 ValueRange ScalarField::range() const
 {
+    // In blocks on every core: a field of a large cloud is read whole, and
+    // `info` asks for every field's range.
+    constexpr std::size_t kBlock = 1 << 16; // (the lane counts hold up to 2^32 each)
+    const bool exact = exact_ != Exact::None;
+    const Extremes e = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, values_.size(), kBlock), Extremes{},
+        [&](const tbb::blocked_range<std::size_t>& block, Extremes part) {
+            if (!exact) {
+                // Floats first, the offset once per block.
+                Extremes f = floatExtremes(values_.data() + block.begin(), values_.data() + block.end());
+                if (f.count > 0) {
+                    f.lo = offset_ + f.lo;
+                    f.hi = offset_ + f.hi;
+                }
+                part.merge(f);
+                return part;
+            }
+            // The exact values' own extremes, not their float roundings.
+            for (std::size_t i = block.begin(); i < block.end(); ++i) {
+                if (std::isnan(values_[i]))
+                    continue;
+                const double v = value(i);
+                part.lo = std::min(part.lo, v);
+                part.hi = std::max(part.hi, v);
+                ++part.count;
+            }
+            return part;
+        },
+        [](Extremes a, const Extremes& b) {
+            a.merge(b);
+            return a;
+        });
     ValueRange r;
-    if (exact_ != Exact::None) {
-        // The exact values' own extremes, not their float roundings.
-        double lo = std::numeric_limits<double>::infinity();
-        double hi = -lo;
-        for (std::size_t i = 0; i < values_.size(); ++i) {
-            if (std::isnan(values_[i]))
-                continue;
-            const double v = value(i);
-            lo = std::min(lo, v);
-            hi = std::max(hi, v);
-            ++r.validCount;
-        }
-        if (r.validCount > 0) {
-            r.min = lo;
-            r.max = hi;
-        }
-        return r;
-    }
-    float lo = std::numeric_limits<float>::infinity();
-    float hi = -std::numeric_limits<float>::infinity();
-    for (float v : values_) {
-        if (std::isnan(v))
-            continue;
-        lo = std::min(lo, v);
-        hi = std::max(hi, v);
-        ++r.validCount;
-    }
-    if (r.validCount > 0) {
-        r.min = offset_ + static_cast<double>(lo);
-        r.max = offset_ + static_cast<double>(hi);
+    r.validCount = e.count;
+    if (e.count > 0) {
+        r.min = e.lo;
+        r.max = e.hi;
     }
     return r;
 }

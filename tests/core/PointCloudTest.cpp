@@ -133,6 +133,69 @@ TEST(ScalarField, RangeWithOffsetKeepsLargeValuesPrecise)
     EXPECT_TRUE(std::isnan(ScalarField("empty", 4).range().min));
 }
 
+// range() reads a field in blocks on every core, eight lanes at a time: a
+// field of several blocks, NaN here and there, the extremes in a middle block
+// and in the tail that is not a multiple of eight, against a plain loop.
+TEST(ScalarField, RangeOfALargeFieldEqualsAPlainLoop)
+{
+    const std::size_t n = 5 * 65536 + 13;
+    auto bruteForce = [](const ScalarField& f) {
+        ValueRange r;
+        double lo = INFINITY, hi = -INFINITY;
+        for (std::size_t i = 0; i < f.size(); ++i) {
+            const double v = f.value(i);
+            if (std::isnan(v))
+                continue;
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+            ++r.validCount;
+        }
+        if (r.validCount > 0) {
+            r.min = lo;
+            r.max = hi;
+        }
+        return r;
+    };
+    auto expectSame = [](const ValueRange& got, const ValueRange& want) {
+        EXPECT_EQ(got.validCount, want.validCount);
+        EXPECT_EQ(got.min, want.min);
+        EXPECT_EQ(got.max, want.max);
+    };
+
+    ScalarField floats("height", n);
+    floats.setOffset(100.0);
+    std::uint32_t state = 12345;
+    for (std::size_t i = 0; i < n; ++i) {
+        state = state * 1664525u + 1013904223u;
+        floats.setValue(i, i % 7 == 3 ? NAN : 100.0 + (state >> 8) * 1e-3);
+    }
+    floats.setValue(2 * 65536 + 5, 99.0);    // the lowest, in the third block
+    floats.setValue(n - 2, 1e6);             // the highest, in the tail
+    ASSERT_FALSE(floats.isDouble());
+    const ValueRange r = floats.range();
+    expectSame(r, bruteForce(floats));
+    EXPECT_EQ(r.min, 99.0);
+    EXPECT_EQ(r.max, 100.0 + static_cast<double>(static_cast<float>(1e6 - 100.0)));
+    EXPECT_EQ(r.validCount, n - (n + 3) / 7);
+
+    floats.setValue(7, -INFINITY); // infinities are values
+    EXPECT_EQ(floats.range().min, -INFINITY);
+
+    // Values only doubles hold: the exact extremes, not the floats'.
+    ScalarField ids("pulse", n);
+    ids.setOffset(4e9);
+    ids.keepDoubles();
+    for (std::size_t i = 0; i < n; ++i)
+        ids.setValue(i, i % 5 == 0 ? NAN : 4e9 + 1e6 * static_cast<double>((i * 7919) % n) + 1.0);
+    ASSERT_TRUE(ids.isDouble());
+    expectSame(ids.range(), bruteForce(ids));
+    EXPECT_EQ(ids.range().max, 4e9 + 1e6 * static_cast<double>(n - 1) + 1.0);
+
+    const ValueRange none = ScalarField("nothing", n).range();
+    EXPECT_EQ(none.validCount, 0u);
+    EXPECT_TRUE(std::isnan(none.min) && std::isnan(none.max));
+}
+
 TEST(Mesh, ConsistencyAndDegenerateTriangles)
 {
     Mesh m;
