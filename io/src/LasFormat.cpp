@@ -510,51 +510,59 @@ DecodedFacts decodeRange(const char* records, std::size_t recordLength, std::siz
     unsigned colorBits = 0;
     const char* p = records;
     for (std::size_t i = at; i < at + count; ++i, p += recordLength) {
+        // A field the reader left out (known to be 0 everywhere, see readLas)
+        // has no array: the branch goes the same way at every point.
+        auto put = [i](float* field, float value) {
+            if (field)
+                field[i] = value;
+        };
         out.positions[i] = Eigen::Vector3f(static_cast<float>(load<std::int32_t>(p) * sx + tx),
                                            static_cast<float>(load<std::int32_t>(p + 4) * sy + ty),
                                            static_cast<float>(load<std::int32_t>(p + 8) * sz + tz));
-        out.intensity[i] = load<std::uint16_t>(p + 12);
+        put(out.intensity, load<std::uint16_t>(p + 12));
         const auto returns = static_cast<unsigned char>(p[14]);
         if constexpr (Extended) {
             // Byte 14: return number (bits 0-3), number of returns (4-7).
             // Byte 15: classification flags (0-3: synthetic, key-point, withheld,
             // overlap), scanner channel (4-5), scan direction (6), edge of flight line (7).
             const auto flags = static_cast<unsigned char>(p[15]);
-            out.returnNumber[i] = returns & 0x0F;
-            out.numberOfReturns[i] = returns >> 4;
-            out.classificationFlags[i] = flags & 0x0F;
-            out.scannerChannel[i] = (flags >> 4) & 0x03;
-            out.scanDirectionFlag[i] = (flags >> 6) & 0x01;
-            out.edgeOfFlightLine[i] = flags >> 7;
-            out.classification[i] = static_cast<unsigned char>(p[16]);
-            out.userData[i] = static_cast<unsigned char>(p[17]);
+            put(out.returnNumber, returns & 0x0F);
+            put(out.numberOfReturns, returns >> 4);
+            put(out.classificationFlags, flags & 0x0F);
+            put(out.scannerChannel, (flags >> 4) & 0x03);
+            put(out.scanDirectionFlag, (flags >> 6) & 0x01);
+            put(out.edgeOfFlightLine, flags >> 7);
+            put(out.classification, static_cast<unsigned char>(p[16]));
+            put(out.userData, static_cast<unsigned char>(p[17]));
             // Scan angle: int16 in units of 0.006 degree.
-            out.scanAngle[i] = static_cast<float>(load<std::int16_t>(p + 18) * 0.006);
-            out.pointSourceId[i] = load<std::uint16_t>(p + 20);
+            put(out.scanAngle, static_cast<float>(load<std::int16_t>(p + 18) * 0.006));
+            put(out.pointSourceId, load<std::uint16_t>(p + 20));
         } else {
             // Byte 14: return number (bits 0-2), number of returns (3-5), scan
             // direction (6), edge of flight line (7). Byte 15: classification
             // (bits 0-4), synthetic (5), key-point (6), withheld (7); the flags are
             // stored as bits 0-2 of classification_flags, as in formats 6-10.
             const auto classByte = static_cast<unsigned char>(p[15]);
-            out.returnNumber[i] = returns & 0x07;
-            out.numberOfReturns[i] = (returns >> 3) & 0x07;
-            out.scanDirectionFlag[i] = (returns >> 6) & 0x01;
-            out.edgeOfFlightLine[i] = returns >> 7;
-            out.classification[i] = classByte & 0x1F;
-            out.classificationFlags[i] = classByte >> 5;
+            put(out.returnNumber, returns & 0x07);
+            put(out.numberOfReturns, (returns >> 3) & 0x07);
+            put(out.scanDirectionFlag, (returns >> 6) & 0x01);
+            put(out.edgeOfFlightLine, returns >> 7);
+            put(out.classification, classByte & 0x1F);
+            put(out.classificationFlags, classByte >> 5);
             // Scan angle rank: int8, whole degrees.
-            out.scanAngle[i] = static_cast<signed char>(p[16]);
-            out.userData[i] = static_cast<unsigned char>(p[17]);
-            out.pointSourceId[i] = load<std::uint16_t>(p + 18);
+            put(out.scanAngle, static_cast<signed char>(p[16]));
+            put(out.userData, static_cast<unsigned char>(p[17]));
+            put(out.pointSourceId, load<std::uint16_t>(p + 18));
         }
         if constexpr (HasGpsTime) {
-            const double time = load<double>(p + gpsOffset);
-            const auto f = static_cast<float>(time - out.gpsTimeOffset);
-            out.gpsTime[i] = f;
-            out.gpsTimeResidual[i] = ScalarField::residualOf(time, out.gpsTimeOffset, f);
-            if (!ScalarField::residualHolds(time, out.gpsTimeOffset))
-                facts.gpsTimeResidualFailed = true;
+            if (out.gpsTime) {
+                const double time = load<double>(p + gpsOffset);
+                const auto f = static_cast<float>(time - out.gpsTimeOffset);
+                out.gpsTime[i] = f;
+                out.gpsTimeResidual[i] = ScalarField::residualOf(time, out.gpsTimeOffset, f);
+                if (!ScalarField::residualHolds(time, out.gpsTimeOffset))
+                    facts.gpsTimeResidualFailed = true;
+            }
         }
         if constexpr (HasRgb) {
             const unsigned r = load<std::uint16_t>(p + rgbOffset);
@@ -566,7 +574,7 @@ DecodedFacts decodeRange(const char* records, std::size_t recordLength, std::siz
                                  static_cast<std::uint8_t>((b + 128) / 257)};
         }
         if constexpr (HasNir)
-            out.nir[i] = load<std::uint16_t>(p + nirOffset);
+            put(out.nir, load<std::uint16_t>(p + nirOffset));
     }
     facts.colorBits = colorBits;
     return facts;
@@ -755,6 +763,36 @@ std::vector<std::string> standardFieldNames(int format)
     return names;
 }
 
+//! Whether the bits of standard field `name` of a record of `format` are all
+//! set in `zeroBits` (a mask over the record: set where the bit is 0 in every
+//! record). Only formats 6-10, whose LAZ chunks can tell.
+bool fieldIsZeroIn(const std::vector<std::uint8_t>& zeroBits, int format, const std::string& name)
+{
+    if (format < 6)
+        return false;
+    struct Bits
+    {
+        const char* name;
+        std::size_t first, last; // bytes
+        std::uint8_t mask;
+    };
+    static const Bits kFields[] = {
+        {"intensity", 12, 13, 0xFF},          {"return_number", 14, 14, 0x0F},     {"number_of_returns", 14, 14, 0xF0},
+        {"classification_flags", 15, 15, 0x0F}, {"scanner_channel", 15, 15, 0x30}, {"scan_direction_flag", 15, 15, 0x40},
+        {"edge_of_flight_line", 15, 15, 0x80}, {"classification", 16, 16, 0xFF},  {"user_data", 17, 17, 0xFF},
+        {"scan_angle", 18, 19, 0xFF},         {"point_source_id", 20, 21, 0xFF},  {"gps_time", 22, 29, 0xFF},
+        {"nir", 36, 37, 0xFF}};
+    for (const Bits& field : kFields) {
+        if (name != field.name)
+            continue;
+        for (std::size_t b = field.first; b <= field.last; ++b)
+            if (b >= zeroBits.size() || (zeroBits[b] & field.mask) != field.mask)
+                return false;
+        return true;
+    }
+    return false;
+}
+
 //! The LASzip record of a LAZ file.
 LazLayout findLazLayout(const MappedFile& file, const LasHeader& h)
 {
@@ -918,7 +956,17 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
         // A fresh array's pages are zeroed by the kernel as they are first
         // touched, a fifth to a half of a read's time on this machine: the
         // arrays are made on both cores, the positions beside the fields.
-        const std::vector<std::string> names = standardFieldNames(format);
+        std::vector<std::string> names = standardFieldNames(format);
+        if (h.compressed && !range) {
+            // Fields the LAZ chunks show to be 0 in every record are not made
+            // at all (the reader would drop them once read, below): no pages
+            // to zero, fill and write for them.
+            const std::vector<std::uint8_t> zeroBits =
+                lazBitsZeroInEveryRecord(file.data(), file.size(), chunks, *layout, h.recordLength);
+            names.erase(std::remove_if(names.begin(), names.end(),
+                                       [&](const std::string& name) { return fieldIsZeroIn(zeroBits, format, name); }),
+                        names.end());
+        }
         std::vector<ScalarField> standard(names.size());
         tbb::parallel_invoke(
             [&] {

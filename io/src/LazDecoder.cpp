@@ -389,6 +389,44 @@ void decompressLazRecords(const fs::path& path, const char* data, std::size_t si
     }
 }
 
+std::vector<std::uint8_t> lazBitsZeroInEveryRecord(const char* data, std::size_t size, const std::vector<LazChunk>& chunks,
+                                                   const LazLayout& layout, std::size_t recordLength)
+{
+    std::vector<std::uint8_t> zero(recordLength, 0);
+    if (layout.compressor != 3 || chunks.empty())
+        return zero;
+    // Each layer's bits at their place in the record.
+    std::vector<std::vector<std::uint8_t>> layers;
+    std::size_t at = 0;
+    for (const LazItem& item : layout.items) {
+        for (const std::vector<std::uint8_t>& bits : laz::layerBits(item.type, item.size)) {
+            layers.emplace_back(recordLength, 0);
+            std::copy(bits.begin(), bits.end(), layers.back().begin() + static_cast<std::ptrdiff_t>(at));
+        }
+        at += item.size;
+    }
+    for (const std::vector<std::uint8_t>& bits : layers)
+        for (std::size_t b = 0; b < recordLength; ++b)
+            zero[b] |= bits[b];
+    const auto* file = reinterpret_cast<const unsigned char*>(data);
+    for (const LazChunk& chunk : chunks) {
+        if (chunk.points == 0)
+            continue;
+        const std::uint64_t head = recordLength + 4 + 4 * layers.size();
+        if (chunk.offset > size || size - chunk.offset < head)
+            return std::vector<std::uint8_t>(recordLength, 0);
+        const unsigned char* first = file + chunk.offset;
+        const unsigned char* sizes = first + recordLength + 4;
+        for (std::size_t l = 0; l < layers.size(); ++l) {
+            // An empty layer: its bits as in the first record; else anything.
+            const bool empty = chunk.points == 1 || load<std::uint32_t>(sizes + 4 * l) == 0;
+            for (std::size_t b = 0; b < recordLength; ++b)
+                zero[b] &= static_cast<std::uint8_t>(~(layers[l][b] & (empty ? first[b] : 0xFF)));
+        }
+    }
+    return zero;
+}
+
 std::unique_ptr<char[]> decompressLaz(const fs::path& path, const char* data, std::size_t size, std::uint64_t pointsStart,
                                       const LazLayout& layout, std::size_t recordLength, std::uint64_t count,
                                       const std::function<void(std::size_t)>& progress)

@@ -606,6 +606,73 @@ TEST(LazFormat, ChunkByChunkParsingGivesTheLasTwinsCloud)
     EXPECT_EQ(farTime.field("gps_time")->value(0), cloud.field("gps_time")->value(0));
 }
 
+// A standard field 0 in every record is dropped by the reader; a LAZ file's
+// chunks tell which before anything is decoded (a layer empty in a chunk is
+// an attribute that never changes there, equal to the chunk's first record),
+// so the LAZ reader does not make those fields at all. Each case against the
+// LAS twin, which reads every record: the same fields, the same values.
+TEST(LazFormat, FieldsTheLayersShowToBeZeroEverywhereAreNotMade)
+{
+    const fs::path dir = test::tempDir();
+    const PointCloud cloud = standardCloud(120000, true, false, 10);
+    io::writePointCloud(registry(), cloud, dir / "zeros.las");
+    io::writePointCloud(registry(), cloud, dir / "zeros.laz");
+    const std::string lazTemplate = fileBytes(dir / "zeros.laz");
+    std::string las = fileBytes(dir / "zeros.las");
+    const std::size_t start = at<std::uint32_t>(las, kOffsetToPoints), length = at<std::uint16_t>(las, kRecordLength);
+    auto record = [&](std::size_t i) { return start + i * length; };
+    auto twins = [&](const std::string& name) {
+        test::writeText(dir / (name + ".las"), las);
+        test::writeText(dir / (name + ".laz"), compressLikeTemplate(las, lazTemplate));
+        PointCloud fromLaz = io::readPointCloud(registry(), dir / (name + ".laz"));
+        expectSameClouds(io::readPointCloud(registry(), dir / (name + ".las")), fromLaz, name);
+        return fromLaz;
+    };
+    // User data (byte 17) 0 everywhere, and of the flags byte (15) only the
+    // scanner channel's bits left.
+    for (std::size_t i = 0; i < 120000; ++i) {
+        las[record(i) + 17] = 0;
+        las[record(i) + 15] = static_cast<char>(las[record(i) + 15] & 0x30);
+    }
+    const PointCloud zero = twins("zero_everywhere");
+    EXPECT_EQ(zero.field("user_data"), nullptr);
+    EXPECT_EQ(zero.field("classification_flags"), nullptr);
+    EXPECT_EQ(zero.field("scan_direction_flag"), nullptr);
+    EXPECT_EQ(zero.field("edge_of_flight_line"), nullptr);
+    ASSERT_NE(zero.field("scanner_channel"), nullptr);
+    ASSERT_NE(zero.field("classification"), nullptr);
+
+    // 5 at every point of the second chunk: its layer is empty there too,
+    // only its first record tells.
+    for (std::size_t i = 50000; i < 100000; ++i)
+        las[record(i) + 17] = 5;
+    // The scan direction set in all of the first chunk, the other flags not.
+    for (std::size_t i = 0; i < 50000; ++i)
+        las[record(i) + 15] = static_cast<char>(las[record(i) + 15] | 0x40);
+    const PointCloud firstRecords = twins("constant_in_a_chunk");
+    ASSERT_NE(firstRecords.field("user_data"), nullptr);
+    EXPECT_EQ(firstRecords.field("user_data")->value(50000), 5.0);
+    EXPECT_EQ(firstRecords.field("user_data")->value(100000), 0.0);
+    ASSERT_NE(firstRecords.field("scan_direction_flag"), nullptr);
+    EXPECT_EQ(firstRecords.field("scan_direction_flag")->value(49999), 1.0);
+    EXPECT_EQ(firstRecords.field("classification_flags"), nullptr);
+    EXPECT_EQ(firstRecords.field("edge_of_flight_line"), nullptr);
+
+    // 0 in every chunk's first record, 9 at one point inside the third
+    // chunk: only its layer's size tells.
+    for (std::size_t i = 0; i < 120000; ++i)
+        las[record(i) + 17] = 0;
+    las[record(110000) + 17] = 9;
+    const PointCloud oneInside = twins("one_inside_a_chunk");
+    ASSERT_NE(oneInside.field("user_data"), nullptr);
+    EXPECT_EQ(oneInside.field("user_data")->value(110000), 9.0);
+    EXPECT_EQ(oneInside.field("user_data")->value(110001), 0.0);
+
+    // A range of records keeps every field, as the LAS reader's ranges do.
+    const PointCloud range = io::readPointRecords(registry(), dir / "zero_everywhere.laz", io::RecordRange{100, 50});
+    EXPECT_NE(range.field("classification_flags"), nullptr);
+}
+
 TEST(LazFormat, ExtraBytesAreTakenChunkByChunkAsTheWorkersDecode)
 {
     // An extra dimension's offset comes from its first value in the read:

@@ -81,6 +81,16 @@ void decompressLazRecords(const std::filesystem::path& path, const char* data, s
                           std::uint64_t first, std::uint64_t wanted, const LazRecordsConsumer& consume,
                           const std::function<void(std::size_t)>& progress);
 
+//! The bits that are 0 in every record of a layered file, as its chunks tell
+//! without decoding: a layer empty in a chunk holds an attribute that never
+//! changes there, so its bits are the chunk's first record's (stored as is).
+//! A mask over `recordLength` bytes, a bit set where that bit is 0 in every
+//! record; every bit clear for a pointwise file or chunks that do not parse
+//! (the decoder reports those). The reader leaves out the standard fields
+//! that would be 0 everywhere, before allocating them.
+std::vector<std::uint8_t> lazBitsZeroInEveryRecord(const char* data, std::size_t size, const std::vector<LazChunk>& chunks,
+                                                   const LazLayout& layout, std::size_t recordLength);
+
 //! Every record decompressed into one buffer (count × recordLength bytes),
 //! allocated once the chunk table has vouched for the count. The readers
 //! parse chunk by chunk (decompressLazRecords); this is for the tests that

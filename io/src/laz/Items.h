@@ -170,6 +170,12 @@ public:
 //! 3), starting from the chunk's first item.
 std::unique_ptr<LayeredItem> makeLayeredItem(std::uint16_t type, std::size_t size, const unsigned char* first);
 
+//! The bits of a layered item (point14, rgb14, rgbnir14 or byte14) each of its
+//! layers codes, in the order of the layers: a mask over the item's `size`
+//! bytes per layer. A layer empty in a chunk means those bits are the chunk's
+//! first item's at every point of it.
+std::vector<std::vector<std::uint8_t>> layerBits(std::uint16_t type, std::size_t size);
+
 //! The encoder of a layered item, the mirror of LayeredItem: each item of a
 //! chunk after the first goes to encode(), then finish() gives its layers
 //! (empty for an attribute that never changed in the chunk).

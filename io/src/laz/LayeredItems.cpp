@@ -333,4 +333,59 @@ std::unique_ptr<LayeredItem> makeLayeredItem(std::uint16_t type, std::size_t siz
     }
 }
 
+std::vector<std::vector<std::uint8_t>> layerBits(std::uint16_t type, std::size_t size)
+{
+    // Byte by byte: {layer, byte, bits}, for point14 after the layout of a
+    // LAS 1.4 record (Point14::parse) and the layers of Point14Decoder.
+    struct Span
+    {
+        std::size_t layer, byte;
+        std::uint8_t bits;
+    };
+    std::vector<Span> spans;
+    std::size_t layers = 0;
+    switch (type) {
+    case kPoint14: {
+        layers = 9;
+        for (std::size_t b = 0; b < 8; ++b)
+            spans.push_back({0, b, 0xFF}); // x, y
+        spans.push_back({0, 14, 0xFF});  // return number, number of returns
+        spans.push_back({0, 15, 0x30});  // scanner channel
+        for (std::size_t b = 8; b < 12; ++b)
+            spans.push_back({1, b, 0xFF}); // z
+        spans.push_back({2, 16, 0xFF});  // classification
+        spans.push_back({3, 15, 0xCF});  // classification flags, scan direction, edge of flight line
+        spans.push_back({4, 12, 0xFF});  // intensity
+        spans.push_back({4, 13, 0xFF});
+        spans.push_back({5, 18, 0xFF});  // scan angle
+        spans.push_back({5, 19, 0xFF});
+        spans.push_back({6, 17, 0xFF});  // user data
+        spans.push_back({7, 20, 0xFF});  // point source
+        spans.push_back({7, 21, 0xFF});
+        for (std::size_t b = 22; b < 30; ++b)
+            spans.push_back({8, b, 0xFF}); // GPS time
+        break;
+    }
+    case kRgb14:
+    case kRgbNir14:
+        layers = type == kRgbNir14 ? 2 : 1;
+        for (std::size_t b = 0; b < 6; ++b)
+            spans.push_back({0, b, 0xFF});
+        if (type == kRgbNir14) {
+            spans.push_back({1, 6, 0xFF});
+            spans.push_back({1, 7, 0xFF});
+        }
+        break;
+    default:
+        layers = size;
+        for (std::size_t b = 0; b < size; ++b)
+            spans.push_back({b, b, 0xFF});
+        break;
+    }
+    std::vector<std::vector<std::uint8_t>> masks(layers, std::vector<std::uint8_t>(size, 0));
+    for (const Span& span : spans)
+        masks[span.layer][span.byte] |= span.bits;
+    return masks;
+}
+
 } // namespace scandiff::io::detail::laz
