@@ -632,6 +632,52 @@ TEST(LasFormat, OriginFollowsOffsetBoundsAndOptions)
     EXPECT_NEAR(cloud.positions()[0].z(), 10.0f, 1e-6);
 }
 
+// Standard fields 0 in every record are left out before the cloud's arrays
+// are made: the records are read once for it, in blocks of 65,536 on every
+// core. Format 0's 20-byte records (the shortest), four blocks, each field's
+// only other value in another block.
+TEST(LasFormat, FieldsZeroInEveryRecordAreFoundBeforeTheArraysAreMade)
+{
+    const fs::path dir = test::tempDir();
+    const std::size_t n = 3 * 65536 + 5;
+    HeaderSpec s;
+    s.format = 0;
+    s.recordLength = 20;
+    s.count = n;
+    s.max[0] = s.max[1] = s.max[2] = 1.0;
+    Bytes b = makeHeader(s);
+    b.str().resize(227 + n * 20, '\0');
+    for (std::size_t i = 0; i < n; ++i)
+        b.put<std::uint8_t>(227 + i * 20 + 14, 1 | (1 << 3)); // return 1 of 1
+    b.put<std::uint8_t>(227 + 15, 2);                          // classification, first record only
+    b.put<std::uint16_t>(227 + 70000 * 20 + 18, 3);            // point source, second block
+    b.put<std::uint16_t>(227 + (n - 1) * 20 + 12, 7);          // intensity, last record
+    test::writeText(dir / "zeros.las", b.str());
+    PointCloud cloud = io::readPointCloud(lasRegistry(), dir / "zeros.las");
+    for (const char* dropped : {"user_data", "scan_angle", "scan_direction_flag", "edge_of_flight_line", "classification_flags"})
+        EXPECT_EQ(cloud.field(dropped), nullptr) << dropped;
+    ASSERT_NE(cloud.field("classification"), nullptr);
+    ASSERT_NE(cloud.field("point_source_id"), nullptr);
+    ASSERT_NE(cloud.field("intensity"), nullptr);
+    EXPECT_EQ(fieldValue(cloud, "classification", 0), 2.0);
+    EXPECT_EQ(fieldValue(cloud, "classification", 1), 0.0);
+    EXPECT_EQ(fieldValue(cloud, "point_source_id", 70000), 3.0);
+    EXPECT_EQ(fieldValue(cloud, "point_source_id", 69999), 0.0);
+    EXPECT_EQ(fieldValue(cloud, "intensity", n - 1), 7.0);
+    EXPECT_EQ(fieldValue(cloud, "intensity", n - 2), 0.0);
+    EXPECT_EQ(fieldValue(cloud, "number_of_returns", n - 1), 1.0);
+
+    // User data too in the last record: no field is 0 everywhere any more,
+    // which the blocks only know at the last one.
+    b.put<std::uint8_t>(227 + (n - 1) * 20 + 17, 9);
+    test::writeText(dir / "zeros.las", b.str());
+    cloud = io::readPointCloud(lasRegistry(), dir / "zeros.las");
+    ASSERT_NE(cloud.field("user_data"), nullptr);
+    EXPECT_EQ(fieldValue(cloud, "user_data", n - 1), 9.0);
+    EXPECT_EQ(fieldValue(cloud, "user_data", 0), 0.0);
+    EXPECT_EQ(cloud.field("scan_angle"), nullptr);
+}
+
 class CancelAtOnce : public ProgressObserver
 {
 public:
