@@ -807,6 +807,8 @@ bool fieldIsZeroIn(const std::vector<std::uint8_t>& zeroBits, int format, const 
 std::vector<std::uint8_t> lasBitsZeroInEveryRecord(const char* records, std::size_t count, std::size_t recordLength,
                                                    int format, const std::vector<std::string>& names)
 {
+    if (count == 0)
+        return std::vector<std::uint8_t>(recordLength, 0); // no record tells anything: every field is kept, empty
     std::vector<std::uint8_t> seen(recordLength, 0); // bits set in some record
     std::mutex seenMutex;
     std::atomic<bool> settled{false};
