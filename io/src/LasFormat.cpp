@@ -803,9 +803,11 @@ bool fieldIsZeroIn(const std::vector<std::uint8_t>& zeroBits, int format, const 
 //! The bits that are 0 in every one of `count` uncompressed records (a mask
 //! over the record, as lazBitsZeroInEveryRecord gives for LAZ), read in
 //! blocks on every core. Stops early once none of `names` can be 0
-//! everywhere any more, as in most files after the first block.
+//! everywhere any more, as in most files after the first block; throws
+//! Error(Cancelled) between blocks if the ticker's observer asks.
 std::vector<std::uint8_t> lasBitsZeroInEveryRecord(const char* records, std::size_t count, std::size_t recordLength,
-                                                   int format, const std::vector<std::string>& names)
+                                                   int format, const std::vector<std::string>& names,
+                                                   const ProgressTicker& ticker)
 {
     if (count == 0)
         return std::vector<std::uint8_t>(recordLength, 0); // no record tells anything: every field is kept, empty
@@ -822,6 +824,7 @@ std::vector<std::uint8_t> lasBitsZeroInEveryRecord(const char* records, std::siz
     tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t block) {
         if (settled.load(std::memory_order_relaxed))
             return;
+        ticker.checkCancel(); // a file of 100 M points takes seconds
         const std::size_t begin = block * kChunkPoints, end = std::min(count, begin + kChunkPoints);
         // The standard fields lie in bytes 12 to 37 (every record has 20
         // bytes at least): 8-byte words while the record holds them, then
@@ -1027,6 +1030,9 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
         if (!std::isfinite(gpsTimeOffset))
             gpsTimeOffset = 0.0;
     }
+    // From here on, so that the read of the records that finds the fields
+    // 0 everywhere can be cancelled too.
+    ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), count);
     std::vector<std::string> extraNames;
     std::vector<ExtraFieldFiller> extraFillers;
     try {
@@ -1041,7 +1047,7 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
             // uncompressed file's records are read once for it.
             const std::vector<std::uint8_t> zeroBits =
                 h.compressed ? lazBitsZeroInEveryRecord(file.data(), file.size(), chunks, *layout, h.recordLength)
-                             : lasBitsZeroInEveryRecord(records, count, h.recordLength, format, names);
+                             : lasBitsZeroInEveryRecord(records, count, h.recordLength, format, names, ticker);
             names.erase(std::remove_if(names.begin(), names.end(),
                                        [&](const std::string& name) { return fieldIsZeroIn(zeroBits, format, name); }),
                         names.end());
@@ -1107,7 +1113,6 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     out.nir = values("nir");
 
     const CoordinateTransform transform{h.scale, h.offset - cloud.origin()};
-    ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), count);
     if (h.compressed)
         parseLazRecords(file, h, *layout, chunks, first, count, transform, out, extraFillers, cloud, ticker);
     else

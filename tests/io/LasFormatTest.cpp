@@ -15,6 +15,8 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -698,6 +700,50 @@ TEST(LasFormat, CancellationThrowsCancelled)
     options.progress = &cancel;
     test::expectError([&] { io::readPointCloud(lasRegistry(), file, options); }, ErrorCode::Cancelled, fs::path(),
                 "cancelled");
+}
+
+//! Asks to cancel at the given poll, and counts the progress reported before.
+class CancelAtPoll : public ProgressObserver
+{
+public:
+    explicit CancelAtPoll(int poll) : poll_(poll) {}
+    void beginStage(const std::string&) override {}
+    void report(double fraction) override
+    {
+        if (fraction > 0)
+            ++reports;
+    }
+    bool cancelRequested() const override { return ++polls_ >= poll_; }
+    int reports = 0;
+
+private:
+    int poll_;
+    mutable std::atomic<int> polls_{0};
+};
+
+// The read of the records that finds the fields 0 everywhere (a whole pass
+// when one is, here user data) answers Cancel between its blocks, before the
+// parse has reported any progress: asked at the third poll (the ticker's own
+// first, then one per block), with four blocks of records.
+TEST(LasFormat, CancelIsHeardWhileTheRecordsAreReadForZeroFields)
+{
+    const std::size_t n = 3 * 65536 + 5;
+    HeaderSpec s;
+    s.format = 0;
+    s.recordLength = 20;
+    s.count = n;
+    Bytes b = makeHeader(s);
+    b.str().resize(227 + n * 20, '\0');
+    for (std::size_t i = 0; i < n; ++i)
+        b.put<std::uint16_t>(227 + i * 20 + 12, static_cast<std::uint16_t>(i)); // intensity
+    const fs::path file = test::tempDir() / "cancel_scan.las";
+    test::writeText(file, b.str());
+    CancelAtPoll cancel(3);
+    io::ReadOptions options;
+    options.progress = &cancel;
+    test::expectError([&] { io::readPointCloud(lasRegistry(), file, options); }, ErrorCode::Cancelled, fs::path(),
+                      "cancelled");
+    EXPECT_EQ(cancel.reports, 0) << "cancelled in the parse, not in the read before it";
 }
 
 // ---------------------------------------------------------------------------
