@@ -7,6 +7,7 @@
 //
 //   scandiff-laz-decode FILE.laz [THREADS=1] [RUNS=3]
 
+#include "internal/LasLayout.h"
 #include "internal/LazDecoder.h"
 
 #include <tbb/global_control.h>
@@ -52,23 +53,27 @@ int main(int argc, char** argv)
         const int runs = argc > 3 ? std::max(1, std::atoi(argv[3])) : 3;
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
 
-        // LAS header: its size, the offset to the points, the VLR count, the
-        // record length, and the point count (64-bit from LAS 1.4 on).
-        std::size_t vlr = at<std::uint16_t>(bytes, 94), payload = 0, payloadLength = 0;
-        for (std::uint32_t v = 0; v < at<std::uint32_t>(bytes, 100); ++v) {
+        // The LAS header's fields this needs (the reader's parser is private
+        // to LasFormat.cpp); a VLR header holds its record id at byte 18 and
+        // its payload length at byte 20.
+        using namespace las;
+        std::size_t vlr = at<std::uint16_t>(bytes, hdr::headerSize), payload = 0, payloadLength = 0;
+        for (std::uint32_t v = 0; v < at<std::uint32_t>(bytes, hdr::vlrCount); ++v) {
             if (at<std::uint16_t>(bytes, vlr + 18) == kLaszipRecordId) {
-                payload = vlr + 54;
+                payload = vlr + kVlrHeaderSize;
                 payloadLength = at<std::uint16_t>(bytes, vlr + 20);
                 break;
             }
-            vlr += 54 + at<std::uint16_t>(bytes, vlr + 20);
+            vlr += kVlrHeaderSize + at<std::uint16_t>(bytes, vlr + 20);
         }
         if (payload == 0)
             throw std::runtime_error("no LASzip record: not a LAZ file");
-        const std::size_t recordLength = at<std::uint16_t>(bytes, 105);
-        const std::uint64_t count = at<std::uint8_t>(bytes, 25) >= 4 ? at<std::uint64_t>(bytes, 247) : at<std::uint32_t>(bytes, 107);
+        const std::size_t recordLength = at<std::uint16_t>(bytes, hdr::recordLength);
+        const std::uint64_t count = at<std::uint8_t>(bytes, hdr::versionMinor) >= 4 ? at<std::uint64_t>(bytes, hdr::pointCount)
+                                                                                     : at<std::uint32_t>(bytes, hdr::legacyPointCount);
         const LazLayout layout = parseLazLayout(argv[1], bytes.data() + payload, payloadLength, recordLength);
-        const auto chunks = readLazChunks(argv[1], bytes.data(), bytes.size(), at<std::uint32_t>(bytes, 96), layout, recordLength, count);
+        const auto chunks = readLazChunks(argv[1], bytes.data(), bytes.size(), at<std::uint32_t>(bytes, hdr::offsetToPoints), layout,
+                                          recordLength, count);
 
         double best = 1e300;
         std::uint64_t checksum = 0; // one byte of every 997th record, so that nothing is optimised away
