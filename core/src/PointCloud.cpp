@@ -99,6 +99,16 @@ ScalarField& PointCloud::addField(ScalarField newField)
     return fields_.back();
 }
 
+ScalarField& PointCloud::addField(ScalarField newField, std::size_t position)
+{
+    if (field(newField.name()))
+        return addField(std::move(newField));
+    const std::size_t at = std::min(position, fields_.size());
+    addField(std::move(newField)); // checks the size
+    std::rotate(fields_.begin() + static_cast<std::ptrdiff_t>(at), fields_.end() - 1, fields_.end());
+    return fields_[at];
+}
+
 bool PointCloud::removeField(const std::string& fieldName)
 {
     auto it = std::find_if(fields_.begin(), fields_.end(), [&](const ScalarField& f) { return f.name() == fieldName; });

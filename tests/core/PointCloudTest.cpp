@@ -120,6 +120,27 @@ TEST(PointCloud, FieldsByName)
     EXPECT_EQ(c.colors().size(), 5u);
 }
 
+TEST(PointCloud, FieldsAddedAtAPositionKeepTheOrderAroundThem)
+{
+    PointCloud c = threePoints(); // intensity
+    c.addField("distance");
+    ScalarField& first = c.addField(ScalarField("first", 3), 0);
+    EXPECT_EQ(first.name(), "first");
+    c.addField(ScalarField("middle", 3), 2);
+    c.addField(ScalarField("last", 3), 99);
+    std::vector<std::string> names;
+    for (const ScalarField& f : c.fields())
+        names.push_back(f.name());
+    EXPECT_EQ(names, (std::vector<std::string>{"first", "intensity", "middle", "distance", "last"}));
+    // A field of a name already there replaces it where it is.
+    ScalarField replacement("middle", 3);
+    replacement.setValue(1, 7.0);
+    EXPECT_EQ(c.addField(std::move(replacement), 0).value(1), 7.0);
+    EXPECT_EQ(c.fields()[2].name(), "middle");
+    EXPECT_EQ(c.fields().size(), 5u);
+    EXPECT_THROW(c.addField(ScalarField("wrong", 2), 1), Error);
+}
+
 TEST(ScalarField, RangeWithOffsetKeepsLargeValuesPrecise)
 {
     ScalarField gps("gps_time", 3);

@@ -104,6 +104,9 @@ public:
     ScalarField& addField(const std::string& name);
     //! Adds a field built elsewhere; its size must equal size(). Replaces a field of the same name.
     ScalarField& addField(ScalarField field);
+    //! The same, the new field placed before the field at `position` (at the
+    //! end past the last): readers keep a file's order of attributes.
+    ScalarField& addField(ScalarField field, std::size_t position);
     bool removeField(const std::string& name);
 
     //! Scanner poses this cloud was acquired from (visibility needs them).
