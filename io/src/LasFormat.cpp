@@ -853,12 +853,16 @@ void parseRecordsInMemory(const LasHeader& h, const char* records, std::size_t c
 //! workers as they decode each chunk, Extra Bytes included: no buffer of
 //! every record (a file of 10 M points in format 7 would need 360 MB more)
 //! and both cores parse.
+//! With `channel`, the scanner channel is made there once a chunk has a
+//! point of a channel other than 0 (see readLas), else left out.
 void parseLazRecords(const MappedFile& file, const LasHeader& h, const LazLayout& layout,
                      const std::vector<LazChunk>& chunks, std::uint64_t first, std::size_t count,
                      const CoordinateTransform& transform, const PointOutputs& out,
-                     const std::vector<ExtraFieldFiller>& extras, PointCloud& cloud, ProgressTicker& ticker)
+                     const std::vector<ExtraFieldFiller>& extras, PointCloud& cloud, ProgressTicker& ticker,
+                     std::optional<ScalarField>* channel)
 {
     const DecodeFunction decode = decoderFor(h.pointFormat);
+    std::once_flag channelMade;
     std::atomic<unsigned> colorBits{0};
     std::atomic<bool> gpsTimeResidualFailed{false};
     // Runs of points whose colours were taken as 8-bit values because none of
@@ -870,7 +874,22 @@ void parseLazRecords(const MappedFile& file, const LasHeader& h, const LazLayout
         file.path(), file.data(), file.size(), chunks, layout, h.recordLength, first, count,
         [&](std::uint64_t firstPoint, const char* records, std::size_t n) {
             const auto at = static_cast<std::size_t>(firstPoint - first);
-            const DecodedFacts facts = decode(records, h.recordLength, n, at, transform, out);
+            PointOutputs chunkOut = out;
+            if (channel) {
+                // Bits 4-5 of byte 15 (formats 6-10).
+                unsigned bits = 0;
+                for (std::size_t i = 0; i < n; ++i)
+                    bits |= static_cast<unsigned char>(records[i * h.recordLength + 15]);
+                if (bits & 0x30) {
+                    std::call_once(channelMade, [&] {
+                        // Zeros: the chunks parsed before had channel 0.
+                        channel->emplace("scanner_channel");
+                        (*channel)->values().assign(count, 0.0f);
+                    });
+                    chunkOut.scannerChannel = (*channel)->values().data();
+                }
+            }
+            const DecodedFacts facts = decode(records, h.recordLength, n, at, transform, chunkOut);
             for (const ExtraFieldFiller& extra : extras)
                 extra.fill(records, h.recordLength, n, at);
             colorBits.fetch_or(facts.colorBits, std::memory_order_relaxed);
@@ -950,6 +969,9 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     ProgressTicker ticker(options.progress, "Reading " + path.filename().string(), count);
     std::vector<std::string> extraNames;
     std::vector<ExtraFieldFiller> extraFillers;
+    // When the scanner channel is left to the parse to make (LAZ): made or not.
+    bool channelDeferred = false;
+    std::optional<ScalarField> deferredChannel;
     try {
         // A fresh array's pages are zeroed by the kernel as they are first
         // touched, a fifth to a half of a read's time on this machine: the
@@ -966,6 +988,16 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
             names.erase(std::remove_if(names.begin(), names.end(),
                                        [&](const std::string& name) { return fieldIsZeroIn(zeroBits, format, name); }),
                         names.end());
+            // LAZ codes the scanner channel in the x, y layer, which no chunk
+            // leaves empty: only decoding tells whether it is 0 everywhere,
+            // as it is in most files. It is made once a chunk shows another
+            // channel (parseLazRecords), not made and then dropped (4 bytes a
+            // point).
+            const auto channel = std::find(names.begin(), names.end(), "scanner_channel");
+            if (h.compressed && channel != names.end()) {
+                names.erase(channel);
+                channelDeferred = true;
+            }
         }
         std::vector<ScalarField> standard(names.size());
         tbb::parallel_invoke(
@@ -1029,11 +1061,25 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
 
     const CoordinateTransform transform{h.scale, h.offset - cloud.origin()};
     if (h.compressed)
-        parseLazRecords(file, h, *layout, chunks, first, count, transform, out, extraFillers, cloud, ticker);
+        parseLazRecords(file, h, *layout, chunks, first, count, transform, out, extraFillers, cloud, ticker,
+                        channelDeferred ? &deferredChannel : nullptr);
     else
         parseRecordsInMemory(h, records, count, transform, out, extraFillers, cloud, ticker);
     for (ExtraFieldFiller& extra : extraFillers)
         extra.finish();
+    if (deferredChannel) {
+        // At its place among the standard fields, as the LAS reader has it.
+        const std::vector<std::string> standard = standardFieldNames(format);
+        const auto rank = std::find(standard.begin(), standard.end(), "scanner_channel") - standard.begin();
+        std::size_t position = 0;
+        while (position < cloud.fields().size()) {
+            const auto other = std::find(standard.begin(), standard.end(), cloud.fields()[position].name());
+            if (other == standard.end() || other - standard.begin() > rank)
+                break;
+            ++position;
+        }
+        cloud.addField(std::move(*deferredChannel), position);
+    }
 
     // A standard attribute that is 0 for every point (user_data, scanner_channel,
     // flags... in most files) carries nothing: dropping it saves 4 bytes per point

@@ -673,6 +673,48 @@ TEST(LazFormat, FieldsTheLayersShowToBeZeroEverywhereAreNotMade)
     EXPECT_NE(range.field("classification_flags"), nullptr);
 }
 
+TEST(LazFormat, TheScannerChannelIsMadeOnceAChunkShowsAChannelOtherThanZero)
+{
+    // The channel is coded in the x, y layer, which no chunk leaves empty:
+    // the reader makes its field only when a decoded chunk has a point of a
+    // channel other than 0, and puts it where the LAS reader has it.
+    const fs::path dir = test::tempDir();
+    auto names = [](const PointCloud& cloud) {
+        std::vector<std::string> out;
+        for (const ScalarField& f : cloud.fields())
+            out.push_back(f.name());
+        return out;
+    };
+    auto twins = [&](const PointCloud& cloud, const std::string& name) {
+        io::writePointCloud(registry(), cloud, dir / (name + ".las"));
+        io::writePointCloud(registry(), cloud, dir / (name + ".laz"));
+        const PointCloud las = io::readPointCloud(registry(), dir / (name + ".las"));
+        PointCloud laz = io::readPointCloud(registry(), dir / (name + ".laz"));
+        expectSameClouds(las, laz, name);
+        EXPECT_EQ(names(laz), names(las)) << name;
+        return laz;
+    };
+    PointCloud cloud = varyingCloud(120000, true, false, 12); // chunks of 50,000
+    ScalarField& channel = *cloud.field("scanner_channel");
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        channel.setValue(i, 0.0);
+    EXPECT_EQ(twins(cloud, "channel0").field("scanner_channel"), nullptr);
+
+    // Channels in the third chunk only, then in the first and the third:
+    // the chunks decoded before the field is made stay 0.
+    channel.setValue(100001, 2.0);
+    channel.setValue(100002, 3.0);
+    const PointCloud third = twins(cloud, "third_chunk");
+    ASSERT_NE(third.field("scanner_channel"), nullptr);
+    EXPECT_EQ(third.field("scanner_channel")->value(100002), 3.0);
+    EXPECT_EQ(third.field("scanner_channel")->value(0), 0.0);
+    channel.setValue(7, 1.0);
+    const PointCloud both = twins(cloud, "first_and_third");
+    ASSERT_NE(both.field("scanner_channel"), nullptr);
+    EXPECT_EQ(both.field("scanner_channel")->value(7), 1.0);
+    EXPECT_EQ(both.field("scanner_channel")->value(60000), 0.0);
+}
+
 TEST(LazFormat, ExtraBytesAreTakenChunkByChunkAsTheWorkersDecode)
 {
     // An extra dimension's offset comes from its first value in the read:
