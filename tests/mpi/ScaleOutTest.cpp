@@ -145,8 +145,9 @@ protected:
             ASSERT_EQ(got.hasNormals(), expected.hasNormals());
             for (std::size_t i = 0; i < got.size(); ++i) {
                 ASSERT_EQ(got.globalPosition(i), expected.globalPosition(i)) << "point " << i;
-                if (got.hasNormals())
+                if (got.hasNormals()) {
                     ASSERT_EQ(got.normals()[i], expected.normals()[i]) << ranks << " ranks, normal of point " << i;
+                }
             }
             ASSERT_EQ(got.fields().size(), expected.fields().size());
             for (const std::string& name : fields) {
