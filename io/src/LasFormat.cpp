@@ -650,11 +650,16 @@ Eigen::Vector3d chooseOrigin(const LasHeader& h, const char* firstRecord, const 
     return suggestOrigin(box);
 }
 
-std::string uniqueFieldName(const PointCloud& cloud, std::string name)
+//! An Extra Bytes dimension's field name: its own unless the cloud has that
+//! field or it is one of the format's standard attributes (`standard`), made
+//! or not. Then a suffix: the name does not depend on which standard fields
+//! the points leave at 0, and a field made later (the LAZ scanner channel)
+//! never meets it.
+std::string uniqueFieldName(const PointCloud& cloud, std::string name, const std::vector<std::string>& standard)
 {
     if (name.empty())
         name = "extra";
-    if (!cloud.field(name))
+    if (!cloud.field(name) && std::find(standard.begin(), standard.end(), name) == standard.end())
         return name;
     for (int k = 2;; ++k) {
         std::string candidate = name + "_" + std::to_string(k);
@@ -883,8 +888,13 @@ void parseLazRecords(const MappedFile& file, const LasHeader& h, const LazLayout
                 if (bits & 0x30) {
                     std::call_once(channelMade, [&] {
                         // Zeros: the chunks parsed before had channel 0.
-                        channel->emplace("scanner_channel");
-                        (*channel)->values().assign(count, 0.0f);
+                        try {
+                            channel->emplace("scanner_channel");
+                            (*channel)->values().assign(count, 0.0f);
+                        } catch (const std::bad_alloc&) {
+                            throw Error(ErrorCode::Io, file.path().string() + ": not enough memory for the scanner channel of " +
+                                                           std::to_string(count) + " points");
+                        }
                     });
                     chunkOut.scannerChannel = (*channel)->values().data();
                 }
@@ -972,11 +982,12 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     // When the scanner channel is left to the parse to make (LAZ): made or not.
     bool channelDeferred = false;
     std::optional<ScalarField> deferredChannel;
+    const std::vector<std::string> standardNames = standardFieldNames(format);
     try {
         // A fresh array's pages are zeroed by the kernel as they are first
         // touched, a fifth to a half of a read's time on this machine: the
         // arrays are made on both cores, the positions beside the fields.
-        std::vector<std::string> names = standardFieldNames(format);
+        std::vector<std::string> names = standardNames;
         if (!range) {
             // Fields 0 in every record are not made at all (the reader would
             // drop them once read, below): no pages to zero, fill and write
@@ -1022,7 +1033,7 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
         for (ScalarField& field : standard)
             cloud.addField(std::move(field));
         for (const ExtraDimension& dim : extras) {
-            extraNames.push_back(uniqueFieldName(cloud, dim.name));
+            extraNames.push_back(uniqueFieldName(cloud, dim.name, standardNames));
             cloud.addField(ScalarField(extraNames.back(), count));
         }
         // Once every field exists (adding one moves the others).
@@ -1069,12 +1080,11 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
         extra.finish();
     if (deferredChannel) {
         // At its place among the standard fields, as the LAS reader has it.
-        const std::vector<std::string> standard = standardFieldNames(format);
-        const auto rank = std::find(standard.begin(), standard.end(), "scanner_channel") - standard.begin();
+        const auto rank = std::find(standardNames.begin(), standardNames.end(), "scanner_channel") - standardNames.begin();
         std::size_t position = 0;
         while (position < cloud.fields().size()) {
-            const auto other = std::find(standard.begin(), standard.end(), cloud.fields()[position].name());
-            if (other == standard.end() || other - standard.begin() > rank)
+            const auto other = std::find(standardNames.begin(), standardNames.end(), cloud.fields()[position].name());
+            if (other == standardNames.end() || other - standardNames.begin() > rank)
                 break;
             ++position;
         }

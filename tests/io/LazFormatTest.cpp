@@ -713,6 +713,34 @@ TEST(LazFormat, TheScannerChannelIsMadeOnceAChunkShowsAChannelOtherThanZero)
     ASSERT_NE(both.field("scanner_channel"), nullptr);
     EXPECT_EQ(both.field("scanner_channel")->value(7), 1.0);
     EXPECT_EQ(both.field("scanner_channel")->value(60000), 0.0);
+
+    // An Extra Bytes dimension named as the standard attribute (its name
+    // patched in both files): it takes a suffix whether the channel is made
+    // or not, and the channel made late never meets it.
+    auto renamedTwins = [&](const std::string& name) {
+        for (const char* extension : {".las", ".laz"}) {
+            std::string bytes = fileBytes(dir / (name + extension));
+            const std::string from("amplitude\0\0\0\0\0\0\0", 16), to("scanner_channel\0", 16);
+            const std::size_t at = bytes.find(from);
+            EXPECT_NE(at, std::string::npos) << name << extension;
+            if (at != std::string::npos)
+                bytes.replace(at, 16, to);
+            test::writeText(dir / ("renamed_" + name + extension), bytes);
+        }
+        const PointCloud las = io::readPointCloud(registry(), dir / ("renamed_" + name + ".las"));
+        PointCloud laz = io::readPointCloud(registry(), dir / ("renamed_" + name + ".laz"));
+        expectSameClouds(las, laz, "renamed " + name);
+        EXPECT_EQ(names(laz), names(las)) << name;
+        const ScalarField* extra = laz.field("scanner_channel_2");
+        EXPECT_NE(extra, nullptr) << name;
+        if (extra)
+            EXPECT_EQ(extra->value(100002), cloud.field("amplitude")->value(100002)) << name;
+        return laz;
+    };
+    EXPECT_EQ(renamedTwins("channel0").field("scanner_channel"), nullptr);
+    const PointCloud renamed = renamedTwins("first_and_third");
+    ASSERT_NE(renamed.field("scanner_channel"), nullptr);
+    EXPECT_EQ(renamed.field("scanner_channel")->value(100002), 3.0);
 }
 
 TEST(LazFormat, ExtraBytesAreTakenChunkByChunkAsTheWorkersDecode)
