@@ -12,6 +12,9 @@
 #include <scandiff/core/Log.h>
 #include <scandiff/core/Progress.h>
 
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -492,17 +495,27 @@ private:
     void allocate()
     {
         const std::size_t n = static_cast<std::size_t>(records_);
+        // The kernel zeroes a new array's pages as they are first touched, a
+        // sixth of a read on one core: the arrays are made on both.
+        std::vector<ScalarField> made(layout_.copied.size());
         try {
-            cloud_.resize(n);
-            if (layout_.colour[0] >= 0)
-                cloud_.enableColors();
-            if (layout_.normal[0] >= 0)
-                cloud_.enableNormals();
-            for (const auto& copied : layout_.copied) {
-                ScalarField& field = cloud_.addField(ScalarField(copied.fieldName, n));
-                if (copied.exact)
-                    field.keepDoubles();
-            }
+            tbb::parallel_invoke(
+                [&] {
+                    cloud_.resize(n);
+                    if (layout_.colour[0] >= 0)
+                        cloud_.enableColors();
+                    if (layout_.normal[0] >= 0)
+                        cloud_.enableNormals();
+                },
+                [&] {
+                    tbb::parallel_for(std::size_t(0), made.size(), [&](std::size_t f) {
+                        made[f] = ScalarField(layout_.copied[f].fieldName, n);
+                        if (layout_.copied[f].exact)
+                            made[f].keepDoubles();
+                    });
+                });
+            for (ScalarField& field : made)
+                cloud_.addField(std::move(field));
         } catch (const std::bad_alloc&) {
             throw Error(ErrorCode::Io, context_ + ": not enough memory to load " + std::to_string(records_) + " points");
         } catch (const std::length_error&) {
@@ -574,7 +587,10 @@ private:
                     for (int c = 0; c < 3; ++c) {
                         const double span = layout_.colourMax[c] - layout_.colourMin[c];
                         const double scaled = span > 0 ? (value(layout_.colour[c], k) - layout_.colourMin[c]) * 255.0 / span : 0.0;
-                        *channel[c] = static_cast<std::uint8_t>(std::clamp(std::lround(scaled), 0L, 255L));
+                        // Into [0, 255] (NaN: 0), then rounded half up: a
+                        // call of llround per channel was a twentieth of a read.
+                        const double clamped = std::isnan(scaled) ? 0.0 : std::clamp(scaled, 0.0, 255.0);
+                        *channel[c] = static_cast<std::uint8_t>(clamped + 0.5);
                     }
                 }
             }
