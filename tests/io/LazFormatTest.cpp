@@ -26,6 +26,7 @@
 #include <sstream>
 #include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -537,6 +538,20 @@ std::string compressLikeTemplate(const std::string& las, const std::string& lazT
     return out.str();
 }
 
+//! Writes `las` (records patched) as NAME.las in `dir` and its records
+//! compressed as `lazTemplate` lays them out as NAME.laz, checks that both read
+//! as the same cloud, and returns both reads (LAS, LAZ).
+std::pair<PointCloud, PointCloud> expectPatchedTwins(const fs::path& dir, const std::string& name, const std::string& las,
+                                                     const std::string& lazTemplate)
+{
+    test::writeText(dir / (name + ".las"), las);
+    test::writeText(dir / (name + ".laz"), compressLikeTemplate(las, lazTemplate));
+    std::pair<PointCloud, PointCloud> twins{io::readPointCloud(registry(), dir / (name + ".las")),
+                                            io::readPointCloud(registry(), dir / (name + ".laz"))};
+    expectSameClouds(twins.first, twins.second, name);
+    return twins;
+}
+
 //! varyingCloud() without its two Extra Bytes dimensions.
 PointCloud standardCloud(std::size_t count, bool colours, bool nir, unsigned seed)
 {
@@ -583,13 +598,7 @@ TEST(LazFormat, ChunkByChunkParsingGivesTheLasTwinsCloud)
     };
     for (std::size_t i = 0; i < 50000; ++i)
         setColour(i, static_cast<std::uint16_t>(i % 256), static_cast<std::uint16_t>((i / 7) % 256), 200);
-    auto expectTwins = [&](const std::string& name) -> PointCloud {
-        test::writeText(dir / (name + ".las"), las);
-        test::writeText(dir / (name + ".laz"), compressLikeTemplate(las, lazTemplate));
-        PointCloud fromLas = io::readPointCloud(registry(), dir / (name + ".las"));
-        expectSameClouds(fromLas, io::readPointCloud(registry(), dir / (name + ".laz")), name);
-        return fromLas;
-    };
+    auto expectTwins = [&](const std::string& name) { return expectPatchedTwins(dir, name, las, lazTemplate).first; };
     const PointCloud mixed = expectTwins("mixed_colours");
     EXPECT_EQ(mixed.colors()[255], (Rgb8{1, 0, 1})) << "200 of 65535 is 1 of 255";
     // Every chunk fits: 8-bit colours, taken as they are.
@@ -621,13 +630,7 @@ TEST(LazFormat, FieldsTheLayersShowToBeZeroEverywhereAreNotMade)
     std::string las = fileBytes(dir / "zeros.las");
     const std::size_t start = at<std::uint32_t>(las, kOffsetToPoints), length = at<std::uint16_t>(las, kRecordLength);
     auto record = [&](std::size_t i) { return start + i * length; };
-    auto twins = [&](const std::string& name) {
-        test::writeText(dir / (name + ".las"), las);
-        test::writeText(dir / (name + ".laz"), compressLikeTemplate(las, lazTemplate));
-        PointCloud fromLaz = io::readPointCloud(registry(), dir / (name + ".laz"));
-        expectSameClouds(io::readPointCloud(registry(), dir / (name + ".las")), fromLaz, name);
-        return fromLaz;
-    };
+    auto twins = [&](const std::string& name) { return expectPatchedTwins(dir, name, las, lazTemplate).second; };
     // User data (byte 17) 0 everywhere, and of the flags byte (15) only the
     // scanner channel's bits left.
     for (std::size_t i = 0; i < 120000; ++i) {
