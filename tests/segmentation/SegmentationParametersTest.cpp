@@ -45,7 +45,7 @@ TEST(SegmentationParameters, NamesAreUniqueAndDefaultsComeFromTheStructs)
     const ParameterValues defaults = resolve({});
     EXPECT_EQ(defaults.integer("neighbours"), LocalChiSquareParams{}.neighbours);
     EXPECT_EQ(defaults.real("alpha"), PropagationParams{}.alpha);
-    EXPECT_EQ(defaults.integer("min-points"), static_cast<std::int64_t>(ConnectedComponentsParams{}.minPoints));
+    EXPECT_EQ(defaults.integer("min-points"), kDefaultMinRegionPoints);
     EXPECT_FALSE(defaults.has("above"));
 }
 

@@ -142,7 +142,14 @@ TEST(LocalChiSquare, LabelsADiscOffsetByFiveSigma)
         params.confidence = 0.999;
         const LocalChiSquareResult r = localChiSquareTest(cloud, "distance", params);
         EXPECT_EQ(r.classes, 4);
-        EXPECT_NEAR(r.threshold, 16.266236, 1e-4);
+        // The tabulated quantile, and the calibrated cut: independent noise
+        // values spread as chi-square says (lambda near 1), never below it.
+        EXPECT_NEAR(r.quantileThreshold, 16.266236, 1e-4);
+        EXPECT_GE(r.threshold, r.quantileThreshold);
+        EXPECT_LT(r.nullScale, 1.1) << noiseModelName(model);
+        LocalChiSquareParams tabulated = params;
+        tabulated.calibration = NullCalibration::Tabulated;
+        EXPECT_NEAR(localChiSquareTest(cloud, "distance", tabulated).threshold, 16.266236, 1e-4);
         EXPECT_EQ(r.chiSquare.name(), "chi2");
         const double f1 = f1Score(r.changed, truth);
         EXPECT_GE(f1, 0.95) << noiseModelName(model);

@@ -59,6 +59,12 @@ const std::vector<ParameterSpec>& segmentationParameters()
             ParameterSpec::real("confidence", "Confidence", "stat-test: confidence of the test (the chi-square quantile)",
                                 chi.confidence, 0.5, 0.999999)
                 .onlyWith("stat-test"),
+            ParameterSpec::choice("calibration", "Null distribution",
+                                  "stat-test: spatial: the cut is the quantile scaled by how much more the chi-square distances of "
+                                  "this field spread than independent draws would (neighbouring distances are correlated; fitted on "
+                                  "the data); tabulated: the textbook quantile (thesis 000 eq. 3.2)",
+                                  {"spatial", "tabulated"}, nullCalibrationName(chi.calibration))
+                .onlyWith("stat-test"),
             ParameterSpec::real("chi2-threshold", "Chi-square cut", "stat-test: cut on the chi-square distance instead of the quantile",
                                 20.0, 0.0, 1e12)
                 .asOptional()
@@ -84,8 +90,11 @@ const std::vector<ParameterSpec>& segmentationParameters()
                                   {"6", "18", "26"}, "26")
                 .onlyWith("components"),
             // Used by every mode (components, propagation, the single region): always shown.
-            ParameterSpec::integer("min-points", "Minimum region size", "Smaller regions are dropped",
-                                   static_cast<std::int64_t>(cc.minPoints), 1, 1000000000, "points"),
+            // 10 as CloudCompare's connected components: a test at 99 % flags
+            // about 1 % of the unchanged points, scattered in specks of a few
+            // points that are no change anyone can act on.
+            ParameterSpec::integer("min-points", "Minimum region size", "Smaller regions are dropped", kDefaultMinRegionPoints, 1,
+                                   1000000000, "points"),
             ParameterSpec::boolean("propagate", "Front propagation",
                                    "Segment by gradient-constrained fast marching (§3.3) instead of a classification", false),
             ParameterSpec::real("alpha", "Alpha", "propagate: speed exp(alpha (|grad|_j - |grad|_i)) (eq. 3.11)", propagation.alpha,
@@ -228,6 +237,7 @@ SegmentationRun runSegmentation(const PointCloud& cloud, const ParameterValues& 
         p.model = parseNoiseModel(values.text("stat-test"));
         p.neighbours = static_cast<int>(values.integer("neighbours"));
         p.confidence = values.real("confidence");
+        p.calibration = parseNullCalibration(values.text("calibration"));
         if (values.has("chi2-threshold"))
             p.threshold = values.real("chi2-threshold");
         if (values.has("noise")) {
@@ -269,7 +279,13 @@ SegmentationRun runSegmentation(const PointCloud& cloud, const ParameterValues& 
             summary << "mean " << r.noise.mean << " sigma " << r.noise.sigma;
         else
             summary << "shape " << r.noise.shape << " scale " << r.noise.scale;
-        summary << ", n " << p.neighbours << ", " << r.classes << " classes, cut " << r.threshold << ")";
+        if (r.fitRejected > 0)
+            summary << ", fitted without " << r.fitRejected << " values beyond the noise";
+        summary << ", n " << p.neighbours << ", " << r.classes << " classes, cut " << r.threshold;
+        if (!p.threshold && p.calibration == NullCalibration::Spatial)
+            summary << " (spatial calibration on " << r.nullScalePoints << " quiet points: " << r.nullScale << " x the tabulated "
+                    << r.quantileThreshold << ", their own quantile " << r.empiricalThreshold << ")";
+        summary << ")";
         changed = std::move(r.changed);
         run.fields.push_back(std::move(r.chiSquare));
     }

@@ -8,7 +8,6 @@
 #include "Neighbourhoods.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -264,6 +263,179 @@ NoiseDistribution fitNoise(const ScalarField& field, NoiseModel model, const std
     }
 }
 
+namespace {
+
+//! The standard normal quantile, by Newton steps on the CDF from a logistic guess.
+double normalQuantile(double p)
+{
+    double z = std::log(p / (1 - p)) / 1.702;
+    for (int it = 0; it < 50; ++it) {
+        const double density = std::exp(-0.5 * z * z) / std::sqrt(2 * 3.14159265358979323846);
+        const double step = (normalCdf(z) - p) / density;
+        z -= step;
+        if (std::abs(step) < 1e-12)
+            break;
+    }
+    return z;
+}
+
+//! The model fitted to the sorted values' probability plot by least squares
+//! over the plotting positions [low, high] (Bernard's median ranks
+//! (i - 0.3) / (m + 0.4)): the Gaussian's x against the normal quantile
+//! (slope sigma, intercept the mean), the Weibull's ln x against
+//! ln(-ln(1 - F)) (slope 1 / shape). Only the values between those positions
+//! count, so a minority of changed values beyond them does not move the fit.
+NoiseDistribution fitProbabilityPlot(const std::vector<double>& sorted, NoiseModel model, double low, double high)
+{
+    const double m = static_cast<double>(sorted.size());
+    double sx = 0, sy = 0, sxx = 0, sxy = 0, count = 0; // x: the model's ordinate, y: the data
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+        const double f = (static_cast<double>(i) + 0.7) / (m + 0.4);
+        if (f < low || f > high)
+            continue;
+        const double x = model == NoiseModel::Gaussian ? normalQuantile(f) : std::log(-std::log1p(-f));
+        const double y = model == NoiseModel::Gaussian ? sorted[i] : std::log(sorted[i]);
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+        ++count;
+    }
+    NoiseDistribution d;
+    d.model = model;
+    const double spread = sxx - sx * sx / count;
+    const double slope = count >= 2 && spread > 0 ? (sxy - sx * sy / count) / spread : 0.0;
+    if (!(slope > 0))
+        throw Error(ErrorCode::InvalidData, std::string(noiseModelName(model)) + " fit: the central values are all equal (zero spread)");
+    const double intercept = (sy - slope * sx) / count;
+    if (model == NoiseModel::Gaussian) {
+        d.mean = intercept;
+        d.sigma = slope;
+    } else {
+        d.shape = 1.0 / slope;
+        d.scale = std::exp(intercept);
+    }
+    return d;
+}
+
+//! The values the model counts as noise: within its 0.9999 quantile
+//! (the Gaussian: within 3.89 sigma either side).
+bool withinNoise(const NoiseDistribution& d, double v)
+{
+    if (d.model == NoiseModel::Gaussian)
+        return std::abs(v - d.mean) <= 3.8906 * d.sigma;
+    return std::abs(v) <= d.scale * std::pow(-std::log(1e-4), 1.0 / d.shape);
+}
+
+} // namespace
+
+NoiseDistribution fitNoiseRobust(const std::vector<double>& samples, NoiseModel model, std::size_t* rejected)
+{
+    std::vector<double> values;
+    values.reserve(samples.size());
+    for (double v : samples)
+        if (std::isfinite(v) && (model == NoiseModel::Gaussian || v != 0.0))
+            values.push_back(model == NoiseModel::Gaussian ? v : std::abs(v));
+    if (values.size() < 20)
+        return fitNoise(samples, model); // too few to tell noise from change: the plain fit and its errors
+    std::sort(values.begin(), values.end());
+    // The bulk first (the quartiles for the Gaussian, whose changes may lie
+    // either side; 5-75 % for the Weibull of unsigned values, whose changes
+    // are large), then, without the values beyond it, the plot over 5-90 %
+    // (10-90 % for the Gaussian), which the test's outer classes need.
+    NoiseDistribution d = model == NoiseModel::Gaussian ? fitProbabilityPlot(values, model, 0.25, 0.75)
+                                                        : fitProbabilityPlot(values, model, 0.05, 0.75);
+    std::vector<double> noise;
+    for (int round = 0; round < 3; ++round) {
+        noise.clear();
+        for (double v : values)
+            if (withinNoise(d, v))
+                noise.push_back(v);
+        if (noise.size() < 20)
+            break;
+        d = fitProbabilityPlot(noise, model, model == NoiseModel::Gaussian ? 0.1 : 0.05, 0.9);
+    }
+    if (rejected)
+        *rejected = values.size() - noise.size();
+    return d;
+}
+
+NullCalibration parseNullCalibration(const std::string& name)
+{
+    if (name == "spatial")
+        return NullCalibration::Spatial;
+    if (name == "tabulated")
+        return NullCalibration::Tabulated;
+    throw Error(ErrorCode::InvalidArgument, "unknown calibration '" + name + "' (expected spatial or tabulated)");
+}
+
+const char* nullCalibrationName(NullCalibration calibration)
+{
+    return calibration == NullCalibration::Spatial ? "spatial" : "tabulated";
+}
+
+namespace {
+
+//! lambda such that d ~ lambda chi-square(dof) best matches the lower three
+//! quarters of the observed distances' distribution: least squares between
+//! their mid-distribution function (d takes discrete values: at a value, the
+//! mean of the distribution just below and at it) and the scaled chi-square's,
+//! minimised over log lambda by golden section.
+double fitNullScale(const std::vector<float>& d, int dof)
+{
+    if (d.size() < 50)
+        return 1.0;
+    struct Step
+    {
+        double value, midCdf, weight;
+    };
+    std::vector<Step> steps;
+    const double m = static_cast<double>(d.size());
+    for (std::size_t i = 0; i < d.size();) {
+        std::size_t j = i;
+        while (j < d.size() && d[j] == d[i])
+            ++j;
+        const double below = static_cast<double>(i) / m, at = static_cast<double>(j) / m;
+        const double mid = 0.5 * (below + at);
+        if (mid > 0.75)
+            break;
+        steps.push_back({d[i], mid, at - below});
+        i = j;
+    }
+    if (steps.size() < 2)
+        return 1.0;
+    const auto misfit = [&](double logScale) {
+        const double scale = std::exp(logScale);
+        double sum = 0;
+        for (const Step& s : steps) {
+            const double e = s.midCdf - chiSquareCdf(s.value / scale, dof);
+            sum += s.weight * e * e;
+        }
+        return sum;
+    };
+    double lo = std::log(0.1), hi = std::log(100.0);
+    const double golden = 0.5 * (std::sqrt(5.0) - 1.0);
+    double a = hi - golden * (hi - lo), b = lo + golden * (hi - lo), fa = misfit(a), fb = misfit(b);
+    for (int it = 0; it < 80 && hi - lo > 1e-6; ++it) {
+        if (fa < fb) {
+            hi = b;
+            b = a;
+            fb = fa;
+            a = hi - golden * (hi - lo);
+            fa = misfit(a);
+        } else {
+            lo = a;
+            a = b;
+            fa = fb;
+            b = lo + golden * (hi - lo);
+            fb = misfit(b);
+        }
+    }
+    return std::exp(0.5 * (lo + hi));
+}
+
+} // namespace
+
 LocalChiSquareResult localChiSquareTest(const PointCloud& cloud, const std::string& fieldName,
                                         const LocalChiSquareParams& params, ProgressObserver* progress)
 {
@@ -283,24 +455,42 @@ LocalChiSquareResult localChiSquareTest(const PointCloud& cloud, const std::stri
         throw Error(ErrorCode::InvalidData, "chi-square test: cloud '" + cloud.name + "' is empty");
 
     LocalChiSquareResult result;
-    result.noise = params.noise ? *params.noise : fitNoise(*field, params.model);
+    if (params.noise) {
+        result.noise = *params.noise;
+    } else {
+        std::vector<double> samples;
+        samples.reserve(field->size());
+        for (std::size_t i = 0; i < field->size(); ++i)
+            if (field->hasValue(i))
+                samples.push_back(field->value(i));
+        try {
+            result.noise = fitNoiseRobust(samples, params.model, &result.fitRejected);
+        } catch (const Error& e) {
+            throw Error(e.code(), "field '" + field->name() + "': " + e.what());
+        }
+    }
     if (result.noise.model == NoiseModel::Gaussian ? !(result.noise.sigma > 0) : !(result.noise.shape > 0 && result.noise.scale > 0))
         throw Error(ErrorCode::InvalidArgument, "chi-square test: the noise model's spread and scale must be positive");
     const auto n = static_cast<std::size_t>(params.neighbours);
     const auto k = static_cast<std::size_t>(std::floor(std::sqrt(static_cast<double>(n))));
     result.classes = static_cast<int>(k);
     result.quantileThreshold = chiSquareQuantile(params.confidence, result.classes - 1);
-    result.threshold = params.threshold.value_or(result.quantileThreshold);
+    result.calibratedThreshold = result.quantileThreshold;
 
     // Each value's class under the model, computed once: with equiprobable
     // classes it is floor(k * F(v)).
     const std::size_t size = cloud.size();
     std::vector<std::int8_t> valueClass(size, -1);
+    // Values beyond the model's 0.9999 quantile (two-sided for the Gaussian):
+    // a neighbourhood holding one is left out of the calibration (1.6 % of
+    // unchanged neighbourhoods of 16 hold one by chance: the bias is small).
+    std::vector<std::uint8_t> beyondNoise(size, 0);
     for (std::size_t i = 0; i < size; ++i) {
         if (!field->hasValue(i))
             continue;
         const double f = result.noise.cdf(field->value(i));
         valueClass[i] = static_cast<std::int8_t>(std::min<std::size_t>(k - 1, static_cast<std::size_t>(std::max(0.0, f) * k)));
+        beyondNoise[i] = result.noise.model == NoiseModel::Gaussian ? (f > 0.99995 || f < 0.00005) : f > 0.9999;
     }
 
     const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
@@ -308,20 +498,21 @@ LocalChiSquareResult localChiSquareTest(const PointCloud& cloud, const std::stri
                                              : tree.levelNearestMeanPopulation(std::max(8.0, 1.5 * static_cast<double>(n)));
     result.chiSquare = ScalarField(fields::kChiSquare, size);
     result.changed = ScalarField(fields::kChanged, size);
-    std::atomic<std::size_t> changedCount{0};
-    const double threshold = result.threshold;
+    std::vector<std::uint8_t> calm(size, 0); // the neighbourhood holds no value beyond the noise
     ProgressTicker ticker(progress, "Local chi-square test", size);
     detail::forEachNeighbourhood(tree, n, level, ticker, [&](std::size_t i, const octree::Neighbour* list, std::size_t count) {
         if (valueClass[i] < 0)
             return;
         std::size_t histogram[32] = {};
         std::size_t used = 0;
+        bool quiet = true;
         for (std::size_t r = 0; r < count; ++r) {
             const std::int8_t c = valueClass[list[r].index];
             if (c < 0)
                 continue;
             ++histogram[c];
             ++used;
+            quiet = quiet && !beyondNoise[list[r].index];
         }
         if (used < 4)
             return; // too few values to say anything: no decision
@@ -333,12 +524,45 @@ LocalChiSquareResult localChiSquareTest(const PointCloud& cloud, const std::stri
             d += diff * diff / expected;
         }
         result.chiSquare.values()[i] = static_cast<float>(d);
-        const bool isChanged = d > threshold;
-        result.changed.values()[i] = isChanged ? 1.0f : 0.0f;
-        if (isChanged)
-            changedCount.fetch_add(1, std::memory_order_relaxed);
+        calm[i] = quiet;
     });
-    result.changedCount = changedCount.load();
+
+    if (params.calibration == NullCalibration::Spatial) {
+        std::vector<float> quietDistances;
+        for (std::size_t i = 0; i < size; ++i)
+            if (calm[i] && result.chiSquare.hasValue(i))
+                quietDistances.push_back(result.chiSquare.values()[i]);
+        result.nullScalePoints = quietDistances.size();
+        std::sort(quietDistances.begin(), quietDistances.end());
+        result.nullScale = std::max(1.0, fitNullScale(quietDistances, result.classes - 1));
+        result.calibratedThreshold = result.nullScale * result.quantileThreshold;
+        // The scaled law is fitted on the bulk; where the tail is heavier (large
+        // neighbourhoods) or d's discrete values put the cut on a step, the
+        // quiet points' own quantile is the higher cut. Only where it rests on
+        // at least 10 exceedances.
+        const double tail = (1.0 - params.confidence) * static_cast<double>(quietDistances.size());
+        if (tail >= 10.0) {
+            const auto at = static_cast<std::size_t>(std::ceil(params.confidence * static_cast<double>(quietDistances.size()))) - 1;
+            result.empiricalThreshold = quietDistances[std::min(at, quietDistances.size() - 1)];
+            result.calibratedThreshold = std::max(result.calibratedThreshold, result.empiricalThreshold);
+        }
+    }
+    result.threshold = params.threshold.value_or(result.calibratedThreshold);
+    // d is at most n (k - 1), every value in one class.
+    if (result.threshold >= static_cast<double>(n * (k - 1)))
+        logWarning("chi-square test: the cut " + std::to_string(result.threshold) + " is above the largest distance " +
+                   std::to_string(n * (k - 1)) + " a neighbourhood of " + std::to_string(n) +
+                   " can reach: nothing can be flagged. The field's neighbouring values are too alike for this test (" +
+                   std::to_string(result.nullScale) +
+                   " times the spread of independent draws): compute the distances with a local model, use more neighbours, "
+                   "or segment by thresholds");
+    for (std::size_t i = 0; i < size; ++i) {
+        if (!result.chiSquare.hasValue(i))
+            continue;
+        const bool isChanged = result.chiSquare.values()[i] > result.threshold;
+        result.changed.values()[i] = isChanged ? 1.0f : 0.0f;
+        result.changedCount += isChanged;
+    }
     return result;
 }
 

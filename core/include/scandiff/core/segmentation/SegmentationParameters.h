@@ -20,11 +20,14 @@
 
 namespace scandiff {
 
-//! field, absolute, range, above, kmeans, stat-test, neighbours, confidence,
+//! field, absolute, range, above, kmeans, stat-test, neighbours, confidence, calibration,
 //! chi2-threshold, fit-box, noise, components, level, connectivity, min-points,
 //! propagate, alpha, min-seed, stop-speed, gradient-radius, smoothing,
 //! report-field, outline-cell, region-epoch, column-height, volume-cell.
 const std::vector<ParameterSpec>& segmentationParameters();
+
+//! The default of min-points: regions of fewer points are dropped.
+inline constexpr std::int64_t kDefaultMinRegionPoints = 10;
 
 //! What one run produced. `fields` are ready to be added to the cloud
 //! (replacing fields of the same name): always "region_id"; with a

@@ -57,11 +57,49 @@ NoiseDistribution fitNoise(const std::vector<double>& samples, NoiseModel model)
 //! (the indices of a zone the user knows to be unchanged).
 NoiseDistribution fitNoise(const ScalarField& field, NoiseModel model, const std::vector<std::size_t>* points = nullptr);
 
+//! A fit on values of which some are changes, not noise: the maximum-likelihood
+//! fit above is pulled by them (a tail of 1 % of 0.3 m values turns the
+//! Rayleigh-like Weibull of nearest-neighbour distances, shape 2, into an
+//! exponential one, shape 1.1, and the test then flags a quarter of the
+//! unchanged points). Fitted instead on the probability plot (least squares
+//! of the sorted values against the model's quantiles) over its central part
+//! (Gaussian: the quartiles; Weibull: 5-75 %), which holds while changes are
+//! fewer than a quarter of the values; then, without the values beyond the
+//! fit's 0.9999 quantile (two-sided for the Gaussian), over 5-90 % (10-90 %),
+//! twice more: the classes of the test lie at the model's quantiles, and these
+//! are what the fit matches. `rejected`, when given, receives the number of
+//! values left out as not noise. Fewer than 20 values: fitNoise.
+//! Throws as fitNoise.
+NoiseDistribution fitNoiseRobust(const std::vector<double>& samples, NoiseModel model, std::size_t* rejected = nullptr);
+
+//! How the cut on the chi-square distance is set.
+//! Tabulated: the textbook quantile of chi-square with k - 1 degrees of
+//! freedom (thesis 000 eq. 3.2), right when the n values of a neighbourhood
+//! are independent draws. They are not in a distance field: neighbouring
+//! points share their closest reference points and the surface between them,
+//! so their distances move together and the classes' counts spread more than
+//! a multinomial's (on two independent samplings of one terrain, d is about
+//! 1.35 times chi-square with 3 degrees of freedom, and the tabulated cut at
+//! 99 % flags 3.6 % of the unchanged points instead of 1 %).
+//! Spatial: the null distribution is taken from the data themselves, as the
+//! overdispersed multinomial gives it, d ~ lambda x chi-square(k - 1)
+//! (lambda = 1 + (n - 1) rho, rho the correlation of neighbours' classes):
+//! lambda is fitted on the points whose neighbourhoods hold no value beyond
+//! the model's 0.9999 quantile (clear changes are left out: the quiet points),
+//! by matching the lower three quarters of their d's distribution, and the cut
+//! is lambda times the tabulated one (never lower: lambda >= 1), or the quiet
+//! points' own quantile at the confidence when that is higher (the tail of d
+//! is heavier than the scaled law's in large neighbourhoods, and d takes
+//! discrete values) and rests on at least 10 values beyond it.
+enum class NullCalibration { Spatial, Tabulated };
+NullCalibration parseNullCalibration(const std::string& name); //!< "spatial", "tabulated"
+const char* nullCalibrationName(NullCalibration calibration);
+
 struct LocalChiSquareParams
 {
     NoiseModel model = NoiseModel::Weibull;
-    //! The noise model; when absent it is fitted on the whole field (the changed
-    //! points then inflate it: give a fit on an unchanged zone when possible).
+    //! The noise model; when absent it is fitted on the whole field by
+    //! fitNoiseRobust (a fit on a zone known to be unchanged is still better).
     std::optional<NoiseDistribution> noise;
     //! n, the neighbourhood size (the point itself included), in [4, 1024].
     //! The thesis gives no value; 16 keeps k = 4 classes and the test local.
@@ -71,6 +109,7 @@ struct LocalChiSquareParams
     double confidence = 0.99;
     //! Overrides the quantile threshold (the user moves the cut, thesis §3.2.3).
     std::optional<double> threshold;
+    NullCalibration calibration = NullCalibration::Spatial;
     //! Octree level for the neighbour search, 0 = automatic. Speed only.
     int octreeLevel = 0;
 };
@@ -82,7 +121,15 @@ struct LocalChiSquareResult
     NoiseDistribution noise;   //!< the model used
     int classes = 0;           //!< k = floor(sqrt(n))
     double threshold = 0.0;    //!< the cut applied
-    double quantileThreshold = 0.0; //!< the tabulated value at the confidence (= threshold unless overridden)
+    double quantileThreshold = 0.0;   //!< the tabulated value at the confidence
+    double calibratedThreshold = 0.0; //!< the calibration's cut (= quantileThreshold when tabulated)
+    double empiricalThreshold = 0.0;  //!< the quiet points' quantile (0 when not used)
+    //! lambda of the spatial calibration (1 when tabulated), and the number of
+    //! points it was fitted on.
+    double nullScale = 1.0;
+    std::size_t nullScalePoints = 0;
+    //! Values the robust fit left out as not noise (0 when a model was given).
+    std::size_t fitRejected = 0;
     std::size_t changedCount = 0;
 };
 

@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The tools on the scene families of tests/support/families: the issue's case
+// at full size and a number of seeded draws, one line of figures each
+// (docs/benchmarks.md quotes them; the family tests assert the same figures).
+//
+//   scandiff-family-trials FAMILY [--issue] [--draws N] [--first-seed S] [--scale F] [--set KEY=VALUE ...]
+#include "families/ChangeTrials.h"
+#include "families/WallTrials.h"
+
+#include <scandiff/core/Log.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+
+using namespace scandiff;
+using namespace scandiff::test::family;
+
+namespace {
+
+struct Options
+{
+    std::string family;
+    bool issue = false;
+    int draws = 0;
+    std::uint64_t firstSeed = 1;
+    double scale = 0.1;
+    std::map<std::string, std::string> set;
+};
+
+double seconds(std::chrono::steady_clock::time_point since)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+bool facadeRow(const facade::FacadeParams& p, const Options& o, const std::string& label)
+{
+    const auto start = std::chrono::steady_clock::now();
+    const facade::FacadeScene scene = facade::make(p);
+    std::map<std::string, std::string> prim{{"method", "region-growing"}}, cont;
+    for (const auto& [k, v] : o.set)
+        (k.rfind("p.", 0) == 0 ? prim : cont)[k.rfind("p.", 0) == 0 ? k.substr(2) : k] = v;
+    const FacadeTrial t = runFacade(scene, prim, cont);
+    std::printf("%s %s | %zu pts, %zu rings, most vertices %zu | %s | %.1f s%s\n", label.c_str(), facade::describe(p).c_str(),
+                t.points, t.rings, t.largestRingVertices, t.score.summary().c_str(), seconds(start),
+                t.score.meetsIssueTarget ? "" : "  FAIL");
+    for (std::size_t k = 0; k < t.score.openings.size() && !t.score.meetsIssueTarget; ++k) {
+        const auto& s = t.score.openings[k];
+        if (!s.right)
+            std::printf("    opening %zu: IoU %.3f, Hausdorff %.1f mm, %zu vertices, %d rings\n", k, s.iou, s.hausdorff * 1e3,
+                        s.vertices, s.ringsMatching);
+    }
+    std::fflush(stdout);
+    return t.score.meetsIssueTarget;
+}
+
+bool stonesRow(const stonewall::StoneWallParams& p, const Options& o, const std::string& label)
+{
+    const auto start = std::chrono::steady_clock::now();
+    const stonewall::StoneWallScene scene = stonewall::make(p);
+    const StoneTrial t = runStones(scene, o.set);
+    std::printf("%s %s | %zu pts, %zu polygons | %s | %.1f s%s\n", label.c_str(), stonewall::describe(p).c_str(), t.points,
+                t.polygons, t.score.summary().c_str(), seconds(start), t.score.meetsIssueTarget ? "" : "  FAIL");
+    std::fflush(stdout);
+    return t.score.meetsIssueTarget;
+}
+
+bool changeRow(const terrainchange::TerrainChangeParams& p, const Options& o, const std::string& label)
+{
+    const auto start = std::chrono::steady_clock::now();
+    const terrainchange::TerrainChangeScene scene = terrainchange::make(p);
+    std::map<std::string, std::string> c2c, segment{{"stat-test", "weibull"}, {"components", "true"}};
+    for (const auto& [k, v] : o.set)
+        (k.rfind("c.", 0) == 0 ? c2c : segment)[k.rfind("c.", 0) == 0 ? k.substr(2) : k] = v;
+    const ChangeTrial t = runChangeSegmentation(scene, c2c, segment);
+    std::printf("%s %s | %s | %s | %.1f s%s\n", label.c_str(), terrainchange::describe(p).c_str(), t.summary.c_str(),
+                terrainchange::describe(t.score).c_str(), seconds(start), t.met ? "" : "  FAIL");
+    std::fflush(stdout);
+    return t.met;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    Options o;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--issue")
+            o.issue = true;
+        else if (a == "--draws" && i + 1 < argc)
+            o.draws = std::atoi(argv[++i]);
+        else if (a == "--first-seed" && i + 1 < argc)
+            o.firstSeed = std::strtoull(argv[++i], nullptr, 10);
+        else if (a == "--scale" && i + 1 < argc)
+            o.scale = std::atof(argv[++i]);
+        else if (a == "--set" && i + 1 < argc) {
+            const std::string kv = argv[++i];
+            const auto eq = kv.find('=');
+            o.set[kv.substr(0, eq)] = eq == std::string::npos ? "true" : kv.substr(eq + 1);
+        } else if (o.family.empty())
+            o.family = a;
+        else {
+            std::cerr << "unknown argument " << a << "\n";
+            return 2;
+        }
+    }
+    setLogSink([](LogLevel, const std::string&) {});
+    int passed = 0, run = 0;
+    auto tally = [&](bool ok) { passed += ok, ++run; };
+    if (o.family == "facade") {
+        if (o.issue)
+            tally(facadeRow(facade::issueCase(), o, "issue"));
+        for (int d = 0; d < o.draws; ++d)
+            tally(facadeRow(facade::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+    } else if (o.family == "stones") {
+        if (o.issue)
+            tally(stonesRow(stonewall::issueCase(), o, "issue"));
+        for (int d = 0; d < o.draws; ++d)
+            tally(stonesRow(stonewall::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+    } else if (o.family == "change") {
+        if (o.issue)
+            tally(changeRow(terrainchange::issueCase(), o, "issue"));
+        for (int d = 0; d < o.draws; ++d)
+            tally(changeRow(terrainchange::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+    } else {
+        std::cerr << "families: facade, stones, change\n";
+        return 2;
+    }
+    std::printf("%d of %d met the target\n", passed, run);
+    return passed == run ? 0 : 1;
+}
