@@ -81,6 +81,24 @@ bool changeRow(const terrainchange::TerrainChangeParams& p, const Options& o, co
     return t.met;
 }
 
+bool visibilityRow(const grazing::GrazingParams& p, const Options& o, const std::string& label)
+{
+    const auto start = std::chrono::steady_clock::now();
+    const grazing::GrazingScene scene = grazing::make(p);
+    const grazing::VisibilityScore s = runVisibility(scene, o.set);
+    std::printf("%s %s | %zu ref, %zu cmp | agreement %.4f (ground %.4f wall %.4f cube %.4f), visible->hidden %.4f (ground %.4f), "
+                "cube visible %.4f | %.1f s%s\n",
+                label.c_str(), grazing::describe(p).c_str(), scene.reference.size(), scene.compared.size(), s.agreement,
+                s.agreementByPart[0], s.agreementByPart[1], s.agreementByPart[2], s.visibleLabelledHidden,
+                s.visibleGroundLabelledHidden, s.cubeLabelledVisible, seconds(start), s.meetsIssueTargets() ? "" : "  FAIL");
+    std::printf("    confusion [truth][label]:");
+    for (const auto& row : s.confusion)
+        std::printf(" [%zu %zu %zu %zu]", row[0], row[1], row[2], row[3]);
+    std::printf("\n");
+    std::fflush(stdout);
+    return s.meetsIssueTargets();
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -125,8 +143,13 @@ int main(int argc, char** argv)
             tally(changeRow(terrainchange::issueCase(), o, "issue"));
         for (int d = 0; d < o.draws; ++d)
             tally(changeRow(terrainchange::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+    } else if (o.family == "visibility") {
+        if (o.issue)
+            tally(visibilityRow(grazing::issueCase(), o, "issue"));
+        for (int d = 0; d < o.draws; ++d)
+            tally(visibilityRow(grazing::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
     } else {
-        std::cerr << "families: facade, stones, change\n";
+        std::cerr << "families: facade, stones, change, visibility\n";
         return 2;
     }
     std::printf("%d of %d met the target\n", passed, run);

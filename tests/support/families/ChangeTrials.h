@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! The terrain-change family run as `scandiff-cli c2c` then `scandiff-cli
-//! segment` run it (the same parameter declarations and run functions),
-//! scored against its truth. Shared by the family tests and
+//! The distance families run as `scandiff-cli c2c` (then `scandiff-cli
+//! segment`) run them, through the same parameter declarations and run
+//! functions, scored against their truth: the terrain-change family and the
+//! visibility at grazing incidence. Shared by the family tests and
 //! bench/FamilyTrials.cpp.
 
+#include "GrazingVisibilityFamily.h"
 #include "TerrainChangeFamily.h"
 
 #include <scandiff/core/distance/DistanceParameters.h>
@@ -46,6 +48,17 @@ inline ChangeTrial runChangeSegmentation(const terrainchange::TerrainChangeScene
     trial.summary = run.summary;
     trial.met = terrainchange::meetsIssueTargets(trial.score);
     return trial;
+}
+
+//! C2C with the visibility test from the reference's stored scanner pose
+//! (`--visibility`), `options` on top; the visibility labels scored.
+inline grazing::VisibilityScore runVisibility(const grazing::GrazingScene& scene, std::map<std::string, std::string> options)
+{
+    options.emplace("visibility", "true");
+    CloudToCloudRun run =
+        runCloudToCloud(scene.compared, scene.reference, resolveParameters(cloudToCloudParameters(), options, "c2c"), nullptr);
+    const std::vector<float> labels = run.forward.visibility ? run.forward.visibility->values() : std::vector<float>{};
+    return grazing::scoreLabels(scene, labels);
 }
 
 } // namespace scandiff::test::family
