@@ -28,6 +28,7 @@ struct Options
     std::uint64_t firstSeed = 1;
     double scale = 0.1;
     std::map<std::string, std::string> set;
+    std::string svgDir; //!< --svg DIR: the wall families' rings over their truth, one SVG per run
 };
 
 double seconds(std::chrono::steady_clock::time_point since)
@@ -42,15 +43,21 @@ bool facadeRow(const facade::FacadeParams& p, const Options& o, const std::strin
     std::map<std::string, std::string> prim{{"method", "region-growing"}}, cont;
     for (const auto& [k, v] : o.set)
         (k.rfind("p.", 0) == 0 ? prim : cont)[k.rfind("p.", 0) == 0 ? k.substr(2) : k] = v;
-    const FacadeTrial t = runFacade(scene, prim, cont);
-    std::printf("%s %s | %zu pts, %zu rings, most vertices %zu | %s | %.1f s%s\n", label.c_str(), facade::describe(p).c_str(),
-                t.points, t.rings, t.largestRingVertices, t.score.summary().c_str(), seconds(start),
+    const FacadeTrial t = o.set.count("wall-only") ? runFacadeContours(scene, {}) : runFacade(scene, prim, cont);
+    if (!o.svgDir.empty()) {
+        std::vector<wallsurvey::Polygon2> truth = scene.openingTruth;
+        truth.push_back(scene.outlineTruth);
+        writeWallSvg(o.svgDir + "/facade-" + label + ".svg", scene.frame, truth, t.rings, &scene.cloud);
+    }
+    std::printf("%s %s | %zu pts, %zu rings, most vertices %zu, rectangles not 4 corners %zu | %s | %.1f s%s\n", label.c_str(),
+                facade::describe(p).c_str(), t.points, t.rings.size(), t.largestRingVertices, t.rectanglesNotFourCorners, t.score.summary().c_str(), seconds(start),
                 t.score.meetsIssueTarget ? "" : "  FAIL");
     for (std::size_t k = 0; k < t.score.openings.size() && !t.score.meetsIssueTarget; ++k) {
         const auto& s = t.score.openings[k];
         if (!s.right)
-            std::printf("    opening %zu: IoU %.3f, Hausdorff %.1f mm, %zu vertices, %d rings\n", k, s.iou, s.hausdorff * 1e3,
-                        s.vertices, s.ringsMatching);
+            std::printf("    opening %zu at %.2f,%.2f (%.2f x %.2f m%s): IoU %.3f, Hausdorff %.1f mm, %zu vertices, %d rings\n", k,
+                        p.openings[k].x0, p.openings[k].y0, p.openings[k].width, p.openings[k].height,
+                        p.openings[k].arched ? ", arched" : "", s.iou, s.hausdorff * 1e3, s.vertices, s.ringsMatching);
     }
     std::fflush(stdout);
     return t.score.meetsIssueTarget;
@@ -61,6 +68,8 @@ bool stonesRow(const stonewall::StoneWallParams& p, const Options& o, const std:
     const auto start = std::chrono::steady_clock::now();
     const stonewall::StoneWallScene scene = stonewall::make(p);
     const StoneTrial t = runStones(scene, o.set);
+    if (!o.svgDir.empty())
+        writeWallSvg(o.svgDir + "/stones-" + label + ".svg", scene.frame, scene.stoneTruth, t.rings, &scene.cloud, 400);
     std::printf("%s %s | %zu pts, %zu polygons | %s | %.1f s%s\n", label.c_str(), stonewall::describe(p).c_str(), t.points,
                 t.polygons, t.score.summary().c_str(), seconds(start), t.score.meetsIssueTarget ? "" : "  FAIL");
     std::fflush(stdout);
@@ -114,6 +123,8 @@ int main(int argc, char** argv)
             o.firstSeed = std::strtoull(argv[++i], nullptr, 10);
         else if (a == "--scale" && i + 1 < argc)
             o.scale = std::atof(argv[++i]);
+        else if (a == "--svg" && i + 1 < argc)
+            o.svgDir = argv[++i];
         else if (a == "--set" && i + 1 < argc) {
             const std::string kv = argv[++i];
             const auto eq = kv.find('=');

@@ -3,6 +3,7 @@
 #include <scandiff/plugins/contours/PlanarContours.h>
 
 #include <scandiff/core/Error.h>
+#include <scandiff/octree/Octree.h>
 
 #include <Eigen/Eigenvalues>
 
@@ -146,6 +147,32 @@ double medianNearestDistance(const std::vector<Eigen::Vector2d>& points, const s
     nearest.erase(std::remove_if(nearest.begin(), nearest.end(), [](double d) { return !std::isfinite(d); }), nearest.end());
     std::nth_element(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2), nearest.end());
     return nearest.empty() ? 0.0 : nearest[nearest.size() / 2];
+}
+
+//! Each point's own spacing: the side of the square a point covers where it
+//! lies, from the disc reaching its 6th nearest other point (pi r^2 / 6 per
+//! point). A scan is denser near its station than at the far end of a wall
+//! or at grazing incidence (three times on a façade 6 m from the scanner and
+//! 8 m wide); a gap criterion in metres cut the sparse end into holes.
+std::vector<double> localSpacings(const std::vector<Eigen::Vector2d>& points)
+{
+    constexpr std::size_t k = 7; // the point itself and 6 others
+    std::vector<Eigen::Vector3f> planar(points.size());
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& p : points)
+        centre += p / static_cast<double>(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+        planar[i] = Eigen::Vector3f(static_cast<float>(points[i].x() - centre.x()), static_cast<float>(points[i].y() - centre.y()), 0.0f);
+    const octree::Octree tree(planar.data(), planar.size());
+    std::vector<octree::Neighbour> found;
+    tree.nearestBatch(planar.data(), planar.size(), k, tree.levelNearestMeanPopulation(8.0), found);
+    std::vector<double> spacing(points.size(), std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const octree::Neighbour& last = found[i * k + k - 1];
+        if (last.index != UINT32_MAX)
+            spacing[i] = std::sqrt(static_cast<double>(last.squaredDistance) * kPi / static_cast<double>(k - 1));
+    }
+    return spacing;
 }
 
 //! Each point joins the part with most of its kept triangles (partOfKept(k):
@@ -320,13 +347,39 @@ OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const 
     for (std::size_t t = 0; t < triangles.size(); ++t)
         measure[t] = mixed(triangles[t]) ? std::numeric_limits<double>::infinity()
                      : params.method == OutlineMethod::LongEdges ? longestEdge(points, triangles[t]) : circumradius(points, triangles[t]);
+    // The automatic long-edge criterion is relative: each triangle's longest
+    // edge over the spacing where it lies (the mean of its corners'), its
+    // knee floored at 2.5 (a regular grid's diagonal is 1.4 spacings, one
+    // stretched four times by an oblique view 2.1; a missing point leaves 2).
+    // The threshold reported is that knee times the median spacing.
+    const bool relative = params.threshold <= 0 && params.method == OutlineMethod::LongEdges && points.size() >= 16;
+    double medianSpacing = 1.0;
+    if (relative) {
+        const std::vector<double> spacing = localSpacings(points);
+        std::vector<double> finite;
+        for (double d : spacing)
+            if (std::isfinite(d) && d > 0)
+                finite.push_back(d);
+        if (!finite.empty()) {
+            std::nth_element(finite.begin(), finite.begin() + static_cast<std::ptrdiff_t>(finite.size() / 2), finite.end());
+            medianSpacing = finite[finite.size() / 2];
+        }
+        for (std::size_t t = 0; t < triangles.size(); ++t) {
+            double local = 0;
+            for (std::uint32_t v : triangles[t])
+                local += std::isfinite(spacing[v]) && spacing[v] > 0 ? spacing[v] : medianSpacing;
+            measure[t] /= local / 3.0;
+        }
+    }
     // Floors: 2 x the median longest edge (a regular grid's diagonals are the
     // longest edges of its triangles), 1.5 x the median circumradius.
-    result.threshold = params.threshold > 0 ? params.threshold
+    const double cut = params.threshold > 0 ? params.threshold
+                       : relative           ? std::max(2.5, kneeThreshold(measure, 1.0))
                                             : kneeThreshold(measure, params.method == OutlineMethod::LongEdges ? 2.0 : 1.5);
+    result.threshold = relative ? cut * medianSpacing : cut;
     std::vector<std::uint32_t> kept;
     for (std::size_t t = 0; t < triangles.size(); ++t)
-        if (measure[t] <= result.threshold)
+        if (measure[t] <= cut)
             kept.push_back(static_cast<std::uint32_t>(t));
     result.keptTriangles = kept.size();
 

@@ -13,6 +13,8 @@
 #include <scandiff/core/ToolRegistry.h>
 #include <scandiff/plugins/PluginRegistry.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <map>
 #include <string>
 #include <utility>
@@ -33,11 +35,25 @@ inline std::vector<wallsurvey::Ring3> closedRings(const Drawing& drawing, const 
 
 struct FacadeTrial
 {
+    std::vector<wallsurvey::Ring3> rings; //!< every closed ring the contours gave
     facade::FacadeScore score;
     std::size_t points = 0;
-    std::size_t rings = 0;
     std::size_t largestRingVertices = 0; //!< over the openings' matched rings
+    //! Rectangular windows (not arched, not doors) whose ring has other than 4 vertices.
+    std::size_t rectanglesNotFourCorners = 0;
 };
+
+inline void countCorners(const facade::FacadeScene& scene, FacadeTrial& trial)
+{
+    for (std::size_t k = 0; k < trial.score.openings.size(); ++k) {
+        const auto& o = scene.params.openings[k];
+        const auto& s = trial.score.openings[k];
+        if (s.ring >= 0)
+            trial.largestRingVertices = std::max(trial.largestRingVertices, s.vertices);
+        if (!o.arched && !o.door && s.ring >= 0 && s.vertices != 4)
+            ++trial.rectanglesNotFourCorners;
+    }
+}
 
 //! The façade workflow: planes by `segmentation` (the primitives tool), then
 //! `contours --vectorise` on every plane.
@@ -54,17 +70,38 @@ inline FacadeTrial runFacade(const facade::FacadeScene& scene, const std::map<st
     ToolResult outlines = contours.execute(ToolInputs().add("input", labelled), contours.resolve(options), nullptr);
     FacadeTrial trial;
     trial.points = scene.cloud.size();
-    const std::vector<wallsurvey::Ring3> rings = closedRings(std::get<Drawing>(outlines.find("contours")->data));
-    trial.rings = rings.size();
-    trial.score = facade::score(scene, rings);
-    for (const auto& opening : trial.score.openings)
-        if (opening.ring >= 0 && !scene.params.openings.empty())
-            trial.largestRingVertices = std::max(trial.largestRingVertices, opening.vertices);
+    trial.rings = closedRings(std::get<Drawing>(outlines.find("contours")->data));
+    trial.score = facade::score(scene, trial.rings);
+    countCorners(scene, trial);
+    return trial;
+}
+
+//! The wall's own points (its face and the relief on it), as a user who
+//! segmented the façade well would give them to `contours --vectorise`: the
+//! outlines and their vectorisation, apart from the segmentation.
+inline FacadeTrial runFacadeContours(const facade::FacadeScene& scene, const std::map<std::string, std::string>& contourOptions)
+{
+    std::vector<std::size_t> wall;
+    for (std::size_t i = 0; i < scene.surface.size(); ++i)
+        if (scene.surface[i] == facade::Surface::WallFace || scene.surface[i] == facade::Surface::Relief)
+            wall.push_back(i);
+    const PointCloud cloud = scene.cloud.subset(wall);
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& contours = *registry.tools.find("contours");
+    std::map<std::string, std::string> options = contourOptions;
+    options.emplace("vectorise", "true");
+    ToolResult outlines = contours.execute(ToolInputs().add("input", cloud), contours.resolve(options), nullptr);
+    FacadeTrial trial;
+    trial.points = cloud.size();
+    trial.rings = closedRings(std::get<Drawing>(outlines.find("contours")->data));
+    trial.score = facade::score(scene, trial.rings);
+    countCorners(scene, trial);
     return trial;
 }
 
 struct StoneTrial
 {
+    std::vector<wallsurvey::Ring3> rings;
     stonewall::StoneWallScore score;
     std::size_t points = 0;
     std::size_t polygons = 0;
@@ -81,10 +118,55 @@ inline StoneTrial runStones(const stonewall::StoneWallScene& scene, const std::m
             drawing = &std::get<Drawing>(output.data);
     StoneTrial trial;
     trial.points = scene.cloud.size();
-    const std::vector<wallsurvey::Ring3> rings = drawing ? closedRings(*drawing) : std::vector<wallsurvey::Ring3>{};
-    trial.polygons = rings.size();
-    trial.score = stonewall::scorePolygons(scene, rings);
+    trial.rings = drawing ? closedRings(*drawing) : std::vector<wallsurvey::Ring3>{};
+    trial.polygons = trial.rings.size();
+    trial.score = stonewall::scorePolygons(scene, trial.rings);
     return trial;
+}
+
+//! An SVG of rings over the truth in a wall's frame (truth green, rings red,
+//! the wall's points grey when given): to look at a trial that failed.
+inline void writeWallSvg(const std::string& path, const wallsurvey::WallFrame& frame, const std::vector<wallsurvey::Polygon2>& truth,
+                         const std::vector<wallsurvey::Ring3>& rings, const PointCloud* points = nullptr, double pixelsPerMetre = 100)
+{
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+    for (const auto& p : truth)
+        for (const auto& q : p)
+            x0 = std::min(x0, q.x()), y0 = std::min(y0, q.y()), x1 = std::max(x1, q.x()), y1 = std::max(y1, q.y());
+    x0 -= 0.5, y0 -= 0.5, x1 += 0.5, y1 += 0.5;
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    if (!f)
+        return;
+    const auto px = [&](double x) { return (x - x0) * pixelsPerMetre; };
+    const auto py = [&](double y) { return (y1 - y) * pixelsPerMetre; };
+    std::fprintf(f, "<svg xmlns='http://www.w3.org/2000/svg' width='%.0f' height='%.0f'><rect width='100%%' height='100%%' fill='white'/>\n",
+                 px(x1), py(y0));
+    if (points)
+        for (std::size_t i = 0; i < points->size(); ++i) {
+            const Eigen::Vector3d w = frame.toWall(points->globalPosition(i));
+            if (std::abs(w.z()) < 0.05 && w.x() > x0 && w.x() < x1 && w.y() > y0 && w.y() < y1)
+                std::fprintf(f, "<circle cx='%.1f' cy='%.1f' r='0.6' fill='#bbb'/>\n", px(w.x()), py(w.y()));
+        }
+    const auto path2 = [&](const wallsurvey::Polygon2& p, const char* colour, double width) {
+        std::fprintf(f, "<polygon fill='none' stroke='%s' stroke-width='%.1f' points='", colour, width);
+        for (const auto& q : p)
+            std::fprintf(f, "%.1f,%.1f ", px(q.x()), py(q.y()));
+        std::fprintf(f, "'/>\n");
+    };
+    for (const auto& p : truth)
+        path2(p, "green", 1.5);
+    for (const auto& r : rings) {
+        wallsurvey::Polygon2 flat;
+        for (const auto& q : r) {
+            const Eigen::Vector3d w = frame.toWall(q);
+            flat.emplace_back(w.x(), w.y());
+        }
+        path2(flat, "red", 0.8);
+        for (const auto& q : flat)
+            std::fprintf(f, "<circle cx='%.1f' cy='%.1f' r='1.5' fill='red'/>\n", px(q.x()), py(q.y()));
+    }
+    std::fprintf(f, "</svg>\n");
+    std::fclose(f);
 }
 
 } // namespace scandiff::test::family
