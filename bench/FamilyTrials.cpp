@@ -5,11 +5,15 @@
 //
 //   scandiff-family-trials FAMILY [--issue] [--draws N] [--first-seed S] [--scale F] [--set KEY=VALUE ...]
 #include "families/ChangeTrials.h"
+#include "families/RegistrationTrials.h"
 #include "families/WallTrials.h"
 
 #include <scandiff/core/Log.h>
 
+#include <scandiff/io/FileIO.h>
+
 #include <chrono>
+#include <fstream>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -29,6 +33,7 @@ struct Options
     double scale = 0.1;
     std::map<std::string, std::string> set;
     std::string svgDir; //!< --svg DIR: the wall families' rings over their truth, one SVG per run
+    std::string dataDir = "data"; //!< --data DIR: where pcl-data/ lies (the real samples)
 };
 
 double seconds(std::chrono::steady_clock::time_point since)
@@ -108,6 +113,17 @@ bool visibilityRow(const grazing::GrazingParams& p, const Options& o, const std:
     return s.meetsIssueTargets();
 }
 
+bool airborneRow(const airborne::AirborneEpochsScene& scene, const Options& o, const std::string& label, bool real)
+{
+    const auto start = std::chrono::steady_clock::now();
+    const AirborneTrial t = runAirborneRegistration(scene, o.set);
+    const bool met = real ? airborne::meetsRealPairTarget(t.error) : airborne::meetsParkTarget(t.error);
+    std::printf("%s %s | %zu/%zu pts | %s | %s | %.1f s%s\n", label.c_str(), scene.description.c_str(), scene.earlier.size(),
+                scene.later.size(), airborne::describe(t.error).c_str(), t.report.c_str(), seconds(start), met ? "" : "  FAIL");
+    std::fflush(stdout);
+    return met;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -123,6 +139,8 @@ int main(int argc, char** argv)
             o.firstSeed = std::strtoull(argv[++i], nullptr, 10);
         else if (a == "--scale" && i + 1 < argc)
             o.scale = std::atof(argv[++i]);
+        else if (a == "--data" && i + 1 < argc)
+            o.dataDir = argv[++i];
         else if (a == "--svg" && i + 1 < argc)
             o.svgDir = argv[++i];
         else if (a == "--set" && i + 1 < argc) {
@@ -159,8 +177,39 @@ int main(int argc, char** argv)
             tally(visibilityRow(grazing::issueCase(), o, "issue"));
         for (int d = 0; d < o.draws; ++d)
             tally(visibilityRow(grazing::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+    } else if (o.family == "airborne") {
+        if (o.issue)
+            tally(airborneRow(airborne::make(airborne::issueCase()), o, "issue", false));
+        for (int d = 0; d < o.draws; ++d)
+            tally(airborneRow(airborne::make(airborne::drawFamily(o.firstSeed + d, o.scale)), o, "seed " + std::to_string(o.firstSeed + d),
+                              false));
+    } else if (o.family == "airborne-real") {
+        io::FormatRegistry formats;
+        io::registerBuiltinFormats(formats);
+        const std::string dir = o.dataDir + "/pcl-data/";
+        for (const char* sample : {"samp11-utm", "samp53-utm"}) {
+            if (!std::ifstream(dir + sample + ".pcd"))
+                continue;
+            const PointCloud real = io::readPointCloud(formats, dir + sample + ".pcd");
+            const PointCloud ground = io::readPointCloud(formats, dir + sample + "-ground.pcd");
+            if (o.issue) {
+                airborne::RealPairParams p = airborne::realIssueCase();
+                // Trials of the real pair's make-up: r.growth=M (the largest growth; a fifth of it the least), r.class=1.
+                Options rest = o;
+                if (o.set.count("r.growth"))
+                    p.growthMax = std::atof(o.set.at("r.growth").c_str()), p.growthMin = 0.2 * p.growthMax;
+                if (o.set.count("r.class"))
+                    p.withClassification = o.set.at("r.class") == "1";
+                rest.set.erase("r.growth");
+                rest.set.erase("r.class");
+                tally(airborneRow(airborne::makeRealPair(real, ground, p), rest, std::string(sample) + " issue", true));
+            }
+            for (int d = 0; d < o.draws; ++d)
+                tally(airborneRow(airborne::makeRealPair(real, ground, airborne::drawRealPair(o.firstSeed + d, o.scale)), o,
+                                  std::string(sample) + " seed " + std::to_string(o.firstSeed + d), true));
+        }
     } else {
-        std::cerr << "families: facade, stones, change, visibility\n";
+        std::cerr << "families: facade, stones, change, visibility, airborne, airborne-real\n";
         return 2;
     }
     std::printf("%d of %d met the target\n", passed, run);

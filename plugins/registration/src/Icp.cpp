@@ -3,7 +3,9 @@
 
 #include "ReferenceSurface.h"
 
+#include <scandiff/core/CloudOctree.h>
 #include <scandiff/core/Error.h>
+#include <scandiff/core/segmentation/StatisticalTest.h>
 #include <scandiff/core/processing/Subsampling.h>
 
 #include <Eigen/Dense>
@@ -11,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 namespace scandiff::plugins {
 
@@ -127,6 +130,91 @@ double percentile(std::vector<double> values, double p)
     return *at;
 }
 
+//! The sampled moving points on surfaces that do not change (change-robust
+//! mode): where the moving cloud says so by its ASPRS classes (2 ground, 6
+//! building), those; otherwise the points whose 12 nearest neighbours lie on
+//! a plane within 3 times the 20th percentile of that spread over the sample.
+//! A grown tree, a bush, a car, a person is a scatter of points, not a
+//! surface: on airborne epochs of a park half the points are vegetation that
+//! grew between the epochs, no minority the threshold can leave out, and it
+//! pulled the later epoch down by half a metre onto the earlier canopy. The
+//! ground, roofs and walls are planar at the scale of a few spacings. Empty
+//! when too few are left to register on (then every point is used).
+std::vector<char> stableSurfaces(const PointCloud& moving, const std::vector<std::size_t>& sample, std::string& note,
+                                 double& surfaceNoise)
+{
+    std::vector<char> keep(sample.size(), 0);
+    std::size_t kept = 0;
+    if (const ScalarField* classes = moving.field("classification")) {
+        for (std::size_t k = 0; k < sample.size(); ++k) {
+            const double c = classes->value(sample[k]);
+            keep[k] = c == 2 || c == 6;
+            kept += keep[k];
+        }
+        if (kept >= std::max<std::size_t>(100, sample.size() / 20)) {
+            note = "change-robust: the " + std::to_string(kept) + " sampled points classed ground (2) or building (6) registered";
+            return keep;
+        }
+        std::fill(keep.begin(), keep.end(), 0);
+        kept = 0;
+    }
+    constexpr std::size_t kNeighbours = 12;
+    const octree::Octree tree = buildOctree(moving);
+    std::vector<Eigen::Vector3f> queries(sample.size());
+    for (std::size_t k = 0; k < sample.size(); ++k)
+        queries[k] = moving.positions()[sample[k]];
+    std::vector<octree::Neighbour> found;
+    tree.nearestBatch(queries.data(), queries.size(), kNeighbours, tree.levelNearestMeanPopulation(8.0), found);
+    std::vector<double> spread(sample.size(), kInfinity);
+    for (std::size_t k = 0; k < sample.size(); ++k) {
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        std::size_t count = 0;
+        for (std::size_t j = 0; j < kNeighbours; ++j)
+            if (found[k * kNeighbours + j].index != UINT32_MAX) {
+                mean += moving.positions()[found[k * kNeighbours + j].index].cast<double>();
+                ++count;
+            }
+        if (count < 5)
+            continue;
+        mean /= static_cast<double>(count);
+        Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+        for (std::size_t j = 0; j < kNeighbours; ++j)
+            if (found[k * kNeighbours + j].index != UINT32_MAX) {
+                const Eigen::Vector3d d = moving.positions()[found[k * kNeighbours + j].index].cast<double>() - mean;
+                covariance += d * d.transpose() / static_cast<double>(count);
+            }
+        spread[k] = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance, Eigen::EigenvaluesOnly).eigenvalues()(0)));
+    }
+    std::vector<double> finite;
+    for (double v : spread)
+        if (std::isfinite(v))
+            finite.push_back(v);
+    if (finite.size() < 20)
+        return {};
+    const auto at = finite.begin() + static_cast<std::ptrdiff_t>(finite.size() / 5);
+    std::nth_element(finite.begin(), at, finite.end());
+    const double limit = 3.0 * std::max(*at, 1e-9);
+    {
+        std::vector<double> kept;
+        for (double v : finite)
+            if (v <= limit)
+                kept.push_back(v);
+        std::nth_element(kept.begin(), kept.begin() + static_cast<std::ptrdiff_t>(kept.size() / 2), kept.end());
+        surfaceNoise = kept[kept.size() / 2];
+    }
+    for (std::size_t k = 0; k < sample.size(); ++k) {
+        keep[k] = spread[k] <= limit;
+        kept += keep[k];
+    }
+    if (kept < std::max<std::size_t>(100, sample.size() / 20))
+        return {};
+    std::ostringstream text;
+    text << "change-robust: " << kept << " of " << sample.size() << " sampled points on surfaces (12 neighbours within "
+         << limit << " m of a plane) registered; scattered points (vegetation, clutter) left out";
+    note = text.str();
+    return keep;
+}
+
 } // namespace
 
 IcpMethod parseIcpMethod(const std::string& text)
@@ -165,20 +253,39 @@ IcpResult icpRegister(const PointCloud& moving, const PointCloud* referenceCloud
     return detail::icpOnSurface(moving, *surface, params, progress);
 }
 
-namespace detail {
+namespace {
 
-IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface, const IcpParams& params, ProgressObserver* progress)
+//! The moving points the iterations use, in the reference's frame (double),
+//! an even share of them first (the coarse iterations'), and the scale that
+//! turns a rotation into metres.
+struct IterationPoints
 {
-    checkParams(params);
-    if (moving.empty())
-        throw Error(ErrorCode::InvalidData, "registration: the moving cloud '" + moving.name + "' is empty");
-    const bool plane = params.method == IcpMethod::PointToPlane;
-    const Eigen::Vector3d origin = surface.frameOrigin();
+    std::vector<Eigen::Vector3d> x0;
+    std::size_t coarse = 0; //!< the first `coarse` points are the coarse stage's
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    double length = 1.0; //!< the points' RMS distance to their centroid
+    std::string note;    //!< what the change-robust selection kept
+    //! The kept points' median distance to the plane of their 12 neighbours
+    //! (change-robust, without classes), 0 when unknown.
+    double surfaceNoise = 0.0;
+};
 
-    // The moving points the iterations use, in the frame (double).
+IterationPoints iterationPoints(const PointCloud& moving, const Eigen::Vector3d& origin, const IcpParams& params)
+{
+    IterationPoints points;
     std::vector<std::size_t> sample = params.sampleCount > 0 ? randomSubsample(moving, params.sampleCount, params.seed)
                                                              : randomSubsample(moving, moving.size(), 0);
-    std::vector<Eigen::Vector3d> x0;
+    if (params.changeRobust) {
+        const std::vector<char> stable = stableSurfaces(moving, sample, points.note, points.surfaceNoise);
+        if (!stable.empty()) {
+            std::size_t kept = 0;
+            for (std::size_t k = 0; k < sample.size(); ++k)
+                if (stable[k])
+                    sample[kept++] = sample[k];
+            sample.resize(kept);
+        }
+    }
+    std::vector<Eigen::Vector3d>& x0 = points.x0;
     x0.reserve(sample.size());
     for (std::size_t i : sample)
         if (moving.positions()[i].allFinite())
@@ -188,42 +295,58 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
     // Coarse to fine: the first iterations, while the clouds are still apart
     // and each closest-point search goes far, use an even share of the
     // sample (put first); once they have converged, the whole sample.
-    std::size_t active = x0.size();
+    points.coarse = x0.size();
     if (x0.size() > 2 * kCoarsePoints) {
         const std::size_t stride = x0.size() / kCoarsePoints;
         std::vector<Eigen::Vector3d> ordered;
         ordered.reserve(x0.size());
         for (std::size_t i = 0; i < x0.size(); i += stride)
             ordered.push_back(x0[i]);
-        active = ordered.size();
+        points.coarse = ordered.size();
         for (std::size_t i = 0; i < x0.size(); ++i)
             if (i % stride != 0)
                 ordered.push_back(x0[i]);
         x0 = std::move(ordered);
     }
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     for (const auto& p : x0)
-        centroid += p;
-    centroid /= static_cast<double>(x0.size());
+        points.centroid += p;
+    points.centroid /= static_cast<double>(x0.size());
     double spread = 0;
     for (const auto& p : x0)
-        spread += (p - centroid).squaredNorm();
-    // The scale that turns a rotation into metres: the points' RMS distance to their centroid.
-    const double length = std::max(std::sqrt(spread / static_cast<double>(x0.size())), 1e-9);
+        spread += (p - points.centroid).squaredNorm();
+    points.length = std::max(std::sqrt(spread / static_cast<double>(x0.size())), 1e-9);
+    return points;
+}
 
-    Eigen::Isometry3d motion = toLocal(params.initial, origin);
-    IcpResult result;
-    RegistrationReport& report = result.report;
-    report.method = std::string(plane ? "ICP point-to-plane" : "ICP point-to-point") + ", " + dofName(params.constraint.dof) + " DOF" +
-                    (params.changeRobust ? ", change-robust" : "");
+//! Where a run of iterations ended.
+struct IterationRun
+{
+    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+    Eigen::MatrixXd normalMatrix;
+    double threshold = kInfinity; //!< the change threshold reached
+    double cutoff = kInfinity;    //!< the last correspondences' cutoff (trimming, threshold)
+    bool converged = false;
+    std::vector<RegistrationIteration> trace;
+};
+
+//! The iterations from `motion`: match, select, weigh, solve, apply, until
+//! converged or at the limit; `held` directions (orthonormal columns in the
+//! solver's unknowns) are never moved along.
+IterationRun runIterations(const detail::ReferenceSurface& surface, const IterationPoints& points, const IcpParams& params,
+                           Eigen::Isometry3d motion, const Eigen::MatrixXd* held, ProgressTicker& ticker)
+{
+    const bool plane = params.method == IcpMethod::PointToPlane;
+    const std::vector<Eigen::Vector3d>& x0 = points.x0;
+    const double length = points.length;
+    std::size_t active = points.coarse;
+    IterationRun run;
+    const Eigen::Vector3d centre = motion * points.centroid;
     double threshold = kInfinity, previousRms = kInfinity, rmsTwoBefore = kInfinity;
     bool kernelActive = false;
     double kernelScale = kInfinity, medianDistance = kInfinity;
     std::vector<Eigen::Vector3d> x(x0.size()), xs, ys, ns;
     std::vector<double> w, usedResiduals;
-    Eigen::MatrixXd normalMatrix;
     Correspondences c;
-    ProgressTicker ticker(progress, "Registration (ICP)", params.maxIterations);
     for (std::size_t iteration = 1; iteration <= params.maxIterations; ++iteration) {
         x.resize(active);
         for (std::size_t i = 0; i < active; ++i)
@@ -273,27 +396,44 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
         bool solved;
         // The normal matrix of the point-to-plane problem is what tells whether
         // the surfaces hold every direction, whichever method moves the points.
-        Eigen::Isometry3d planeStep;
-        const bool planeSolved = stepPointToPlane(xs, ys, ns, w, params.constraint, length, planeStep, normalMatrix);
+        // About the points' centroid (where the start put it): rotations and
+        // translations are then as apart as they can be, and a direction the
+        // surfaces do not hold is a pure one (flat ground: the horizontal
+        // translations and the turn about the vertical through the data),
+        // not a mix with a tilt about a far frame origin.
+        std::vector<Eigen::Vector3d> xc(xs.size()), yc(ys.size());
+        for (std::size_t i = 0; i < xs.size(); ++i) {
+            xc[i] = xs[i] - centre;
+            yc[i] = ys[i] - centre;
+        }
+        Eigen::Isometry3d centredStep;
+        const bool planeSolved = stepPointToPlane(xc, yc, ns, w, params.constraint, length, centredStep, run.normalMatrix, held);
+        const Eigen::Isometry3d planeStep = Eigen::Translation3d(centre) * centredStep * Eigen::Translation3d(-centre);
         if (plane) {
             solved = planeSolved;
             step = planeStep;
         } else {
             solved = fitPointToPoint(xs, ys, w, params.constraint, step);
+            if (solved && held && held->cols() > 0)
+                step = planeStep; // the closed form cannot hold a direction: the plane step does
         }
         if (!solved)
             throw Error(ErrorCode::InvalidData, "registration: the correspondences do not determine a motion (degenerate geometry)");
         motion = step * motion;
         const double rotationStep = rotationDegrees(step.linear());
         const double translationStep = step.translation().norm();
-        report.trace.push_back({iteration, rms, xs.size(), threshold, rotationStep, translationStep});
-        report.iterations = iteration;
+        run.trace.push_back({iteration, rms, xs.size(), threshold, rotationStep, translationStep});
         medianDistance = medianAbsolute(usedDistances);
         if (params.changeRobust) {
             // Thesis 000 §1.4: the threshold shrinks with the residuals (3 robust
             // sigmas), never below the median spacing of the correspondences,
             // never growing back.
-            threshold = std::min(threshold, std::max(3.0 * 1.4826 * medianAbsolute(usedResiduals), medianDistance));
+            // Point-to-plane: never below 3 times the surfaces' own noise
+            // instead, when it is known (a plane's distance is not a
+            // spacing: on airborne data the floor of a spacing, 0.6 m, kept
+            // roofs raised by less than that in the fit).
+            const double floor = plane && points.surfaceNoise > 0 ? 3.0 * 1.4826 * points.surfaceNoise : medianDistance;
+            threshold = std::min(threshold, std::max(3.0 * 1.4826 * medianAbsolute(usedResiduals), floor));
         }
         ticker.step();
         // Converged when the step moves the points by less than the tolerance
@@ -325,10 +465,118 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
             continue;
         }
         if (still) {
-            report.converged = true;
+            run.converged = true;
             break;
         }
     }
+    run.motion = motion;
+    run.threshold = threshold;
+    run.cutoff = c.cutoff;
+    return run;
+}
+
+//! The directions a normal matrix does not hold (eigenvalue under
+//! kWeakDirectionRatio of the largest), as orthonormal columns.
+Eigen::MatrixXd weakDirections(const Eigen::MatrixXd& normalMatrix)
+{
+    if (normalMatrix.rows() == 0)
+        return {};
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(normalMatrix);
+    const Eigen::VectorXd values = solver.eigenvalues();
+    const double largest = values.maxCoeff();
+    std::vector<Eigen::Index> weak;
+    for (Eigen::Index i = 0; i < values.size(); ++i)
+        if (!(values[i] >= kWeakDirectionRatio * largest && largest > 0))
+            weak.push_back(i);
+    Eigen::MatrixXd columns(normalMatrix.rows(), static_cast<Eigen::Index>(weak.size()));
+    for (std::size_t k = 0; k < weak.size(); ++k)
+        columns.col(static_cast<Eigen::Index>(k)) = solver.eigenvectors().col(weak[k]);
+    return columns;
+}
+
+//! The squared residuals of the whole sample under a motion, each at most
+//! `cutoff`² (a truncated quadratic: what leaves the rules does not pull),
+//! and how many were within it.
+double truncatedCost(const detail::ReferenceSurface& surface, const IterationPoints& points, const IcpParams& params,
+                     const Eigen::Isometry3d& motion, double cutoff, std::size_t& within)
+{
+    std::vector<Eigen::Vector3d> x(points.x0.size());
+    for (std::size_t i = 0; i < x.size(); ++i)
+        x[i] = motion * points.x0[i];
+    Correspondences c;
+    correspond(surface, x, params, kInfinity, c, std::isfinite(cutoff) ? 10 * cutoff : kInfinity);
+    double cost = 0;
+    within = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        const double r = std::isfinite(c.residual[i]) ? std::abs(c.residual[i]) : kInfinity;
+        within += r <= cutoff;
+        cost += std::min(r, cutoff) * std::min(r, cutoff);
+    }
+    return cost;
+}
+
+} // namespace
+
+namespace detail {
+
+IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface, const IcpParams& params, ProgressObserver* progress)
+{
+    checkParams(params);
+    if (moving.empty())
+        throw Error(ErrorCode::InvalidData, "registration: the moving cloud '" + moving.name + "' is empty");
+    const bool plane = params.method == IcpMethod::PointToPlane;
+    const Eigen::Vector3d origin = surface.frameOrigin();
+    const IterationPoints points = iterationPoints(moving, origin, params);
+    IcpResult result;
+    RegistrationReport& report = result.report;
+    report.method = std::string(plane ? "ICP point-to-plane" : "ICP point-to-point") + ", " + dofName(params.constraint.dof) + " DOF" +
+                    (params.changeRobust ? ", change-robust" : "");
+    if (!points.note.empty())
+        report.notes.push_back(points.note);
+    ProgressTicker ticker(progress, "Registration (ICP)", params.maxIterations);
+    const Eigen::Isometry3d start = toLocal(params.initial, origin);
+    IterationRun run = runIterations(surface, points, params, start, nullptr, ticker);
+    // Directions the surfaces do not hold are held, unless the data say
+    // otherwise. The steps a free run takes along them follow noise and a
+    // few edges (airborne epochs of a flat park slid by up to 1.5 m), or the
+    // first steps of a large correction (a 2 degree tilt also turned the
+    // epoch 0.65 degree about the vertical) that no later step undoes. So
+    // again from the start with them held throughout; the free run is kept
+    // only when it explains the data significantly better: its truncated
+    // squared residuals lower by more than the chi-square quantile (0.9999)
+    // of as many degrees of freedom as directions held, in units of the
+    // residual variance (gentle hills do hold the horizontal, weakly).
+    const Eigen::MatrixXd held = weakDirections(run.normalMatrix);
+    if (held.cols() > 0 && held.cols() < run.normalMatrix.rows()) {
+        IterationRun fixed = runIterations(surface, points, params, start, &held, ticker);
+        const double cutoff = std::isfinite(std::min(run.threshold, run.cutoff)) ? std::min(run.threshold, run.cutoff)
+                                                                                   : params.maxDistance.value_or(kInfinity);
+        std::size_t within = 0, withinHeld = 0;
+        const double freeCost = truncatedCost(surface, points, params, run.motion, cutoff, within);
+        const double heldCost = truncatedCost(surface, points, params, fixed.motion, cutoff, withinHeld);
+        const double variance = freeCost / static_cast<double>(std::max<std::size_t>(within, 1));
+        const double gain = variance > 0 ? (heldCost - freeCost) / variance : 0.0;
+        const double significant = chiSquareQuantile(0.9999, static_cast<int>(held.cols()));
+        std::ostringstream note;
+        note.precision(3);
+        if (gain > significant) {
+            note << "the directions the surfaces hold weakly were solved: held fixed, the residuals would rise by " << gain
+                 << " variances (significant above " << significant << ")";
+        } else {
+            note << held.cols() << " direction(s) the surfaces do not hold held fixed (see the degeneracy warning): solving them "
+                 << "would lower the residuals by " << -gain << " variances only (significant above " << significant << ")";
+            run = std::move(fixed);
+        }
+        report.notes.push_back(note.str());
+    }
+    report.trace = run.trace;
+    report.iterations = run.trace.size();
+    report.converged = run.converged;
+    const Eigen::Isometry3d& motion = run.motion;
+    const Eigen::MatrixXd& normalMatrix = run.normalMatrix;
+    const double threshold = run.threshold;
+    const Eigen::Vector3d& centroid = points.centroid;
+    const double cutoff = run.cutoff;
     report.matrix = toGlobal(motion, origin);
     report.centre = centroid + origin;
     report.degeneracy = degeneracyWarning(normalMatrix, dofCount(params.constraint.dof), params.constraint.axis, report.eigenvalues);
@@ -340,7 +588,7 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
     const std::size_t n = moving.size();
     IcpParams final = params;
     final.overlap = 1.0; // the trimming of the last iteration is applied as its cutoff
-    const double finalThreshold = std::min(threshold, c.cutoff);
+    const double finalThreshold = std::min(threshold, cutoff);
     result.residual = ScalarField(fields::kRegistrationResidual, n);
     result.excluded = ScalarField(fields::kRegistrationExcluded, n);
     std::vector<double> magnitudes;

@@ -12,8 +12,7 @@ namespace scandiff::plugins {
 
 namespace {
 
-//! Below this ratio of the largest eigenvalue, a direction is not held.
-constexpr double kWeakRatio = 1e-3;
+constexpr double kWeakRatio = kWeakDirectionRatio;
 
 std::string vectorText(const Eigen::Vector3d& v)
 {
@@ -67,7 +66,8 @@ std::string degeneracyWarning(const Eigen::MatrixXd& normalMatrix, int dofCount,
     if (weak.empty())
         return {};
     return "degenerate geometry: the surfaces do not hold " + weak +
-           " (the result may slide that way; add overlap with other surfaces, or constrain the degrees of freedom)";
+           " (the motion was held fixed that way: what the start had there stays; add overlap with other surfaces, or "
+           "constrain the degrees of freedom)";
 }
 
 Table reportTable(const RegistrationReport& r)

@@ -91,7 +91,7 @@ bool fitPointToPoint(const std::vector<Eigen::Vector3d>& x, const std::vector<Ei
 
 bool stepPointToPlane(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& y,
                       const std::vector<Eigen::Vector3d>& n, const std::vector<double>& w, const DofConstraint& constraint,
-                      double length, Eigen::Isometry3d& step, Eigen::MatrixXd& normalMatrix)
+                      double length, Eigen::Isometry3d& step, Eigen::MatrixXd& normalMatrix, const Eigen::MatrixXd* held)
 {
     const int unknowns = dofCount(constraint.dof);
     const Eigen::Vector3d axis = constraint.axis.normalized();
@@ -114,10 +114,25 @@ bool stepPointToPlane(const std::vector<Eigen::Vector3d>& x, const std::vector<E
         b.noalias() -= w[i] * r * row;
     }
     normalMatrix = a;
-    const Eigen::LDLT<Eigen::MatrixXd> solver(a);
-    if (solver.info() != Eigen::Success || !(a.diagonal().maxCoeff() > 0))
+    if (!(a.diagonal().maxCoeff() > 0) || !a.allFinite())
         return false;
-    const Eigen::VectorXd delta = solver.solve(b);
+    if (held && held->cols() > 0) {
+        // The system restricted to the complement of the held directions.
+        const Eigen::MatrixXd project = Eigen::MatrixXd::Identity(unknowns, unknowns) - *held * held->transpose();
+        a = project * a * project;
+        b = project * b;
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(a);
+    if (solver.info() != Eigen::Success)
+        return false;
+    const Eigen::VectorXd values = solver.eigenvalues();
+    const double largest = values.maxCoeff();
+    Eigen::VectorXd delta = Eigen::VectorXd::Zero(unknowns);
+    for (Eigen::Index i = 0; i < values.size(); ++i)
+        if (values[i] >= kWeakDirectionRatio * largest && values[i] > 0) {
+            const Eigen::VectorXd v = solver.eigenvectors().col(i);
+            delta += v * (v.dot(b) / values[i]);
+        }
     if (!delta.allFinite())
         return false;
     Eigen::Vector3d omega = Eigen::Vector3d::Zero(), tau = Eigen::Vector3d::Zero();

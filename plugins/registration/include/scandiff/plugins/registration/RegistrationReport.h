@@ -58,7 +58,7 @@ std::string reportSummary(const RegistrationReport& report);
 //! "weak: translation along (0.00, 1.00, 0.00)"... from a normal matrix whose
 //! unknowns are (rotation x y z in metres, translation x y z), or the reduced
 //! sets of Four and Translation; empty when the smallest eigenvalue is at least
-//! 1e-3 of the largest. Fills `eigenvalues`.
+//! kWeakDirectionRatio (1e-3) of the largest. Fills `eigenvalues`.
 std::string degeneracyWarning(const Eigen::MatrixXd& normalMatrix, int dofCount, const Eigen::Vector3d& axis,
                               std::vector<double>& eigenvalues);
 

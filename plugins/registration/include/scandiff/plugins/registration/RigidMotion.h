@@ -42,15 +42,30 @@ int dofCount(Dof dof);
 bool fitPointToPoint(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& y, const std::vector<double>& w,
                      const DofConstraint& constraint, Eigen::Isometry3d& motion);
 
+//! Below this share of the largest eigenvalue of a point-to-plane normal
+//! matrix (unknowns in metres), a direction of the motion is not held by the
+//! surfaces: the step does not move along it, and the report names it.
+inline constexpr double kWeakDirectionRatio = 1e-3;
+
 //! The linearised (small-motion) step minimising sum w_i (n_i . (x_i + omega x x_i + tau) - n_i . y_i)^2,
 //! with omega = theta axis for Four and 0 for Translation: solves the normal
-//! equations, returns the step as a motion (the rotation exact, from the
-//! rotation vector) and the normal matrix (columns omega then tau, omega
-//! multiplied by `length`: the displacement it gives at that distance, so both
-//! are metres) for the degeneracy analysis. False when the system is singular.
+//! equations in the eigenvectors of their matrix, leaving out the directions
+//! the surfaces do not hold (eigenvalue under kWeakDirectionRatio of the
+//! largest: on flat ground, the horizontal translations and the turn about
+//! the vertical; a least-squares step along them follows noise and a few
+//! edges, and slid airborne epochs by up to 1.5 m), returns the step as a
+//! motion (the rotation exact, from the rotation vector) and the normal
+//! matrix (columns omega then tau, omega multiplied by `length`: the
+//! displacement it gives at that distance, so both are metres) for the
+//! degeneracy analysis. `held`, when given, holds orthonormal columns (in the
+//! unknowns' space) the step must not move along whatever this system says:
+//! the directions a converged run found weak, so that steps taken while the
+//! clouds were still apart cannot leave a component there that no later step
+//! corrects. False when no direction is held.
 bool stepPointToPlane(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& y,
                       const std::vector<Eigen::Vector3d>& n, const std::vector<double>& w, const DofConstraint& constraint,
-                      double length, Eigen::Isometry3d& step, Eigen::MatrixXd& normalMatrix);
+                      double length, Eigen::Isometry3d& step, Eigen::MatrixXd& normalMatrix,
+                      const Eigen::MatrixXd* held = nullptr);
 
 //! The motion as a 4 x 4 matrix acting on global coordinates, from one acting
 //! on coordinates relative to `frameOrigin`.
