@@ -124,6 +124,36 @@ bool airborneRow(const airborne::AirborneEpochsScene& scene, const Options& o, c
     return met;
 }
 
+bool stationsRow(const stations::StationsParams& p, const Options& o, const std::string& label)
+{
+    const auto start = std::chrono::steady_clock::now();
+    const stations::StationsScene scene = stations::make(p);
+    const double made = seconds(start);
+    const StationsTrial t = runStations(scene, o.set);
+    const bool met = stations::withinTolerance(t.errors, scene.clouds.size());
+    std::size_t points = 0;
+    for (const PointCloud& c : scene.clouds)
+        points += c.size();
+    std::printf("%s %s | %zu stations, %zu pts | errors:", label.c_str(), stations::describe(p).c_str(), scene.clouds.size(), points);
+    for (const auto& e : t.errors)
+        std::printf(" %.4f deg/%.1f mm", e.rotationDeg, e.maxDisplacement * 1e3);
+    std::printf(" | %s | scene %.1f s, tool %.1f s%s\n", t.report.c_str(), made, seconds(start) - made, met ? "" : "  FAIL");
+    if (o.set.count("verbose"))
+        for (const auto& row : t.pairs.rows) {
+            std::printf("    pair");
+            for (const auto& cell : row)
+                std::visit([](const auto& v) {
+                    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, double>)
+                        std::printf(" %.4g", v);
+                    else
+                        std::printf(" %s", v.c_str());
+                }, cell);
+            std::printf("\n");
+        }
+    std::fflush(stdout);
+    return met;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -177,6 +207,13 @@ int main(int argc, char** argv)
             tally(visibilityRow(grazing::issueCase(), o, "issue"));
         for (int d = 0; d < o.draws; ++d)
             tally(visibilityRow(grazing::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+    } else if (o.family == "stations") {
+        Options rest = o;
+        rest.set.erase("verbose");
+        if (o.issue)
+            tally(stationsRow(stations::issueCase(), o, "issue"));
+        for (int d = 0; d < o.draws; ++d)
+            tally(stationsRow(stations::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
     } else if (o.family == "airborne") {
         if (o.issue)
             tally(airborneRow(airborne::make(airborne::issueCase()), o, "issue", false));
