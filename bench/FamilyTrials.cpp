@@ -129,7 +129,9 @@ bool stationsRow(const stations::StationsParams& p, const Options& o, const std:
     const auto start = std::chrono::steady_clock::now();
     const stations::StationsScene scene = stations::make(p);
     const double made = seconds(start);
-    const StationsTrial t = runStations(scene, o.set);
+    std::map<std::string, std::string> options = o.set;
+    options.erase("verbose");
+    const StationsTrial t = runStations(scene, options);
     const bool met = stations::withinTolerance(t.errors, scene.clouds.size());
     std::size_t points = 0;
     for (const PointCloud& c : scene.clouds)
@@ -207,9 +209,23 @@ int main(int argc, char** argv)
             tally(visibilityRow(grazing::issueCase(), o, "issue"));
         for (int d = 0; d < o.draws; ++d)
             tally(visibilityRow(grazing::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+    } else if (o.family == "stations-pair") {
+        // One pair of the issue's stations by ICP from the true pose: what the data allow.
+        const stations::StationsScene scene = stations::make(stations::issueCase());
+        const PluginRegistry registry = makePluginRegistry();
+        const ToolSpec& tool = *registry.tools.find("register");
+        const std::size_t a = std::stoul(o.set.count("a") ? o.set.at("a") : "0"), b = std::stoul(o.set.count("b") ? o.set.at("b") : "1");
+        const Eigen::Matrix4d truth = scene.trueRelativePose(a).inverse() * scene.trueRelativePose(b);
+        std::string initial;
+        for (int k = 0; k < 16; ++k)
+            initial += (k ? " " : "") + std::to_string(truth(k / 4, k % 4));
+        std::map<std::string, std::string> options{{"initial", initial}, {"exclude-changes", "true"}, {"kernel", "cauchy"}};
+        ToolResult r = tool.execute(ToolInputs().add("reference", scene.clouds[a]).add("moving", scene.clouds[b]), tool.resolve(options), nullptr);
+        const Eigen::Matrix4d m = r.transform("matrix");
+        std::printf("pair %zu-%zu from the truth: %s\n  moved %.5f deg, %.5f m\n", a, b, r.summary.c_str(),
+                    Eigen::AngleAxisd(Eigen::Matrix3d((m * truth.inverse()).topLeftCorner<3, 3>())).angle() * 57.2958,
+                    (m * truth.inverse()).topRightCorner<3, 1>().norm());
     } else if (o.family == "stations") {
-        Options rest = o;
-        rest.set.erase("verbose");
         if (o.issue)
             tally(stationsRow(stations::issueCase(), o, "issue"));
         for (int d = 0; d < o.draws; ++d)

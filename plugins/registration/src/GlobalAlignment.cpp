@@ -40,10 +40,13 @@ double automaticSpacing(const PointCloud& reference, std::size_t target)
     return std::max(cell, std::sqrt(cells * cell * cell / static_cast<double>(std::max<std::size_t>(target, 100))));
 }
 
+} // namespace
+
 //! A cloud thinned to the spacing, with normals and descriptors; positions
 //! relative to its centroid (double), which `centre` holds in global coordinates.
-struct Described
+struct AlignmentFeatures
 {
+    double spacing = 0;
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     std::vector<Eigen::Vector3d> points;
     std::vector<Eigen::Vector3d> normals; //!< unit
@@ -52,7 +55,9 @@ struct Described
     std::vector<Eigen::Vector3f> thinNormals; //!< of every thinned point, zero where none
 };
 
-Described describe(const PointCloud& cloud, double spacing, ProgressObserver* progress)
+namespace {
+
+AlignmentFeatures describe(const PointCloud& cloud, double spacing, ProgressObserver* progress)
 {
     PointCloud thin = cloud.subset(spatialSubsample(cloud, spacing, progress));
     // Normals turned away from the centroid: a rule that moves with the cloud,
@@ -73,7 +78,8 @@ Described describe(const PointCloud& cloud, double spacing, ProgressObserver* pr
     std::vector<detail::Descriptor> descriptors;
     std::vector<char> valid;
     detail::fpfhDescriptors(points, unitNormals, 5 * spacing, descriptors, valid);
-    Described d;
+    AlignmentFeatures d;
+    d.spacing = spacing;
     for (std::size_t k = 0; k < kept.size(); ++k)
         if (valid[k]) {
             d.points.push_back(thin.globalPosition(kept[k]));
@@ -305,7 +311,7 @@ std::vector<Hypothesis> ransac(const Matches& m, const std::vector<std::vector<s
 //! site that is mostly ground, a wrong turn about the vertical still lands
 //! most points on ground; what tells it from the right one is the walls, and
 //! this gives each orientation of wall as much say as the ground.
-std::vector<std::size_t> normalSpaceSample(const Described& d, std::size_t perBin)
+std::vector<std::size_t> normalSpaceSample(const AlignmentFeatures& d, std::size_t perBin)
 {
     constexpr int kPolar = 6, kAzimuth = 12;
     constexpr double kPi = 3.14159265358979323846;
@@ -336,7 +342,7 @@ std::vector<std::size_t> normalSpaceSample(const Described& d, std::size_t perBi
 class Verifier
 {
 public:
-    Verifier(const Described& moving, const Described& reference, double spacing, double tolerance, const DofConstraint& constraint)
+    Verifier(const AlignmentFeatures& moving, const AlignmentFeatures& reference, double spacing, double tolerance, const DofConstraint& constraint)
         : moving_(moving), reference_(reference), spacing_(spacing), tolerance_(tolerance), constraint_(constraint),
           tree_(buildOctree(reference.thin)), level_(tree_.levelNearestMeanPopulation(8.0)), sample_(normalSpaceSample(moving, 200)),
           shift_(reference.centre - reference.thin.origin())
@@ -419,8 +425,8 @@ private:
         }
     }
 
-    const Described& moving_;
-    const Described& reference_;
+    const AlignmentFeatures& moving_;
+    const AlignmentFeatures& reference_;
     double spacing_, tolerance_;
     DofConstraint constraint_;
     octree::Octree tree_;
@@ -456,7 +462,32 @@ GlobalAlignmentResult globalAlign(const PointCloud& moving, const PointCloud* re
     if (referenceCloud->empty())
         throw Error(ErrorCode::InvalidData, "global alignment: the reference cloud '" + referenceCloud->name + "' is empty");
     const double spacing = params.spacing ? *params.spacing : automaticSpacing(*referenceCloud, params.targetPoints);
-    const Described a = describe(moving, spacing, progress), b = describe(*referenceCloud, spacing, progress);
+    const auto a = describeForAlignment(moving, spacing, progress), b = describeForAlignment(*referenceCloud, spacing, progress);
+    return globalAlign(*a, *b, params, progress);
+}
+
+double alignmentSpacing(const PointCloud& reference, std::size_t targetPoints)
+{
+    return automaticSpacing(reference, targetPoints);
+}
+
+std::shared_ptr<const AlignmentFeatures> describeForAlignment(const PointCloud& cloud, double spacing, ProgressObserver* progress)
+{
+    if (!(spacing > 0 && std::isfinite(spacing)))
+        throw Error(ErrorCode::InvalidArgument, "global alignment: the spacing must be > 0");
+    if (cloud.empty())
+        throw Error(ErrorCode::InvalidData, "global alignment: the cloud '" + cloud.name + "' is empty");
+    return std::make_shared<const AlignmentFeatures>(describe(cloud, spacing, progress));
+}
+
+GlobalAlignmentResult globalAlign(const AlignmentFeatures& a, const AlignmentFeatures& b, const GlobalAlignmentParams& params,
+                                  ProgressObserver* progress)
+{
+    if (!(params.inlierSpacings > 0) || params.maxIterations == 0)
+        throw Error(ErrorCode::InvalidArgument, "global alignment: the inlier spacings and hypotheses are > 0");
+    if (a.spacing != b.spacing)
+        throw Error(ErrorCode::InvalidArgument, "global alignment: both clouds must be described at one spacing");
+    const double spacing = a.spacing;
     const std::size_t size = minimalSetSize(params.constraint.dof);
     const auto pairs = detail::matchDescriptors(a.descriptors, b.descriptors, 50);
     Matches m;
@@ -494,19 +525,22 @@ GlobalAlignmentResult globalAlign(const PointCloud& moving, const PointCloud* re
     for (std::size_t i = 0; i < leaders.size(); ++i)
         coarse.emplace_back(-verifier.share(leaders[i].motion, tolerance), i);
     std::sort(coarse.begin(), coarse.end());
-    Hypothesis best;
-    double bestShare = -1, bestRms = 0;
+    struct Refined
+    {
+        Hypothesis h;
+        double share, rms;
+    };
+    std::vector<Refined> refined;
     for (std::size_t k = 0; k < std::min<std::size_t>(16, coarse.size()); ++k) {
         Hypothesis h = leaders[coarse[k].second];
         h.motion = verifier.refine(h.motion, 10);
         double rms = 0;
         const double share = verifier.share(h.motion, 0.25 * spacing, &rms);
-        if (share > bestShare) {
-            bestShare = share;
-            bestRms = rms;
-            best = h;
-        }
+        refined.push_back({h, share, rms});
     }
+    std::stable_sort(refined.begin(), refined.end(), [](const Refined& x, const Refined& y) { return x.share > y.share; });
+    Hypothesis best = refined.front().h;
+    const double bestShare = refined.front().share, bestRms = refined.front().rms;
     score(m, best.motion, tolerance, best);
 
     GlobalAlignmentResult result;
@@ -523,6 +557,27 @@ GlobalAlignmentResult globalAlign(const PointCloud& moving, const PointCloud* re
     toB.topRightCorner<3, 1>() = b.centre;
     fromA.topRightCorner<3, 1>() = -a.centre;
     report.matrix = toB * local * fromA;
+    // The next distinct motions by share (a symmetric site lands most of its
+    // points under a half turn too: the caller may weigh them on every point).
+    const auto global = [&](const Eigen::Isometry3d& motion) {
+        Eigen::Matrix4d l = Eigen::Matrix4d::Identity();
+        l.topLeftCorner<3, 3>() = motion.linear();
+        l.topRightCorner<3, 1>() = motion.translation();
+        return Eigen::Matrix4d(toB * l * fromA);
+    };
+    std::vector<Eigen::Isometry3d> kept{best.motion};
+    for (const Refined& r : refined) {
+        if (result.alternatives.size() + 1 >= params.alternatives || r.share < 0.5 * bestShare)
+            break;
+        bool distinct = true;
+        for (const Eigen::Isometry3d& k : kept)
+            distinct = distinct && (rotationDegrees(k.linear().transpose() * r.h.motion.linear()) > 2.0 ||
+                                    (k.translation() - r.h.motion.translation()).norm() > 2 * spacing);
+        if (!distinct)
+            continue;
+        kept.push_back(r.h.motion);
+        result.alternatives.push_back(global(r.h.motion));
+    }
     report.centre = a.centre;
     report.rms = bestRms; // of the verification points that landed
     report.median = report.p90 = report.p95 = report.p99 = std::numeric_limits<double>::quiet_NaN();

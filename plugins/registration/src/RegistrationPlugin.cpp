@@ -475,10 +475,11 @@ Table stationsReportTable(const StationResult& s)
 Table stationPairsTable(const StationResult& s)
 {
     Table t;
-    t.columns = {"station_a", "station_b", "overlap", "pairwise_rms_m", "adjusted_rms_m", "disagreement_deg", "disagreement_m", "warning"};
+    t.columns = {"station_a", "station_b", "used", "overlap", "pairwise_rms_m", "adjusted_rms_m", "disagreement_deg", "disagreement_m",
+                 "note", "warning"};
     for (const auto& p : s.pairs)
-        t.rows.push_back({static_cast<double>(p.a), static_cast<double>(p.b), p.overlap, p.pairwise.rms, p.adjustedRms,
-                          p.disagreementDegrees, p.disagreementMetres, p.pairwise.degeneracy});
+        t.rows.push_back({static_cast<double>(p.a), static_cast<double>(p.b), p.used ? 1.0 : 0.0, p.overlap, p.pairwise.rms, p.adjustedRms,
+                          p.disagreementDegrees, p.disagreementMetres, p.note, p.pairwise.degeneracy});
     return t;
 }
 
@@ -503,7 +504,8 @@ void addStationsTool(ToolRegistry& registry)
     tool.title = "Multi-station adjustment";
     tool.category = "Registration";
     tool.description =
-        "Registers several scans of a site, roughly in a common frame, together: every overlapping pair by ICP alone "
+        "Registers several scans of a site together, each in its own scanner frame (any heading and place): every pair "
+        "alone by global alignment then ICP, pairs that overlap too little or disagree with the loops they close left out "
         "(the misclosure of every loop of pairs is reported), then every pose at once in one least-squares problem "
         "over the point-to-plane residuals of all pairs, the first station fixed (6 unknowns per other station, 4 for "
         "levelled scanners: thesis 004 §III-2.2.1). Writes each station moved and poses.txt (16 numbers a line, row by "
@@ -516,10 +518,21 @@ void addStationsTool(ToolRegistry& registry)
                     OutputSpec{"loops", "Loop misclosures", DataKind::Table, false},
                     OutputSpec{"trace", "Convergence trace", DataKind::Table, false}};
     tool.parameters = dofParameters();
+    tool.parameters.push_back(ParameterSpec::choice("start", "Stations start",
+                                                    "any: each station in its own scanner frame, any heading and place (each "
+                                                    "pair aligned globally first); near: roughly in one frame already (within "
+                                                    "the maximum distance)",
+                                                    {"any", "near"}, defaults.anyStart ? "any" : "near"));
     tool.parameters.push_back(ParameterSpec::real("max-dist", "Maximum distance",
-                                                  "Correspondences farther are left out; points this close overlap. The "
-                                                  "stations must start within it",
+                                                  "Correspondences farther are left out of the adjustment; with start near, "
+                                                  "the stations must start within it",
                                                   defaults.maxDistance, 1e-9, 1e9, "m"));
+    tool.parameters.push_back(ParameterSpec::real("spacing", "Feature spacing",
+                                                  "start any: the spacing the stations are thinned to for their shape "
+                                                  "descriptors; absent: the median station keeps about 10 000 points",
+                                                  0.1, 1e-6, 1e6, "m")
+                                  .asOptional()
+                                  .onlyWith("start=any"));
     tool.parameters.push_back(ParameterSpec::real("min-overlap", "Minimum overlap",
                                                   "Pairs whose overlap (fraction of a station's points near the other) is "
                                                   "smaller are not registered",
@@ -533,6 +546,9 @@ void addStationsTool(ToolRegistry& registry)
         StationParams params;
         params.constraint = dofFrom(values);
         params.maxDistance = values.real("max-dist");
+        params.anyStart = values.text("start") == "any";
+        if (values.has("spacing"))
+            params.featureSpacing = values.real("spacing");
         params.minOverlap = values.real("min-overlap");
         params.sampleCount = static_cast<std::size_t>(values.integer("sample"));
         params.maxIterations = static_cast<std::size_t>(values.integer("iterations"));
@@ -553,6 +569,9 @@ void addStationsTool(ToolRegistry& registry)
         summary << "; " << adjusted.report.iterations << " iterations" << (adjusted.report.converged ? "" : " (not converged)");
         if (!adjusted.report.degeneracy.empty())
             summary << "; WARNING " << adjusted.report.degeneracy;
+        for (const std::string& note : adjusted.report.notes)
+            if (note.find("ambiguous") != std::string::npos)
+                summary << "; WARNING " << note;
         result.summary = summary.str();
         for (std::size_t k = 0; k < stations.size(); ++k)
             result.add("station", transformCloud(*stations[k], adjusted.poses[k], adjusted.report.method));

@@ -5,6 +5,7 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/processing/Subsampling.h>
+#include <scandiff/plugins/registration/GlobalAlignment.h>
 #include <scandiff/plugins/registration/Icp.h>
 
 #include <Eigen/Dense>
@@ -14,6 +15,8 @@
 #include <deque>
 #include <limits>
 #include <memory>
+#include <sstream>
+#include <string>
 
 namespace scandiff::plugins {
 
@@ -120,17 +123,6 @@ std::vector<Station> prepare(const std::vector<const PointCloud*>& clouds, const
     return stations;
 }
 
-//! The fraction of `from`'s first points within the distance of `on`, both as given.
-double overlapFraction(const Station& from, const Station& on, const Eigen::Vector3d& worldOrigin, double distance)
-{
-    Matched m;
-    match(from, Eigen::Isometry3d::Identity(), on, Eigen::Isometry3d::Identity(), worldOrigin, 4000, m);
-    std::size_t near = 0;
-    for (double d : m.distance)
-        near += d <= distance;
-    return static_cast<double>(near) / static_cast<double>(std::max<std::size_t>(m.x.size(), 1));
-}
-
 //! Poses along a breadth-first spanning tree from station 0, composed from the
 //! pairwise motions; `parentEdge[k]` is the pair that reached k (none for 0).
 std::vector<Eigen::Matrix4d> chainPoses(std::size_t count, const std::vector<StationPair>& pairs, std::vector<std::ptrdiff_t>& parentEdge,
@@ -208,6 +200,305 @@ std::vector<StationLoop> loopMisclosures(const std::vector<Station>& stations, c
     return loops;
 }
 
+//! The fraction of `from`'s first points within the distance of `on`, `from`
+//! moved by `fromToOn` (global matrix from -> on).
+double posedOverlap(const Station& from, const Station& on, const Eigen::Matrix4d& fromToOn, const Eigen::Vector3d& worldOrigin,
+                    double distance)
+{
+    Matched m;
+    match(from, toLocal(fromToOn, worldOrigin), on, Eigen::Isometry3d::Identity(), worldOrigin, 4000, m);
+    std::size_t near = 0;
+    for (double d : m.distance)
+        near += d <= distance;
+    return static_cast<double>(near) / static_cast<double>(std::max<std::size_t>(m.x.size(), 1));
+}
+
+//! The fraction of `from`'s first points (moved by `fromToOn`) that lie
+//! within `tolerance` of the tangent plane of their closest point of `on`,
+//! that point within `reach`.
+double posedAgreement(const Station& from, const Station& on, const Eigen::Matrix4d& fromToOn, const Eigen::Vector3d& worldOrigin,
+                      double tolerance, double reach)
+{
+    Matched m;
+    match(from, toLocal(fromToOn, worldOrigin), on, Eigen::Isometry3d::Identity(), worldOrigin, 4000, m);
+    std::size_t agree = 0;
+    for (std::size_t i = 0; i < m.x.size(); ++i)
+        agree += m.distance[i] <= reach && std::abs(m.residual[i]) <= tolerance;
+    return static_cast<double>(agree) / static_cast<double>(std::max<std::size_t>(m.x.size(), 1));
+}
+
+//! A pair registered alone: its candidate motions (b -> a), each refined by
+//! ICP, with how much of both stations each brings onto the other.
+struct PairHypotheses
+{
+    StationPair pair; //!< pairwise: the candidate chosen
+    std::vector<RegistrationReport> candidates;
+    std::vector<double> shares;
+};
+
+//! One pair registered alone: global alignment from the descriptors (any
+//! start), then change-robust ICP from it; or ICP from where the stations
+//! are. Its overlap after that, both ways.
+PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a, std::size_t b,
+                            const std::vector<std::shared_ptr<const AlignmentFeatures>>& features, double spacing,
+                            const StationParams& params, const Eigen::Vector3d& worldOrigin)
+{
+    PairHypotheses hypotheses;
+    StationPair& pair = hypotheses.pair;
+    pair.a = a;
+    pair.b = b;
+    IcpParams icp;
+    icp.constraint = params.constraint;
+    icp.kernel = RobustKernel::Cauchy;
+    icp.changeRobust = true;
+    icp.sampleCount = params.sampleCount;
+    icp.seed = params.seed;
+    icp.maxDistance = params.maxDistance;
+    std::vector<Eigen::Matrix4d> starts{Eigen::Matrix4d::Identity()};
+    if (params.anyStart) {
+        GlobalAlignmentParams global;
+        global.constraint = params.constraint;
+        global.seed = params.seed + 31 * a + b;
+        global.alternatives = 4;
+        try {
+            const GlobalAlignmentResult found = globalAlign(*features[b], *features[a], global);
+            // Where the stations already are is a candidate too: stations
+            // brought roughly together before (or a survey's own poses) keep
+            // that start, which the global search may not rank first in a
+            // hall that repeats itself.
+            starts = {Eigen::Matrix4d::Identity(), found.report.matrix};
+            starts.insert(starts.end(), found.alternatives.begin(), found.alternatives.end());
+        } catch (const Error& e) {
+            if (e.code() == ErrorCode::Cancelled)
+                throw;
+            pair.note = std::string("no global alignment (") + e.what() + "): from where the stations are";
+        }
+        // From within about a feature spacing: the ICP needs no more reach.
+        icp.maxDistance = std::min(params.maxDistance, 4 * spacing);
+    }
+    // Each start refined by ICP; the one that brings the most points of both
+    // stations onto the other's surface within 3 robust sigmas of the
+    // residuals (the smallest of the candidates') wins. A hall is near
+    // symmetric under a half turn: the turned one lands walls, floor and roof
+    // as well, and only the clutter (racks, machines, a partition's door)
+    // tells them apart; within half a feature spacing, the clutter of the
+    // wrong turn found something to land on too, and the ICP's own RMS,
+    // over what it kept, preferred the wrong turn that kept less.
+    struct Candidate
+    {
+        RegistrationReport report;
+        double sigma;
+    };
+    std::vector<Candidate> candidates;
+    std::string failure;
+    for (const Eigen::Matrix4d& start : starts) {
+        icp.initial = start;
+        try {
+            RegistrationReport report = detail::icpOnSurface(*stations[b].cloud, *stations[a].surface, icp, nullptr).report;
+            const double sigma = 1.4826 * report.median;
+            candidates.push_back({std::move(report), sigma});
+        } catch (const Error& e) {
+            if (e.code() == ErrorCode::Cancelled)
+                throw;
+            failure = e.what();
+        }
+    }
+    double sigma = std::numeric_limits<double>::infinity();
+    for (const Candidate& c : candidates)
+        if (std::isfinite(c.sigma) && c.sigma > 0)
+            sigma = std::min(sigma, c.sigma);
+    for (Candidate& c : candidates) {
+        const double tolerance = std::isfinite(sigma) ? 3 * sigma : spacing;
+        const double share = posedAgreement(stations[b], stations[a], c.report.matrix, worldOrigin, tolerance, 2 * spacing) +
+                             posedAgreement(stations[a], stations[b], c.report.matrix.inverse(), worldOrigin, tolerance, 2 * spacing);
+        bool repeated = false; // the same motion from another start
+        for (const RegistrationReport& kept : hypotheses.candidates)
+            repeated = repeated || (rotationDegrees(kept.matrix.topLeftCorner<3, 3>().transpose() * c.report.matrix.topLeftCorner<3, 3>()) < 0.05 &&
+                                    (kept.matrix.topRightCorner<3, 1>() - c.report.matrix.topRightCorner<3, 1>()).norm() < spacing);
+        if (repeated)
+            continue;
+        hypotheses.candidates.push_back(std::move(c.report));
+        hypotheses.shares.push_back(share);
+    }
+    if (hypotheses.candidates.empty()) {
+        pair.used = false;
+        pair.note = "no registration: " + failure;
+        return hypotheses;
+    }
+    const auto best = static_cast<std::size_t>(std::max_element(hypotheses.shares.begin(), hypotheses.shares.end()) - hypotheses.shares.begin());
+    pair.pairwise = hypotheses.candidates[best];
+    // Overlapping: within two feature spacings (the joint adjustment's
+    // distance at most) of the other station, after the pair's own motion.
+    const double near = std::min(params.maxDistance, 2 * spacing);
+    pair.overlap = std::max(posedOverlap(stations[b], stations[a], pair.pairwise.matrix, worldOrigin, near),
+                            posedOverlap(stations[a], stations[b], pair.pairwise.matrix.inverse(), worldOrigin, near));
+    if (pair.overlap < params.minOverlap) {
+        pair.used = false;
+        pair.note = "overlap " + std::to_string(pair.overlap) + " below the minimum";
+    }
+    return hypotheses;
+}
+
+//! The candidate of each pair such that the loops close: a hall is near
+//! symmetric under a half turn and repeats along its columns, and a pair
+//! alone may prefer a turned or shifted fit by a percent of its points; the
+//! loops of three stations do not close on such a choice. Each choice is
+//! scored 3 for every triangle of pairs that closes (within `degrees` and
+//! `metres` at the third station's centre), -3 for every one that does not,
+//! plus the pairs' shares; the best is sought over every combination when
+//! there are few (at most 100 000), else by changing one pair at a time
+//! from the best shares while the score rises.
+void chooseConsistentCandidates(std::vector<PairHypotheses>& pairs, const std::vector<Station>& stations,
+                                const Eigen::Vector3d& worldOrigin, double degrees, double metres)
+{
+    const std::size_t count = stations.size();
+    std::vector<std::vector<std::ptrdiff_t>> index(count, std::vector<std::ptrdiff_t>(count, -1));
+    for (std::size_t e = 0; e < pairs.size(); ++e)
+        if (pairs[e].pair.used && !pairs[e].candidates.empty())
+            index[pairs[e].pair.a][pairs[e].pair.b] = index[pairs[e].pair.b][pairs[e].pair.a] = static_cast<std::ptrdiff_t>(e);
+    std::vector<std::size_t> choice(pairs.size(), 0);
+    for (std::size_t e = 0; e < pairs.size(); ++e)
+        if (!pairs[e].shares.empty())
+            choice[e] = static_cast<std::size_t>(std::max_element(pairs[e].shares.begin(), pairs[e].shares.end()) - pairs[e].shares.begin());
+    const auto motion = [&](std::size_t to, std::size_t from, const std::vector<std::size_t>& pick) { // from -> to
+        const auto e = static_cast<std::size_t>(index[to][from]);
+        const Eigen::Matrix4d& m = pairs[e].candidates[pick[e]].matrix;
+        return pairs[e].pair.a == to ? Eigen::Matrix4d(m) : Eigen::Matrix4d(m.inverse());
+    };
+    const auto scoreOf = [&](const std::vector<std::size_t>& pick) {
+        double score = 0;
+        for (std::size_t e = 0; e < pairs.size(); ++e)
+            if (index[pairs[e].pair.a][pairs[e].pair.b] == static_cast<std::ptrdiff_t>(e))
+                score += pairs[e].shares[pick[e]];
+        for (std::size_t a = 0; a < count; ++a)
+            for (std::size_t b = a + 1; b < count; ++b)
+                for (std::size_t c = b + 1; c < count; ++c) {
+                    if (index[a][b] < 0 || index[a][c] < 0 || index[b][c] < 0)
+                        continue;
+                    double angle = 0, shift = 0;
+                    motionSize(motion(a, b, pick).inverse() * motion(a, c, pick) * motion(c, b, pick), stations[b].centre + worldOrigin,
+                               angle, shift);
+                    score += angle <= degrees && shift <= metres ? 3.0 : -3.0;
+                }
+        return score;
+    };
+    double combinations = 1;
+    std::vector<std::size_t> varying;
+    for (std::size_t e = 0; e < pairs.size(); ++e)
+        if (index[pairs[e].pair.a][pairs[e].pair.b] == static_cast<std::ptrdiff_t>(e) && pairs[e].candidates.size() > 1) {
+            combinations *= static_cast<double>(pairs[e].candidates.size());
+            varying.push_back(e);
+        }
+    double best = scoreOf(choice);
+    if (combinations <= 100000) {
+        std::vector<std::size_t> pick = choice;
+        for (double n = 1; n < combinations; ++n) {
+            for (std::size_t e : varying) { // the next combination, as an odometer
+                if (++pick[e] < pairs[e].candidates.size())
+                    break;
+                pick[e] = 0;
+            }
+            const double score = scoreOf(pick);
+            if (score > best) {
+                best = score;
+                choice = pick;
+            }
+        }
+    } else {
+        for (bool better = true; better;) {
+            better = false;
+            for (std::size_t e : varying)
+                for (std::size_t k = 0; k < pairs[e].candidates.size(); ++k) {
+                    std::vector<std::size_t> pick = choice;
+                    pick[e] = k;
+                    const double score = scoreOf(pick);
+                    if (score > best + 1e-9) {
+                        best = score;
+                        choice = pick;
+                        better = true;
+                    }
+                }
+        }
+    }
+    for (std::size_t e = 0; e < pairs.size(); ++e)
+        if (!pairs[e].candidates.empty())
+            pairs[e].pair.pairwise = pairs[e].candidates[choice[e]];
+    // A site that repeats itself (a hall under a half or a quarter turn, a
+    // row of columns) fits a turned or shifted pair nearly as well: said,
+    // not hidden. Nearly: within 5 % of the chosen candidate's share.
+    for (PairHypotheses& h : pairs) {
+        if (h.candidates.size() < 2 || !h.pair.used)
+            continue;
+        const std::size_t chosen = choice[static_cast<std::size_t>(&h - pairs.data())];
+        for (std::size_t k = 0; k < h.candidates.size(); ++k) {
+            if (k == chosen || h.shares[k] < 0.95 * h.shares[chosen])
+                continue;
+            const Eigen::Matrix4d between = h.candidates[chosen].matrix.inverse() * h.candidates[k].matrix;
+            double angle = 0, shift = 0;
+            motionSize(between, stations[h.pair.b].centre + worldOrigin, angle, shift);
+            std::ostringstream note;
+            note.precision(3);
+            note << "ambiguous: another fit, turned " << angle << " deg and moved " << shift << " m, brings "
+                 << 100 * h.shares[k] / h.shares[chosen] << " % as many points together (the site repeats itself); check this pose";
+            if (h.pair.note.empty())
+                h.pair.note = note.str();
+            break;
+        }
+    }
+}
+
+//! Leaves out the pairs that disagree with the loops they close. A pair's
+//! motion b -> a should equal any path a -> c -> b's; each triangle of used
+//! pairs is a vote for (closes within `degrees` and `metres` at b's centre)
+//! or against each of its three pairs. While a pair has more votes against
+//! than for, the worst such pair (most against, then least overlap) is left
+//! out and the votes are counted again: a wrong pair, from a symmetric hall
+//! or a repeated rack, disagrees with every triangle it is in, while a right
+//! one is outvoted only where wrong ones meet.
+void leaveOutInconsistentPairs(std::vector<StationPair>& pairs, const std::vector<Station>& stations, const Eigen::Vector3d& worldOrigin,
+                               double degrees, double metres)
+{
+    const std::size_t count = stations.size();
+    for (;;) {
+        // index[a][b]: the used pair between a and b, or none.
+        std::vector<std::vector<std::ptrdiff_t>> index(count, std::vector<std::ptrdiff_t>(count, -1));
+        for (std::size_t e = 0; e < pairs.size(); ++e)
+            if (pairs[e].used)
+                index[pairs[e].a][pairs[e].b] = index[pairs[e].b][pairs[e].a] = static_cast<std::ptrdiff_t>(e);
+        const auto motion = [&](std::size_t to, std::size_t from) { // from -> to
+            const StationPair& p = pairs[static_cast<std::size_t>(index[to][from])];
+            return p.a == to ? Eigen::Matrix4d(p.pairwise.matrix) : Eigen::Matrix4d(p.pairwise.matrix.inverse());
+        };
+        std::vector<int> against(pairs.size(), 0), support(pairs.size(), 0);
+        for (std::size_t a = 0; a < count; ++a)
+            for (std::size_t b = a + 1; b < count; ++b)
+                for (std::size_t c = b + 1; c < count; ++c) {
+                    if (index[a][b] < 0 || index[a][c] < 0 || index[b][c] < 0)
+                        continue;
+                    const Eigen::Matrix4d misclosure = motion(a, b).inverse() * motion(a, c) * motion(c, b);
+                    double angle = 0, shift = 0;
+                    motionSize(misclosure, stations[b].centre + worldOrigin, angle, shift);
+                    const bool closes = angle <= degrees && shift <= metres;
+                    for (const std::ptrdiff_t e : {index[a][b], index[a][c], index[b][c]})
+                        (closes ? support : against)[static_cast<std::size_t>(e)] += 1;
+                }
+        std::ptrdiff_t worst = -1;
+        for (std::size_t e = 0; e < pairs.size(); ++e) {
+            if (!pairs[e].used || against[e] <= support[e])
+                continue;
+            if (worst < 0 || against[e] > against[static_cast<std::size_t>(worst)] ||
+                (against[e] == against[static_cast<std::size_t>(worst)] && pairs[e].overlap < pairs[static_cast<std::size_t>(worst)].overlap))
+                worst = static_cast<std::ptrdiff_t>(e);
+        }
+        if (worst < 0)
+            return;
+        StationPair& p = pairs[static_cast<std::size_t>(worst)];
+        p.used = false;
+        p.note = "disagrees with " + std::to_string(against[static_cast<std::size_t>(worst)]) + " of the loops it closes (agrees with " +
+                 std::to_string(support[static_cast<std::size_t>(worst)]) + ")";
+    }
+}
+
 } // namespace
 
 StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const StationParams& params, ProgressObserver* progress)
@@ -223,29 +514,42 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
     const std::size_t count = stations.size();
     StationResult result;
 
-    // Overlapping pairs, each registered alone.
+    // Every pair registered alone; those that disagree with their loops left out.
+    double spacing = params.featureSpacing.value_or(0.0);
+    std::vector<std::shared_ptr<const AlignmentFeatures>> features(count);
+    if (params.anyStart) {
+        if (!params.featureSpacing) {
+            std::vector<double> spacings;
+            for (const Station& s : stations)
+                spacings.push_back(alignmentSpacing(*s.cloud, 10000));
+            spacing = medianOf(spacings);
+        }
+        ProgressTicker describeTicker(progress, "Stations: shape descriptors", count);
+        for (std::size_t k = 0; k < count; ++k) {
+            features[k] = describeForAlignment(*stations[k].cloud, spacing, nullptr);
+            describeTicker.step();
+        }
+    } else {
+        spacing = params.maxDistance / 2;
+    }
+    std::vector<PairHypotheses> hypotheses;
     ProgressTicker pairTicker(progress, "Stations: pairwise registration", count * (count - 1) / 2);
     for (std::size_t a = 0; a < count; ++a)
         for (std::size_t b = a + 1; b < count; ++b) {
-            const double overlap = std::max(overlapFraction(stations[b], stations[a], worldOrigin, params.maxDistance),
-                                            overlapFraction(stations[a], stations[b], worldOrigin, params.maxDistance));
+            hypotheses.push_back(registerPair(stations, a, b, features, spacing, params, worldOrigin));
             pairTicker.step();
-            if (overlap < params.minOverlap)
-                continue;
-            IcpParams icp;
-            icp.constraint = params.constraint;
-            icp.maxDistance = params.maxDistance;
-            icp.kernel = RobustKernel::Cauchy;
-            icp.changeRobust = true;
-            icp.sampleCount = params.sampleCount;
-            icp.seed = params.seed;
-            StationPair pair;
-            pair.a = a;
-            pair.b = b;
-            pair.overlap = overlap;
-            pair.pairwise = detail::icpOnSurface(*stations[b].cloud, *stations[a].surface, icp, nullptr).report;
-            result.pairs.push_back(std::move(pair));
         }
+    chooseConsistentCandidates(hypotheses, stations, worldOrigin, 0.5, std::max(0.05, 2 * spacing));
+    std::vector<StationPair> allPairs;
+    for (PairHypotheses& h : hypotheses) {
+        if (h.pair.note.rfind("ambiguous", 0) == 0)
+            result.report.notes.push_back("pair " + std::to_string(h.pair.a) + "-" + std::to_string(h.pair.b) + " " + h.pair.note);
+        allPairs.push_back(std::move(h.pair));
+    }
+    leaveOutInconsistentPairs(allPairs, stations, worldOrigin, 0.5, std::max(0.05, 2 * spacing));
+    std::vector<StationPair> leftOut;
+    for (StationPair& p : allPairs)
+        (p.used ? result.pairs : leftOut).push_back(std::move(p));
     std::vector<std::ptrdiff_t> parentEdge;
     std::vector<std::size_t> parent;
     const std::vector<Eigen::Matrix4d> chain = chainPoses(count, result.pairs, parentEdge, parent);
@@ -404,6 +708,11 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
                    p.disagreementMetres);
         if (!p.pairwise.degeneracy.empty())
             report.notes.push_back("pair " + std::to_string(p.a) + "-" + std::to_string(p.b) + ": " + p.pairwise.degeneracy);
+    }
+    for (StationPair& p : leftOut) {
+        report.notes.push_back("pair " + std::to_string(p.a) + "-" + std::to_string(p.b) + " left out: " + p.note);
+        p.adjustedRms = p.disagreementDegrees = p.disagreementMetres = std::numeric_limits<double>::quiet_NaN();
+        result.pairs.push_back(std::move(p));
     }
     double sum2 = 0;
     for (double r : finalResiduals)

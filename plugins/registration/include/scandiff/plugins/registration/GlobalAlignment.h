@@ -18,6 +18,7 @@
 #include <scandiff/plugins/registration/RigidMotion.h>
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 
 namespace scandiff::plugins {
@@ -37,6 +38,8 @@ struct GlobalAlignmentParams
     //! Hypotheses drawn (minimal sets of mutually consistent matches).
     std::size_t maxIterations = 100000;
     std::uint64_t seed = 0;
+    //! Motions returned in all, the best and the next distinct ones.
+    std::size_t alternatives = 1;
 };
 
 struct GlobalAlignmentResult
@@ -45,7 +48,26 @@ struct GlobalAlignmentResult
     double spacing = 0;
     std::size_t matches = 0;   //!< descriptor matches tried
     std::size_t inliers = 0;   //!< matches that agree with the motion
+    //! The next distinct motions (rotations 2 degrees or 2 spacings apart),
+    //! best first, each landing at least half as many points as the best
+    //! (GlobalAlignmentParams::alternatives - 1 at most).
+    std::vector<Eigen::Matrix4d> alternatives;
 };
+
+//! A cloud prepared for global alignment at a spacing (thinned, normals,
+//! descriptors): built once, aligned with many others (the stations of a
+//! survey, pair by pair).
+struct AlignmentFeatures;
+
+//! The spacing at which `reference` keeps about `targetPoints` points (the
+//! automatic spacing of globalAlign).
+double alignmentSpacing(const PointCloud& reference, std::size_t targetPoints);
+std::shared_ptr<const AlignmentFeatures> describeForAlignment(const PointCloud& cloud, double spacing,
+                                                              ProgressObserver* progress = nullptr);
+//! globalAlign on clouds described at one spacing (params.spacing and
+//! targetPoints are not used).
+GlobalAlignmentResult globalAlign(const AlignmentFeatures& moving, const AlignmentFeatures& reference,
+                                  const GlobalAlignmentParams& params, ProgressObserver* progress = nullptr);
 
 //! The motion moving -> reference. A mesh reference is sampled on its
 //! surface. Throws Error(InvalidData) for empty clouds or when no motion is

@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! Multi-station adjustment: N scans of one site, roughly in a common frame,
-//! registered jointly. Every overlapping pair is first registered alone (ICP);
+//! Multi-station adjustment: N scans of one site, each in its own scanner
+//! frame (any heading, any place), registered jointly. Every pair is first
+//! registered alone: global alignment (FPFH and RANSAC on descriptors made
+//! once per station, 4 DOF for levelled scanners) then ICP from it; a pair is
+//! kept when enough of it overlaps and it agrees with the loops it closes
+//! (pairs that disagree with the rest are left out, most doubtful first);
 //! those pairwise motions give the starting poses (along a spanning tree from
 //! station 0) and the misclosure of every loop of the overlap graph. Then all
 //! poses are estimated together in one least-squares problem over the
@@ -18,6 +22,8 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace scandiff::plugins {
@@ -25,10 +31,15 @@ namespace scandiff::plugins {
 struct StationParams
 {
     DofConstraint constraint;
-    //! Correspondences farther than this (m) are left out; also the distance
-    //! within which points count as overlapping. The stations' start must be
-    //! within it.
+    //! Correspondences farther than this (m) are left out of the joint
+    //! adjustment; also the distance within which points count as overlapping.
     double maxDistance = 1.0;
+    //! True: the stations arrive in any heading and place (a global alignment
+    //! per pair); false: roughly in one frame already (ICP from where they are).
+    bool anyStart = true;
+    //! The global alignment's feature spacing (m); absent: chosen so the
+    //! median station keeps about 10 000 points.
+    std::optional<double> featureSpacing;
     //! A pair overlaps when at least this fraction of one station's sampled
     //! points lies within maxDistance of the other.
     double minOverlap = 0.1;
@@ -40,7 +51,11 @@ struct StationParams
 struct StationPair
 {
     std::size_t a = 0, b = 0;
-    double overlap = 0;            //!< the larger of the two directions' fractions
+    double overlap = 0;            //!< the larger of the two directions' fractions (after the pair's own registration)
+    //! Left out of the adjustment: it disagrees with the loops it closes
+    //! (why in `note`), or its alignment failed.
+    bool used = true;
+    std::string note;
     RegistrationReport pairwise;   //!< b registered alone on a (matrix: b -> a)
     double adjustedRms = 0;        //!< point-to-plane RMS of the pair under the adjusted poses (m)
     //! How far the adjusted relative pose is from the pairwise one: angle
