@@ -75,6 +75,13 @@ bool stonesRow(const stonewall::StoneWallParams& p, const Options& o, const std:
     const StoneTrial t = runStones(scene, o.set);
     if (!o.svgDir.empty())
         writeWallSvg(o.svgDir + "/stones-" + label + ".svg", scene.frame, scene.stoneTruth, t.rings, &scene.cloud, 400);
+    std::size_t merged = 0, jagged = 0, several = 0;
+    for (const auto& m : t.score.stones) {
+        merged += m.iou < 0.8;
+        jagged += m.iou >= 0.8 && m.polygonsAbove == 1 && m.hausdorff > 0.03;
+        several += m.polygonsAbove > 1;
+    }
+    std::printf("    wrong stones: %zu with IoU < 0.8, %zu within IoU but beyond 3 cm, %zu in several polygons\n", merged, jagged, several);
     std::printf("%s %s | %zu pts, %zu polygons | %s | %.1f s%s\n", label.c_str(), stonewall::describe(p).c_str(), t.points,
                 t.polygons, t.score.summary().c_str(), seconds(start), t.score.meetsIssueTarget ? "" : "  FAIL");
     std::fflush(stdout);

@@ -325,7 +325,10 @@ ToolSpec stonesTool()
         "centroid, plane residual).";
     tool.parameters = {
         ParameterSpec::text("field", "Intensity field", "The field classified into stone and joint", "intensity").asFieldOf("input"),
-        ParameterSpec::choice("polarity", "Stones are", "dark: stones below the threshold; bright: above", {"dark", "bright"}, "dark"),
+        ParameterSpec::choice("polarity", "Stones are",
+                              "dark: stones below the threshold; bright: above; auto: the side with more points (stones cover "
+                              "most of a wall, joints are narrow)",
+                              {"auto", "dark", "bright"}, "auto"),
         ParameterSpec::real("threshold", "Threshold",
                             "The intensity separating stone from joint (the workbench proposes the bound dragged on the "
                             "field's histogram); absent: the thesis's iterative inter-means threshold",
@@ -353,6 +356,10 @@ ToolSpec stonesTool()
         ParameterSpec::real("grow-variance", "Variance tolerance", "grow: largest intensity variance of a region", 0.0, 0.0, 1e30)
             .withZeroMeaning("automatic (the variance of the stone class)")
             .onlyWith("method=grow"),
+        ParameterSpec::boolean("vectorise", "Vectorise outlines",
+                               "Each stone's outline as straight pieces and arcs with corners at their intersections (as "
+                               "contours --vectorise), its edges half a spacing out; off: the alpha shape's ring",
+                               true),
     };
     tool.outputs = {OutputSpec{"stones", "Cloud with stone_id", DataKind::Cloud, true},
                     OutputSpec{"drawing", "Stone contours", DataKind::Drawing, false, false, "stones"},
@@ -362,6 +369,7 @@ ToolSpec stonesTool()
         StoneParams params;
         params.field = values.text("field");
         params.polarity = parseStonePolarity(values.text("polarity"));
+        params.vectorise = values.boolean("vectorise");
         if (values.has("threshold"))
             params.threshold = values.real("threshold");
         params.method = parseStoneMethod(values.text("method"));

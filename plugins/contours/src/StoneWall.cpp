@@ -2,6 +2,7 @@
 // The stone-wall workflow of thesis 003 (its retained procedure, §IV.2):
 // threshold, classify, clean, contour, in the wall's plane.
 #include <scandiff/plugins/contours/StoneWall.h>
+#include <scandiff/plugins/contours/Vectorisation.h>
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/segmentation/RunningMoments.h>
@@ -213,7 +214,9 @@ StonePolarity parseStonePolarity(const std::string& name)
         return StonePolarity::Dark;
     if (name == "bright")
         return StonePolarity::Bright;
-    throw Error(ErrorCode::InvalidArgument, "stones: polarity '" + name + "': expected dark or bright");
+    if (name == "auto")
+        return StonePolarity::Auto;
+    throw Error(ErrorCode::InvalidArgument, "stones: polarity '" + name + "': expected dark, bright or auto");
 }
 
 StoneMethod parseStoneMethod(const std::string& name)
@@ -259,12 +262,21 @@ StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params
         result.threshold = found.threshold;
         result.thresholdIterations = found.iterations;
     }
+    StonePolarity polarity = params.polarity;
+    if (polarity == StonePolarity::Auto) {
+        std::size_t below = 0, above = 0;
+        for (float v : intensity)
+            if (std::isfinite(v))
+                (v <= result.threshold ? below : above) += 1;
+        polarity = below >= above ? StonePolarity::Dark : StonePolarity::Bright;
+    }
+    result.polarity = polarity;
     result.stoneClass.assign(n, 0);
     double sums[2] = {0, 0};
     std::size_t counts[2] = {0, 0};
     for (std::size_t i = 0; i < n; ++i) {
         const float v = intensity[i];
-        result.stoneClass[i] = std::isfinite(v) && (params.polarity == StonePolarity::Dark ? v <= result.threshold : v > result.threshold);
+        result.stoneClass[i] = std::isfinite(v) && (polarity == StonePolarity::Dark ? v <= result.threshold : v > result.threshold);
         if (std::isfinite(v)) {
             sums[result.stoneClass[i]] += v;
             ++counts[result.stoneClass[i]];
@@ -345,10 +357,19 @@ StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params
         const OutlinePart& part = parts.parts[p];
         Stone stone;
         stone.outline2d = part.outer;
-        for (const Eigen::Vector2d& q : part.outer)
+        if (params.vectorise) {
+            VectoriseParams vector;
+            vector.tolerance = 1.5 * result.spacing;
+            vector.edgeOffset = 0.5 * result.spacing;
+            vector.arcs = false; // a stone's sides are straight: its rounded corners are the outline's, not the stone's
+            Ring2d drawn = vectoriseRing(part.outer, vector).vertices;
+            if (drawn.size() >= 3 && std::abs(signedArea(drawn)) > 0.5 * std::abs(signedArea(part.outer)))
+                stone.outline2d = std::move(drawn);
+        }
+        for (const Eigen::Vector2d& q : stone.outline2d)
             stone.outline.push_back(result.wall.toWorld(q));
-        stone.area = signedArea(part.outer);
-        stone.perimeter = ringPerimeter(part.outer);
+        stone.area = signedArea(stone.outline2d);
+        stone.perimeter = ringPerimeter(stone.outline2d);
         stone.centroid = result.wall.toWorld(centre[p]);
         stoneOfPart[p] = static_cast<std::int32_t>(result.stones.size());
         result.stones.push_back(std::move(stone));

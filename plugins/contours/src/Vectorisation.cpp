@@ -221,6 +221,7 @@ struct RunSums
 //! one more piece, and the largest mean square a piece may have.
 struct SegmentationCosts
 {
+    bool arcs = true;
     double variance = 1.0;
     double linePenalty = 0.0, arcPenalty = 0.0;
     double meanSquareLimit = 1.0;
@@ -246,7 +247,7 @@ Candidate bestPiece(const RunSums& sums, const Eigen::Vector2d& first, const Eig
         out.cost = lineSq / c.variance + c.linePenalty;
     double arcSq = 0, radius = 0;
     Eigen::Vector2d centre;
-    if (sums.n >= 6 && sums.circleSquares(arcSq, centre, radius) && arcSq <= c.meanSquareLimit * sums.n) {
+    if (c.arcs && sums.n >= 6 && sums.circleSquares(arcSq, centre, radius) && arcSq <= c.meanSquareLimit * sums.n) {
         const double span = (last - first).norm();
         const double swept = std::abs(turnAngle(first - centre, middle - centre)) + std::abs(turnAngle(middle - centre, last - centre));
         const double bulge = radius * (1 - std::cos(std::min(swept, kPi) / 2));
@@ -343,7 +344,7 @@ double boundaryScatter(const std::vector<Eigen::Vector2d>& p, double tolerance)
 //! or made a short chamfer or a small arc of the corner; the corner itself
 //! comes from the neighbours' intersection (step 5). Each piece is refitted
 //! from its points.
-std::vector<Piece> segmentRing(const Ring2d& input, double tolerance)
+std::vector<Piece> segmentRing(const Ring2d& input, double tolerance, bool arcs)
 {
     const std::size_t n = input.size();
     const std::size_t start = flattestPoint(input);
@@ -351,6 +352,7 @@ std::vector<Piece> segmentRing(const Ring2d& input, double tolerance)
     for (std::size_t k = 0; k <= n; ++k)
         p[k] = input[(start + k) % n]; // closed: p[n] is p[0]
     SegmentationCosts c;
+    c.arcs = arcs;
     // The scatter of boundary points about their edge, measured on the ring;
     // one more piece costs what its parameters cost in the information
     // criterion (a line 4, with its two ends; an arc 6: a circle's three, its
@@ -704,7 +706,7 @@ VectorRing vectoriseRing(const Ring2d& ring, const VectoriseParams& params)
 {
     if (!(params.tolerance > 0) || !(params.snapDegrees >= 0) || !(params.edgeOffset >= 0) || !(params.arcStepDegrees > 0))
         throw Error(ErrorCode::InvalidArgument, "vectorisation: the tolerance and the arc step must be > 0, the snap angle and offset >= 0");
-    const std::vector<Piece> kept = ring.size() < 4 ? std::vector<Piece>{} : classifyPieces(segmentRing(ring, params.tolerance), params);
+    const std::vector<Piece> kept = ring.size() < 4 ? std::vector<Piece>{} : classifyPieces(segmentRing(ring, params.tolerance, params.arcs), params);
     if (kept.size() < 2) { // too small to split: the ring as it is
         VectorRing out;
         out.vertices = ring;

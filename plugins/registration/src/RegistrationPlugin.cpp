@@ -475,10 +475,10 @@ Table stationsReportTable(const StationResult& s)
 Table stationPairsTable(const StationResult& s)
 {
     Table t;
-    t.columns = {"station_a", "station_b", "used", "overlap", "pairwise_rms_m", "adjusted_rms_m", "disagreement_deg", "disagreement_m",
+    t.columns = {"station_a", "station_b", "used", "overlap", "agreement", "pairwise_rms_m", "adjusted_rms_m", "disagreement_deg", "disagreement_m",
                  "note", "warning"};
     for (const auto& p : s.pairs)
-        t.rows.push_back({static_cast<double>(p.a), static_cast<double>(p.b), p.used ? 1.0 : 0.0, p.overlap, p.pairwise.rms, p.adjustedRms,
+        t.rows.push_back({static_cast<double>(p.a), static_cast<double>(p.b), p.used ? 1.0 : 0.0, p.overlap, p.agreement, p.pairwise.rms, p.adjustedRms,
                           p.disagreementDegrees, p.disagreementMetres, p.note, p.pairwise.degeneracy});
     return t;
 }

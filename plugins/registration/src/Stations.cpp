@@ -307,10 +307,17 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
     for (const Candidate& c : candidates)
         if (std::isfinite(c.sigma) && c.sigma > 0)
             sigma = std::min(sigma, c.sigma);
-    for (Candidate& c : candidates) {
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+        Candidate& c = candidates[k];
         const double tolerance = std::isfinite(sigma) ? 3 * sigma : spacing;
-        const double share = posedAgreement(stations[b], stations[a], c.report.matrix, worldOrigin, tolerance, 2 * spacing) +
-                             posedAgreement(stations[a], stations[b], c.report.matrix.inverse(), worldOrigin, tolerance, 2 * spacing);
+        double share = posedAgreement(stations[b], stations[a], c.report.matrix, worldOrigin, tolerance, 2 * spacing) +
+                       posedAgreement(stations[a], stations[b], c.report.matrix.inverse(), worldOrigin, tolerance, 2 * spacing);
+        // Where the stations are is where the surveyor put them: it keeps
+        // a tenth in hand over a fit found elsewhere (a site that repeats
+        // itself offers those), which a station in another heading, far
+        // from its place, does not come near.
+        if (k == 0 && params.anyStart)
+            share *= 1.1;
         bool repeated = false; // the same motion from another start
         for (const RegistrationReport& kept : hypotheses.candidates)
             repeated = repeated || (rotationDegrees(kept.matrix.topLeftCorner<3, 3>().transpose() * c.report.matrix.topLeftCorner<3, 3>()) < 0.05 &&
@@ -327,6 +334,7 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
     }
     const auto best = static_cast<std::size_t>(std::max_element(hypotheses.shares.begin(), hypotheses.shares.end()) - hypotheses.shares.begin());
     pair.pairwise = hypotheses.candidates[best];
+    pair.agreement = hypotheses.shares[best];
     // Overlapping: within two feature spacings (the joint adjustment's
     // distance at most) of the other station, after the pair's own motion.
     const double near = std::min(params.maxDistance, 2 * spacing);
@@ -421,8 +429,10 @@ void chooseConsistentCandidates(std::vector<PairHypotheses>& pairs, const std::v
         }
     }
     for (std::size_t e = 0; e < pairs.size(); ++e)
-        if (!pairs[e].candidates.empty())
+        if (!pairs[e].candidates.empty()) {
             pairs[e].pair.pairwise = pairs[e].candidates[choice[e]];
+            pairs[e].pair.agreement = pairs[e].shares[choice[e]];
+        }
     // A site that repeats itself (a hall under a half or a quarter turn, a
     // row of columns) fits a turned or shifted pair nearly as well: said,
     // not hidden. Nearly: within 5 % of the chosen candidate's share.
@@ -451,7 +461,7 @@ void chooseConsistentCandidates(std::vector<PairHypotheses>& pairs, const std::v
 //! motion b -> a should equal any path a -> c -> b's; each triangle of used
 //! pairs is a vote for (closes within `degrees` and `metres` at b's centre)
 //! or against each of its three pairs. While a pair has more votes against
-//! than for, the worst such pair (most against, then least overlap) is left
+//! than for, the worst such pair (most against, then least agreement) is left
 //! out and the votes are counted again: a wrong pair, from a symmetric hall
 //! or a repeated rack, disagrees with every triangle it is in, while a right
 //! one is outvoted only where wrong ones meet.
@@ -487,7 +497,7 @@ void leaveOutInconsistentPairs(std::vector<StationPair>& pairs, const std::vecto
             if (!pairs[e].used || against[e] <= support[e])
                 continue;
             if (worst < 0 || against[e] > against[static_cast<std::size_t>(worst)] ||
-                (against[e] == against[static_cast<std::size_t>(worst)] && pairs[e].overlap < pairs[static_cast<std::size_t>(worst)].overlap))
+                (against[e] == against[static_cast<std::size_t>(worst)] && pairs[e].agreement < pairs[static_cast<std::size_t>(worst)].agreement))
                 worst = static_cast<std::ptrdiff_t>(e);
         }
         if (worst < 0)

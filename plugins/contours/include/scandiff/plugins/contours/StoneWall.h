@@ -31,15 +31,17 @@ struct InterMeansThreshold
 //! two distinct finite values remain (no threshold separates anything).
 InterMeansThreshold interMeansThreshold(const std::vector<float>& values, std::optional<double> initial = std::nullopt);
 
-enum class StonePolarity { Dark, Bright }; //!< stones below or above the threshold
+//! Stones below or above the threshold; Auto: the class with more points
+//! (stones cover most of a wall, joints are narrow lines between them).
+enum class StonePolarity { Dark, Bright, Auto };
 enum class StoneMethod { Classify, Grow };
-StonePolarity parseStonePolarity(const std::string& name); //!< "dark", "bright"
+StonePolarity parseStonePolarity(const std::string& name); //!< "dark", "bright", "auto"
 StoneMethod parseStoneMethod(const std::string& name);     //!< "classify", "grow"
 
 struct StoneParams
 {
     std::string field = "intensity";
-    StonePolarity polarity = StonePolarity::Dark;
+    StonePolarity polarity = StonePolarity::Auto;
     std::optional<double> threshold; //!< absent: the inter-means threshold
     StoneMethod method = StoneMethod::Classify;
     //! Cleaning: a stone point with fewer than `cleaningNeighbours` other stone
@@ -57,11 +59,18 @@ struct StoneParams
     //! stone class found by the threshold).
     double growRadius = 0.0;
     double growVariance = 0.0;
+    //! Each stone's outline vectorised as the façade openings are (straight
+    //! pieces and arcs, corners at their intersections, the edges moved half
+    //! a spacing out where the joint begins): the alpha shape's boundary
+    //! zigzags by a spacing and rounds every corner, 3 cm and more off the
+    //! stone's edge at its corners. Off: the alpha shape's ring.
+    bool vectorise = true;
 };
 
 struct Stone
 {
     std::vector<Eigen::Vector3d> outline; //!< closed, counter-clockwise seen from the front, in the wall plane, global
+    //! (vectorised: the corners; arcs as points every 2 degrees)
     Ring2d outline2d;                     //!< the same in the plane's (u, v)
     double area = 0.0, perimeter = 0.0;
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero(); //!< of the polygon, global
@@ -74,6 +83,7 @@ struct StoneWallResult
     PlaneFrame wall;
     double threshold = 0.0;
     int thresholdIterations = 0; //!< 0 when the threshold was given
+    StonePolarity polarity = StonePolarity::Dark; //!< the one used (Auto resolved)
     double stoneMean = 0.0, jointMean = 0.0; //!< the two classes' mean intensities (the histogram's modes)
     double spacing = 0.0;        //!< median distance of a point to its nearest neighbour
     double alpha = 0.0;          //!< the one used

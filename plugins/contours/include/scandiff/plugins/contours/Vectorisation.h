@@ -23,6 +23,7 @@ struct VectoriseParams
     //! fall short of the edges). 0: none.
     double edgeOffset = 0.0;
     double arcStepDegrees = 2.0; //!< arcs are written as polylines with this angular step
+    bool arcs = true;            //!< false: straight pieces only (a stone's sides)
 };
 
 enum class PieceKind { Horizontal, Vertical, Inclined, Arc, Chain };

@@ -52,6 +52,10 @@ struct StationPair
 {
     std::size_t a = 0, b = 0;
     double overlap = 0;            //!< the larger of the two directions' fractions (after the pair's own registration)
+    //! How well the pair's motion brings both stations together: the shares
+    //! of each station's points within 3 robust sigmas of the other's surface,
+    //! summed (0 to 2).
+    double agreement = 0;
     //! Left out of the adjustment: it disagrees with the loops it closes
     //! (why in `note`), or its alignment failed.
     bool used = true;
