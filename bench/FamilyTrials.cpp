@@ -5,6 +5,7 @@
 //
 //   scandiff-family-trials FAMILY [--issue] [--draws N] [--first-seed S] [--scale F] [--set KEY=VALUE ...]
 #include "families/ChangeTrials.h"
+#include "families/PrimitiveTrials.h"
 #include "families/RegistrationTrials.h"
 #include "families/WallTrials.h"
 
@@ -163,6 +164,20 @@ bool stationsRow(const stations::StationsParams& p, const Options& o, const std:
     return met;
 }
 
+bool primitivesRow(const primitives::PrimitivesParams& p, const Options& o, const std::string& label)
+{
+    const auto start = std::chrono::steady_clock::now();
+    const primitives::PrimitivesScene scene = primitives::make(p);
+    const double made = seconds(start);
+    const PrimitivesTrial t = runPrimitives(scene, o.set);
+    std::printf("%s %s | %zu pts | %s | scene %.1f s, tool %.1f s%s\n", label.c_str(), primitives::describe(p).c_str(), scene.cloud.size(),
+                t.score.summary().c_str(), made, seconds(start) - made, t.score.meetsTarget() ? "" : "  FAIL");
+    if (!t.score.meetsTarget())
+        std::printf("%s\n", t.score.table().c_str());
+    std::fflush(stdout);
+    return t.score.meetsTarget();
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -216,6 +231,11 @@ int main(int argc, char** argv)
             tally(visibilityRow(grazing::issueCase(), o, "issue"));
         for (int d = 0; d < o.draws; ++d)
             tally(visibilityRow(grazing::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+    } else if (o.family == "primitives") {
+        if (o.issue)
+            tally(primitivesRow(primitives::issueCase(), o, "issue"));
+        for (int d = 0; d < o.draws; ++d)
+            tally(primitivesRow(primitives::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
     } else if (o.family == "stations-pair") {
         // One pair of the issue's stations by ICP from the true pose: what the data allow.
         const stations::StationsScene scene = stations::make(stations::issueCase());
