@@ -211,31 +211,23 @@ int main(int argc, char** argv)
     setLogSink([](LogLevel, const std::string&) {});
     int passed = 0, run = 0;
     auto tally = [&](bool ok) { passed += ok, ++run; };
+    // The issue's case (with --issue), then the draws, each through `row`.
+    const auto family = [&](const auto& issueCase, const auto& drawFamily, const auto& row) {
+        if (o.issue)
+            tally(row(issueCase(), o, "issue"));
+        for (int d = 0; d < o.draws; ++d)
+            tally(row(drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+    };
     if (o.family == "facade") {
-        if (o.issue)
-            tally(facadeRow(facade::issueCase(), o, "issue"));
-        for (int d = 0; d < o.draws; ++d)
-            tally(facadeRow(facade::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+        family([] { return facade::issueCase(); }, [](std::uint64_t seed, double scale) { return facade::drawFamily(seed, scale); }, facadeRow);
     } else if (o.family == "stones") {
-        if (o.issue)
-            tally(stonesRow(stonewall::issueCase(), o, "issue"));
-        for (int d = 0; d < o.draws; ++d)
-            tally(stonesRow(stonewall::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+        family([] { return stonewall::issueCase(); }, [](std::uint64_t seed, double scale) { return stonewall::drawFamily(seed, scale); }, stonesRow);
     } else if (o.family == "change") {
-        if (o.issue)
-            tally(changeRow(terrainchange::issueCase(), o, "issue"));
-        for (int d = 0; d < o.draws; ++d)
-            tally(changeRow(terrainchange::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+        family([] { return terrainchange::issueCase(); }, [](std::uint64_t seed, double scale) { return terrainchange::drawFamily(seed, scale); }, changeRow);
     } else if (o.family == "visibility") {
-        if (o.issue)
-            tally(visibilityRow(grazing::issueCase(), o, "issue"));
-        for (int d = 0; d < o.draws; ++d)
-            tally(visibilityRow(grazing::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+        family([] { return grazing::issueCase(); }, [](std::uint64_t seed, double scale) { return grazing::drawFamily(seed, scale); }, visibilityRow);
     } else if (o.family == "primitives") {
-        if (o.issue)
-            tally(primitivesRow(primitives::issueCase(), o, "issue"));
-        for (int d = 0; d < o.draws; ++d)
-            tally(primitivesRow(primitives::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+        family([] { return primitives::issueCase(); }, [](std::uint64_t seed, double scale) { return primitives::drawFamily(seed, scale); }, primitivesRow);
     } else if (o.family == "stations-pair") {
         // One pair of the issue's stations by ICP from the true pose: what the data allow.
         const stations::StationsScene scene = stations::make(stations::issueCase());
@@ -253,10 +245,7 @@ int main(int argc, char** argv)
                     Eigen::AngleAxisd(Eigen::Matrix3d((m * truth.inverse()).topLeftCorner<3, 3>())).angle() * 57.2958,
                     (m * truth.inverse()).topRightCorner<3, 1>().norm());
     } else if (o.family == "stations") {
-        if (o.issue)
-            tally(stationsRow(stations::issueCase(), o, "issue"));
-        for (int d = 0; d < o.draws; ++d)
-            tally(stationsRow(stations::drawFamily(o.firstSeed + d, o.scale), o, "seed " + std::to_string(o.firstSeed + d)));
+        family([] { return stations::issueCase(); }, [](std::uint64_t seed, double scale) { return stations::drawFamily(seed, scale); }, stationsRow);
     } else if (o.family == "airborne") {
         if (o.issue)
             tally(airborneRow(airborne::make(airborne::issueCase()), o, "issue", false));
