@@ -200,19 +200,6 @@ std::vector<StationLoop> loopMisclosures(const std::vector<Station>& stations, c
     return loops;
 }
 
-//! The fraction of `from`'s first points within the distance of `on`, `from`
-//! moved by `fromToOn` (global matrix from -> on).
-double posedOverlap(const Station& from, const Station& on, const Eigen::Matrix4d& fromToOn, const Eigen::Vector3d& worldOrigin,
-                    double distance)
-{
-    Matched m;
-    match(from, toLocal(fromToOn, worldOrigin), on, Eigen::Isometry3d::Identity(), worldOrigin, 4000, m);
-    std::size_t near = 0;
-    for (double d : m.distance)
-        near += d <= distance;
-    return static_cast<double>(near) / static_cast<double>(std::max<std::size_t>(m.x.size(), 1));
-}
-
 //! The fraction of `from`'s first points (moved by `fromToOn`) that lie
 //! within `tolerance` of the tangent plane of their closest point of `on`,
 //! that point within `reach`.
@@ -288,6 +275,7 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
     {
         RegistrationReport report;
         double sigma;
+        bool whereTheyAre; //!< from the stations' own start
     };
     std::vector<Candidate> candidates;
     std::string failure;
@@ -296,7 +284,7 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
         try {
             RegistrationReport report = detail::icpOnSurface(*stations[b].cloud, *stations[a].surface, icp, nullptr).report;
             const double sigma = 1.4826 * report.median;
-            candidates.push_back({std::move(report), sigma});
+            candidates.push_back({std::move(report), sigma, start.isIdentity()});
         } catch (const Error& e) {
             if (e.code() == ErrorCode::Cancelled)
                 throw;
@@ -316,7 +304,7 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
         // a tenth in hand over a fit found elsewhere (a site that repeats
         // itself offers those), which a station in another heading, far
         // from its place, does not come near.
-        if (k == 0 && params.anyStart)
+        if (c.whereTheyAre && params.anyStart)
             share *= 1.1;
         bool repeated = false; // the same motion from another start
         for (const RegistrationReport& kept : hypotheses.candidates)
@@ -338,8 +326,8 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
     // Overlapping: within two feature spacings (the joint adjustment's
     // distance at most) of the other station, after the pair's own motion.
     const double near = std::min(params.maxDistance, 2 * spacing);
-    pair.overlap = std::max(posedOverlap(stations[b], stations[a], pair.pairwise.matrix, worldOrigin, near),
-                            posedOverlap(stations[a], stations[b], pair.pairwise.matrix.inverse(), worldOrigin, near));
+    pair.overlap = std::max(posedAgreement(stations[b], stations[a], pair.pairwise.matrix, worldOrigin, kInfinity, near),
+                            posedAgreement(stations[a], stations[b], pair.pairwise.matrix.inverse(), worldOrigin, kInfinity, near));
     if (pair.overlap < params.minOverlap) {
         pair.used = false;
         pair.note = "overlap " + std::to_string(pair.overlap) + " below the minimum";
