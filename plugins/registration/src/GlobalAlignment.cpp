@@ -550,21 +550,13 @@ GlobalAlignmentResult globalAlign(const AlignmentFeatures& a, const AlignmentFea
     RegistrationReport& report = result.report;
     report.method = std::string("global (FPFH, RANSAC), ") + dofName(params.constraint.dof) + " DOF";
     // y + cb = R (x_global - ca) + t + cb  ->  global matrix T(cb) [R t] T(-ca).
-    Eigen::Matrix4d local = Eigen::Matrix4d::Identity();
-    local.topLeftCorner<3, 3>() = best.motion.linear();
-    local.topRightCorner<3, 1>() = best.motion.translation();
     Eigen::Matrix4d toB = Eigen::Matrix4d::Identity(), fromA = Eigen::Matrix4d::Identity();
     toB.topRightCorner<3, 1>() = b.centre;
     fromA.topRightCorner<3, 1>() = -a.centre;
-    report.matrix = toB * local * fromA;
+    const auto global = [&](const Eigen::Isometry3d& motion) { return Eigen::Matrix4d(toB * motion.matrix() * fromA); };
+    report.matrix = global(best.motion);
     // The next distinct motions by share (a symmetric site lands most of its
     // points under a half turn too: the caller may weigh them on every point).
-    const auto global = [&](const Eigen::Isometry3d& motion) {
-        Eigen::Matrix4d l = Eigen::Matrix4d::Identity();
-        l.topLeftCorner<3, 3>() = motion.linear();
-        l.topRightCorner<3, 1>() = motion.translation();
-        return Eigen::Matrix4d(toB * l * fromA);
-    };
     std::vector<Eigen::Isometry3d> kept{best.motion};
     for (const Refined& r : refined) {
         if (result.alternatives.size() + 1 >= params.alternatives || r.share < 0.5 * bestShare)

@@ -458,25 +458,6 @@ IterationRun runIterations(const detail::ReferenceSurface& surface, const Iterat
     return run;
 }
 
-//! The directions a normal matrix does not hold (eigenvalue under
-//! kWeakDirectionRatio of the largest), as orthonormal columns.
-Eigen::MatrixXd weakDirections(const Eigen::MatrixXd& normalMatrix)
-{
-    if (normalMatrix.rows() == 0)
-        return {};
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(normalMatrix);
-    const Eigen::VectorXd values = solver.eigenvalues();
-    const double largest = values.maxCoeff();
-    std::vector<Eigen::Index> weak;
-    for (Eigen::Index i = 0; i < values.size(); ++i)
-        if (!(values[i] >= kWeakDirectionRatio * largest && largest > 0))
-            weak.push_back(i);
-    Eigen::MatrixXd columns(normalMatrix.rows(), static_cast<Eigen::Index>(weak.size()));
-    for (std::size_t k = 0; k < weak.size(); ++k)
-        columns.col(static_cast<Eigen::Index>(k)) = solver.eigenvectors().col(weak[k]);
-    return columns;
-}
-
 //! The sample's point-to-plane residuals under a motion, each at most
 //! `cutoff` (a truncated quadratic: what changed does not pull), squared and
 //! summed.

@@ -12,7 +12,6 @@ namespace scandiff::plugins {
 
 namespace {
 
-constexpr double kWeakRatio = kWeakDirectionRatio;
 
 std::string vectorText(const Eigen::Vector3d& v)
 {
@@ -31,21 +30,12 @@ double centreShift(const RegistrationReport& r)
 std::string degeneracyWarning(const Eigen::MatrixXd& normalMatrix, int dofCount, const Eigen::Vector3d& axis,
                               std::vector<double>& eigenvalues)
 {
-    eigenvalues.clear();
-    if (normalMatrix.rows() == 0)
-        return {};
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(normalMatrix);
-    const Eigen::VectorXd values = solver.eigenvalues();
-    for (Eigen::Index i = 0; i < values.size(); ++i)
-        eigenvalues.push_back(values[i]);
-    const double largest = values.maxCoeff();
+    const Eigen::MatrixXd weakColumns = weakDirections(normalMatrix, &eigenvalues);
     std::string weak;
-    for (Eigen::Index i = 0; i < values.size(); ++i) {
-        if (values[i] >= kWeakRatio * largest && largest > 0)
-            continue;
+    for (Eigen::Index i = 0; i < weakColumns.cols(); ++i) {
         // The direction's rotation and translation parts (unknowns in the
         // order of the solver: rotation first for Six and Four).
-        const Eigen::VectorXd v = solver.eigenvectors().col(i);
+        const Eigen::VectorXd v = weakColumns.col(i);
         Eigen::Vector3d rotation = Eigen::Vector3d::Zero(), translation = Eigen::Vector3d::Zero();
         if (dofCount == 6) {
             rotation = v.head<3>();

@@ -89,6 +89,27 @@ bool fitPointToPoint(const std::vector<Eigen::Vector3d>& x, const std::vector<Ei
     return true;
 }
 
+Eigen::MatrixXd weakDirections(const Eigen::MatrixXd& normalMatrix, std::vector<double>* eigenvalues)
+{
+    if (eigenvalues)
+        eigenvalues->clear();
+    if (normalMatrix.rows() == 0)
+        return {};
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(normalMatrix);
+    const Eigen::VectorXd values = solver.eigenvalues();
+    if (eigenvalues)
+        eigenvalues->assign(values.data(), values.data() + values.size());
+    const double largest = values.maxCoeff();
+    std::vector<Eigen::Index> weak;
+    for (Eigen::Index i = 0; i < values.size(); ++i)
+        if (!(values[i] >= kWeakDirectionRatio * largest && largest > 0))
+            weak.push_back(i);
+    Eigen::MatrixXd columns(normalMatrix.rows(), static_cast<Eigen::Index>(weak.size()));
+    for (std::size_t k = 0; k < weak.size(); ++k)
+        columns.col(static_cast<Eigen::Index>(k)) = solver.eigenvectors().col(weak[k]);
+    return columns;
+}
+
 bool stepPointToPlane(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& y,
                       const std::vector<Eigen::Vector3d>& n, const std::vector<double>& w, const DofConstraint& constraint,
                       double length, Eigen::Isometry3d& step, Eigen::MatrixXd& normalMatrix, const Eigen::MatrixXd* held)

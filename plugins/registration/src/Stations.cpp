@@ -214,6 +214,17 @@ double posedAgreement(const Station& from, const Station& on, const Eigen::Matri
     return static_cast<double>(agree) / static_cast<double>(std::max<std::size_t>(m.x.size(), 1));
 }
 
+//! Whether the motions b -> a, c -> a and b -> c agree: b -> a equals going
+//! through c, within `degrees` and `metres` (the misclosure's displacement at
+//! `at`, b's centre).
+bool triangleCloses(const Eigen::Matrix4d& ab, const Eigen::Matrix4d& ac, const Eigen::Matrix4d& cb, const Eigen::Vector3d& at,
+                    double degrees, double metres)
+{
+    double angle = 0, shift = 0;
+    motionSize(ab.inverse() * ac * cb, at, angle, shift);
+    return angle <= degrees && shift <= metres;
+}
+
 //! A pair registered alone: its candidate motions (b -> a), each refined by
 //! ICP, with how much of both stations each brings onto the other.
 struct PairHypotheses
@@ -371,10 +382,10 @@ void chooseConsistentCandidates(std::vector<PairHypotheses>& pairs, const std::v
                 for (std::size_t c = b + 1; c < count; ++c) {
                     if (index[a][b] < 0 || index[a][c] < 0 || index[b][c] < 0)
                         continue;
-                    double angle = 0, shift = 0;
-                    motionSize(motion(a, b, pick).inverse() * motion(a, c, pick) * motion(c, b, pick), stations[b].centre + worldOrigin,
-                               angle, shift);
-                    score += angle <= degrees && shift <= metres ? 3.0 : -3.0;
+                    score += triangleCloses(motion(a, b, pick), motion(a, c, pick), motion(c, b, pick),
+                                            stations[b].centre + worldOrigin, degrees, metres)
+                                 ? 3.0
+                                 : -3.0;
                 }
         return score;
     };
@@ -473,10 +484,8 @@ void leaveOutInconsistentPairs(std::vector<StationPair>& pairs, const std::vecto
                 for (std::size_t c = b + 1; c < count; ++c) {
                     if (index[a][b] < 0 || index[a][c] < 0 || index[b][c] < 0)
                         continue;
-                    const Eigen::Matrix4d misclosure = motion(a, b).inverse() * motion(a, c) * motion(c, b);
-                    double angle = 0, shift = 0;
-                    motionSize(misclosure, stations[b].centre + worldOrigin, angle, shift);
-                    const bool closes = angle <= degrees && shift <= metres;
+                    const bool closes = triangleCloses(motion(a, b), motion(a, c), motion(c, b), stations[b].centre + worldOrigin,
+                                                       degrees, metres);
                     for (const std::ptrdiff_t e : {index[a][b], index[a][c], index[b][c]})
                         (closes ? support : against)[static_cast<std::size_t>(e)] += 1;
                 }

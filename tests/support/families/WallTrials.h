@@ -55,6 +55,22 @@ inline void countCorners(const facade::FacadeScene& scene, FacadeTrial& trial)
     }
 }
 
+//! `contours --vectorise` with `options` on `cloud` (the scene's points, or
+//! some of them, with or without a segment field), scored.
+inline FacadeTrial outlineFacade(const facade::FacadeScene& scene, const PointCloud& cloud, std::map<std::string, std::string> options)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& contours = *registry.tools.find("contours");
+    options.emplace("vectorise", "true");
+    ToolResult outlines = contours.execute(ToolInputs().add("input", cloud), contours.resolve(options), nullptr);
+    FacadeTrial trial;
+    trial.points = cloud.size();
+    trial.rings = closedRings(std::get<Drawing>(outlines.find("contours")->data));
+    trial.score = facade::score(scene, trial.rings);
+    countCorners(scene, trial);
+    return trial;
+}
+
 //! The façade workflow: planes by `segmentation` (the primitives tool), then
 //! `contours --vectorise` on every plane.
 inline FacadeTrial runFacade(const facade::FacadeScene& scene, const std::map<std::string, std::string>& primitiveOptions,
@@ -64,16 +80,7 @@ inline FacadeTrial runFacade(const facade::FacadeScene& scene, const std::map<st
     const ToolSpec& primitives = *registry.tools.find("primitives");
     ToolResult planes = primitives.execute(ToolInputs().add("input", scene.cloud), primitives.resolve(primitiveOptions), nullptr);
     const PointCloud& labelled = std::get<PointCloud>(planes.find("primitives")->data);
-    const ToolSpec& contours = *registry.tools.find("contours");
-    std::map<std::string, std::string> options = contourOptions;
-    options.emplace("vectorise", "true");
-    ToolResult outlines = contours.execute(ToolInputs().add("input", labelled), contours.resolve(options), nullptr);
-    FacadeTrial trial;
-    trial.points = scene.cloud.size();
-    trial.rings = closedRings(std::get<Drawing>(outlines.find("contours")->data));
-    trial.score = facade::score(scene, trial.rings);
-    countCorners(scene, trial);
-    return trial;
+    return outlineFacade(scene, labelled, contourOptions);
 }
 
 //! The wall's own points (its face and the relief on it), as a user who
@@ -85,18 +92,7 @@ inline FacadeTrial runFacadeContours(const facade::FacadeScene& scene, const std
     for (std::size_t i = 0; i < scene.surface.size(); ++i)
         if (scene.surface[i] == facade::Surface::WallFace || scene.surface[i] == facade::Surface::Relief)
             wall.push_back(i);
-    const PointCloud cloud = scene.cloud.subset(wall);
-    const PluginRegistry registry = makePluginRegistry();
-    const ToolSpec& contours = *registry.tools.find("contours");
-    std::map<std::string, std::string> options = contourOptions;
-    options.emplace("vectorise", "true");
-    ToolResult outlines = contours.execute(ToolInputs().add("input", cloud), contours.resolve(options), nullptr);
-    FacadeTrial trial;
-    trial.points = cloud.size();
-    trial.rings = closedRings(std::get<Drawing>(outlines.find("contours")->data));
-    trial.score = facade::score(scene, trial.rings);
-    countCorners(scene, trial);
-    return trial;
+    return outlineFacade(scene, scene.cloud.subset(wall), contourOptions);
 }
 
 struct StoneTrial

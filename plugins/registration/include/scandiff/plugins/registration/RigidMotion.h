@@ -47,6 +47,12 @@ bool fitPointToPoint(const std::vector<Eigen::Vector3d>& x, const std::vector<Ei
 //! surfaces: the step does not move along it, and the report names it.
 inline constexpr double kWeakDirectionRatio = 1e-3;
 
+//! The directions a point-to-plane normal matrix does not hold (eigenvalue
+//! under kWeakDirectionRatio of the largest), as orthonormal columns: what
+//! the solver holds fixed and the degeneracy warning names. `eigenvalues`,
+//! when given, receives every eigenvalue, increasing.
+Eigen::MatrixXd weakDirections(const Eigen::MatrixXd& normalMatrix, std::vector<double>* eigenvalues = nullptr);
+
 //! The linearised (small-motion) step minimising sum w_i (n_i . (x_i + omega x x_i + tau) - n_i . y_i)^2,
 //! with omega = theta axis for Four and 0 for Translation: solves the normal
 //! equations in the eigenvectors of their matrix, leaving out the directions
