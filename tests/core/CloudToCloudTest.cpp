@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include <scandiff/core/Error.h>
 #include <scandiff/core/distance/CloudToCloud.h>
+#include <scandiff/core/distance/Visibility.h>
 #include <scandiff/core/geometry/PointTriangleDistance.h>
 
 #include "TestSupport.h"
@@ -279,6 +280,43 @@ TEST(CloudToCloud, VisibilityOnTheWallScenario)
     params.viewpoints = {scanner, second};
     const CloudToCloudResult twoViews = cloudToCloud(behind, both, params);
     EXPECT_EQ(twoViews.visibility->values()[0], 0.0f);
+}
+
+TEST(DepthMap, FreeSpaceIsWhereTheScannerLookedThrough)
+{
+    // The wall of thesis 000 Fig. 2.8 (x = 10 m, 5 cm grid): the scanner at
+    // the origin looked through everything nearer than the wall, within the
+    // wall's angles, less the tolerance along the ray (at normal incidence,
+    // the tolerance itself).
+    PointCloud wall;
+    for (int i = -40; i <= 40; ++i)
+        for (int j = -40; j <= 40; ++j) {
+            wall.resize(wall.size() + 1);
+            wall.positions().back() = {10.0f, i * 0.05f, j * 0.05f};
+        }
+    SensorPose scanner;
+    scanner.maxRange = 30.0;
+    VisibilityParams params;
+    params.tolerance = 0.05;
+    const DepthMap map(wall, scanner, params);
+    EXPECT_TRUE(map.inFreeSpace({5.0, 0.3, 0.2}));      // halfway along a ray
+    EXPECT_TRUE(map.inFreeSpace({9.9, -1.0, 1.0}));     // 10 cm before the wall
+    EXPECT_FALSE(map.inFreeSpace({9.97, -1.0, 1.0}));   // within the tolerance
+    EXPECT_FALSE(map.inFreeSpace({10.0, 0.3, 0.2}));    // on the wall
+    EXPECT_FALSE(map.inFreeSpace({12.0, 0.5, -0.4}));   // behind it: hidden, not seen through
+    EXPECT_FALSE(map.inFreeSpace({5.0, 6.0, 0.0}));     // beside it: no ray went there
+    EXPECT_FALSE(map.inFreeSpace({-5.0, 0.0, 0.0}));    // behind the scanner: outside the scanned angles
+    // A turned and moved scanner: the same wall, the same answers.
+    SensorPose moved;
+    moved.position = {100, 200, 3};
+    moved.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(2.0, Eigen::Vector3d::UnitZ()));
+    moved.maxRange = 30.0;
+    PointCloud placed = wall.clone();
+    for (auto& p : placed.positions())
+        p = (moved.orientation * p.cast<double>() + moved.position).cast<float>();
+    const DepthMap placedMap(placed, moved, params);
+    EXPECT_TRUE(placedMap.inFreeSpace(moved.orientation * Eigen::Vector3d(5.0, 0.3, 0.2) + moved.position));
+    EXPECT_FALSE(placedMap.inFreeSpace(moved.orientation * Eigen::Vector3d(12.0, 0.5, -0.4) + moved.position));
 }
 
 TEST(CloudToCloud, BadInputs)

@@ -297,6 +297,16 @@ VisibilityLabel DepthMap::classify(const Eigen::Vector3d& globalPoint) const
     return a.range <= surface.range + tolerance_ * surface.alongRay ? VisibilityLabel::Visible : VisibilityLabel::Hidden;
 }
 
+bool DepthMap::inFreeSpace(const Eigen::Vector3d& globalPoint) const
+{
+    const Angular a = toAngular(worldToSensor_, pose_.position, globalPoint);
+    const int u = column(a.yaw), v = row(a.pitch);
+    if (u < 0 || v < 0 || u >= width_ || v >= height_ || !std::isfinite(a.range) || a.range > pose_.maxRange)
+        return false;
+    const SurfaceAlong surface = surfaceAlong(a.yaw, a.pitch, u, v);
+    return surface.seen && a.range < surface.range - tolerance_ * surface.alongRay;
+}
+
 std::vector<VisibilityLabel> visibilityLabels(const PointCloud& compared, const PointCloud& reference,
                                               const std::vector<SensorPose>& viewpoints, const VisibilityParams& params,
                                               ProgressObserver* progress)

@@ -4,6 +4,7 @@
 #include "ReferenceSurface.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/distance/Visibility.h>
 #include <scandiff/core/processing/Subsampling.h>
 #include <scandiff/plugins/registration/GlobalAlignment.h>
 #include <scandiff/plugins/registration/Icp.h>
@@ -15,6 +16,7 @@
 #include <deque>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -23,6 +25,14 @@ namespace scandiff::plugins {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+//! What a point put where another scanner saw through costs a pose, in
+//! points brought together: the right pose puts there only what moved
+//! between the stations, a wrong one that fits the walls of a hall that
+//! repeats itself puts its clutter there.
+constexpr double kFreeSpaceWeight = 10;
+//! How far a station's own vertical may be from another's: 10 degrees,
+//! twice a tripod scanner's compensator range.
+constexpr double kMaxStationTilt = 10 * M_PI / 180;
 
 //! One station: its cloud, the surface others are matched on, and its
 //! sampled points in station coordinates relative to the world origin.
@@ -32,6 +42,8 @@ struct Station
     std::unique_ptr<detail::ReferenceSurface> surface;
     std::vector<Eigen::Vector3d> sample;
     Eigen::Vector3d centre = Eigen::Vector3d::Zero(); //!< of the sample, world-relative station coordinates
+    std::unique_ptr<DepthMap> view; //!< what the scanner saw, when the cloud holds its one sensor pose
+    std::optional<Eigen::Vector3d> scanner; //!< its centre, world-relative station coordinates, with the view
 };
 
 //! A pair's correspondences one way: points of `from` matched on `on`'s surface.
@@ -60,9 +72,26 @@ void match(const Station& from, const Eigen::Isometry3d& fromPose, const Station
     m.n.assign(count, Eigen::Vector3d::Zero());
     m.residual.assign(count, std::numeric_limits<double>::quiet_NaN());
     m.distance.assign(count, kInfinity);
+    // A surface is seen from its front: a point a scanner saw lies on a
+    // surface that faces that scanner. The two faces of a thin wall (a
+    // partition, a door leaf), each seen from its own side, are not one
+    // surface; matched as one, they hold the stations on either side slid
+    // by the wall's thickness.
+    const bool sided = from.scanner && on.scanner;
+    Eigen::Vector3d fromScanner = Eigen::Vector3d::Zero(), onScanner = Eigen::Vector3d::Zero();
+    if (sided) {
+        fromScanner = toOn * (fromPose * *from.scanner) + toSurface;
+        onScanner = *on.scanner + toSurface;
+    }
     for (std::size_t i = 0; i < count; ++i) {
         if (!closest.found[i] || closest.normals[i] == Eigen::Vector3d::Zero())
             continue;
+        if (sided) {
+            const Eigen::Vector3d& n = closest.normals[i];
+            const double facingOn = n.dot(onScanner - closest.points[i]), facingFrom = n.dot(fromScanner - local[i]);
+            if (facingOn * facingFrom < 0)
+                continue;
+        }
         m.q[i] = onPose * (closest.points[i] - toSurface);
         m.n[i] = onPose.linear() * closest.normals[i];
         const Eigen::Vector3d d = m.x[i] - m.q[i];
@@ -214,6 +243,23 @@ double posedAgreement(const Station& from, const Station& on, const Eigen::Matri
     return static_cast<double>(agree) / static_cast<double>(std::max<std::size_t>(m.x.size(), 1));
 }
 
+//! The fraction of `from`'s first points (moved by `fromToOn`) that lie
+//! where `on`'s scanner looked through empty space (0 without its view).
+//! The right pose puts a few there (moved objects, depth edges); a pose that
+//! fits the walls of a hall that repeats itself puts the clutter of one
+//! station in the other's empty aisles.
+double freeSpaceShare(const Station& from, const Station& on, const Eigen::Matrix4d& fromToOn, const Eigen::Vector3d& worldOrigin)
+{
+    if (!on.view)
+        return 0;
+    const Eigen::Isometry3d pose = toLocal(fromToOn, worldOrigin);
+    const std::size_t count = std::min<std::size_t>(4000, from.sample.size());
+    std::size_t through = 0;
+    for (std::size_t i = 0; i < count; ++i)
+        through += on.view->inFreeSpace(pose * from.sample[i] + worldOrigin);
+    return static_cast<double>(through) / static_cast<double>(std::max<std::size_t>(count, 1));
+}
+
 //! Whether the motions b -> a, c -> a and b -> c agree: b -> a equals going
 //! through c, within `degrees` and `metres` (the misclosure's displacement at
 //! `at`, b's centre).
@@ -232,11 +278,79 @@ struct PairHypotheses
     StationPair pair; //!< pairwise: the candidate chosen
     std::vector<RegistrationReport> candidates;
     std::vector<double> shares;
+    std::vector<bool> fromWhereTheyAre; //!< per candidate: refined from the stations' own start
+    double tolerance = 0; //!< of the agreement: 3 robust sigmas of the best candidate's residuals
 };
 
+//! The change-robust ICP that refines a pair's candidates.
+IcpParams pairIcp(const StationParams& params, double spacing)
+{
+    IcpParams icp;
+    icp.constraint = params.constraint;
+    icp.kernel = RobustKernel::Cauchy;
+    icp.changeRobust = true;
+    icp.sampleCount = params.sampleCount;
+    icp.seed = params.seed;
+    // From within about a feature spacing (any start): the ICP needs no more reach.
+    icp.maxDistance = params.anyStart ? std::min(params.maxDistance, 4 * spacing) : params.maxDistance;
+    return icp;
+}
+
+//! A candidate's score: the points of both stations it brings onto the
+//! other's surface within `tolerance`, less those it puts where the other
+//! scanner saw through. A hall is near symmetric under a half turn: the
+//! turned fit lands walls, floor and roof as well, and only the clutter
+//! (racks, machines, a partition's door) tells them apart; the ICP's own RMS,
+//! over what it kept, preferred the wrong turn that kept less.
+double candidateShare(const std::vector<Station>& stations, std::size_t a, std::size_t b, const Eigen::Matrix4d& motion,
+                      double tolerance, double spacing, const Eigen::Vector3d& worldOrigin)
+{
+    const Eigen::Matrix4d back = motion.inverse();
+    return posedAgreement(stations[b], stations[a], motion, worldOrigin, tolerance, 2 * spacing) +
+           posedAgreement(stations[a], stations[b], back, worldOrigin, tolerance, 2 * spacing) -
+           kFreeSpaceWeight * (freeSpaceShare(stations[b], stations[a], motion, worldOrigin) +
+                               freeSpaceShare(stations[a], stations[b], back, worldOrigin));
+}
+
+//! Whether two motions are the same (within 0.05 deg and `metres`).
+bool sameMotion(const Eigen::Matrix4d& p, const Eigen::Matrix4d& q, double metres)
+{
+    return rotationDegrees(p.topLeftCorner<3, 3>().transpose() * q.topLeftCorner<3, 3>()) < 0.05 &&
+           (p.topRightCorner<3, 1>() - q.topRightCorner<3, 1>()).norm() < metres;
+}
+
+//! Adds a candidate unless the same motion is there already.
+void addCandidate(PairHypotheses& hypotheses, RegistrationReport report, double share, bool fromWhereTheyAre, double spacing)
+{
+    for (const RegistrationReport& kept : hypotheses.candidates)
+        if (sameMotion(kept.matrix, report.matrix, spacing))
+            return;
+    hypotheses.candidates.push_back(std::move(report));
+    hypotheses.shares.push_back(share);
+    hypotheses.fromWhereTheyAre.push_back(fromWhereTheyAre);
+}
+
+//! The pair's best candidate becomes its motion, with its overlap: within
+//! two feature spacings (the joint adjustment's distance at most) of the
+//! other station, both ways.
+void chooseBestCandidate(PairHypotheses& hypotheses, const std::vector<Station>& stations, double spacing,
+                         const StationParams& params, const Eigen::Vector3d& worldOrigin)
+{
+    StationPair& pair = hypotheses.pair;
+    const auto best = static_cast<std::size_t>(std::max_element(hypotheses.shares.begin(), hypotheses.shares.end()) - hypotheses.shares.begin());
+    pair.pairwise = hypotheses.candidates[best];
+    pair.agreement = hypotheses.shares[best];
+    const double near = std::min(params.maxDistance, 2 * spacing);
+    pair.overlap = std::max(posedAgreement(stations[pair.b], stations[pair.a], pair.pairwise.matrix, worldOrigin, kInfinity, near),
+                            posedAgreement(stations[pair.a], stations[pair.b], pair.pairwise.matrix.inverse(), worldOrigin, kInfinity, near));
+    pair.used = pair.overlap >= params.minOverlap;
+    if (!pair.used)
+        pair.note = "overlap " + std::to_string(pair.overlap) + " below the minimum";
+}
+
 //! One pair registered alone: global alignment from the descriptors (any
-//! start), then change-robust ICP from it; or ICP from where the stations
-//! are. Its overlap after that, both ways.
+//! start), then change-robust ICP from it and from where the stations are;
+//! or ICP from where the stations are.
 PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a, std::size_t b,
                             const std::vector<std::shared_ptr<const AlignmentFeatures>>& features, double spacing,
                             const StationParams& params, const Eigen::Vector3d& worldOrigin)
@@ -245,13 +359,7 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
     StationPair& pair = hypotheses.pair;
     pair.a = a;
     pair.b = b;
-    IcpParams icp;
-    icp.constraint = params.constraint;
-    icp.kernel = RobustKernel::Cauchy;
-    icp.changeRobust = true;
-    icp.sampleCount = params.sampleCount;
-    icp.seed = params.seed;
-    icp.maxDistance = params.maxDistance;
+    IcpParams icp = pairIcp(params, spacing);
     std::vector<Eigen::Matrix4d> starts{Eigen::Matrix4d::Identity()};
     if (params.anyStart) {
         GlobalAlignmentParams global;
@@ -266,172 +374,221 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
             // hall that repeats itself.
             starts = {Eigen::Matrix4d::Identity(), found.report.matrix};
             starts.insert(starts.end(), found.alternatives.begin(), found.alternatives.end());
+            // A scan that holds its scanner's pose is a station on a tripod:
+            // its frame has z up within the scanner's levelling (a
+            // compensator's few degrees). A fit that tips one station's
+            // vertical over (a floor on a roof, a wall on a floor) is a
+            // symmetry of the site, not a pose.
+            if (stations[a].scanner && stations[b].scanner)
+                starts.erase(std::remove_if(starts.begin() + 1, starts.end(),
+                                            [](const Eigen::Matrix4d& m) {
+                                                return m.topLeftCorner<3, 3>().col(2).z() < std::cos(kMaxStationTilt);
+                                            }),
+                             starts.end());
         } catch (const Error& e) {
             if (e.code() == ErrorCode::Cancelled)
                 throw;
             pair.note = std::string("no global alignment (") + e.what() + "): from where the stations are";
         }
-        // From within about a feature spacing: the ICP needs no more reach.
-        icp.maxDistance = std::min(params.maxDistance, 4 * spacing);
     }
-    // Each start refined by ICP; the one that brings the most points of both
-    // stations onto the other's surface within 3 robust sigmas of the
-    // residuals (the smallest of the candidates') wins. A hall is near
-    // symmetric under a half turn: the turned one lands walls, floor and roof
-    // as well, and only the clutter (racks, machines, a partition's door)
-    // tells them apart; within half a feature spacing, the clutter of the
-    // wrong turn found something to land on too, and the ICP's own RMS,
-    // over what it kept, preferred the wrong turn that kept less.
-    struct Candidate
-    {
-        RegistrationReport report;
-        double sigma;
-        bool whereTheyAre; //!< from the stations' own start
-    };
-    std::vector<Candidate> candidates;
+    std::vector<RegistrationReport> refined;
+    std::vector<bool> fromWhereTheyAre;
     std::string failure;
+    double sigma = kInfinity;
     for (const Eigen::Matrix4d& start : starts) {
         icp.initial = start;
         try {
-            RegistrationReport report = detail::icpOnSurface(*stations[b].cloud, *stations[a].surface, icp, nullptr).report;
-            const double sigma = 1.4826 * report.median;
-            candidates.push_back({std::move(report), sigma, start.isIdentity()});
+            refined.push_back(detail::icpOnSurface(*stations[b].cloud, *stations[a].surface, icp, nullptr).report);
+            fromWhereTheyAre.push_back(start.isIdentity());
+            const double s = 1.4826 * refined.back().median;
+            if (std::isfinite(s) && s > 0)
+                sigma = std::min(sigma, s);
         } catch (const Error& e) {
             if (e.code() == ErrorCode::Cancelled)
                 throw;
             failure = e.what();
         }
     }
-    double sigma = std::numeric_limits<double>::infinity();
-    for (const Candidate& c : candidates)
-        if (std::isfinite(c.sigma) && c.sigma > 0)
-            sigma = std::min(sigma, c.sigma);
-    for (std::size_t k = 0; k < candidates.size(); ++k) {
-        Candidate& c = candidates[k];
-        const double tolerance = std::isfinite(sigma) ? 3 * sigma : spacing;
-        double share = posedAgreement(stations[b], stations[a], c.report.matrix, worldOrigin, tolerance, 2 * spacing) +
-                       posedAgreement(stations[a], stations[b], c.report.matrix.inverse(), worldOrigin, tolerance, 2 * spacing);
+    hypotheses.tolerance = std::isfinite(sigma) ? 3 * sigma : spacing;
+    for (std::size_t k = 0; k < refined.size(); ++k) {
+        double share = candidateShare(stations, a, b, refined[k].matrix, hypotheses.tolerance, spacing, worldOrigin);
         // Where the stations are is where the surveyor put them: it keeps
         // a tenth in hand over a fit found elsewhere (a site that repeats
         // itself offers those), which a station in another heading, far
         // from its place, does not come near.
-        if (c.whereTheyAre && params.anyStart)
+        if (fromWhereTheyAre[k] && params.anyStart)
             share *= 1.1;
-        bool repeated = false; // the same motion from another start
-        for (const RegistrationReport& kept : hypotheses.candidates)
-            repeated = repeated || (rotationDegrees(kept.matrix.topLeftCorner<3, 3>().transpose() * c.report.matrix.topLeftCorner<3, 3>()) < 0.05 &&
-                                    (kept.matrix.topRightCorner<3, 1>() - c.report.matrix.topRightCorner<3, 1>()).norm() < spacing);
-        if (repeated)
-            continue;
-        hypotheses.candidates.push_back(std::move(c.report));
-        hypotheses.shares.push_back(share);
+        addCandidate(hypotheses, std::move(refined[k]), share, fromWhereTheyAre[k] && params.anyStart, spacing);
     }
     if (hypotheses.candidates.empty()) {
         pair.used = false;
         pair.note = "no registration: " + failure;
         return hypotheses;
     }
-    const auto best = static_cast<std::size_t>(std::max_element(hypotheses.shares.begin(), hypotheses.shares.end()) - hypotheses.shares.begin());
-    pair.pairwise = hypotheses.candidates[best];
-    pair.agreement = hypotheses.shares[best];
-    // Overlapping: within two feature spacings (the joint adjustment's
-    // distance at most) of the other station, after the pair's own motion.
-    const double near = std::min(params.maxDistance, 2 * spacing);
-    pair.overlap = std::max(posedAgreement(stations[b], stations[a], pair.pairwise.matrix, worldOrigin, kInfinity, near),
-                            posedAgreement(stations[a], stations[b], pair.pairwise.matrix.inverse(), worldOrigin, kInfinity, near));
-    if (pair.overlap < params.minOverlap) {
-        pair.used = false;
-        pair.note = "overlap " + std::to_string(pair.overlap) + " below the minimum";
-    }
+    chooseBestCandidate(hypotheses, stations, spacing, params, worldOrigin);
     return hypotheses;
 }
 
-//! The candidate of each pair such that the loops close: a hall is near
-//! symmetric under a half turn and repeats along its columns, and a pair
-//! alone may prefer a turned or shifted fit by a percent of its points; the
-//! loops of three stations do not close on such a choice. Each choice is
-//! scored 3 for every triangle of pairs that closes (within `degrees` and
-//! `metres` at the third station's centre), -3 for every one that does not,
-//! plus the pairs' shares; the best is sought over every combination when
-//! there are few (at most 100 000), else by changing one pair at a time
-//! from the best shares while the score rises.
-void chooseConsistentCandidates(std::vector<PairHypotheses>& pairs, const std::vector<Station>& stations,
-                                const Eigen::Vector3d& worldOrigin, double degrees, double metres)
+//! The report of a motion composed through other stations: its residuals
+//! over the points of b that land within two feature spacings of a.
+RegistrationReport composedReport(const std::vector<Station>& stations, std::size_t a, std::size_t b, const Eigen::Matrix4d& motion,
+                                  double spacing, const Eigen::Vector3d& worldOrigin)
+{
+    RegistrationReport report;
+    report.method = "composed through the other stations";
+    report.matrix = motion;
+    report.centre = stations[b].centre + worldOrigin;
+    Matched m;
+    match(stations[b], toLocal(motion, worldOrigin), stations[a], Eigen::Isometry3d::Identity(), worldOrigin, stations[b].sample.size(), m);
+    std::vector<double> residuals;
+    double squares = 0;
+    for (std::size_t i = 0; i < m.x.size(); ++i)
+        if (m.distance[i] <= 2 * spacing) {
+            residuals.push_back(std::abs(m.residual[i]));
+            squares += m.residual[i] * m.residual[i];
+        }
+    report.rms = residuals.empty() ? 0 : std::sqrt(squares / static_cast<double>(residuals.size()));
+    report.median = medianOf(residuals);
+    report.overlap = static_cast<double>(residuals.size()) / static_cast<double>(std::max<std::size_t>(m.x.size(), 1));
+    return report;
+}
+
+//! Places the stations one at a time from a starting pair's motion, each
+//! where its candidates agree best with every station already placed. A
+//! hall is near symmetric under a half turn and repeats along its columns:
+//! a pair alone may prefer a turned or shifted fit (two stations that see
+//! the hall from far apart share little but its shell), while the stations
+//! already placed, together, see the clutter such a fit puts in their empty
+//! aisles. Of every candidate of a pair between a placed and an unplaced
+//! station, the pose whose summed score (candidateShare) against all placed
+//! stations is highest places its station. Poses in the starting pair's
+//! frame; a station no pair links stays unplaced.
+struct Placement
+{
+    std::vector<Eigen::Matrix4d> pose;
+    std::vector<bool> placed;
+    double score = 0; //!< summed over the pairs of placed stations
+};
+
+Placement placeFrom(const std::vector<PairHypotheses>& pairs, const std::vector<std::vector<std::ptrdiff_t>>& index, std::size_t startPair,
+                    std::size_t startCandidate, const std::vector<Station>& stations, double tolerance, double spacing,
+                    const Eigen::Vector3d& worldOrigin)
+{
+    const std::size_t count = stations.size();
+    Placement placement{std::vector<Eigen::Matrix4d>(count, Eigen::Matrix4d::Identity()), std::vector<bool>(count, false), 0};
+    std::vector<Eigen::Matrix4d>& pose = placement.pose;
+    std::vector<bool>& placed = placement.placed;
+    const PairHypotheses& first = pairs[startPair];
+    placed[first.pair.a] = placed[first.pair.b] = true;
+    pose[first.pair.b] = first.candidates[startCandidate].matrix;
+    placement.score = candidateShare(stations, first.pair.a, first.pair.b, pose[first.pair.b], tolerance, spacing, worldOrigin);
+    for (;;) {
+        double bestScore = -kInfinity;
+        std::size_t bestStation = 0;
+        Eigen::Matrix4d bestPose = Eigen::Matrix4d::Identity();
+        for (std::size_t k = 0; k < count; ++k) {
+            if (placed[k])
+                continue;
+            for (std::size_t p = 0; p < count; ++p) {
+                if (!placed[p] || index[p][k] < 0)
+                    continue;
+                const PairHypotheses& h = pairs[static_cast<std::size_t>(index[p][k])];
+                for (std::size_t c = 0; c < h.candidates.size(); ++c) {
+                    const Eigen::Matrix4d& m = h.candidates[c].matrix; // b -> a
+                    const Eigen::Matrix4d candidate = pose[p] * (h.pair.a == p ? m : Eigen::Matrix4d(m.inverse()));
+                    double score = 0;
+                    for (std::size_t q = 0; q < count; ++q)
+                        if (placed[q])
+                            score += candidateShare(stations, q, k, pose[q].inverse() * candidate, tolerance, spacing, worldOrigin);
+                    if (h.fromWhereTheyAre[c])
+                        score *= 1.1;
+                    if (score > bestScore) {
+                        bestScore = score;
+                        bestStation = k;
+                        bestPose = candidate;
+                    }
+                }
+            }
+        }
+        if (!std::isfinite(bestScore))
+            return placement;
+        placed[bestStation] = true;
+        pose[bestStation] = bestPose;
+        placement.score += bestScore;
+    }
+}
+
+//! The placement that scores best over a few starts: the best candidate of
+//! each of the three pairs that agree best (a wrong start, a pair turned by
+//! the hall's symmetry, turns every station placed from it). Returns each
+//! station's pose (station -> station 0, global coordinates); a station no
+//! pair links to station 0's side stays where it is.
+std::vector<Eigen::Matrix4d> placeStations(const std::vector<PairHypotheses>& pairs, const std::vector<Station>& stations, double spacing,
+                                           const Eigen::Vector3d& worldOrigin)
 {
     const std::size_t count = stations.size();
     std::vector<std::vector<std::ptrdiff_t>> index(count, std::vector<std::ptrdiff_t>(count, -1));
+    std::vector<double> tolerances;
+    std::vector<std::size_t> starts;
     for (std::size_t e = 0; e < pairs.size(); ++e)
-        if (pairs[e].pair.used && !pairs[e].candidates.empty())
+        if (pairs[e].pair.used && !pairs[e].candidates.empty()) {
             index[pairs[e].pair.a][pairs[e].pair.b] = index[pairs[e].pair.b][pairs[e].pair.a] = static_cast<std::ptrdiff_t>(e);
-    std::vector<std::size_t> choice(pairs.size(), 0);
-    for (std::size_t e = 0; e < pairs.size(); ++e)
-        if (!pairs[e].shares.empty())
-            choice[e] = static_cast<std::size_t>(std::max_element(pairs[e].shares.begin(), pairs[e].shares.end()) - pairs[e].shares.begin());
-    const auto motion = [&](std::size_t to, std::size_t from, const std::vector<std::size_t>& pick) { // from -> to
-        const auto e = static_cast<std::size_t>(index[to][from]);
-        const Eigen::Matrix4d& m = pairs[e].candidates[pick[e]].matrix;
-        return pairs[e].pair.a == to ? Eigen::Matrix4d(m) : Eigen::Matrix4d(m.inverse());
-    };
-    const auto scoreOf = [&](const std::vector<std::size_t>& pick) {
-        double score = 0;
-        for (std::size_t e = 0; e < pairs.size(); ++e)
-            if (index[pairs[e].pair.a][pairs[e].pair.b] == static_cast<std::ptrdiff_t>(e))
-                score += pairs[e].shares[pick[e]];
-        for (std::size_t a = 0; a < count; ++a)
-            for (std::size_t b = a + 1; b < count; ++b)
-                for (std::size_t c = b + 1; c < count; ++c) {
-                    if (index[a][b] < 0 || index[a][c] < 0 || index[b][c] < 0)
-                        continue;
-                    score += triangleCloses(motion(a, b, pick), motion(a, c, pick), motion(c, b, pick),
-                                            stations[b].centre + worldOrigin, degrees, metres)
-                                 ? 3.0
-                                 : -3.0;
-                }
-        return score;
-    };
-    double combinations = 1;
-    std::vector<std::size_t> varying;
-    for (std::size_t e = 0; e < pairs.size(); ++e)
-        if (index[pairs[e].pair.a][pairs[e].pair.b] == static_cast<std::ptrdiff_t>(e) && pairs[e].candidates.size() > 1) {
-            combinations *= static_cast<double>(pairs[e].candidates.size());
-            varying.push_back(e);
+            tolerances.push_back(pairs[e].tolerance);
+            starts.push_back(e);
         }
-    double best = scoreOf(choice);
-    if (combinations <= 100000) {
-        std::vector<std::size_t> pick = choice;
-        for (double n = 1; n < combinations; ++n) {
-            for (std::size_t e : varying) { // the next combination, as an odometer
-                if (++pick[e] < pairs[e].candidates.size())
-                    break;
-                pick[e] = 0;
-            }
-            const double score = scoreOf(pick);
-            if (score > best) {
-                best = score;
-                choice = pick;
-            }
-        }
-    } else {
-        for (bool better = true; better;) {
-            better = false;
-            for (std::size_t e : varying)
-                for (std::size_t k = 0; k < pairs[e].candidates.size(); ++k) {
-                    std::vector<std::size_t> pick = choice;
-                    pick[e] = k;
-                    const double score = scoreOf(pick);
-                    if (score > best + 1e-9) {
-                        best = score;
-                        choice = pick;
-                        better = true;
-                    }
-                }
-        }
+    std::vector<Eigen::Matrix4d> pose(count, Eigen::Matrix4d::Identity());
+    if (starts.empty())
+        return pose;
+    const double tolerance = medianOf(tolerances);
+    std::sort(starts.begin(), starts.end(), [&](std::size_t p, std::size_t q) { return pairs[p].pair.agreement > pairs[q].pair.agreement; });
+    starts.resize(std::min<std::size_t>(3, starts.size()));
+    Placement best;
+    best.score = -kInfinity;
+    for (std::size_t e : starts) {
+        const auto candidate = static_cast<std::size_t>(std::max_element(pairs[e].shares.begin(), pairs[e].shares.end()) - pairs[e].shares.begin());
+        Placement placement = placeFrom(pairs, index, e, candidate, stations, tolerance, spacing, worldOrigin);
+        if (placement.score > best.score)
+            best = std::move(placement);
     }
-    for (std::size_t e = 0; e < pairs.size(); ++e)
-        if (!pairs[e].candidates.empty()) {
-            pairs[e].pair.pairwise = pairs[e].candidates[choice[e]];
-            pairs[e].pair.agreement = pairs[e].shares[choice[e]];
+    const Eigen::Matrix4d toStation0 = best.pose[0].inverse();
+    for (std::size_t k = 0; k < count; ++k)
+        pose[k] = best.placed[k] && best.placed[0] ? Eigen::Matrix4d(toStation0 * best.pose[k]) : Eigen::Matrix4d::Identity();
+    return pose;
+}
+
+//! Each pair takes the candidate the placement implies (within `degrees`
+//! and `metres` at b's centre); a pair whose own search missed that motion
+//! gets it, composed through the other stations.
+void chooseImpliedCandidates(std::vector<PairHypotheses>& pairs, const std::vector<Station>& stations, const std::vector<Eigen::Matrix4d>& pose,
+                             double spacing, const Eigen::Vector3d& worldOrigin, double degrees, double metres)
+{
+    std::vector<std::size_t> choice(pairs.size(), 0);
+    for (std::size_t e = 0; e < pairs.size(); ++e) {
+        PairHypotheses& h = pairs[e];
+        if (h.candidates.empty() || !h.pair.used)
+            continue;
+        const Eigen::Matrix4d implied = pose[h.pair.a].inverse() * pose[h.pair.b];
+        const Eigen::Vector3d at = stations[h.pair.b].centre + worldOrigin;
+        double nearest = kInfinity;
+        for (std::size_t k = 0; k < h.candidates.size(); ++k) {
+            double angle = 0, shift = 0;
+            motionSize(implied.inverse() * h.candidates[k].matrix, at, angle, shift);
+            if (angle <= degrees && shift <= metres && shift < nearest) {
+                nearest = shift;
+                choice[e] = k;
+            }
         }
+        if (!std::isfinite(nearest)) {
+            RegistrationReport report = composedReport(stations, h.pair.a, h.pair.b, implied, spacing, worldOrigin);
+            h.candidates.push_back(std::move(report));
+            h.shares.push_back(candidateShare(stations, h.pair.a, h.pair.b, implied, h.tolerance, spacing, worldOrigin));
+            h.fromWhereTheyAre.push_back(false);
+            choice[e] = h.candidates.size() - 1;
+            h.pair.note = "its own search missed the motion the other stations place it at";
+        }
+        h.pair.pairwise = h.candidates[choice[e]];
+        h.pair.agreement = h.shares[choice[e]];
+    }
     // A site that repeats itself (a hall under a half or a quarter turn, a
     // row of columns) fits a turned or shifted pair nearly as well: said,
     // not hidden. Nearly: within 5 % of the chosen candidate's share.
@@ -439,6 +596,8 @@ void chooseConsistentCandidates(std::vector<PairHypotheses>& pairs, const std::v
         if (h.candidates.size() < 2 || !h.pair.used)
             continue;
         const std::size_t chosen = choice[static_cast<std::size_t>(&h - pairs.data())];
+        if (!h.pair.note.empty())
+            continue;
         for (std::size_t k = 0; k < h.candidates.size(); ++k) {
             if (k == chosen || h.shares[k] < 0.95 * h.shares[chosen])
                 continue;
@@ -449,8 +608,7 @@ void chooseConsistentCandidates(std::vector<PairHypotheses>& pairs, const std::v
             note.precision(3);
             note << "ambiguous: another fit, turned " << angle << " deg and moved " << shift << " m, brings "
                  << 100 * h.shares[k] / h.shares[chosen] << " % as many points together (the site repeats itself); check this pose";
-            if (h.pair.note.empty())
-                h.pair.note = note.str();
+            h.pair.note = note.str();
             break;
         }
     }
@@ -539,6 +697,15 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
     } else {
         spacing = params.maxDistance / 2;
     }
+    // Each scanner's view, for the free-space test: a point nearer than what
+    // it saw by a feature spacing (at least 5 cm) contradicts a pose.
+    VisibilityParams seeing;
+    seeing.tolerance = std::max(0.05, spacing);
+    for (Station& s : stations)
+        if (s.cloud->sensors().size() == 1) {
+            s.view = std::make_unique<DepthMap>(*s.cloud, s.cloud->sensors().front(), seeing);
+            s.scanner = s.cloud->sensors().front().position - worldOrigin;
+        }
     std::vector<PairHypotheses> hypotheses;
     ProgressTicker pairTicker(progress, "Stations: pairwise registration", count * (count - 1) / 2);
     for (std::size_t a = 0; a < count; ++a)
@@ -546,7 +713,8 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
             hypotheses.push_back(registerPair(stations, a, b, features, spacing, params, worldOrigin));
             pairTicker.step();
         }
-    chooseConsistentCandidates(hypotheses, stations, worldOrigin, 0.5, std::max(0.05, 2 * spacing));
+    const std::vector<Eigen::Matrix4d> placement = placeStations(hypotheses, stations, spacing, worldOrigin);
+    chooseImpliedCandidates(hypotheses, stations, placement, spacing, worldOrigin, 0.5, std::max(0.05, 2 * spacing));
     std::vector<StationPair> allPairs;
     for (PairHypotheses& h : hypotheses) {
         if (h.pair.note.rfind("ambiguous", 0) == 0)
@@ -598,6 +766,7 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
             v = full.tail<3>();
         return v;
     };
+    double graduatedScale = params.maxDistance / 3;
     ProgressTicker ticker(progress, "Stations: joint adjustment", params.maxIterations);
     Eigen::MatrixXd h;
     for (std::size_t iteration = 1; iteration <= params.maxIterations; ++iteration) {
@@ -628,7 +797,15 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
         std::vector<double> magnitudes(rows.size());
         for (std::size_t i = 0; i < rows.size(); ++i)
             magnitudes[i] = std::abs(rows[i].r);
-        const double scale = std::max(1.4826 * medianOf(magnitudes), 1e-12 * length);
+        // Graduated: the weights start wide (a third of the maximum
+        // distance) and narrow by half each iteration to the residuals' own
+        // robust scale. Narrow from the start, a station slid along a hall
+        // by a pair that saw little across it stays slid: the few surfaces
+        // across the slide (an end wall, a column) are outliers to the many
+        // along it.
+        const double robustScale = std::max(1.4826 * medianOf(magnitudes), 1e-12 * length);
+        const double scale = std::max(robustScale, graduatedScale);
+        graduatedScale /= 2;
         double sum2 = 0;
         std::fill(pairSquares.begin(), pairSquares.end(), 0.0);
         std::fill(pairCount.begin(), pairCount.end(), 0.0);
@@ -695,7 +872,8 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
         threshold = std::min(threshold, std::max(3 * scale, medianOf(distances)));
         ticker.step();
         const double tolerance = 1e-7 * std::max(rms, 1e-12);
-        if (largestMove < 1e-7 || std::abs(previousRms - rms) <= tolerance || std::abs(rmsTwoBefore - rms) <= tolerance) {
+        const bool graduated = scale <= robustScale;
+        if (graduated && (largestMove < 1e-7 || std::abs(previousRms - rms) <= tolerance || std::abs(rmsTwoBefore - rms) <= tolerance)) {
             report.converged = true;
             break;
         }

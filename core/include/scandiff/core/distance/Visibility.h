@@ -64,6 +64,14 @@ public:
     //! (also where no sample is near: the ray met nothing the scanner saw).
     VisibilityLabel classify(const Eigen::Vector3d& globalPoint) const;
 
+    //! Whether the scanner looked through the point: it lies in the field,
+    //! within range, and nearer than the surface along its direction by more
+    //! than the tolerance taken along the ray. Something there now was not
+    //! there when the scanner passed (or is misplaced): the free-space
+    //! contradiction a pose that puts a station's clutter in another's empty
+    //! room makes.
+    bool inFreeSpace(const Eigen::Vector3d& globalPoint) const;
+
     int width() const { return width_; }
     int height() const { return height_; }
     double yawStep() const { return yawStep_; }
