@@ -32,6 +32,9 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kFreeSpaceWeight = 10;
 //! How far a station's own vertical may be from another's: 10 degrees,
 //! twice a tripod scanner's compensator range.
+//! Where the stations are is where the surveyor put them: a candidate from
+//! there keeps a tenth of its score in hand (scores may be negative).
+constexpr double kWhereTheyAreBonus = 0.1;
 constexpr double kMaxStationTilt = 10 * M_PI / 180;
 
 //! One station: its cloud, the surface others are matched on, and its
@@ -44,6 +47,7 @@ struct Station
     Eigen::Vector3d centre = Eigen::Vector3d::Zero(); //!< of the sample, world-relative station coordinates
     std::unique_ptr<DepthMap> view; //!< what the scanner saw, when the cloud holds its one sensor pose
     std::optional<Eigen::Vector3d> scanner; //!< its centre, world-relative station coordinates, with the view
+    Eigen::Vector3d up = Eigen::Vector3d::UnitZ(); //!< the scanner's vertical in the station's coordinates
 };
 
 //! A pair's correspondences one way: points of `from` matched on `on`'s surface.
@@ -279,7 +283,7 @@ struct PairHypotheses
     std::vector<RegistrationReport> candidates;
     std::vector<double> shares;
     std::vector<bool> fromWhereTheyAre; //!< per candidate: refined from the stations' own start
-    double tolerance = 0; //!< of the agreement: 3 robust sigmas of the best candidate's residuals
+    double tolerance = 0; //!< of the agreement: 3 robust sigmas of the residuals, the smallest over the candidates
 };
 
 //! The change-robust ICP that refines a pair's candidates.
@@ -330,9 +334,21 @@ void addCandidate(PairHypotheses& hypotheses, RegistrationReport report, double 
     hypotheses.fromWhereTheyAre.push_back(fromWhereTheyAre);
 }
 
-//! The pair's best candidate becomes its motion, with its overlap: within
-//! two feature spacings (the joint adjustment's distance at most) of the
-//! other station, both ways.
+//! The pair's overlap after its motion: within two feature spacings (the
+//! joint adjustment's distance at most) of the other station, the larger of
+//! both ways; below the minimum, the pair is left out.
+void measureOverlap(StationPair& pair, const std::vector<Station>& stations, double spacing, const StationParams& params,
+                    const Eigen::Vector3d& worldOrigin)
+{
+    const double near = std::min(params.maxDistance, 2 * spacing);
+    pair.overlap = std::max(posedAgreement(stations[pair.b], stations[pair.a], pair.pairwise.matrix, worldOrigin, kInfinity, near),
+                            posedAgreement(stations[pair.a], stations[pair.b], pair.pairwise.matrix.inverse(), worldOrigin, kInfinity, near));
+    pair.used = pair.overlap >= params.minOverlap;
+    if (!pair.used)
+        pair.note = "overlap " + std::to_string(pair.overlap) + " below the minimum";
+}
+
+//! The pair's best candidate becomes its motion, with its overlap.
 void chooseBestCandidate(PairHypotheses& hypotheses, const std::vector<Station>& stations, double spacing,
                          const StationParams& params, const Eigen::Vector3d& worldOrigin)
 {
@@ -340,12 +356,7 @@ void chooseBestCandidate(PairHypotheses& hypotheses, const std::vector<Station>&
     const auto best = static_cast<std::size_t>(std::max_element(hypotheses.shares.begin(), hypotheses.shares.end()) - hypotheses.shares.begin());
     pair.pairwise = hypotheses.candidates[best];
     pair.agreement = hypotheses.shares[best];
-    const double near = std::min(params.maxDistance, 2 * spacing);
-    pair.overlap = std::max(posedAgreement(stations[pair.b], stations[pair.a], pair.pairwise.matrix, worldOrigin, kInfinity, near),
-                            posedAgreement(stations[pair.a], stations[pair.b], pair.pairwise.matrix.inverse(), worldOrigin, kInfinity, near));
-    pair.used = pair.overlap >= params.minOverlap;
-    if (!pair.used)
-        pair.note = "overlap " + std::to_string(pair.overlap) + " below the minimum";
+    measureOverlap(pair, stations, spacing, params, worldOrigin);
 }
 
 //! One pair registered alone: global alignment from the descriptors (any
@@ -375,14 +386,14 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
             starts = {Eigen::Matrix4d::Identity(), found.report.matrix};
             starts.insert(starts.end(), found.alternatives.begin(), found.alternatives.end());
             // A scan that holds its scanner's pose is a station on a tripod:
-            // its frame has z up within the scanner's levelling (a
-            // compensator's few degrees). A fit that tips one station's
-            // vertical over (a floor on a roof, a wall on a floor) is a
-            // symmetry of the site, not a pose.
+            // the scanner's z is up within its levelling (a compensator's
+            // few degrees). A fit that tips one station's vertical over (a
+            // floor on a roof, a wall on a floor) is a symmetry of the site,
+            // not a pose.
             if (stations[a].scanner && stations[b].scanner)
                 starts.erase(std::remove_if(starts.begin() + 1, starts.end(),
-                                            [](const Eigen::Matrix4d& m) {
-                                                return m.topLeftCorner<3, 3>().col(2).z() < std::cos(kMaxStationTilt);
+                                            [&](const Eigen::Matrix4d& m) {
+                                                return (m.topLeftCorner<3, 3>() * stations[b].up).dot(stations[a].up) < std::cos(kMaxStationTilt);
                                             }),
                              starts.end());
         } catch (const Error& e) {
@@ -417,7 +428,7 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
         // itself offers those), which a station in another heading, far
         // from its place, does not come near.
         if (fromWhereTheyAre[k] && params.anyStart)
-            share *= 1.1;
+            share += kWhereTheyAreBonus * std::abs(share);
         addCandidate(hypotheses, std::move(refined[k]), share, fromWhereTheyAre[k] && params.anyStart, spacing);
     }
     if (hypotheses.candidates.empty()) {
@@ -501,7 +512,7 @@ Placement placeFrom(const std::vector<PairHypotheses>& pairs, const std::vector<
                         if (placed[q])
                             score += candidateShare(stations, q, k, pose[q].inverse() * candidate, tolerance, spacing, worldOrigin);
                     if (h.fromWhereTheyAre[c])
-                        score *= 1.1;
+                        score += kWhereTheyAreBonus * std::abs(score);
                     if (score > bestScore) {
                         bestScore = score;
                         bestStation = k;
@@ -520,10 +531,11 @@ Placement placeFrom(const std::vector<PairHypotheses>& pairs, const std::vector<
 
 //! The placement that scores best over a few starts: the best candidate of
 //! each of the three pairs that agree best (a wrong start, a pair turned by
-//! the hall's symmetry, turns every station placed from it). Returns each
-//! station's pose (station -> station 0, global coordinates); a station no
-//! pair links to station 0's side stays where it is.
-std::vector<Eigen::Matrix4d> placeStations(const std::vector<PairHypotheses>& pairs, const std::vector<Station>& stations, double spacing,
+//! the hall's symmetry, turns every station placed from it). Each station's
+//! pose is station -> station 0 (global coordinates); none is placed when
+//! station 0 is not (the stations fall apart in groups: the spanning tree
+//! says so later).
+Placement placeStations(const std::vector<PairHypotheses>& pairs, const std::vector<Station>& stations, double spacing,
                                            const Eigen::Vector3d& worldOrigin)
 {
     const std::size_t count = stations.size();
@@ -536,37 +548,45 @@ std::vector<Eigen::Matrix4d> placeStations(const std::vector<PairHypotheses>& pa
             tolerances.push_back(pairs[e].tolerance);
             starts.push_back(e);
         }
-    std::vector<Eigen::Matrix4d> pose(count, Eigen::Matrix4d::Identity());
+    Placement best{std::vector<Eigen::Matrix4d>(count, Eigen::Matrix4d::Identity()), std::vector<bool>(count, false), -kInfinity};
     if (starts.empty())
-        return pose;
+        return best;
     const double tolerance = medianOf(tolerances);
     std::sort(starts.begin(), starts.end(), [&](std::size_t p, std::size_t q) { return pairs[p].pair.agreement > pairs[q].pair.agreement; });
     starts.resize(std::min<std::size_t>(3, starts.size()));
-    Placement best;
-    best.score = -kInfinity;
     for (std::size_t e : starts) {
         const auto candidate = static_cast<std::size_t>(std::max_element(pairs[e].shares.begin(), pairs[e].shares.end()) - pairs[e].shares.begin());
         Placement placement = placeFrom(pairs, index, e, candidate, stations, tolerance, spacing, worldOrigin);
         if (placement.score > best.score)
             best = std::move(placement);
     }
+    if (!best.placed[0])
+        return Placement{std::vector<Eigen::Matrix4d>(count, Eigen::Matrix4d::Identity()), std::vector<bool>(count, false), -kInfinity};
     const Eigen::Matrix4d toStation0 = best.pose[0].inverse();
     for (std::size_t k = 0; k < count; ++k)
-        pose[k] = best.placed[k] && best.placed[0] ? Eigen::Matrix4d(toStation0 * best.pose[k]) : Eigen::Matrix4d::Identity();
-    return pose;
+        best.pose[k] = best.placed[k] ? Eigen::Matrix4d(toStation0 * best.pose[k]) : Eigen::Matrix4d::Identity();
+    return best;
 }
 
-//! Each pair takes the candidate the placement implies (within `degrees`
-//! and `metres` at b's centre); a pair whose own search missed that motion
-//! gets it, composed through the other stations.
-void chooseImpliedCandidates(std::vector<PairHypotheses>& pairs, const std::vector<Station>& stations, const std::vector<Eigen::Matrix4d>& pose,
-                             double spacing, const Eigen::Vector3d& worldOrigin, double degrees, double metres)
+//! Each pair between placed stations takes the candidate the placement
+//! implies (within `degrees` and `metres` at b's centre), or, when its own
+//! search missed that motion, the motion composed through the other
+//! stations; its overlap is measured again at that motion (a pair whose own
+//! best fit, turned, overlapped too little, comes back).
+void chooseImpliedCandidates(std::vector<PairHypotheses>& pairs, const std::vector<Station>& stations, const Placement& placement,
+                             double spacing, const StationParams& params, const Eigen::Vector3d& worldOrigin, double degrees, double metres)
 {
+    const std::vector<Eigen::Matrix4d>& pose = placement.pose;
     std::vector<std::size_t> choice(pairs.size(), 0);
     for (std::size_t e = 0; e < pairs.size(); ++e) {
         PairHypotheses& h = pairs[e];
-        if (h.candidates.empty() || !h.pair.used)
+        if (h.candidates.empty()) {
             continue;
+        }
+        if (!placement.placed[h.pair.a] || !placement.placed[h.pair.b]) {
+            choice[e] = static_cast<std::size_t>(std::max_element(h.shares.begin(), h.shares.end()) - h.shares.begin());
+            continue;
+        }
         const Eigen::Matrix4d implied = pose[h.pair.a].inverse() * pose[h.pair.b];
         const Eigen::Vector3d at = stations[h.pair.b].centre + worldOrigin;
         double nearest = kInfinity;
@@ -585,9 +605,12 @@ void chooseImpliedCandidates(std::vector<PairHypotheses>& pairs, const std::vect
             h.fromWhereTheyAre.push_back(false);
             choice[e] = h.candidates.size() - 1;
             h.pair.note = "its own search missed the motion the other stations place it at";
+        } else if (h.pair.note.rfind("overlap", 0) == 0) {
+            h.pair.note.clear();
         }
         h.pair.pairwise = h.candidates[choice[e]];
         h.pair.agreement = h.shares[choice[e]];
+        measureOverlap(h.pair, stations, spacing, params, worldOrigin);
     }
     // A site that repeats itself (a hall under a half or a quarter turn, a
     // row of columns) fits a turned or shifted pair nearly as well: said,
@@ -596,7 +619,7 @@ void chooseImpliedCandidates(std::vector<PairHypotheses>& pairs, const std::vect
         if (h.candidates.size() < 2 || !h.pair.used)
             continue;
         const std::size_t chosen = choice[static_cast<std::size_t>(&h - pairs.data())];
-        if (!h.pair.note.empty())
+        if (!h.pair.note.empty() || !(h.shares[chosen] > 0))
             continue;
         for (std::size_t k = 0; k < h.candidates.size(); ++k) {
             if (k == chosen || h.shares[k] < 0.95 * h.shares[chosen])
@@ -705,6 +728,7 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
         if (s.cloud->sensors().size() == 1) {
             s.view = std::make_unique<DepthMap>(*s.cloud, s.cloud->sensors().front(), seeing);
             s.scanner = s.cloud->sensors().front().position - worldOrigin;
+            s.up = s.cloud->sensors().front().orientation * Eigen::Vector3d::UnitZ();
         }
     std::vector<PairHypotheses> hypotheses;
     ProgressTicker pairTicker(progress, "Stations: pairwise registration", count * (count - 1) / 2);
@@ -713,8 +737,8 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
             hypotheses.push_back(registerPair(stations, a, b, features, spacing, params, worldOrigin));
             pairTicker.step();
         }
-    const std::vector<Eigen::Matrix4d> placement = placeStations(hypotheses, stations, spacing, worldOrigin);
-    chooseImpliedCandidates(hypotheses, stations, placement, spacing, worldOrigin, 0.5, std::max(0.05, 2 * spacing));
+    const Placement placement = placeStations(hypotheses, stations, spacing, worldOrigin);
+    chooseImpliedCandidates(hypotheses, stations, placement, spacing, params, worldOrigin, 0.5, std::max(0.05, 2 * spacing));
     std::vector<StationPair> allPairs;
     for (PairHypotheses& h : hypotheses) {
         if (h.pair.note.rfind("ambiguous", 0) == 0)

@@ -54,7 +54,8 @@ struct StationPair
     double overlap = 0;            //!< the larger of the two directions' fractions (after the pair's own registration)
     //! How well the pair's motion brings both stations together: the shares
     //! of each station's points within 3 robust sigmas of the other's surface,
-    //! summed (0 to 2).
+    //! summed (0 to 2), less ten times the shares put where the other scanner
+    //! saw through empty space (when both carry their scanner's pose).
     double agreement = 0;
     //! Left out of the adjustment: it disagrees with the loops it closes
     //! (why in `note`), or its alignment failed.
