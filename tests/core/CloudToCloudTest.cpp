@@ -223,16 +223,27 @@ TEST(CloudToCloud, SignedByReferenceNormalsOrModel)
     EXPECT_EQ(test::errorCodeOf([&] { cloudToCloud(compared, reference, params); }), ErrorCode::InvalidArgument);
 }
 
+namespace {
+
+//! The wall of thesis 000 Fig. 2.8: x = 10 m, y and z in [-2, 2] on a 5 cm grid.
+PointCloud wallOfFigure28()
+{
+    PointCloud wall;
+    for (int i = -40; i <= 40; ++i)
+        for (int j = -40; j <= 40; ++j) {
+            wall.resize(wall.size() + 1);
+            wall.positions().back() = {10.0f, i * 0.05f, j * 0.05f};
+        }
+    return wall;
+}
+
+} // namespace
+
 TEST(CloudToCloud, VisibilityOnTheWallScenario)
 {
     // Thesis 000 Fig. 2.8: a scanner at the origin looks at a wall 10 m away
     // (x = 10, y and z in [-2, 2]); the reference never saw what is behind it.
-    PointCloud reference;
-    for (int i = -40; i <= 40; ++i)
-        for (int j = -40; j <= 40; ++j) {
-            reference.resize(reference.size() + 1);
-            reference.positions().back() = {10.0f, i * 0.05f, j * 0.05f};
-        }
+    PointCloud reference = wallOfFigure28();
     SensorPose scanner;
     scanner.maxRange = 30.0;
     PointCloud compared;
@@ -288,12 +299,7 @@ TEST(DepthMap, FreeSpaceIsWhereTheScannerLookedThrough)
     // the origin looked through everything nearer than the wall, within the
     // wall's angles, less the tolerance along the ray (at normal incidence,
     // the tolerance itself).
-    PointCloud wall;
-    for (int i = -40; i <= 40; ++i)
-        for (int j = -40; j <= 40; ++j) {
-            wall.resize(wall.size() + 1);
-            wall.positions().back() = {10.0f, i * 0.05f, j * 0.05f};
-        }
+    const PointCloud wall = wallOfFigure28();
     SensorPose scanner;
     scanner.maxRange = 30.0;
     VisibilityParams params;
