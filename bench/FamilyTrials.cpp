@@ -3,7 +3,7 @@
 // at full size and a number of seeded draws, one line of figures each
 // (docs/benchmarks.md quotes them; the family tests assert the same figures).
 //
-//   scandiff-family-trials FAMILY [--issue] [--draws N] [--first-seed S] [--scale F] [--set KEY=VALUE ...]
+//   scandiff-family-trials FAMILY [--issue] [--verbose] [--draws N] [--first-seed S] [--scale F] [--set KEY=VALUE ...]
 #include "families/ChangeTrials.h"
 #include "families/PrimitiveTrials.h"
 #include "families/RegistrationTrials.h"
@@ -35,6 +35,7 @@ struct Options
     std::map<std::string, std::string> set;
     std::string svgDir; //!< --svg DIR: the wall families' rings over their truth, one SVG per run
     std::string dataDir = "data"; //!< --data DIR: where pcl-data/ lies (the real samples)
+    bool verbose = false;         //!< --verbose: the tool's report and, for primitives, how each shape was split
 };
 
 double seconds(std::chrono::steady_clock::time_point since)
@@ -174,6 +175,8 @@ bool primitivesRow(const primitives::PrimitivesParams& p, const Options& o, cons
                 t.score.summary().c_str(), made, seconds(start) - made, t.score.meetsTarget() ? "" : "  FAIL");
     if (!t.score.meetsTarget())
         std::printf("%s\n", t.score.table().c_str());
+    if (o.verbose)
+        std::printf("%s\n%s\n", t.report.c_str(), spread(scene, t).c_str());
     std::fflush(stdout);
     return t.score.meetsTarget();
 }
@@ -187,6 +190,8 @@ int main(int argc, char** argv)
         const std::string a = argv[i];
         if (a == "--issue")
             o.issue = true;
+        else if (a == "--verbose")
+            o.verbose = true;
         else if (a == "--draws" && i + 1 < argc)
             o.draws = std::atoi(argv[++i]);
         else if (a == "--first-seed" && i + 1 < argc)

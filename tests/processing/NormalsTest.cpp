@@ -287,3 +287,43 @@ TEST(Normals, SomePointsOnlyGiveTheNormalsOfTheWholeCloud)
         ASSERT_EQ(some[i], all.normals[i]) << i;
     EXPECT_THROW(planeNormalsOf(cloud, tree, first, 2, some), Error);
 }
+
+TEST(Normals, ARadiusWidensToTheNearestPointsWhereTheScanIsSparse)
+{
+    // One tilted plane sampled at 1 cm near the scanner and at 10 cm far from
+    // it: a 3 cm radius holds the near points' neighbours and none of the far
+    // ones'. With at least 12 neighbours, the far points are fitted on their
+    // 12 nearest: every normal exact; the near ones keep their radius (the
+    // same normals as without the minimum).
+    const Eigen::Matrix3d tilt = Eigen::AngleAxisd(0.3, Eigen::Vector3d(2, 1, 0).normalized()).toRotationMatrix();
+    const Eigen::Vector3d origin(512000, 5403000, 100);
+    PointCloud near = test::gridCloud(40, 40, 0.01, tilt, origin);
+    const PointCloud far = test::gridCloud(20, 20, 0.10, tilt, origin + tilt * Eigen::Vector3d(5, 0, 0));
+    const std::size_t nearCount = near.size();
+    for (std::size_t i = 0; i < far.size(); ++i)
+        near.positions().push_back((far.globalPosition(i) - near.origin()).cast<float>());
+    const PointCloud& cloud = near;
+    const Eigen::Vector3d expected = tilt * Eigen::Vector3d::UnitZ();
+    NormalParams params;
+    params.radius = 0.03;
+    const NormalResult radiusOnly = computeNormals(cloud, params);
+    EXPECT_EQ(radiusOnly.unfitted, far.size());
+    params.minNeighbours = 12;
+    const NormalResult widened = computeNormals(cloud, params);
+    EXPECT_EQ(widened.unfitted, 0u);
+    EXPECT_LT(worstAngle(cloud, widened.normals, [&](const Eigen::Vector3d&) { return expected; }), 1e-3);
+    for (std::size_t i = 0; i < nearCount; ++i)
+        ASSERT_LT(degreesBetween(widened.normals[i].cast<double>(), radiusOnly.normals[i].cast<double>()), 1e-4) << i;
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        EXPECT_LT(widened.surfaceVariation.value(i), 1e-6) << i;
+    // A minimum goes with a radius and the plane model, and is at least 3.
+    NormalParams bad = params;
+    bad.minNeighbours = 2;
+    EXPECT_EQ(test::errorCodeOf([&] { computeNormals(cloud, bad); }), ErrorCode::InvalidArgument);
+    bad.minNeighbours = 12;
+    bad.radius.reset();
+    EXPECT_EQ(test::errorCodeOf([&] { computeNormals(cloud, bad); }), ErrorCode::InvalidArgument);
+    bad.radius = 0.03;
+    bad.model = NormalModel::Quadric;
+    EXPECT_EQ(test::errorCodeOf([&] { computeNormals(cloud, bad); }), ErrorCode::InvalidArgument);
+}

@@ -232,22 +232,14 @@ PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressO
         withNormals(cloud, used, points, progress, pairedPoints, normals);
         if (normals.size() < 5)
             cannotFit(kind, "too few points with a normal");
-        Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
-        for (const auto& nrm : normals)
-            m.noalias() += nrm * nrm.transpose();
-        const Eigen::Vector3d d0 = smallestAxis(m);
+        const std::optional<Primitive> start = cylinderFromNormals(points, normals, Eigen::Vector3d::Zero());
+        if (!start)
+            cannotFit(kind, "the points do not determine a circle across the axis");
+        const Eigen::Vector3d d0 = start->direction;
         Eigen::Vector3d e1, e2;
         orthonormalFrame(d0, e1, e2);
-        std::vector<Eigen::Vector2d> planar;
-        planar.reserve(points.size());
-        for (const auto& p : points)
-            planar.emplace_back(p.dot(e1), p.dot(e2));
-        Eigen::Vector2d centre;
-        double radius = 0;
-        if (!fitCircle(planar, centre, radius))
-            cannotFit(kind, "the points do not determine a circle across the axis");
         Eigen::VectorXd x(5);
-        x << centre.x(), centre.y(), 0, 0, radius;
+        x << start->point.dot(e1), start->point.dot(e2), 0, 0, start->radius;
         const auto axisOf = [d0, e1, e2](const Eigen::VectorXd& x) { return (d0 + x[2] * e1 + x[3] * e2).normalized(); };
         refine(points, x, [&](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
             const Eigen::Vector3d d = axisOf(x), v = p - (x[0] * e1 + x[1] * e2);
@@ -478,6 +470,34 @@ bool fitCircle(const std::vector<Eigen::Vector2d>& p, Eigen::Vector2d& centre, d
     return s.allFinite() && radius > 0;
 }
 
+
+std::optional<Primitive> cylinderFromNormals(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals,
+                                             const Eigen::Vector3d& centre)
+{
+    if (normals.size() < 5 || points.size() < 5)
+        return std::nullopt;
+    // Every normal of a cylinder is orthogonal to its axis.
+    Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+    for (const auto& n : normals)
+        m.noalias() += n * n.transpose();
+    const Eigen::Vector3d axis = smallestAxis(m);
+    Eigen::Vector3d e1, e2;
+    orthonormalFrame(axis, e1, e2);
+    std::vector<Eigen::Vector2d> planar;
+    planar.reserve(points.size());
+    for (const auto& p : points)
+        planar.emplace_back(p.dot(e1), p.dot(e2));
+    Eigen::Vector2d circleCentre;
+    double radius = 0;
+    if (!fitCircle(planar, circleCentre, radius))
+        return std::nullopt;
+    Primitive cylinder;
+    cylinder.kind = PrimitiveKind::Cylinder;
+    cylinder.direction = axis;
+    cylinder.point = centre + circleCentre.x() * e1 + circleCentre.y() * e2;
+    cylinder.radius = radius;
+    return cylinder;
+}
 
 std::optional<Primitive> algebraicSphere(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre)
 {

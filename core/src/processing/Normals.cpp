@@ -84,6 +84,10 @@ void checkParams(const NormalParams& params)
     if (params.radius && !(*params.radius > 0 && std::isfinite(*params.radius)))
         throw Error(ErrorCode::InvalidArgument, "normals: the radius must be > 0");
     const std::size_t minimum = params.model == NormalModel::Quadric ? 6 : 3;
+    if (params.minNeighbours != 0 && (params.minNeighbours < 3 || params.minNeighbours > 10000))
+        throw Error(ErrorCode::InvalidArgument, "normals: the minimum neighbours must be 0 (off) or in [3, 10000]");
+    if (params.minNeighbours != 0 && !(params.radius && params.model == NormalModel::Plane))
+        throw Error(ErrorCode::InvalidArgument, "normals: a minimum of neighbours goes with a radius and the plane model");
     if (!params.radius && (params.knn < minimum || params.knn > 10000))
         throw Error(ErrorCode::InvalidArgument, "normals: --knn must be in [" + std::to_string(minimum) +
                                                     ", 10000] for this model (the fit needs that many points)");
@@ -94,6 +98,11 @@ void checkCloud(const PointCloud& cloud, const char* what)
     if (cloud.empty())
         throw Error(ErrorCode::InvalidData, std::string(what) + ": cloud '" + cloud.name + "' is empty");
 }
+
+//! Plane normals of the points `indices` on their `knn` nearest points,
+//! unoriented, with their surface variation when `variation` is given.
+void fitOnNearest(const PointCloud& cloud, const octree::Octree& tree, const std::vector<std::uint32_t>& indices, std::size_t knn,
+                  std::vector<Eigen::Vector3f>& normals, std::vector<float>* variation);
 
 } // namespace
 
@@ -112,13 +121,23 @@ NormalResult computeNormals(const PointCloud& cloud, const NormalParams& params,
     ProgressTicker ticker(progress, "Fitting normals", n);
     if (params.radius && params.model == NormalModel::Plane) {
         // The plane needs only the neighbourhood's moments.
+        std::vector<char> sparse(params.minNeighbours ? n : 0, 0);
         detail::forEachPointMoments(tree, *params.radius, ticker, [&](std::size_t i, const octree::NeighbourhoodMoments& moments) {
+            if (moments.count < params.minNeighbours) {
+                sparse[i] = 1;
+                return;
+            }
             detail::LocalPlane plane;
             if (!detail::fitLocalPlane(moments, false, plane))
                 return;
             result.normals[i] = plane.normal.cast<float>();
             variation[i] = static_cast<float>(surfaceVariationOf(plane));
         });
+        std::vector<std::uint32_t> widened;
+        for (std::size_t i = 0; i < sparse.size(); ++i)
+            if (sparse[i])
+                widened.push_back(static_cast<std::uint32_t>(i));
+        fitOnNearest(cloud, tree, widened, params.minNeighbours, result.normals, &variation);
     } else {
         detail::forEachPointNeighbourhood(tree, params.radius, params.knn, ticker, [&](std::size_t i, const octree::Neighbour* list, std::size_t count) {
             const Eigen::Vector3f& p = positions[i];
@@ -165,6 +184,19 @@ void planeNormalsOf(const PointCloud& cloud, const octree::Octree& tree, const s
         throw Error(ErrorCode::InvalidArgument, "normals: at least 3 neighbours");
     if (normals.size() != cloud.size())
         throw Error(ErrorCode::InvalidArgument, "normals: one slot per point of the cloud");
+    fitOnNearest(cloud, tree, indices, knn, normals, nullptr);
+    for (std::uint32_t i : indices)
+        if (normals[i].z() < 0)
+            normals[i] = -normals[i];
+}
+
+namespace {
+
+void fitOnNearest(const PointCloud& cloud, const octree::Octree& tree, const std::vector<std::uint32_t>& indices, std::size_t knn,
+                  std::vector<Eigen::Vector3f>& normals, std::vector<float>* variation)
+{
+    if (indices.empty())
+        return;
     const auto& positions = cloud.positions();
     std::vector<Eigen::Vector3f> queries(indices.size());
     for (std::size_t q = 0; q < indices.size(); ++q)
@@ -181,14 +213,12 @@ void planeNormalsOf(const PointCloud& cloud, const octree::Octree& tree, const s
         Eigen::Vector3f normal = Eigen::Vector3f::Zero();
         if (detail::fitLocalPlane(positions.data(), queries[q], list, count, plane)) {
             normal = plane.normal.cast<float>();
-            if (normal.z() < 0)
-                normal = -normal;
+            if (variation)
+                (*variation)[indices[q]] = static_cast<float>(surfaceVariationOf(plane));
         }
         normals[indices[q]] = normal;
     });
 }
-
-namespace {
 
 void orientTowards(const PointCloud& cloud, std::vector<Eigen::Vector3f>& normals,
                    const std::function<Eigen::Vector3d(std::size_t)>& target)

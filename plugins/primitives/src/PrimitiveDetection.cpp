@@ -4,6 +4,7 @@
 #include "EfficientRansac.h"
 #include "RegionGrowing.h"
 #include "SequentialRansac.h"
+#include "ShapeParts.h"
 
 #include <scandiff/core/CloudOctree.h>
 #include <scandiff/core/Error.h>
@@ -33,6 +34,7 @@ constexpr double kPi = 3.14159265358979323846;
 struct ScanScale
 {
     double spacing = 0;
+    double sparseSpacing = 0; //!< the spacing that 90 % of the sampled points are within
     double noise = 0;
 };
 
@@ -74,6 +76,10 @@ ScanScale estimateScale(const PointCloud& cloud, const octree::Octree& tree)
         std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
         return v[v.size() / 2];
     };
+    if (!spacing.empty()) {
+        std::nth_element(spacing.begin(), spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() * 9 / 10), spacing.end());
+        scale.sparseSpacing = spacing[spacing.size() * 9 / 10];
+    }
     scale.spacing = median(spacing);
     scale.noise = median(noise);
     return scale;
@@ -103,37 +109,6 @@ bool radiusPlausible(const Primitive& p, double extent)
     return false;
 }
 
-//! The key of the cube of side `cell` holding p, moved by (dx, dy, dz) cells.
-std::uint64_t cellKey(const Eigen::Vector3d& p, double cell, int dx = 0, int dy = 0, int dz = 0)
-{
-    const auto c = [cell](double v, int d) {
-        return static_cast<std::uint64_t>((static_cast<std::int64_t>(std::floor(v / cell)) + d) & 0x1fffff);
-    };
-    return c(p.x(), dx) | c(p.y(), dy) << 21 | c(p.z(), dz) << 42;
-}
-
-//! The occupied area of points on their surface: cells of `cell` (m) they
-//! fall in, counted in 3D, times the cell's area.
-double footprint(const std::vector<Eigen::Vector3d>& points, double cell)
-{
-    std::unordered_set<std::uint64_t> cells;
-    for (const auto& p : points)
-        cells.insert(cellKey(p, cell));
-    return static_cast<double>(cells.size()) * cell * cell;
-}
-
-//! A cylinder's or cone's extent along its axis.
-double lengthAlong(const Primitive& p, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre)
-{
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const auto& q : points) {
-        const double t = (centre + q - p.point).dot(p.direction);
-        lo = std::min(lo, t);
-        hi = std::max(hi, t);
-    }
-    return hi - lo;
-}
-
 //! The least-squares plane of points (their frame), as a primitive (global).
 Primitive pcaPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre)
 {
@@ -151,6 +126,37 @@ Primitive pcaPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vect
     return plane;
 }
 
+//! The cylinder a "plane" of RANSAC's is a strip of, when it is one: on a
+//! thin pipe a strip as wide as the noise allows fits a plane within
+//! epsilon, and RANSAC, trying planes first, takes the pipe as planes. The
+//! normals turn across such a strip; the cylinder orthogonal to them, refitted
+//! on an even sample of the points (at most 5,000), must fit clearly better
+//! than the plane on the same sample and be no wider than twice the points'
+//! extent. Empty otherwise (a flat wall: the cylinder is huge or no better).
+std::optional<Primitive> cylinderOfStrip(const std::vector<Eigen::Vector3d>& members, const std::vector<Eigen::Vector3d>& memberNormals,
+                                         const Eigen::Vector3d& centre, const Primitive& plane, double typeTolerance)
+{
+    const std::size_t stride = std::max<std::size_t>(1, members.size() / 5000);
+    std::vector<Eigen::Vector3d> sample, sampleNormals;
+    for (std::size_t k = 0; k < members.size(); k += stride)
+        if (memberNormals[k].squaredNorm() > 0) {
+            sample.push_back(members[k]);
+            sampleNormals.push_back(memberNormals[k]);
+        }
+    const std::optional<Primitive> start = cylinderFromNormals(sample, sampleNormals, centre);
+    if (!start || !radiusPlausible(*start, extentOf(members)))
+        return std::nullopt;
+    try {
+        const PrimitiveRefinement cylinder = refinePrimitive(sample, centre, *start);
+        const PrimitiveRefinement flat = refinePrimitive(sample, centre, plane);
+        if (radiusPlausible(cylinder.primitive, extentOf(members)) && (1 + typeTolerance) * cylinder.rms < flat.rms)
+            return cylinder.primitive;
+    } catch (const Error&) {
+        // Neither fit says more than RANSAC's plane.
+    }
+    return std::nullopt;
+}
+
 //! The shape's type, chosen among the types asked for: each candidate (the
 //! type RANSAC found, a plane, a sphere, a cylinder for a cone) refitted by
 //! least squares, and the
@@ -160,12 +166,16 @@ Primitive pcaPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vect
 //! sphere stays a sphere when a spindle torus fits it too. Empty when no
 //! candidate holds the points within epsilon. `foundIsAGuess`: the shape is
 //! a grown region's first guess, not a type a detector claimed, and a change
-//! of type is not worth a note.
-std::optional<PrimitiveRefinement> chooseType(const std::vector<Eigen::Vector3d>& members, const Eigen::Vector3d& centre,
-                                              const Primitive& found, const PrimitiveDetectionParams& params, double epsilon,
-                                              std::vector<std::string>& notes, bool foundIsAGuess = false)
+//! of type is not worth a note. `memberNormals` (one per member, or empty):
+//! a plane a detector found is also tried as the cylinder it may be a strip of.
+std::optional<PrimitiveRefinement> chooseType(const std::vector<Eigen::Vector3d>& members, const std::vector<Eigen::Vector3d>& memberNormals,
+                                              const Eigen::Vector3d& centre, const Primitive& found, const PrimitiveDetectionParams& params,
+                                              double epsilon, std::vector<std::string>& notes, bool foundIsAGuess = false)
 {
     std::vector<Primitive> candidates{found};
+    if (params.kinds.count(PrimitiveKind::Cylinder) && found.kind == PrimitiveKind::Plane && !foundIsAGuess && !memberNormals.empty())
+        if (const auto cylinder = cylinderOfStrip(members, memberNormals, centre, found, params.typeTolerance))
+            candidates.push_back(*cylinder);
     if (params.kinds.count(PrimitiveKind::Plane) && found.kind != PrimitiveKind::Plane)
         candidates.push_back(pcaPlane(members, centre));
     if (params.kinds.count(PrimitiveKind::Sphere) && found.kind != PrimitiveKind::Sphere && found.kind != PrimitiveKind::Plane)
@@ -210,22 +220,6 @@ std::optional<PrimitiveRefinement> chooseType(const std::vector<Eigen::Vector3d>
         notes.push_back(std::string("a ") + primitiveKindName(found.kind) + " of " + std::to_string(members.size()) + " points is a " +
                         primitiveKindName(chosen->primitive.kind) + " (it fits them as well, with fewer parameters)");
     return *chosen;
-}
-
-//! Whether two point sets come within about one cell of each other: the
-//! cells (of side `cell`) of one, and the 27-cell blocks around the other's.
-bool touching(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b, double cell)
-{
-    std::unordered_set<std::uint64_t> cells;
-    for (const auto& p : a)
-        cells.insert(cellKey(p, cell));
-    for (const auto& p : b)
-        for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dz = -1; dz <= 1; ++dz)
-                    if (cells.count(cellKey(p, cell, dx, dy, dz)))
-                        return true;
-    return false;
 }
 
 //! The shapes efficient RANSAC finds (in the frame of `points`).
@@ -325,11 +319,18 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
     const octree::Octree tree = buildOctree(cloud, std::nullopt, progress);
     const ScanScale scale = estimateScale(cloud, tree);
     result.epsilon = params.epsilon ? *params.epsilon : std::max(3.0 * scale.noise, 1e-6);
-    result.clusterEpsilon = params.clusterEpsilon ? *params.clusterEpsilon : std::max(3.0 * scale.spacing, result.epsilon);
+    // A scan's spacing grows with range: RANSAC's shapes linked at the
+    // spacing near the scanner leave a far wall in pieces too small to be
+    // shapes. Regions grow at the median spacing (thesis 003's stones, 001's
+    // façade pixels), where a wider link would bridge a joint.
+    const bool ransac = params.method == PrimitiveMethod::EfficientRansac;
+    result.clusterEpsilon = params.clusterEpsilon ? *params.clusterEpsilon
+                                                  : std::max(3.0 * (ransac ? scale.sparseSpacing : scale.spacing), result.epsilon);
     if (!params.epsilon)
         result.notes.push_back("epsilon " + std::to_string(result.epsilon) + " m: 3 x the noise estimated from the points");
     if (!params.clusterEpsilon)
-        result.notes.push_back("cluster epsilon " + std::to_string(result.clusterEpsilon) + " m: 3 x the median spacing");
+        result.notes.push_back("cluster epsilon " + std::to_string(result.clusterEpsilon) + " m: 3 x the " +
+                               (ransac ? "spacing 90 % of the points are within" : "median spacing"));
 
     std::vector<Eigen::Vector3f> normalsStore;
     const std::vector<Eigen::Vector3f>* normals = &cloud.normals();
@@ -341,6 +342,11 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
         // scattered for the shapes' normal test, which then breaks them up.
         NormalParams normalParams;
         normalParams.radius = std::max(2.5 * scale.spacing, 10.0 * scale.noise);
+        // Far from the scanner the spacing is several times the median: there
+        // the radius widens to the 12 nearest points (a far wall's normals
+        // otherwise come from one or two neighbours, and its points fail the
+        // shapes' normal test).
+        normalParams.minNeighbours = 12;
         normalParams.orientation.kind = NormalOrientation::Kind::None;
         normalsStore = computeNormals(cloud, normalParams, progress).normals;
         normals = &normalsStore;
@@ -360,7 +366,6 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
         const Eigen::Vector3d n = normals->empty() ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : Eigen::Vector3d((*normals)[i].cast<double>());
         unitNormals[i] = n.norm() > 0 ? n.normalized() : Eigen::Vector3d::UnitZ();
     }
-    std::vector<Eigen::Vector3f>().swap(normalsStore); // copied into unitNormals
 
     std::vector<detail::RansacShape> found;
     bool cancelled = false;
@@ -450,6 +455,15 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
     // The shapes are independent: refitted in parallel (one task each), their
     // results and notes then taken in the shapes' order, so the outcome never
     // depends on the threads.
+    detail::SurfaceEvidence evidence(points, *normals);
+    evidence.centre = centre;
+    evidence.epsilon = result.epsilon;
+    evidence.linkDistance = result.clusterEpsilon;
+    evidence.normalCosine = std::cos(params.normalDeviationDegrees * kPi / 180.0);
+    evidence.typeTolerance = params.typeTolerance;
+    evidence.spacing = scale.spacing;
+    evidence.minPoints = params.minPoints;
+    evidence.checkCancel = [&ticker] { ticker.checkCancel(); };
     std::vector<std::optional<DetectedPrimitive>> refitted(found.size());
     std::vector<std::vector<std::string>> shapeNotes(found.size());
     std::atomic<bool> stopped{false};
@@ -461,10 +475,13 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
                 return;
             }
             const detail::RansacShape& shape = found[s];
-            std::vector<Eigen::Vector3d> members;
+            std::vector<Eigen::Vector3d> members, memberNormals;
             members.reserve(shape.members.size());
             for (std::uint32_t i : shape.members)
                 members.push_back(points[i]);
+            if (!normals->empty())
+                for (std::uint32_t i : shape.members)
+                    memberNormals.push_back((*normals)[i].cast<double>().normalized());
             if (members.size() < params.minPoints)
                 continue;
             Primitive initial = shape.primitive;
@@ -481,7 +498,7 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
                 }
             }
             initial.point += centre; // CGAL's frame -> global
-            std::optional<PrimitiveRefinement> chosen = chooseType(members, centre, initial, typeParams, result.epsilon, shapeNotes[s], typedRegions);
+            std::optional<PrimitiveRefinement> chosen = chooseType(members, memberNormals, centre, initial, typeParams, result.epsilon, shapeNotes[s], typedRegions);
             if (!chosen)
                 continue;
             const PrimitiveRefinement& refined = *chosen;
@@ -491,12 +508,7 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
             std::sort(detected.inliers.begin(), detected.inliers.end());
             detected.rms = refined.rms;
             detected.uncertainty = refined.uncertainty;
-            detected.area = footprint(members, std::max(2.0 * scale.spacing, 1e-6));
-            for (const Eigen::Vector3d& m : members)
-                detected.centroid += m;
-            detected.centroid = centre + detected.centroid / static_cast<double>(members.size());
-            if (detected.primitive.kind == PrimitiveKind::Cylinder || detected.primitive.kind == PrimitiveKind::Cone)
-                detected.length = lengthAlong(detected.primitive, members, centre);
+            detail::measureShape(detected, evidence);
             refitted[s] = std::move(detected);
         }
     }, tbb::simple_partitioner());
@@ -508,59 +520,18 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
     }
     ticker.step(20);
 
-    // RANSAC may take one surface in two parts (a sphere's cap found apart
-    // from the rest): touching shapes of one type whose union fits as well as
-    // each part are merged. Disjoint coplanar plates do not touch: they stay apart.
-    // Regions grown on a value are not: they are apart by their values (the
-    // stones of one wall plane, the joints between them).
-    const bool mergeTouching = !(params.method == PrimitiveMethod::RegionGrowing && params.growOn == GrowOn::Value);
-    for (bool merged = mergeTouching; merged;) {
-        merged = false;
-        for (std::size_t a = 0; a < result.primitives.size() && !merged; ++a)
-            for (std::size_t b = a + 1; b < result.primitives.size() && !merged; ++b) {
-                ticker.checkCancel();
-                DetectedPrimitive& first = result.primitives[a];
-                DetectedPrimitive& second = result.primitives[b];
-                if (first.primitive.kind != second.primitive.kind)
-                    continue;
-                // A cheap look first: a sample of the second part on the first's surface?
-                std::size_t near = 0, tried = 0;
-                const std::size_t step = std::max<std::size_t>(1, second.inliers.size() / 100);
-                for (std::size_t k = 0; k < second.inliers.size(); k += step, ++tried)
-                    near += std::abs(signedDistance(first.primitive, centre + points[second.inliers[k]])) <= result.epsilon;
-                if (2 * near < tried)
-                    continue;
-                std::vector<Eigen::Vector3d> pa, pb;
-                for (std::uint32_t i : first.inliers)
-                    pa.push_back(points[i]);
-                for (std::uint32_t i : second.inliers)
-                    pb.push_back(points[i]);
-                if (!touching(pa, pb, result.clusterEpsilon))
-                    continue;
-                std::vector<Eigen::Vector3d> both = pa;
-                both.insert(both.end(), pb.begin(), pb.end());
-                PrimitiveRefinement joint;
-                try {
-                    joint = refinePrimitive(both, centre, first.inliers.size() >= second.inliers.size() ? first.primitive : second.primitive);
-                } catch (const Error&) {
-                    continue;
-                }
-                if (!(joint.rms <= (1 + params.typeTolerance) * std::max(first.rms, second.rms)))
-                    continue;
-                first.inliers.insert(first.inliers.end(), second.inliers.begin(), second.inliers.end());
-                std::sort(first.inliers.begin(), first.inliers.end());
-                first.primitive = joint.primitive;
-                first.rms = joint.rms;
-                first.uncertainty = joint.uncertainty;
-                first.area += second.area;
-                const double firstShare = static_cast<double>(pa.size()) / static_cast<double>(both.size());
-                first.centroid = firstShare * first.centroid + (1.0 - firstShare) * second.centroid;
-                if (first.primitive.kind == PrimitiveKind::Cylinder || first.primitive.kind == PrimitiveKind::Cone)
-                    first.length = lengthAlong(first.primitive, both, centre);
-                result.notes.push_back(std::string("two touching parts of one ") + primitiveKindName(first.primitive.kind) + " merged");
-                result.primitives.erase(result.primitives.begin() + static_cast<std::ptrdiff_t>(b));
-                merged = true;
-            }
+    // RANSAC returns a surface in parts (a wall cut by a column's shadow, a
+    // sphere's cap found apart from the rest) and gives the points where two
+    // shapes meet to the one found first: parts of one surface merged, then
+    // each point given to the shape it lies on, then parts merged again (the
+    // points given may join them). Regions grown on a value are left as they
+    // are: they are apart by their values (the stones of one wall plane).
+    if (!(params.method == PrimitiveMethod::RegionGrowing && params.growOn == GrowOn::Value)) {
+        if (ransac)
+            evidence.views = detail::scannerViews(cloud, scale.spacing);
+        detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
+        if (ransac && detail::claimPoints(result.primitives, evidence, cloud.size(), result.notes) > 0)
+            detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
     }
 
     // Largest first; ties by first inlier, so the order never depends on threads.

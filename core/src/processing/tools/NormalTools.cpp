@@ -45,6 +45,10 @@ void addNormalsTool(ToolRegistry& registry)
             .asAlternative("neighbourhood"),
         ParameterSpec::real("radius", "Radius", "Fit on every point within this radius", 0.1, 1e-9, 1e9, "m")
             .asAlternative("neighbourhood"),
+        ParameterSpec::integer("min-neighbours", "At least",
+                               "With a radius: a point with fewer points within it is fitted on this many nearest ones (0: never); "
+                               "for a scan whose spacing grows with range",
+                               0, 0, 10000, "points"),
         ParameterSpec::choice("model", "Local model", "Surface fitted on each neighbourhood", {"plane", "quadric", "triangulation"},
                               "plane"),
         ParameterSpec::text("orient", "Orientation", kOrientHelp, "+z").withSuggestions(kOrientations),
@@ -59,6 +63,7 @@ void addNormalsTool(ToolRegistry& registry)
             params.radius = values.real("radius");
         if (values.has("knn"))
             params.knn = static_cast<std::size_t>(values.integer("knn"));
+        params.minNeighbours = static_cast<std::size_t>(values.integer("min-neighbours"));
         const std::string& model = values.text("model");
         params.model = model == "plane" ? NormalModel::Plane : model == "quadric" ? NormalModel::Quadric : NormalModel::Triangulation;
         params.orientation = orientationFrom(values);

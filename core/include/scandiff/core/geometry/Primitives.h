@@ -59,6 +59,13 @@ PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressO
 //! `centre`; empty when they determine none. A start for refinePrimitive().
 std::optional<Primitive> algebraicSphere(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre);
 
+//! The cylinder whose axis is orthogonal to every normal (the smallest axis
+//! of their second moments) and whose section is the algebraic circle of the
+//! points across that axis: a start for refinePrimitive(). Points relative
+//! to `centre` (the result is global); empty when they determine none.
+std::optional<Primitive> cylinderFromNormals(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals,
+                                             const Eigen::Vector3d& centre);
+
 //! Kasa's algebraic circle through 2D points: its centre and radius; false
 //! when they determine none. A start for a cylinder's section.
 bool fitCircle(const std::vector<Eigen::Vector2d>& points, Eigen::Vector2d& centre, double& radius);

@@ -64,6 +64,11 @@ struct NormalParams
     //! Neighbours within this radius (m, > 0); absent: the `knn` nearest.
     std::optional<double> radius;
     std::size_t knn = 12; //!< >= 3 (>= 6 for the quadric)
+    //! With a radius, plane model: a point with fewer than this many points
+    //! within the radius is fitted on this many nearest ones instead (0:
+    //! never). A scan's spacing grows with range: a radius wide enough for
+    //! the noise near the scanner holds one or two points on a far wall.
+    std::size_t minNeighbours = 0;
     NormalModel model = NormalModel::Plane;
     NormalOrientation orientation;
     bool flip = false; //!< reverse every normal after orienting it

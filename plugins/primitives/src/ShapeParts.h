@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! After detection (internal to the plugin): the parts of one surface that
+//! a detector returned apart brought together, and the points each shape
+//! should hold given to it.
+//!
+//! A scan's shapes come out of RANSAC in pieces for reasons that are not in
+//! the surface: a wall is cut by the shadow of a column standing in front of
+//! it, a pipe by the tank it passes behind, a narrow strip of a thin pipe
+//! fits a plane as well as its cylinder, and the points where two shapes
+//! meet go to whichever shape was found first. Two parts are one surface
+//! when their points lie on one shape and nothing separates them but what
+//! no scanner saw: the space between them either holds points (they touch)
+//! or lies behind something from every scanner (the cloud's sensor poses
+//! say which). A gap a scanner looked through is real: two plates with the
+//! floor seen between them stay two shapes.
+
+#include <scandiff/core/PointCloud.h>
+#include <scandiff/plugins/primitives/PrimitiveDetection.h>
+
+#include <Eigen/Core>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace scandiff::plugins::detail {
+
+//! What a scanner saw, as the nearest range in each direction (cells of
+//! about its angular step, from every point of the cloud: a surface hides
+//! what lies behind it from every scanner, whichever scan its points came
+//! from). Unlike the visibility test's depth map, which finds the surface
+//! through a direction, this keeps the nearest return only: a wall another
+//! station saw behind a platform this one saw never counts as seen through
+//! the platform.
+class ScannerView
+{
+public:
+    //! `step`: the scanner's angular step (rad, > 0).
+    ScannerView(const PointCloud& cloud, const SensorPose& pose, double step);
+
+    //! Whether the scanner looked past the point (global): its direction and
+    //! the 8 around it hold returns, all farther than the point by more than
+    //! `tolerance` (along the ray). False where nothing came back around it.
+    bool lookedPast(const Eigen::Vector3d& point, double tolerance) const;
+
+    const Eigen::Vector3d& position() const { return position_; }
+
+private:
+    bool cellOf(const Eigen::Vector3d& point, int& u, int& v, double& range) const;
+
+    Eigen::Vector3d position_;
+    Eigen::Matrix3d worldToSensor_;
+    double step_ = 0;
+    int width_ = 0, height_ = 0;
+    std::vector<float> nearest_; //!< per cell, the nearest range (infinity: no return)
+};
+
+//! What the steps read: the points relative to `centre` (the shapes'
+//! primitives are global), their unit normals (zero: unknown; empty: none),
+//! the tolerances, and the scanners' depth maps (empty: no sensor pose).
+struct SurfaceEvidence
+{
+    SurfaceEvidence(const std::vector<Eigen::Vector3d>& points_, const std::vector<Eigen::Vector3f>& normals_)
+        : points(points_), normals(normals_)
+    {
+    }
+
+    const std::vector<Eigen::Vector3d>& points;
+    const std::vector<Eigen::Vector3f>& normals;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    double epsilon = 0.01;        //!< a point on a surface lies within this (m)
+    double linkDistance = 0.05;   //!< points closer than this are neighbours on a surface (m)
+    double normalCosine = 0.9;    //!< a point's normal within this of its surface's (unoriented)
+    double typeTolerance = 0.2;   //!< a union fits when its RMS is within this of its parts'
+    double spacing = 0.01;        //!< the scan's median spacing, for the shapes' footprints (m)
+    std::size_t minPoints = 200;  //!< a shape left with fewer is dropped
+    std::vector<ScannerView> views; //!< one per scanner, built on every point of the cloud
+    std::function<void()> checkCancel = [] {};
+};
+
+//! The views of the cloud's sensor poses (empty without any). A pose
+//! without its angular step gets the scan's spacing over the points' median
+//! range from it.
+std::vector<ScannerView> scannerViews(const PointCloud& cloud, double spacing);
+
+//! The shape's area, centroid and (cylinder, cone) length from its inliers.
+void measureShape(DetectedPrimitive& shape, const SurfaceEvidence& evidence);
+
+//! Merges pairs of shapes whose points lie on one of them and which touch
+//! or are separated only by what no scanner saw; the union is refitted and
+//! kept when it fits as well as its parts. A part of another type (a plane
+//! strip of a pipe) joins a shape of more parameters that holds its points.
+//! `mergeApart`: also across hidden gaps (false for regions grown on values,
+//! which are apart by their values). Returns the merges, noted in `notes`.
+std::size_t mergeSurfaceParts(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, bool mergeApart,
+                              std::vector<std::string>& notes);
+
+//! Gives each point the shape whose surface it lies nearest to (within
+//! epsilon, its normal agreeing), among the shapes holding points within
+//! the link distance of it, repeated while shapes grow: the points a shape
+//! left next to it join it, a point at the meeting of two shapes goes to
+//! the one it lies on. Changed shapes are refitted; shapes left with fewer
+//! than the minimum support are dropped. Returns the points that changed.
+std::size_t claimPoints(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, std::size_t cloudSize,
+                        std::vector<std::string>& notes);
+
+} // namespace scandiff::plugins::detail
