@@ -246,6 +246,112 @@ std::vector<detail::RansacShape> findByRansac(const std::vector<Eigen::Vector3d>
     });
 }
 
+//! RANSAC's (or the regions') shapes refitted by least squares, each with
+//! its type checked (chooseType), measured; the ones no type holds are left
+//! out. In parallel, one task a shape; the outcome and the notes in the
+//! shapes' order, whatever the threads.
+std::vector<DetectedPrimitive> typedShapes(const std::vector<detail::RansacShape>& found, const std::vector<Eigen::Vector3d>& points,
+                                           const std::vector<Eigen::Vector3f>& normals, const Eigen::Vector3d& centre,
+                                           const PrimitiveDetectionParams& typeParams, bool typedRegions,
+                                           const detail::SurfaceEvidence& evidence, ProgressObserver* progress, std::vector<std::string>& notes)
+{
+    std::vector<std::optional<DetectedPrimitive>> refitted(found.size());
+    std::vector<std::vector<std::string>> shapeNotes(found.size());
+    std::atomic<bool> stopped{false};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, found.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t s = range.begin(); s != range.end(); ++s) {
+            // Asked before each shape, kept or not: a refit can take a few tenths of a second.
+            if (stopped || (progress && progress->cancelRequested())) {
+                stopped = true;
+                return;
+            }
+            const detail::RansacShape& shape = found[s];
+            std::vector<Eigen::Vector3d> members, memberNormals;
+            members.reserve(shape.members.size());
+            for (std::uint32_t i : shape.members)
+                members.push_back(points[i]);
+            if (!normals.empty())
+                for (std::uint32_t i : shape.members)
+                    memberNormals.push_back(normals[i].cast<double>().normalized());
+            if (members.size() < evidence.minPoints)
+                continue;
+            Primitive initial = shape.primitive;
+            if (!typeParams.kinds.count(initial.kind)) { // a region whose normals turn, cylinders not asked for
+                if (typeParams.kinds.count(PrimitiveKind::Sphere)) {
+                    const std::optional<Primitive> sphere = algebraicSphere(members, Eigen::Vector3d::Zero());
+                    if (!sphere)
+                        continue;
+                    initial = *sphere;
+                } else if (typeParams.kinds.count(PrimitiveKind::Plane)) {
+                    initial = pcaPlane(members, Eigen::Vector3d::Zero());
+                } else {
+                    continue; // a flat region, planes not asked for
+                }
+            }
+            initial.point += centre; // CGAL's frame -> global
+            std::optional<PrimitiveRefinement> chosen = chooseType(members, memberNormals, centre, initial, typeParams, evidence.epsilon, shapeNotes[s], typedRegions);
+            if (!chosen)
+                continue;
+            const PrimitiveRefinement& refined = *chosen;
+            DetectedPrimitive detected;
+            detected.primitive = refined.primitive;
+            detected.inliers.assign(shape.members.begin(), shape.members.end());
+            std::sort(detected.inliers.begin(), detected.inliers.end());
+            detected.rms = refined.rms;
+            detected.uncertainty = refined.uncertainty;
+            detail::measureShape(detected, evidence);
+            refitted[s] = std::move(detected);
+        }
+    }, tbb::simple_partitioner());
+    std::vector<DetectedPrimitive> shapes;
+    for (std::size_t s = 0; s < found.size(); ++s) {
+        notes.insert(notes.end(), shapeNotes[s].begin(), shapeNotes[s].end());
+        if (refitted[s])
+            shapes.push_back(std::move(*refitted[s]));
+    }
+    return shapes;
+}
+
+//! A second search among the points left on no shape: RANSAC draws at
+//! random, and a shape whose first candidate no type held (a reducer taken
+//! for a torus with part of its pipe) leaves its points to nobody. Their
+//! shapes, typed, join the result. Returns how many.
+std::size_t searchLeftOver(PrimitiveDetectionResult& result, const std::vector<Eigen::Vector3d>& points,
+                           const std::vector<Eigen::Vector3f>& normals, const Eigen::Vector3d& centre,
+                           const PrimitiveDetectionParams& params, const detail::SurfaceEvidence& evidence, ProgressObserver* progress,
+                           bool& cancelled)
+{
+    std::vector<char> taken(points.size(), 0);
+    for (const DetectedPrimitive& shape : result.primitives)
+        for (std::uint32_t i : shape.inliers)
+            taken[i] = 1;
+    std::vector<std::uint32_t> left;
+    for (std::size_t i = 0; i < points.size(); ++i)
+        if (!taken[i])
+            left.push_back(static_cast<std::uint32_t>(i));
+    if (left.size() < 2 * params.minPoints)
+        return 0;
+    std::vector<Eigen::Vector3d> leftPoints, leftNormals;
+    for (std::uint32_t i : left) {
+        leftPoints.push_back(points[i]);
+        const Eigen::Vector3d n = normals.empty() ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : Eigen::Vector3d(normals[i].cast<double>());
+        leftNormals.push_back(n.norm() > 0 ? n.normalized() : Eigen::Vector3d::UnitZ());
+    }
+    std::vector<detail::RansacShape> found = findByRansac(leftPoints, std::move(leftNormals), params, result, progress, cancelled);
+    if (cancelled)
+        return 0;
+    for (detail::RansacShape& shape : found)
+        for (std::uint32_t& member : shape.members)
+            member = left[member];
+    std::vector<DetectedPrimitive> more = typedShapes(found, points, normals, centre, params, false, evidence, progress, result.notes);
+    for (DetectedPrimitive& shape : more)
+        result.primitives.push_back(std::move(shape));
+    if (!more.empty())
+        result.notes.push_back(std::to_string(more.size()) + " shapes found in a second search among the " + std::to_string(left.size()) +
+                               " points left on no shape");
+    return more.size();
+}
+
 void checkParameters(const PrimitiveDetectionParams& params)
 {
     auto bad = [](const std::string& why) { throw Error(ErrorCode::InvalidArgument, "primitives: " + why); };
@@ -464,60 +570,8 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
     evidence.spacing = scale.spacing;
     evidence.minPoints = params.minPoints;
     evidence.checkCancel = [&ticker] { ticker.checkCancel(); };
-    std::vector<std::optional<DetectedPrimitive>> refitted(found.size());
-    std::vector<std::vector<std::string>> shapeNotes(found.size());
-    std::atomic<bool> stopped{false};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, found.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t s = range.begin(); s != range.end(); ++s) {
-            // Asked before each shape, kept or not: a refit can take a few tenths of a second.
-            if (stopped || (progress && progress->cancelRequested())) {
-                stopped = true;
-                return;
-            }
-            const detail::RansacShape& shape = found[s];
-            std::vector<Eigen::Vector3d> members, memberNormals;
-            members.reserve(shape.members.size());
-            for (std::uint32_t i : shape.members)
-                members.push_back(points[i]);
-            if (!normals->empty())
-                for (std::uint32_t i : shape.members)
-                    memberNormals.push_back((*normals)[i].cast<double>().normalized());
-            if (members.size() < params.minPoints)
-                continue;
-            Primitive initial = shape.primitive;
-            if (!typeParams.kinds.count(initial.kind)) { // a region whose normals turn, cylinders not asked for
-                if (typeParams.kinds.count(PrimitiveKind::Sphere)) {
-                    const std::optional<Primitive> sphere = algebraicSphere(members, Eigen::Vector3d::Zero());
-                    if (!sphere)
-                        continue;
-                    initial = *sphere;
-                } else if (typeParams.kinds.count(PrimitiveKind::Plane)) {
-                    initial = pcaPlane(members, Eigen::Vector3d::Zero());
-                } else {
-                    continue; // a flat region, planes not asked for
-                }
-            }
-            initial.point += centre; // CGAL's frame -> global
-            std::optional<PrimitiveRefinement> chosen = chooseType(members, memberNormals, centre, initial, typeParams, result.epsilon, shapeNotes[s], typedRegions);
-            if (!chosen)
-                continue;
-            const PrimitiveRefinement& refined = *chosen;
-            DetectedPrimitive detected;
-            detected.primitive = refined.primitive;
-            detected.inliers.assign(shape.members.begin(), shape.members.end());
-            std::sort(detected.inliers.begin(), detected.inliers.end());
-            detected.rms = refined.rms;
-            detected.uncertainty = refined.uncertainty;
-            detail::measureShape(detected, evidence);
-            refitted[s] = std::move(detected);
-        }
-    }, tbb::simple_partitioner());
+    result.primitives = typedShapes(found, points, *normals, centre, typeParams, typedRegions, evidence, progress, result.notes);
     ticker.checkCancel();
-    for (std::size_t s = 0; s < found.size(); ++s) {
-        result.notes.insert(result.notes.end(), shapeNotes[s].begin(), shapeNotes[s].end());
-        if (refitted[s])
-            result.primitives.push_back(std::move(*refitted[s]));
-    }
     ticker.step(20);
 
     // RANSAC returns a surface in parts (a wall cut by a column's shadow, a
@@ -532,6 +586,15 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
         detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
         if (ransac && detail::claimPoints(result.primitives, evidence, cloud.size(), result.notes) > 0)
             detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
+        if (ransac && searchLeftOver(result, points, *normals, centre, params, evidence, progress, cancelled) > 0) {
+            detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
+            if (detail::claimPoints(result.primitives, evidence, cloud.size(), result.notes) > 0)
+                detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
+        }
+        if (cancelled)
+            ticker.checkCancel();
+        if (ransac)
+            detail::dropUnseeable(result.primitives, evidence, result.notes);
     }
 
     // Largest first; ties by first inlier, so the order never depends on threads.

@@ -62,21 +62,31 @@ Eigen::Vector3d surfaceNormal(const Primitive& shape, const Eigen::Vector3d& glo
     return norm > 0 ? Eigen::Vector3d(g / norm) : Eigen::Vector3d::Zero();
 }
 
+//! |distance| of point i to the shape when it lies within epsilon of it,
+//! else infinity.
+double distanceWithin(const Primitive& shape, std::uint32_t i, const SurfaceEvidence& evidence)
+{
+    const double d = std::abs(signedDistance(shape, evidence.centre + evidence.points[i]));
+    return d <= evidence.epsilon ? d : std::numeric_limits<double>::infinity();
+}
+
+//! Whether point i's normal agrees with the shape's there (true where the
+//! point has none).
+bool normalAgrees(const Primitive& shape, std::uint32_t i, const SurfaceEvidence& evidence)
+{
+    if (evidence.normals.empty())
+        return true;
+    const Eigen::Vector3d n = evidence.normals[i].cast<double>();
+    const double length = n.norm();
+    return !(length > 0) || std::abs(n.dot(surfaceNormal(shape, evidence.centre + evidence.points[i]))) >= evidence.normalCosine * length;
+}
+
 //! |distance| of point i to the shape when it lies on it (within epsilon,
 //! its normal agreeing where it has one), else infinity.
 double distanceOnSurface(const Primitive& shape, std::uint32_t i, const SurfaceEvidence& evidence)
 {
-    const Eigen::Vector3d global = evidence.centre + evidence.points[i];
-    const double d = std::abs(signedDistance(shape, global));
-    if (!(d <= evidence.epsilon))
-        return std::numeric_limits<double>::infinity();
-    if (!evidence.normals.empty()) {
-        const Eigen::Vector3d n = evidence.normals[i].cast<double>();
-        const double length = n.norm();
-        if (length > 0 && std::abs(n.dot(surfaceNormal(shape, global))) < evidence.normalCosine * length)
-            return std::numeric_limits<double>::infinity();
-    }
-    return d;
+    const double d = distanceWithin(shape, i, evidence);
+    return std::isfinite(d) && normalAgrees(shape, i, evidence) ? d : std::numeric_limits<double>::infinity();
 }
 
 //! At most `most` of the members, evenly spread over their order.
@@ -100,7 +110,24 @@ std::vector<Eigen::Vector3d> positionsOf(const std::vector<std::uint32_t>& membe
     return out;
 }
 
-//! The closest points (local) of two parts, from samples of each.
+//! The nearest of `among` to p (local).
+Eigen::Vector3d nearestOf(const std::vector<std::uint32_t>& among, const Eigen::Vector3d& p, const SurfaceEvidence& evidence)
+{
+    double best = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d nearest = p;
+    for (std::uint32_t i : among) {
+        const double d = (evidence.points[i] - p).squaredNorm();
+        if (d < best) {
+            best = d;
+            nearest = evidence.points[i];
+        }
+    }
+    return nearest;
+}
+
+//! The closest points (local) of two parts: the closest pair of samples of
+//! each, then the nearest point of each part to the other's (a sample of a
+//! floor's 600,000 points is centimetres off its edge).
 std::pair<Eigen::Vector3d, Eigen::Vector3d> closestPoints(const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b,
                                                           const SurfaceEvidence& evidence)
 {
@@ -115,6 +142,8 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> closestPoints(const std::vector<std:
                 closest = {evidence.points[i], evidence.points[j]};
             }
         }
+    closest.first = nearestOf(a, closest.second, evidence);
+    closest.second = nearestOf(b, closest.first, evidence);
     return closest;
 }
 
@@ -414,10 +443,177 @@ std::size_t splitWhereShapesMeet(const std::vector<DetectedPrimitive>& shapes, c
     return moves.size();
 }
 
+//! Where the shapes are while they grow: each point's shape (-1: none), the
+//! cells (of the link distance) each shape holds points in, and the box its
+//! next point may lie in.
+struct ShapeGrowth
+{
+    std::vector<int>& owner;
+    std::vector<std::unordered_set<std::uint64_t>>& cells;
+    std::vector<Eigen::AlignedBox3d>& reach;
+
+    void give(std::uint32_t i, int shape, const SurfaceEvidence& evidence)
+    {
+        const Eigen::Vector3d& p = evidence.points[i];
+        const double link = evidence.linkDistance;
+        owner[i] = shape;
+        cells[std::size_t(shape)].insert(cellKey(p, link));
+        reach[std::size_t(shape)].extend(Eigen::Vector3d(p.array() - link));
+        reach[std::size_t(shape)].extend(Eigen::Vector3d(p.array() + link));
+    }
+};
+
+//! Passes over the contested points while shapes grow: each goes to the
+//! shape it lies nearest to among those holding points next to it.
+std::size_t growByAdjacency(const std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence,
+                            const std::vector<std::uint32_t>& contested, ShapeGrowth& growth)
+{
+    constexpr int kMaxPasses = 30;
+    std::size_t changed = 0;
+    for (int pass = 0; pass < kMaxPasses; ++pass) {
+        evidence.checkCancel();
+        std::size_t changedThisPass = 0;
+        for (std::uint32_t i : contested) {
+            const Eigen::Vector3d& p = evidence.points[i];
+            const int current = growth.owner[i];
+            // The shapes next to the point that it lies within epsilon of (its own first).
+            std::vector<std::pair<int, double>> near;
+            if (current >= 0)
+                near.emplace_back(current, distanceWithin(shapes[std::size_t(current)].primitive, i, evidence));
+            for (std::size_t s = 0; s < shapes.size(); ++s) {
+                if (static_cast<int>(s) == current || !growth.reach[s].contains(p))
+                    continue;
+                const double d = distanceWithin(shapes[s].primitive, i, evidence);
+                if (std::isfinite(d) && nearCells(growth.cells[s], p, evidence.linkDistance))
+                    near.emplace_back(static_cast<int>(s), d);
+            }
+            // Between shapes its normal decides, then the distance; on one
+            // surface only, the distance alone (a normal fitted on one scan
+            // line at grazing incidence turns anywhere about it).
+            int best = current;
+            double bestDistance = std::numeric_limits<double>::infinity();
+            const bool between = near.size() >= 2;
+            for (const auto& [s, d] : near)
+                if (d < bestDistance && (!between || normalAgrees(shapes[std::size_t(s)].primitive, i, evidence))) {
+                    best = s;
+                    bestDistance = d;
+                }
+            if (best == current)
+                continue;
+            growth.give(i, best, evidence);
+            ++changedThisPass;
+        }
+        changed += changedThisPass;
+        if (changedThisPass == 0)
+            break;
+    }
+    return changed;
+}
+
+//! The points left on no shape that lie on one in groups apart from it (a
+//! box top cut by the shadow of the sphere standing on it, in parts too
+//! small for RANSAC): a group of at least 10 points joins the shape when no
+//! scanner looked through the gap between them.
+std::size_t joinHiddenParts(const std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence,
+                            const std::vector<std::uint32_t>& contested, ShapeGrowth& growth, std::vector<std::string>& notes)
+{
+    constexpr std::size_t kSmallestGroup = 10;
+    if (evidence.views.empty())
+        return 0;
+    std::size_t joined = 0;
+    for (std::size_t s = 0; s < shapes.size(); ++s) {
+        evidence.checkCancel();
+        // The free points on this shape's surface, by cell.
+        std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> free;
+        for (std::uint32_t i : contested)
+            if (growth.owner[i] < 0 && std::isfinite(distanceOnSurface(shapes[s].primitive, i, evidence)))
+                free[cellKey(evidence.points[i], evidence.linkDistance)].push_back(i);
+        // Their groups: cells linked through their 26 neighbours.
+        std::unordered_set<std::uint64_t> visited;
+        for (const auto& [start, unused] : free) {
+            if (!visited.insert(start).second)
+                continue;
+            std::vector<std::uint32_t> group;
+            std::vector<std::uint64_t> stack{start};
+            while (!stack.empty()) {
+                const std::uint64_t key = stack.back();
+                stack.pop_back();
+                const std::vector<std::uint32_t>& here = free.at(key);
+                group.insert(group.end(), here.begin(), here.end());
+                const Eigen::Vector3d& p = evidence.points[here.front()];
+                for (int dx = -1; dx <= 1; ++dx)
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dz = -1; dz <= 1; ++dz) {
+                            const std::uint64_t next = cellKey(p, evidence.linkDistance, dx, dy, dz);
+                            if (free.count(next) && visited.insert(next).second)
+                                stack.push_back(next);
+                        }
+            }
+            if (group.size() < kSmallestGroup || !gapUnseen(shapes[s].primitive, shapes[s].inliers, group, evidence))
+                continue;
+            for (std::uint32_t i : group)
+                growth.give(i, static_cast<int>(s), evidence);
+            joined += group.size();
+        }
+    }
+    if (joined)
+        notes.push_back(std::to_string(joined) + " points on no shape joined the shape they lie on across gaps no scanner saw into");
+    return joined;
+}
+
+std::size_t dropUnseeable(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, std::vector<std::string>& notes)
+{
+    if (evidence.views.empty())
+        return 0;
+    const double grazing = std::cos(88.0 * 3.14159265358979323846 / 180.0);
+    const double tolerance = std::max(2.0 * evidence.epsilon, 0.5 * evidence.linkDistance);
+    std::size_t dropped = 0, shapesDropped = 0;
+    std::vector<DetectedPrimitive> kept;
+    for (DetectedPrimitive& shape : shapes) {
+        evidence.checkCancel();
+        const Primitive& surface = shape.primitive;
+        const bool twoSided = surface.kind == PrimitiveKind::Plane;
+        std::vector<char> keep(shape.inliers.size(), 0);
+        tbb::parallel_for(std::size_t(0), shape.inliers.size(), [&](std::size_t k) {
+            const Eigen::Vector3d x = evidence.centre + evidence.points[shape.inliers[k]];
+            const Eigen::Vector3d outward = surfaceNormal(surface, x);
+            bool facing = false;
+            for (const ScannerView& view : evidence.views) {
+                const Eigen::Vector3d toScanner = (view.position() - x).normalized();
+                const double c = twoSided ? std::abs(toScanner.dot(outward)) : toScanner.dot(outward);
+                if (c <= grazing)
+                    continue;
+                facing = true;
+                if (c > std::cos(80.0 * 3.14159265358979323846 / 180.0) && view.lookedPast(x, tolerance / c))
+                    return; // a scanner facing the surface there saw through it
+            }
+            keep[k] = facing;
+        });
+        std::vector<std::uint32_t> inliers;
+        for (std::size_t k = 0; k < keep.size(); ++k)
+            if (keep[k])
+                inliers.push_back(shape.inliers[k]);
+        dropped += shape.inliers.size() - inliers.size();
+        if (inliers.size() < evidence.minPoints) {
+            ++shapesDropped;
+            continue;
+        }
+        if (inliers.size() != shape.inliers.size()) {
+            shape.inliers = std::move(inliers);
+            measureShape(shape, evidence);
+        }
+        kept.push_back(std::move(shape));
+    }
+    shapes = std::move(kept);
+    if (dropped)
+        notes.push_back(std::to_string(dropped) + " points left out where no scanner faced their shape, or one facing it saw through it" +
+                        (shapesDropped ? " (" + std::to_string(shapesDropped) + " shapes dropped)" : std::string()));
+    return dropped;
+}
+
 std::size_t claimPoints(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, std::size_t cloudSize,
                         std::vector<std::string>& notes)
 {
-    constexpr int kMaxPasses = 30;
     const double link = evidence.linkDistance;
     std::vector<int> owner(cloudSize, -1);
     std::vector<std::unordered_set<std::uint64_t>> cells(shapes.size());
@@ -438,42 +634,20 @@ std::size_t claimPoints(std::vector<DetectedPrimitive>& shapes, const SurfaceEvi
         for (std::size_t i = range.begin(); i != range.end(); ++i)
             for (std::size_t s = 0; s < shapes.size() && !onAnother[i]; ++s)
                 onAnother[i] = static_cast<int>(s) != owner[i] &&
-                               std::isfinite(distanceOnSurface(shapes[s].primitive, static_cast<std::uint32_t>(i), evidence));
+                               std::isfinite(distanceWithin(shapes[s].primitive, static_cast<std::uint32_t>(i), evidence));
     });
     std::vector<std::uint32_t> contested;
     for (std::size_t i = 0; i < cloudSize; ++i)
         if (onAnother[i])
             contested.push_back(static_cast<std::uint32_t>(i));
     std::vector<char>().swap(onAnother);
+    ShapeGrowth growth{owner, cells, reach};
     std::size_t changed = 0;
-    for (int pass = 0; pass < kMaxPasses; ++pass) {
-        evidence.checkCancel();
-        std::size_t changedThisPass = 0;
-        for (std::uint32_t i : contested) {
-            const Eigen::Vector3d& p = evidence.points[i];
-            const int current = owner[i];
-            int best = current;
-            double bestDistance = current >= 0 ? std::abs(signedDistance(shapes[std::size_t(current)].primitive, evidence.centre + p))
-                                               : std::numeric_limits<double>::infinity();
-            for (std::size_t s = 0; s < shapes.size(); ++s) {
-                if (static_cast<int>(s) == current || !reach[s].contains(p))
-                    continue;
-                const double d = distanceOnSurface(shapes[s].primitive, i, evidence);
-                if (d < bestDistance && nearCells(cells[s], p, link)) {
-                    best = static_cast<int>(s);
-                    bestDistance = d;
-                }
-            }
-            if (best == current)
-                continue;
-            owner[i] = best;
-            cells[std::size_t(best)].insert(cellKey(p, link));
-            reach[std::size_t(best)].extend(Eigen::Vector3d(p.array() - link));
-            reach[std::size_t(best)].extend(Eigen::Vector3d(p.array() + link));
-            ++changedThisPass;
-        }
-        changed += changedThisPass;
-        if (changedThisPass == 0)
+    for (int round = 0; round < 3; ++round) {
+        const std::size_t grown = growByAdjacency(shapes, evidence, contested, growth);
+        const std::size_t joined = joinHiddenParts(shapes, evidence, contested, growth, notes);
+        changed += grown + joined;
+        if (joined == 0)
             break;
     }
     changed += splitWhereShapesMeet(shapes, evidence, contested, owner);

@@ -105,4 +105,13 @@ std::size_t mergeSurfaceParts(std::vector<DetectedPrimitive>& shapes, const Surf
 std::size_t claimPoints(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, std::size_t cloudSize,
                         std::vector<std::string>& notes);
 
+//! Leaves out of each shape the points no return of its surface can be: a
+//! point where no scanner faces the surface (its back, or beyond 88 degrees
+//! of incidence: the mixed pixels behind a pipe's silhouette), or where a
+//! scanner facing the surface looked through it (the returns along a ray
+//! past a box's edge, on its face's plane beyond the face). Shapes left
+//! with fewer than the minimum support are dropped. Without sensor poses,
+//! nothing is left out. Returns the points left out.
+std::size_t dropUnseeable(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, std::vector<std::string>& notes);
+
 } // namespace scandiff::plugins::detail

@@ -24,7 +24,8 @@
 //! A point's truth is the shape its ray met. Clutter, `clutterFraction` of all
 //! points: small lumpy objects (valves, bags, cable boxes: no primitive fits
 //! them) scanned with the scene and hiding what is behind them; mixed pixels
-//! between the two ranges of a depth jump at silhouette edges; returns a
+//! between the two ranges of a depth jump at silhouette edges (clear of every
+//! shape's surface by 4 noise sigmas, 3 cm at least); returns a
 //! little in front of surfaces (2-15 cm and at least 4 noise sigmas off:
 //! dust, straps, insulation); spurious returns in the air along real rays.
 //! The points are shuffled; the cloud's sensors() holds the stations.
@@ -213,13 +214,30 @@ inline void addClutter(const PrimitivesParams& p, const std::vector<ScanHit>& sh
     for (std::size_t i = 0; i < edges.size(); ++i)
         if (edges[i].farRange - edges[i].nearRange > 2 * edgeMargin + 0.02)
             wideEdges.push_back(i);
+    // Clear of them across the surfaces too: a ray running along a face
+    // (a box side seen edge-on) would put its "mixed pixel" on the face,
+    // where it is a return of the face. Such draws are dropped.
+    std::vector<Primitive> surfaces;
+    for (const ShapeSpec& shape : p.shapes)
+        surfaces.push_back(toPrimitive(shape));
+    const auto clearOfSurfaces = [&](const Vector3d& x) {
+        for (const Primitive& surface : surfaces)
+            if (std::abs(signedDistance(surface, x)) < edgeMargin)
+                return false;
+        return true;
+    };
     const std::size_t mixed = std::min(wideEdges.size(), budget / 5);
+    std::size_t mixedMade = 0;
     for (std::size_t i : pickIndices(rng, wideEdges.size(), mixed)) {
         const EdgeCandidate& e = edges[wideEdges[i]];
         const double range = uniformIn(rng, e.nearRange + edgeMargin, e.farRange - edgeMargin);
-        out.push_back({p.stations[std::size_t(e.station)].position + range * e.direction, -1, PointKind::MixedPixel});
+        const Vector3d x = p.stations[std::size_t(e.station)].position + range * e.direction;
+        if (!clearOfSurfaces(x))
+            continue;
+        out.push_back({x, -1, PointKind::MixedPixel});
+        ++mixedMade;
     }
-    const std::size_t rest = budget - objects - mixed, near = rest * 7 / 10;
+    const std::size_t rest = budget - objects - mixedMade, near = rest * 7 / 10;
     const double minOffset = std::max(0.02, 4 * p.rangeNoise);
     for (std::size_t made = 0, attempt = 0; made < rest && attempt < 20 * rest + 100; ++attempt) {
         const ScanHit& h = shapeHits[rng.below(shapeHits.size())];
