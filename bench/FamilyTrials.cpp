@@ -3,7 +3,7 @@
 // at full size and a number of seeded draws, one line of figures each
 // (docs/benchmarks.md quotes them; the family tests assert the same figures).
 //
-//   scandiff-family-trials FAMILY [--issue] [--verbose] [--draws N] [--first-seed S] [--scale F] [--set KEY=VALUE ...]
+//   scandiff-family-trials FAMILY [--issue] [--verbose] [--cloudcompare DIR] [--draws N] [--first-seed S] [--scale F] [--set KEY=VALUE ...]
 #include "families/ChangeTrials.h"
 #include "families/PrimitiveTrials.h"
 #include "families/RegistrationTrials.h"
@@ -13,7 +13,10 @@
 
 #include <scandiff/io/FileIO.h>
 
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
+#include <tuple>
 #include <fstream>
 #include <cstdio>
 #include <cstdlib>
@@ -36,6 +39,7 @@ struct Options
     std::string svgDir; //!< --svg DIR: the wall families' rings over their truth, one SVG per run
     std::string dataDir = "data"; //!< --data DIR: where pcl-data/ lies (the real samples)
     bool verbose = false;         //!< --verbose: the tool's report and, for primitives, how each shape was split
+    std::string cloudCompareDir;  //!< --cloudcompare DIR: primitives also through CloudCompare's RANSAC plugin, files in DIR
 };
 
 double seconds(std::chrono::steady_clock::time_point since)
@@ -165,6 +169,78 @@ bool stationsRow(const stations::StationsParams& p, const Options& o, const std:
     return met;
 }
 
+//! The scene through CloudCompare 2.11's RANSAC plugin (given our epsilon and
+//! normal radius, its other settings its own), its shapes scored as ours: the
+//! scene is written in local coordinates (CloudCompare's global shift stays
+//! out of it), each subcloud's points found back by their coordinates, each
+//! subcloud's type read from its file name.
+std::string cloudCompareRow(const primitives::PrimitivesScene& scene, const std::string& report, const std::string& dir)
+{
+    const auto number = [&](const std::string& before) {
+        const auto at = report.find(before);
+        return at == std::string::npos ? 0.0 : std::atof(report.c_str() + at + before.size());
+    };
+    const double epsilon = number("epsilon "), normalRadius = number("fitted within ");
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir + "/shapes");
+    PointCloud local = scene.cloud.clone();
+    local.setOrigin(Eigen::Vector3d::Zero());
+    io::FormatRegistry formats;
+    io::registerBuiltinFormats(formats);
+    io::writePointCloud(formats, local, dir + "/scene.ply");
+    char command[1024];
+    std::snprintf(command, sizeof command,
+                  "cd %s && QT_QPA_PLATFORM=offscreen CloudCompare -SILENT -NO_TIMESTAMP -AUTO_SAVE OFF -C_EXPORT_FMT PLY -O scene.ply "
+                  "-OCTREE_NORMALS %.6f -RANSAC EPSILON_ABSOLUTE %.6f SUPPORT_POINTS 200 ENABLE_PRIMITIVE PLANE SPHERE CYLINDER CONE TORUS "
+                  "OUTPUT_INDIVIDUAL_SUBCLOUDS OUT_CLOUD_DIR shapes > cloudcompare.log 2>&1",
+                  dir.c_str(), normalRadius, epsilon);
+    const auto start = std::chrono::steady_clock::now();
+    const int status = std::system(command);
+    const double wall = seconds(start);
+    std::map<std::tuple<float, float, float>, std::size_t> index;
+    for (std::size_t i = 0; i < local.size(); ++i)
+        index.emplace(std::make_tuple(local.positions()[i].x(), local.positions()[i].y(), local.positions()[i].z()), i);
+    std::vector<int> assignment(local.size(), -1);
+    std::vector<Primitive> detected;
+    std::size_t unmatched = 0;
+    std::vector<std::filesystem::path> files;
+    for (const auto& entry : std::filesystem::directory_iterator(dir + "/shapes"))
+        files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
+    for (const std::filesystem::path& file : files) {
+        std::string name = file.filename().string();
+        std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+        Primitive shape;
+        if (name.find("plane") != std::string::npos)
+            shape.kind = PrimitiveKind::Plane;
+        else if (name.find("sphere") != std::string::npos)
+            shape.kind = PrimitiveKind::Sphere;
+        else if (name.find("cylinder") != std::string::npos)
+            shape.kind = PrimitiveKind::Cylinder;
+        else if (name.find("cone") != std::string::npos)
+            shape.kind = PrimitiveKind::Cone;
+        else if (name.find("torus") != std::string::npos)
+            shape.kind = PrimitiveKind::Torus;
+        else
+            continue;
+        const PointCloud part = io::readPointCloud(formats, file);
+        for (std::size_t k = 0; k < part.size(); ++k) {
+            const Eigen::Vector3d g = part.globalPosition(k);
+            const auto found = index.find(std::make_tuple(static_cast<float>(g.x()), static_cast<float>(g.y()), static_cast<float>(g.z())));
+            if (found == index.end())
+                ++unmatched;
+            else
+                assignment[found->second] = static_cast<int>(detected.size());
+        }
+        detected.push_back(shape);
+    }
+    const primitives::DetectionScore score = primitives::score(scene, detected, assignment);
+    char line[512];
+    std::snprintf(line, sizeof line, "  CloudCompare (exit %d, %.1f s, %zu subclouds, %zu points not found back): %s%s", status, wall, detected.size(),
+                  unmatched, score.summary().c_str(), score.meetsTarget() ? "" : "  FAIL");
+    return line;
+}
+
 bool primitivesRow(const primitives::PrimitivesParams& p, const Options& o, const std::string& label)
 {
     const auto start = std::chrono::steady_clock::now();
@@ -177,6 +253,11 @@ bool primitivesRow(const primitives::PrimitivesParams& p, const Options& o, cons
         std::printf("%s\n", t.score.table().c_str());
     if (o.verbose)
         std::printf("%s\n%s\n", t.report.c_str(), spread(scene, t).c_str());
+    if (!o.cloudCompareDir.empty()) {
+        std::string dir = o.cloudCompareDir + "/" + label;
+        std::replace(dir.begin(), dir.end(), ' ', '-');
+        std::printf("%s\n", cloudCompareRow(scene, t.report, dir).c_str());
+    }
     std::fflush(stdout);
     return t.score.meetsTarget();
 }
@@ -192,6 +273,8 @@ int main(int argc, char** argv)
             o.issue = true;
         else if (a == "--verbose")
             o.verbose = true;
+        else if (a == "--cloudcompare" && i + 1 < argc)
+            o.cloudCompareDir = argv[++i];
         else if (a == "--draws" && i + 1 < argc)
             o.draws = std::atoi(argv[++i]);
         else if (a == "--first-seed" && i + 1 < argc)
