@@ -246,6 +246,54 @@ std::vector<detail::RansacShape> findByRansac(const std::vector<Eigen::Vector3d>
     });
 }
 
+//! The shape most of a rejected candidate's points lie on, when RANSAC's
+//! type holds none of them within epsilon (a reducer and part of its pipe
+//! taken for one torus): each other type asked for fitted from the points'
+//! normals (fitPrimitive), its points within epsilon kept, the type keeping
+//! the most, if at least half of them and the minimum support, refitted on
+//! them. `kept`: their positions in `members`.
+std::optional<PrimitiveRefinement> mainShapeOf(const std::vector<Eigen::Vector3d>& members, const std::vector<Eigen::Vector3d>& memberNormals,
+                                               const Eigen::Vector3d& centre, const PrimitiveDetectionParams& params,
+                                               const detail::SurfaceEvidence& evidence, std::vector<std::size_t>& kept,
+                                               std::vector<std::string>& notes)
+{
+    PointCloud part;
+    part.setOrigin(centre);
+    part.resize(members.size());
+    std::vector<Eigen::Vector3f>& normals = part.enableNormals();
+    for (std::size_t k = 0; k < members.size(); ++k) {
+        part.positions()[k] = members[k].cast<float>();
+        normals[k] = memberNormals[k].cast<float>();
+    }
+    std::optional<PrimitiveRefinement> best;
+    for (PrimitiveKind kind : {PrimitiveKind::Plane, PrimitiveKind::Sphere, PrimitiveKind::Cylinder, PrimitiveKind::Cone}) {
+        if (!params.kinds.count(kind))
+            continue;
+        try {
+            const Primitive start = fitPrimitive(part, kind).primitive;
+            std::vector<std::size_t> within;
+            for (std::size_t k = 0; k < members.size(); ++k)
+                if (std::abs(signedDistance(start, centre + members[k])) <= evidence.epsilon)
+                    within.push_back(k);
+            if (within.size() < std::max(evidence.minPoints, members.size() / 2) || (best && within.size() <= kept.size()))
+                continue;
+            std::vector<Eigen::Vector3d> points;
+            for (std::size_t k : within)
+                points.push_back(members[k]);
+            PrimitiveRefinement refined = refinePrimitive(points, centre, start);
+            if (!(refined.rms < evidence.epsilon) || !radiusPlausible(refined.primitive, extentOf(points)))
+                continue;
+            best = std::move(refined);
+            kept = std::move(within);
+        } catch (const Error&) {
+            // This type does not fit them: the others are tried.
+        }
+    }
+    if (best)
+        notes.push_back(std::string("of those, ") + std::to_string(kept.size()) + " points are a " + primitiveKindName(best->primitive.kind));
+    return best;
+}
+
 //! RANSAC's (or the regions') shapes refitted by least squares, each with
 //! its type checked (chooseType), measured; the ones no type holds are left
 //! out. In parallel, one task a shape; the outcome and the notes in the
@@ -290,12 +338,20 @@ std::vector<DetectedPrimitive> typedShapes(const std::vector<detail::RansacShape
             }
             initial.point += centre; // CGAL's frame -> global
             std::optional<PrimitiveRefinement> chosen = chooseType(members, memberNormals, centre, initial, typeParams, evidence.epsilon, shapeNotes[s], typedRegions);
+            std::vector<std::uint32_t> inliers(shape.members.begin(), shape.members.end());
+            if (!chosen && !typedRegions && !memberNormals.empty()) {
+                std::vector<std::size_t> kept;
+                chosen = mainShapeOf(members, memberNormals, centre, typeParams, evidence, kept, shapeNotes[s]);
+                inliers.clear();
+                for (std::size_t k : kept)
+                    inliers.push_back(shape.members[k]);
+            }
             if (!chosen)
                 continue;
             const PrimitiveRefinement& refined = *chosen;
             DetectedPrimitive detected;
             detected.primitive = refined.primitive;
-            detected.inliers.assign(shape.members.begin(), shape.members.end());
+            detected.inliers = std::move(inliers);
             std::sort(detected.inliers.begin(), detected.inliers.end());
             detected.rms = refined.rms;
             detected.uncertainty = refined.uncertainty;
@@ -584,17 +640,26 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
         if (ransac)
             evidence.views = detail::scannerViews(cloud, scale.spacing);
         detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
-        if (ransac && detail::claimPoints(result.primitives, evidence, cloud.size(), result.notes) > 0)
+        // Claims refit the shapes, and refitted shapes claim better: a torus
+        // fitted without the points its leg took gives them back once
+        // refitted with the rest, up to three times.
+        const auto claimAndMerge = [&] {
+            for (int round = 0; round < 3 && detail::claimPoints(result.primitives, evidence, cloud.size(), result.notes) > cloud.size() / 2000; ++round)
+                ;
             detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
+        };
+        if (ransac)
+            claimAndMerge();
         if (ransac && searchLeftOver(result, points, *normals, centre, params, evidence, progress, cancelled) > 0) {
             detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
-            if (detail::claimPoints(result.primitives, evidence, cloud.size(), result.notes) > 0)
-                detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
+            claimAndMerge();
         }
         if (cancelled)
             ticker.checkCancel();
         if (ransac)
             detail::dropUnseeable(result.primitives, evidence, result.notes);
+        if (ransac)
+            detail::dropFormedResiduals(result.primitives, evidence, result.notes);
     }
 
     // Largest first; ties by first inlier, so the order never depends on threads.

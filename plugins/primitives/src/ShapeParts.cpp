@@ -580,7 +580,11 @@ std::size_t dropUnseeable(std::vector<DetectedPrimitive>& shapes, const SurfaceE
             bool facing = false;
             for (const ScannerView& view : evidence.views) {
                 const Eigen::Vector3d toScanner = (view.position() - x).normalized();
-                const double c = twoSided ? std::abs(toScanner.dot(outward)) : toScanner.dot(outward);
+                // The inside of a sphere, a cylinder, a cone (convex) faces a
+                // scanner standing in it (a tunnel, a hopper seen from above its
+                // rim), the outside one standing out of it.
+                const double side = twoSided ? 0.0 : signedDistance(surface, view.position()) >= 0 ? 1.0 : -1.0;
+                const double c = twoSided ? std::abs(toScanner.dot(outward)) : side * toScanner.dot(outward);
                 if (c <= grazing)
                     continue;
                 facing = true;
@@ -608,6 +612,49 @@ std::size_t dropUnseeable(std::vector<DetectedPrimitive>& shapes, const SurfaceE
     if (dropped)
         notes.push_back(std::to_string(dropped) + " points left out where no scanner faced their shape, or one facing it saw through it" +
                         (shapesDropped ? " (" + std::to_string(shapesDropped) + " shapes dropped)" : std::string()));
+    return dropped;
+}
+
+double residualStructure(const DetectedPrimitive& shape, const SurfaceEvidence& evidence)
+{
+    struct Cell
+    {
+        double sum = 0;
+        std::size_t count = 0;
+    };
+    std::unordered_map<std::uint64_t, Cell> cells;
+    double squares = 0;
+    for (std::uint32_t i : shape.inliers) {
+        const double r = signedDistance(shape.primitive, evidence.centre + evidence.points[i]);
+        Cell& cell = cells[cellKey(evidence.points[i], evidence.linkDistance)];
+        cell.sum += r;
+        ++cell.count;
+        squares += r * r;
+    }
+    const double variance = squares / static_cast<double>(std::max<std::size_t>(1, shape.inliers.size()));
+    double weighted = 0;
+    std::size_t used = 0;
+    for (const auto& [key, cell] : cells)
+        if (cell.count >= 4) {
+            weighted += cell.sum * cell.sum / static_cast<double>(cell.count); // n * mean^2
+            ++used;
+        }
+    return used == 0 || !(variance > 0) ? 1.0 : weighted / (static_cast<double>(used) * variance);
+}
+
+std::size_t dropFormedResiduals(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, std::vector<std::string>& notes)
+{
+    constexpr double kNoiseStructure = 4, kNoiseShare = 0.5;
+    const std::size_t before = shapes.size();
+    shapes.erase(std::remove_if(shapes.begin(), shapes.end(),
+                                [&](const DetectedPrimitive& shape) {
+                                    return shape.rms > kNoiseShare * evidence.epsilon && residualStructure(shape, evidence) > kNoiseStructure;
+                                }),
+                 shapes.end());
+    const std::size_t dropped = before - shapes.size();
+    if (dropped)
+        notes.push_back(std::to_string(dropped) + " shapes left out: their points lie off them in a form of their own, wider than the noise "
+                        "(lumpy objects, a corner fitted with a curve)");
     return dropped;
 }
 

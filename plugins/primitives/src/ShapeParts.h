@@ -107,11 +107,24 @@ std::size_t claimPoints(std::vector<DetectedPrimitive>& shapes, const SurfaceEvi
 
 //! Leaves out of each shape the points no return of its surface can be: a
 //! point where no scanner faces the surface (its back, or beyond 88 degrees
-//! of incidence: the mixed pixels behind a pipe's silhouette), or where a
+//! of incidence: the mixed pixels behind a pipe's silhouette; a sphere's,
+//! a cylinder's or a cone's inside faces the scanners standing in it), or where a
 //! scanner facing the surface looked through it (the returns along a ray
 //! past a box's edge, on its face's plane beyond the face). Shapes left
 //! with fewer than the minimum support are dropped. Without sensor poses,
 //! nothing is left out. Returns the points left out.
 std::size_t dropUnseeable(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, std::vector<std::string>& notes);
+
+//! How much of a shape's residuals is a form rather than noise: over cells
+//! of the link distance (4 points or more), the mean of n x (the cell's mean
+//! residual)^2 over the residuals' variance. About 1 when the residuals are
+//! independent noise; n when each cell's points lie off the shape together
+//! (a lumpy bag fitted with a sphere, two walls' corner with a cylinder).
+double residualStructure(const DetectedPrimitive& shape, const SurfaceEvidence& evidence);
+
+//! Leaves out the shapes that are no surface of their type: residuals
+//! wider than half epsilon (1.5 times the scan's noise, epsilon being 3
+//! times it) and formed (residualStructure above 4). Returns how many.
+std::size_t dropFormedResiduals(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, std::vector<std::string>& notes);
 
 } // namespace scandiff::plugins::detail

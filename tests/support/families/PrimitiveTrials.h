@@ -24,6 +24,7 @@ struct PrimitivesTrial
     std::string report;
     std::vector<Primitive> detected;
     std::vector<int> assignment; //!< per point: detected shape, -1 none
+    std::vector<double> rms;     //!< per detected shape, its fit's (m)
 };
 
 //! Per true shape, the detected shapes holding its points, largest first
@@ -53,7 +54,8 @@ inline std::string spread(const primitives::PrimitivesScene& scene, const Primit
         if (trial.assignment[i] >= 0)
             ++makeUp[trial.assignment[i]][scene.labels[i] >= 0 ? scene.labels[i] : -1 - int(scene.kinds[i])];
     for (const auto& [d, parts] : makeUp) {
-        out += "#" + std::to_string(d) + " " + primitives::DetectionScore::primitiveKindLabel(trial.detected[std::size_t(d)].kind) + ":";
+        out += "#" + std::to_string(d) + " " + primitives::DetectionScore::primitiveKindLabel(trial.detected[std::size_t(d)].kind) +
+               (std::size_t(d) < trial.rms.size() ? " rms " + std::to_string(trial.rms[std::size_t(d)]) : std::string()) + ":";
         for (const auto& [t, n] : parts)
             out += " " + (t >= 0 ? scene.shapes[std::size_t(t)].name : "clutter kind " + std::to_string(-1 - t)) + " " + std::to_string(n) + ";";
         out += "\n";
@@ -83,6 +85,7 @@ inline PrimitivesTrial runPrimitives(const primitives::PrimitivesScene& scene, c
         assignment[i] = static_cast<int>(k);
     }
     // The shapes' parameters, from the tool's JSON document (ids are the labels' values).
+    std::vector<double> rmsOf;
     if (const ToolOutput* document = result.find("document")) {
         const nlohmann::json json = nlohmann::json::parse(std::get<TextDocument>(document->data).text);
         const auto vector = [](const nlohmann::json& v) { return Eigen::Vector3d(v[0].get<double>(), v[1].get<double>(), v[2].get<double>()); };
@@ -105,6 +108,9 @@ inline PrimitivesTrial runPrimitives(const primitives::PrimitivesScene& scene, c
                     p.radius = shape[key].get<double>();
             if (shape.contains("minor_radius"))
                 p.minorRadius = shape["minor_radius"].get<double>();
+            if (rmsOf.size() <= k)
+                rmsOf.resize(k + 1, 0.0);
+            rmsOf[k] = shape.value("rms", 0.0);
             if (shape.contains("half_angle_deg"))
                 p.halfAngle = shape["half_angle_deg"].get<double>() * 3.14159265358979323846 / 180.0;
         }
@@ -114,6 +120,7 @@ inline PrimitivesTrial runPrimitives(const primitives::PrimitivesScene& scene, c
     trial.report = result.summary;
     trial.detected = std::move(detected);
     trial.assignment = std::move(assignment);
+    trial.rms = std::move(rmsOf);
     return trial;
 }
 
