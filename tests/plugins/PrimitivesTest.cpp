@@ -612,7 +612,7 @@ TEST(Primitives, EachShapeHasItsSurfaceAsAMeshOnTheShapeOverItsPoints)
 
 namespace {
 
-//! What a scanner at `station` sees of a wall (plane x = 8, 8 m wide, 4 m
+//! What a scanner at (0, 0, 2) sees of a wall (plane x = 8, 8 m wide, 4 m
 //! high) behind a column (vertical cylinder, axis (6, 0), radius 0.3) and of
 //! two plates (z = 0.8, 1 m square, 1 m apart along x) over a floor (seen
 //! through the gap between them, as far as the wall): the
@@ -627,7 +627,7 @@ struct SeenScene
 
 SeenScene seenScene(std::uint64_t seed)
 {
-    const Eigen::Vector3d station(0, 0, 1.5);
+    const Eigen::Vector3d station(0, 0, 2.0);
     const double step = 0.015, columnRadius = 0.3;
     const Eigen::Vector2d columnAxis(6, 0);
     // Whether the segment from the station to p (xy) passes through the column.
@@ -675,6 +675,13 @@ SeenScene seenScene(std::uint64_t seed)
             for (double z = 0.5; z <= 3.5; z += 2 * step)
                 add({p.x(), p.y(), z}, 5);
     }
+    // Returns where the scanner saw the floor through: on the plates' plane
+    // 5 and 10 cm past plate 2's edge, one every 6 cm (mixed pixels off its
+    // edge, dust: scattered, no surface of their own). Nearer than about two
+    // of the scanner's steps to the edge, a return cannot be told from it.
+    for (double x : {3.05, 3.10})
+        for (double y = 1.6; y <= 2.4; y += 0.06)
+            add({x, y, 0.8}, 6);
     for (double x = 2; x <= 5; x += step)
         for (double y = 1.5; y <= 2.5; y += step)
             if (onPlate({x, y, 0.8}) >= 0)
@@ -697,7 +704,8 @@ TEST(Primitives, PartsOfOneSurfaceAreJoinedAcrossWhatNoScannerSawAndKeptApartWhe
     // wall in two parts 0.6 m or more apart, and they are one plane, for no
     // ray went through the strip. The floor seen between the plates says
     // their gap is real: two plates. Points just behind the column, where
-    // no scanner faces its surface, are on no shape. Two seeds.
+    // no scanner faces its surface, and points on the plates' plane where the
+    // scanner saw the floor through, are on no shape. Two seeds.
     for (std::uint64_t seed : {1u, 2u}) {
         const SeenScene scene = seenScene(seed);
         const PrimitiveDetectionResult result = detectPrimitives(scene.cloud, PrimitiveDetectionParams{});
@@ -724,6 +732,15 @@ TEST(Primitives, PartsOfOneSurfaceAreJoinedAcrossWhatNoScannerSawAndKeptApartWhe
             }
         EXPECT_GT(behind, 100u);
         EXPECT_EQ(held, 0u) << "seed " << seed << ": of " << behind << " returns behind the column";
+        // Nor the returns on the plates' plane where the scanner saw the floor through.
+        std::size_t past = 0, kept = 0;
+        for (std::size_t i = 0; i < scene.label.size(); ++i)
+            if (scene.label[i] == 6) {
+                ++past;
+                kept += result.primitiveId[i] >= 0;
+            }
+        EXPECT_GT(past, 20u);
+        EXPECT_EQ(kept, 0u) << "seed " << seed << ": of " << past << " returns past plate 2";
         // The two plates are two shapes.
         std::map<int, std::set<int>> labelsOfShape;
         for (std::size_t i = 0; i < scene.label.size(); ++i)

@@ -136,7 +136,7 @@ Primitive pcaPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vect
 std::optional<Primitive> cylinderOfStrip(const std::vector<Eigen::Vector3d>& members, const std::vector<Eigen::Vector3d>& memberNormals,
                                          const Eigen::Vector3d& centre, const Primitive& plane, double typeTolerance)
 {
-    const std::size_t stride = std::max<std::size_t>(1, members.size() / 5000);
+    const std::size_t stride = std::max<std::size_t>(1, (members.size() + 4999) / 5000);
     std::vector<Eigen::Vector3d> sample, sampleNormals;
     for (std::size_t k = 0; k < members.size(); k += stride)
         if (memberNormals[k].squaredNorm() > 0) {
@@ -408,6 +408,95 @@ std::size_t searchLeftOver(PrimitiveDetectionResult& result, const std::vector<E
     return more.size();
 }
 
+//! The candidates of the method asked for (in the frame of `points`):
+//! regions grown, a façade's planes by sequential RANSAC, or efficient
+//! RANSAC's shapes. `keepGoing` asks for Cancel; `cancelled` says it came.
+std::vector<detail::RansacShape> findCandidates(const PointCloud& cloud, const std::vector<Eigen::Vector3d>& points,
+                                                std::vector<Eigen::Vector3d> unitNormals, const octree::Octree& tree, double spacing,
+                                                const PrimitiveDetectionParams& params, PrimitiveDetectionResult& result,
+                                                ProgressObserver* progress, const std::function<bool()>& keepGoing, bool& cancelled)
+{
+    if (params.method == PrimitiveMethod::RegionGrowing) {
+        detail::RegionGrowingSettings growing;
+        growing.epsilon = result.epsilon;
+        growing.normalDegrees = params.normalDeviationDegrees;
+        growing.neighbourRadius = result.clusterEpsilon;
+        growing.minPoints = params.minPoints;
+        growing.smoothnessDegrees = params.smoothnessDegrees;
+        growing.curvature = params.curvature;
+        growing.tolerance = params.valueTolerance;
+        if (params.growOn == GrowOn::Plane) {
+            return detail::growPlanarRegions(points, unitNormals, tree, growing, keepGoing);
+        } else {
+            detail::GrowingOutcome outcome;
+            if (params.growOn == GrowOn::Smoothness) {
+                outcome = detail::growSmoothRegions(points, unitNormals, tree, growing, keepGoing);
+                result.notes.push_back("smooth regions: neighbours' normals within " + std::to_string(params.smoothnessDegrees) +
+                                       " deg, spread by points of surface variation up to " + std::to_string(outcome.curvature));
+            } else {
+                const ScalarField* field = cloud.field(params.valueField);
+                if (!field)
+                    throw Error(ErrorCode::InvalidArgument, "primitives: the cloud '" + cloud.name + "' has no field '" + params.valueField +
+                                                                "' to grow regions on");
+                const double radius = params.valueRadius ? *params.valueRadius : 2.0 * spacing;
+                outcome = detail::growValueRegions(points, field->values(), tree, radius, growing, keepGoing);
+                result.notes.push_back("regions of " + params.valueField + ": variance up to " + std::to_string(outcome.tolerance) +
+                                       ", grown by " + std::to_string(radius) + " m");
+            }
+            for (detail::RansacShape& region : outcome.regions)
+                region.primitive = detail::initialShape(points, unitNormals, region.members);
+            return std::move(outcome.regions);
+        }
+    } else if (params.method == PrimitiveMethod::Sequential) {
+        detail::SequentialSettings sequential;
+        sequential.distance = result.epsilon;
+        sequential.pixel = result.clusterEpsilon;
+        sequential.toleranceDegrees = params.orientationToleranceDegrees;
+        sequential.minPoints = params.minPoints;
+        sequential.probability = 1.0 - params.probability;
+        sequential.seed = params.seed;
+        detail::SequentialOutcome outcome = detail::sequentialPlanes(points, tree, sequential, keepGoing);
+        result.facadeNormal = outcome.facadeNormal;
+        result.notes.insert(result.notes.end(), outcome.notes.begin(), outcome.notes.end());
+        return std::move(outcome.planes);
+    } else {
+        return findByRansac(points, std::move(unitNormals), params, result, progress, cancelled);
+    }
+}
+
+//! The shapes once typed, completed (ShapeParts.h). RANSAC returns a
+//! surface in parts (a wall cut by a column's shadow, a sphere's cap found
+//! apart from the rest) and gives the points where two shapes meet to the
+//! one found first: parts of one surface merged, each point given to the
+//! shape it lies on (repeated while the refits move shapes: a torus fitted
+//! without the points its leg took gives them back once refitted), a second
+//! search among the points left on no shape, then the returns no scanner
+//! could make and the shapes that are no surface left out. Other methods'
+//! shapes: touching parts merged only.
+void completeShapes(PrimitiveDetectionResult& result, const PointCloud& cloud, const std::vector<Eigen::Vector3d>& points,
+                    const std::vector<Eigen::Vector3f>& normals, const Eigen::Vector3d& centre, const PrimitiveDetectionParams& params,
+                    detail::SurfaceEvidence& evidence, double spacing, ProgressObserver* progress, bool& cancelled)
+{
+    if (params.method != PrimitiveMethod::EfficientRansac) {
+        detail::mergeSurfaceParts(result.primitives, evidence, false, result.notes);
+        return;
+    }
+    evidence.views = detail::scannerViews(cloud, spacing);
+    const auto claimAndMerge = [&] {
+        for (int round = 0; round < 3 && detail::claimPoints(result.primitives, evidence, cloud.size(), result.notes) > cloud.size() / 2000; ++round)
+            ;
+        detail::mergeSurfaceParts(result.primitives, evidence, true, result.notes);
+    };
+    detail::mergeSurfaceParts(result.primitives, evidence, true, result.notes);
+    claimAndMerge();
+    if (searchLeftOver(result, points, normals, centre, params, evidence, progress, cancelled) > 0) {
+        detail::mergeSurfaceParts(result.primitives, evidence, true, result.notes);
+        claimAndMerge();
+    }
+    detail::dropUnseeable(result.primitives, evidence, result.notes);
+    detail::dropFormedResiduals(result.primitives, evidence, result.notes);
+}
+
 void checkParameters(const PrimitiveDetectionParams& params)
 {
     auto bad = [](const std::string& why) { throw Error(ErrorCode::InvalidArgument, "primitives: " + why); };
@@ -541,55 +630,7 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
         cancelled = cancelled || (progress && progress->cancelRequested());
         return !cancelled;
     };
-    if (params.method == PrimitiveMethod::RegionGrowing) {
-        detail::RegionGrowingSettings growing;
-        growing.epsilon = result.epsilon;
-        growing.normalDegrees = params.normalDeviationDegrees;
-        growing.neighbourRadius = result.clusterEpsilon;
-        growing.minPoints = params.minPoints;
-        growing.smoothnessDegrees = params.smoothnessDegrees;
-        growing.curvature = params.curvature;
-        growing.tolerance = params.valueTolerance;
-        if (params.growOn == GrowOn::Plane) {
-            found = detail::growPlanarRegions(points, unitNormals, tree, growing, keepGoing);
-        } else {
-            detail::GrowingOutcome outcome;
-            if (params.growOn == GrowOn::Smoothness) {
-                outcome = detail::growSmoothRegions(points, unitNormals, tree, growing, keepGoing);
-                result.notes.push_back("smooth regions: neighbours' normals within " + std::to_string(params.smoothnessDegrees) +
-                                       " deg, spread by points of surface variation up to " + std::to_string(outcome.curvature));
-            } else {
-                const ScalarField* field = cloud.field(params.valueField);
-                if (!field)
-                    throw Error(ErrorCode::InvalidArgument, "primitives: the cloud '" + cloud.name + "' has no field '" + params.valueField +
-                                                                "' to grow regions on");
-                const double radius = params.valueRadius ? *params.valueRadius : 2.0 * scale.spacing;
-                outcome = detail::growValueRegions(points, field->values(), tree, radius, growing, keepGoing);
-                result.notes.push_back("regions of " + params.valueField + ": variance up to " + std::to_string(outcome.tolerance) +
-                                       ", grown by " + std::to_string(radius) + " m");
-            }
-            for (detail::RansacShape& region : outcome.regions)
-                region.primitive = detail::initialShape(points, unitNormals, region.members);
-            found = std::move(outcome.regions);
-        }
-    } else if (params.method == PrimitiveMethod::Sequential) {
-        detail::SequentialSettings sequential;
-        sequential.distance = result.epsilon;
-        sequential.pixel = result.clusterEpsilon;
-        sequential.toleranceDegrees = params.orientationToleranceDegrees;
-        sequential.minPoints = params.minPoints;
-        sequential.probability = 1.0 - params.probability;
-        sequential.seed = params.seed;
-        detail::SequentialOutcome outcome = detail::sequentialPlanes(points, tree, sequential, [&] {
-            cancelled = cancelled || (progress && progress->cancelRequested());
-            return !cancelled;
-        });
-        found = std::move(outcome.planes);
-        result.facadeNormal = outcome.facadeNormal;
-        result.notes.insert(result.notes.end(), outcome.notes.begin(), outcome.notes.end());
-    } else {
-        found = findByRansac(points, std::move(unitNormals), params, result, progress, cancelled);
-    }
+    found = findCandidates(cloud, points, std::move(unitNormals), tree, scale.spacing, params, result, progress, keepGoing, cancelled);
     if (cancelled)
         ticker.checkCancel();
     ticker.step(60);
@@ -630,37 +671,12 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
     ticker.checkCancel();
     ticker.step(20);
 
-    // RANSAC returns a surface in parts (a wall cut by a column's shadow, a
-    // sphere's cap found apart from the rest) and gives the points where two
-    // shapes meet to the one found first: parts of one surface merged, then
-    // each point given to the shape it lies on, then parts merged again (the
-    // points given may join them). Regions grown on a value are left as they
-    // are: they are apart by their values (the stones of one wall plane).
-    if (!(params.method == PrimitiveMethod::RegionGrowing && params.growOn == GrowOn::Value)) {
-        if (ransac)
-            evidence.views = detail::scannerViews(cloud, scale.spacing);
-        detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
-        // Claims refit the shapes, and refitted shapes claim better: a torus
-        // fitted without the points its leg took gives them back once
-        // refitted with the rest, up to three times.
-        const auto claimAndMerge = [&] {
-            for (int round = 0; round < 3 && detail::claimPoints(result.primitives, evidence, cloud.size(), result.notes) > cloud.size() / 2000; ++round)
-                ;
-            detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
-        };
-        if (ransac)
-            claimAndMerge();
-        if (ransac && searchLeftOver(result, points, *normals, centre, params, evidence, progress, cancelled) > 0) {
-            detail::mergeSurfaceParts(result.primitives, evidence, ransac, result.notes);
-            claimAndMerge();
-        }
-        if (cancelled)
-            ticker.checkCancel();
-        if (ransac)
-            detail::dropUnseeable(result.primitives, evidence, result.notes);
-        if (ransac)
-            detail::dropFormedResiduals(result.primitives, evidence, result.notes);
-    }
+    // Regions grown on a value are apart by their values (the stones of one
+    // wall plane): left as they are.
+    if (!(params.method == PrimitiveMethod::RegionGrowing && params.growOn == GrowOn::Value))
+        completeShapes(result, cloud, points, *normals, centre, params, evidence, scale.spacing, progress, cancelled);
+    if (cancelled)
+        ticker.checkCancel();
 
     // Largest first; ties by first inlier, so the order never depends on threads.
     std::sort(result.primitives.begin(), result.primitives.end(), [](const DetectedPrimitive& a, const DetectedPrimitive& b) {

@@ -232,17 +232,24 @@ ScannerView::ScannerView(const PointCloud& cloud, const SensorPose& pose, double
     : position_(pose.position), worldToSensor_(pose.orientation.toRotationMatrix().transpose())
 {
     constexpr double kPi = 3.14159265358979323846;
-    constexpr double kMostCells = 16.0 * (1 << 20); // 64 MB: a coarser grid for very fine steps
+    constexpr double kMostCells = 8.0 * (1 << 20); // 64 MB: a coarser grid for very fine steps
+    constexpr float kNone = std::numeric_limits<float>::infinity();
     step_ = std::max(step, std::sqrt(2 * kPi * kPi / kMostCells));
     width_ = static_cast<int>(std::ceil(2 * kPi / step_));
     height_ = static_cast<int>(std::ceil(kPi / step_));
-    nearest_.assign(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_), std::numeric_limits<float>::infinity());
+    nearest_.assign(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_), {kNone, kNone});
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         int u = 0, v = 0;
         double range = 0;
-        if (cellOf(cloud.globalPosition(i), u, v, range)) {
-            float& cell = nearest_[static_cast<std::size_t>(v) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(u)];
-            cell = std::min(cell, static_cast<float>(range));
+        if (!cellOf(cloud.globalPosition(i), u, v, range))
+            continue;
+        std::array<float, 2>& cell = nearest_[static_cast<std::size_t>(v) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(u)];
+        const auto r = static_cast<float>(range);
+        if (r < cell[0]) {
+            cell[1] = cell[0];
+            cell[0] = r;
+        } else if (r < cell[1]) {
+            cell[1] = r;
         }
     }
 }
@@ -260,22 +267,30 @@ bool ScannerView::cellOf(const Eigen::Vector3d& point, int& u, int& v, double& r
     return true;
 }
 
-bool ScannerView::lookedPast(const Eigen::Vector3d& point, double tolerance) const
+bool ScannerView::lookedPast(const Eigen::Vector3d& point, double tolerance, bool isAReturn) const
 {
     int u = 0, v = 0;
     double range = 0;
     if (!cellOf(point, u, v, range))
         return false;
+    // A stored range this close to the point's is the point's own (float rounding).
+    const double self = 1e-5 * range + 1e-6;
+    int withReturns = 0;
     for (int dv = -1; dv <= 1; ++dv)
         for (int du = -1; du <= 1; ++du) {
             const int vv = v + dv, uu = (u + du + width_) % width_; // the yaw wraps
             if (vv < 0 || vv >= height_)
                 continue;
-            const float nearest = nearest_[static_cast<std::size_t>(vv) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(uu)];
-            if ((du == 0 && dv == 0 && !std::isfinite(nearest)) || nearest <= range + tolerance)
+            const std::array<float, 2>& cell = nearest_[static_cast<std::size_t>(vv) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(uu)];
+            const bool ownReturnFirst = isAReturn && du == 0 && dv == 0 && std::abs(cell[0] - range) <= self;
+            const float nearest = ownReturnFirst ? cell[1] : cell[0];
+            if (!std::isfinite(nearest))
+                continue;
+            if (nearest <= range + tolerance)
                 return false;
+            ++withReturns;
         }
-    return true;
+    return withReturns >= 3;
 }
 
 std::vector<ScannerView> scannerViews(const PointCloud& cloud, double spacing)
@@ -313,6 +328,13 @@ void measureShape(DetectedPrimitive& shape, const SurfaceEvidence& evidence)
         }
     }
     shape.area = static_cast<double>(cells.size()) * cell * cell;
+    // The RMS of the inliers as they are now (points given or taken since the fit).
+    double squares = 0;
+    for (std::uint32_t i : shape.inliers) {
+        const double d = signedDistance(shape.primitive, evidence.centre + evidence.points[i]);
+        squares += d * d;
+    }
+    shape.rms = std::sqrt(squares / static_cast<double>(std::max<std::size_t>(1, shape.inliers.size())));
     shape.centroid = evidence.centre + sum / static_cast<double>(std::max<std::size_t>(1, shape.inliers.size()));
     shape.length = hasAxis ? hi - lo : 0.0;
 }
@@ -358,6 +380,7 @@ std::size_t mergeSurfaceParts(std::vector<DetectedPrimitive>& shapes, const Surf
                     apart.insert({host.inliers.front(), part.inliers.front()});
                     continue;
                 }
+                const std::uint32_t hostKey = host.inliers.front();
                 const std::string partKind = primitiveKindName(part.primitive.kind);
                 const std::size_t partPoints = part.inliers.size();
                 std::sort(both.begin(), both.end());
@@ -368,6 +391,14 @@ std::size_t mergeSurfaceParts(std::vector<DetectedPrimitive>& shapes, const Surf
                 measureShape(host, evidence);
                 notes.push_back(std::string("a ") + partKind + " of " + std::to_string(partPoints) + " points joined a " +
                                 primitiveKindName(host.primitive.kind) + (touch ? " it touches" : " across a gap no scanner saw into"));
+                // The grown shape may now touch, or fit, one it was apart from:
+                // its pairs, and the part's, are looked at again.
+                const std::uint32_t partKey = shapes[p].inliers.front();
+                for (auto pair = apart.begin(); pair != apart.end();) {
+                    const bool involved = pair->first == hostKey || pair->second == hostKey || pair->first == partKey ||
+                                          pair->second == partKey || pair->first == host.inliers.front() || pair->second == host.inliers.front();
+                    pair = involved ? apart.erase(pair) : std::next(pair);
+                }
                 shapes.erase(shapes.begin() + static_cast<std::ptrdiff_t>(p));
                 ++merges;
                 merged = true;
@@ -375,6 +406,8 @@ std::size_t mergeSurfaceParts(std::vector<DetectedPrimitive>& shapes, const Surf
     }
     return merges;
 }
+
+namespace {
 
 //! Where two shapes meet smoothly (an elbow's torus and its straight leg, a
 //! reducer and its pipe) a band of points lies within epsilon of both, and
@@ -492,7 +525,7 @@ std::size_t growByAdjacency(const std::vector<DetectedPrimitive>& shapes, const 
             // line at grazing incidence turns anywhere about it).
             int best = current;
             double bestDistance = std::numeric_limits<double>::infinity();
-            const bool between = near.size() >= 2;
+            const bool between = std::count_if(near.begin(), near.end(), [](const auto& n) { return std::isfinite(n.second); }) >= 2;
             for (const auto& [s, d] : near)
                 if (d < bestDistance && (!between || normalAgrees(shapes[std::size_t(s)].primitive, i, evidence))) {
                     best = s;
@@ -549,6 +582,7 @@ std::size_t joinHiddenParts(const std::vector<DetectedPrimitive>& shapes, const 
                                 stack.push_back(next);
                         }
             }
+            std::sort(group.begin(), group.end()); // the cells' hash order out of the samples taken
             if (group.size() < kSmallestGroup || !gapUnseen(shapes[s].primitive, shapes[s].inliers, group, evidence))
                 continue;
             for (std::uint32_t i : group)
@@ -560,6 +594,8 @@ std::size_t joinHiddenParts(const std::vector<DetectedPrimitive>& shapes, const 
         notes.push_back(std::to_string(joined) + " points on no shape joined the shape they lie on across gaps no scanner saw into");
     return joined;
 }
+
+} // namespace
 
 std::size_t dropUnseeable(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, std::vector<std::string>& notes)
 {
@@ -577,7 +613,10 @@ std::size_t dropUnseeable(std::vector<DetectedPrimitive>& shapes, const SurfaceE
         tbb::parallel_for(std::size_t(0), shape.inliers.size(), [&](std::size_t k) {
             const Eigen::Vector3d x = evidence.centre + evidence.points[shape.inliers[k]];
             const Eigen::Vector3d outward = surfaceNormal(surface, x);
-            bool facing = false;
+            // A plane is kept up to grazing incidence: a floor 45 m from a
+            // tripod is met at 88 degrees and still returns; the facing test
+            // is for the back of a curved shape, where mixed pixels land.
+            bool facing = twoSided;
             for (const ScannerView& view : evidence.views) {
                 const Eigen::Vector3d toScanner = (view.position() - x).normalized();
                 // The inside of a sphere, a cylinder, a cone (convex) faces a
@@ -585,10 +624,10 @@ std::size_t dropUnseeable(std::vector<DetectedPrimitive>& shapes, const SurfaceE
                 // rim), the outside one standing out of it.
                 const double side = twoSided ? 0.0 : signedDistance(surface, view.position()) >= 0 ? 1.0 : -1.0;
                 const double c = twoSided ? std::abs(toScanner.dot(outward)) : side * toScanner.dot(outward);
-                if (c <= grazing)
+                if (c <= (twoSided ? 0.0 : grazing))
                     continue;
                 facing = true;
-                if (c > std::cos(80.0 * 3.14159265358979323846 / 180.0) && view.lookedPast(x, tolerance / c))
+                if (c > std::cos(80.0 * 3.14159265358979323846 / 180.0) && view.lookedPast(x, tolerance / c, true))
                     return; // a scanner facing the surface there saw through it
             }
             keep[k] = facing;

@@ -20,6 +20,8 @@
 
 #include <Eigen/Core>
 
+#include <array>
+
 #include <functional>
 #include <string>
 #include <vector>
@@ -39,10 +41,12 @@ public:
     //! `step`: the scanner's angular step (rad, > 0).
     ScannerView(const PointCloud& cloud, const SensorPose& pose, double step);
 
-    //! Whether the scanner looked past the point (global): its direction and
-    //! the 8 around it hold returns, all farther than the point by more than
-    //! `tolerance` (along the ray). False where nothing came back around it.
-    bool lookedPast(const Eigen::Vector3d& point, double tolerance) const;
+    //! Whether the scanner looked past the point (global): at least 3 of its
+    //! direction's cell and the 8 around it hold returns, and every return
+    //! there lies farther than the point by more than `tolerance` (along the
+    //! ray). False where next to nothing came back. `isAReturn`: the point
+    //! is one of the cloud's, and its own return does not count.
+    bool lookedPast(const Eigen::Vector3d& point, double tolerance, bool isAReturn = false) const;
 
     const Eigen::Vector3d& position() const { return position_; }
 
@@ -53,7 +57,9 @@ private:
     Eigen::Matrix3d worldToSensor_;
     double step_ = 0;
     int width_ = 0, height_ = 0;
-    std::vector<float> nearest_; //!< per cell, the nearest range (infinity: no return)
+    //! Per cell, the two nearest ranges (infinity: none): a return of the
+    //! cloud asked about is told from what lies in front of or behind it.
+    std::vector<std::array<float, 2>> nearest_;
 };
 
 //! What the steps read: the points relative to `centre` (the shapes'
@@ -105,14 +111,16 @@ std::size_t mergeSurfaceParts(std::vector<DetectedPrimitive>& shapes, const Surf
 std::size_t claimPoints(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, std::size_t cloudSize,
                         std::vector<std::string>& notes);
 
-//! Leaves out of each shape the points no return of its surface can be: a
-//! point where no scanner faces the surface (its back, or beyond 88 degrees
-//! of incidence: the mixed pixels behind a pipe's silhouette; a sphere's,
-//! a cylinder's or a cone's inside faces the scanners standing in it), or where a
-//! scanner facing the surface looked through it (the returns along a ray
-//! past a box's edge, on its face's plane beyond the face). Shapes left
-//! with fewer than the minimum support are dropped. Without sensor poses,
-//! nothing is left out. Returns the points left out.
+//! Leaves out of each shape the points no return of its surface can be: on
+//! a sphere, a cylinder, a cone or a torus, a point where no scanner faces
+//! the surface at less than 88 degrees of incidence (its back: the mixed
+//! pixels just behind a pipe's silhouette; the inside of a sphere, a
+//! cylinder or a cone faces the scanners standing in it); on any shape, a
+//! point where a scanner facing the surface (below 80 degrees) looked past
+//! it, its own return aside (a return on a face's plane beyond the face,
+//! with the floor seen behind it). Shapes left with fewer than the minimum
+//! support are dropped. Without sensor poses, nothing is left out. Returns
+//! the points left out.
 std::size_t dropUnseeable(std::vector<DetectedPrimitive>& shapes, const SurfaceEvidence& evidence, std::vector<std::string>& notes);
 
 //! How much of a shape's residuals is a form rather than noise: over cells

@@ -24,8 +24,8 @@
 //! A point's truth is the shape its ray met. Clutter, `clutterFraction` of all
 //! points: small lumpy objects (valves, bags, cable boxes: no primitive fits
 //! them) scanned with the scene and hiding what is behind them; mixed pixels
-//! between the two ranges of a depth jump at silhouette edges (clear of every
-//! shape's surface by 4 noise sigmas, 3 cm at least); returns a
+//! between the two ranges of a depth jump at silhouette edges (clear of the
+//! surfaces they lie near by 4 noise sigmas, 3 cm at least); returns a
 //! little in front of surfaces (2-15 cm and at least 4 noise sigmas off:
 //! dust, straps, insulation); spurious returns in the air along real rays.
 //! The points are shuffled; the cloud's sensors() holds the stations.
@@ -58,6 +58,7 @@
 
 #include <cstdio>
 #include <numeric>
+#include <unordered_map>
 #include <string>
 #include <vector>
 
@@ -214,16 +215,35 @@ inline void addClutter(const PrimitivesParams& p, const std::vector<ScanHit>& sh
     for (std::size_t i = 0; i < edges.size(); ++i)
         if (edges[i].farRange - edges[i].nearRange > 2 * edgeMargin + 0.02)
             wideEdges.push_back(i);
-    // Clear of them across the surfaces too: a ray running along a face
-    // (a box side seen edge-on) would put its "mixed pixel" on the face,
-    // where it is a return of the face. Such draws are dropped.
+    // Clear of them across the surfaces too where they are: a ray running
+    // along a face (a box side seen edge-on) would put its "mixed pixel" on
+    // the face, where it is a return of the face. Such draws are dropped:
+    // within the margin of a shape's surface and within 10 cm of one of that
+    // shape's returns. (On the surface's extension past the face they stay:
+    // a detector must tell them from the face.)
     std::vector<Primitive> surfaces;
     for (const ShapeSpec& shape : p.shapes)
         surfaces.push_back(toPrimitive(shape));
+    constexpr double kFaceReach = 0.10;
+    const auto cellOf = [&](const Vector3d& x, int dx, int dy, int dz) {
+        const auto c = [](double v, int d) { return static_cast<std::uint64_t>((static_cast<std::int64_t>(std::floor(v / kFaceReach)) + d) & 0x1fffff); };
+        return c(x.x(), dx) | c(x.y(), dy) << 21 | c(x.z(), dz) << 42;
+    };
+    std::unordered_map<std::uint64_t, std::vector<std::size_t>> hitsByCell;
+    for (std::size_t h = 0; h < shapeHits.size(); ++h)
+        hitsByCell[cellOf(shapeHits[h].position, 0, 0, 0)].push_back(h);
     const auto clearOfSurfaces = [&](const Vector3d& x) {
-        for (const Primitive& surface : surfaces)
-            if (std::abs(signedDistance(surface, x)) < edgeMargin)
-                return false;
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dz = -1; dz <= 1; ++dz) {
+                    const auto found = hitsByCell.find(cellOf(x, dx, dy, dz));
+                    if (found == hitsByCell.end())
+                        continue;
+                    for (std::size_t h : found->second)
+                        if ((shapeHits[h].position - x).norm() < kFaceReach &&
+                            std::abs(signedDistance(surfaces[std::size_t(shapeHits[h].target)], x)) < edgeMargin)
+                            return false;
+                }
         return true;
     };
     const std::size_t mixed = std::min(wideEdges.size(), budget / 5);
