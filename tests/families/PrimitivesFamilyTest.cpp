@@ -38,5 +38,27 @@ TEST(PrimitivesFamily, TheIssuePlantComesOutWholeWithoutFalseShapes)
     EXPECT_LT(pipe.axisErrorDeg, 0.1) << table;
 }
 
+TEST(PrimitivesFamily, HeldOutDrawsFindMostShapesAndAlmostNoFalseOnes)
+{
+    // Twelve draws the code was not changed on (seeds 13-24 at 0.3 scale:
+    // 150-450 k points, rooms in any heading, 8-20 shapes, noise 1-10 mm,
+    // clutter 0-10 %, UTM offsets in half). Measured 113 of 136 shapes and 2
+    // false ones (CloudCompare's plugin: 91 and 25; this code at the start
+    // of the work: about half). Asserted: at least 78 % of the required
+    // shapes over the twelve, at most 4 false shapes, each draw at least
+    // half of its shapes. The whole target on every draw is not met yet.
+    std::size_t required = 0, found = 0, falseShapes = 0;
+    for (std::uint64_t seed = 13; seed <= 24; ++seed) {
+        const pf::PrimitivesScene scene = pf::make(pf::drawFamily(seed, 0.3));
+        const test::family::PrimitivesTrial t = test::family::runPrimitives(scene, {});
+        required += t.score.required;
+        found += t.score.found;
+        falseShapes += t.score.falseShapes.size();
+        EXPECT_GE(2 * t.score.found, t.score.required) << "seed " << seed << "\n" << t.score.table();
+    }
+    EXPECT_GE(100 * found, 78 * required) << found << " of " << required;
+    EXPECT_LE(falseShapes, 4u);
+}
+
 } // namespace
 } // namespace scandiff
