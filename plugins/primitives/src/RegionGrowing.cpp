@@ -360,24 +360,15 @@ Primitive initialShape(const std::vector<Eigen::Vector3d>& points, const std::ve
     if (turning.eigenvalues()[1] > 0.05 * turning.eigenvalues().sum()) {
         // The normals turn: a cylinder across them, its section the Kasa circle
         // of the points projected along the axis.
-        const Eigen::Vector3d axis = turning.eigenvectors().col(0).normalized();
-        const Eigen::Vector3d u = turning.eigenvectors().col(1).normalized(), v = axis.cross(u);
-        std::vector<Eigen::Vector2d> section;
-        section.reserve(members.size());
+        std::vector<Eigen::Vector3d> offsets, memberNormals;
+        offsets.reserve(members.size());
+        memberNormals.reserve(members.size());
         for (std::uint32_t i : members) {
-            const Eigen::Vector3d d = points[i] - mean;
-            section.emplace_back(d.dot(u), d.dot(v));
+            offsets.push_back(points[i] - mean);
+            memberNormals.push_back(normals[i]);
         }
-        Eigen::Vector2d circle;
-        double radius = 0;
-        if (fitCircle(section, circle, radius)) {
-            Primitive shape;
-            shape.kind = PrimitiveKind::Cylinder;
-            shape.direction = axis;
-            shape.point = mean + circle.x() * u + circle.y() * v;
-            shape.radius = radius;
-            return shape;
-        }
+        if (const std::optional<Primitive> cylinder = cylinderFromNormals(offsets, memberNormals, mean))
+            return *cylinder;
     }
     return leastSquaresPlane(points, members);
 }
