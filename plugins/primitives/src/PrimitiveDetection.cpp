@@ -109,6 +109,14 @@ bool radiusPlausible(const Primitive& p, double extent)
     return false;
 }
 
+//! Point i's normal as RANSAC takes it: unit, +Z where the cloud has none
+//! or the point's is zero.
+Eigen::Vector3d unitNormalOf(const std::vector<Eigen::Vector3f>& normals, std::size_t i)
+{
+    const Eigen::Vector3d n = normals.empty() ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : Eigen::Vector3d(normals[i].cast<double>());
+    return n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d(Eigen::Vector3d::UnitZ());
+}
+
 //! The least-squares plane of points (their frame), as a primitive (global).
 Primitive pcaPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& centre)
 {
@@ -144,12 +152,13 @@ std::optional<Primitive> cylinderOfStrip(const std::vector<Eigen::Vector3d>& mem
             sampleNormals.push_back(memberNormals[k]);
         }
     const std::optional<Primitive> start = cylinderFromNormals(sample, sampleNormals, centre);
-    if (!start || !radiusPlausible(*start, extentOf(members)))
+    const double extent = extentOf(members);
+    if (!start || !radiusPlausible(*start, extent))
         return std::nullopt;
     try {
         const PrimitiveRefinement cylinder = refinePrimitive(sample, centre, *start);
         const PrimitiveRefinement flat = refinePrimitive(sample, centre, plane);
-        if (radiusPlausible(cylinder.primitive, extentOf(members)) && (1 + typeTolerance) * cylinder.rms < flat.rms)
+        if (radiusPlausible(cylinder.primitive, extent) && (1 + typeTolerance) * cylinder.rms < flat.rms)
             return cylinder.primitive;
     } catch (const Error&) {
         // Neither fit says more than RANSAC's plane.
@@ -353,9 +362,8 @@ std::vector<DetectedPrimitive> typedShapes(const std::vector<detail::RansacShape
             detected.primitive = refined.primitive;
             detected.inliers = std::move(inliers);
             std::sort(detected.inliers.begin(), detected.inliers.end());
-            detected.rms = refined.rms;
             detected.uncertainty = refined.uncertainty;
-            detail::measureShape(detected, evidence);
+            detail::measureShape(detected, evidence); // its RMS too
             refitted[s] = std::move(detected);
         }
     }, tbb::simple_partitioner());
@@ -390,8 +398,7 @@ std::size_t searchLeftOver(PrimitiveDetectionResult& result, const std::vector<E
     std::vector<Eigen::Vector3d> leftPoints, leftNormals;
     for (std::uint32_t i : left) {
         leftPoints.push_back(points[i]);
-        const Eigen::Vector3d n = normals.empty() ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : Eigen::Vector3d(normals[i].cast<double>());
-        leftNormals.push_back(n.norm() > 0 ? n.normalized() : Eigen::Vector3d::UnitZ());
+        leftNormals.push_back(unitNormalOf(normals, i));
     }
     std::vector<detail::RansacShape> found = findByRansac(leftPoints, std::move(leftNormals), params, result, progress, cancelled);
     if (cancelled)
@@ -475,13 +482,13 @@ std::vector<detail::RansacShape> findCandidates(const PointCloud& cloud, const s
 //! shapes: touching parts merged only.
 void completeShapes(PrimitiveDetectionResult& result, const PointCloud& cloud, const std::vector<Eigen::Vector3d>& points,
                     const std::vector<Eigen::Vector3f>& normals, const Eigen::Vector3d& centre, const PrimitiveDetectionParams& params,
-                    detail::SurfaceEvidence& evidence, double spacing, ProgressObserver* progress, bool& cancelled)
+                    detail::SurfaceEvidence& evidence, ProgressObserver* progress, bool& cancelled)
 {
     if (params.method != PrimitiveMethod::EfficientRansac) {
         detail::mergeSurfaceParts(result.primitives, evidence, false, result.notes);
         return;
     }
-    evidence.views = detail::scannerViews(cloud, spacing);
+    evidence.views = detail::scannerViews(cloud, evidence.spacing);
     const auto claimAndMerge = [&] {
         for (int round = 0; round < 3 && detail::claimPoints(result.primitives, evidence, cloud.size(), result.notes) > cloud.size() / 2000; ++round)
             ;
@@ -614,8 +621,7 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
     std::vector<Eigen::Vector3d> points(cloud.size()), unitNormals(cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         points[i] = cloud.positions()[i].cast<double>() - localCentre;
-        const Eigen::Vector3d n = normals->empty() ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : Eigen::Vector3d((*normals)[i].cast<double>());
-        unitNormals[i] = n.norm() > 0 ? n.normalized() : Eigen::Vector3d::UnitZ();
+        unitNormals[i] = unitNormalOf(*normals, i);
     }
 
     std::vector<detail::RansacShape> found;
@@ -674,7 +680,7 @@ PrimitiveDetectionResult detectPrimitives(const PointCloud& cloud, const Primiti
     // Regions grown on a value are apart by their values (the stones of one
     // wall plane): left as they are.
     if (!(params.method == PrimitiveMethod::RegionGrowing && params.growOn == GrowOn::Value))
-        completeShapes(result, cloud, points, *normals, centre, params, evidence, scale.spacing, progress, cancelled);
+        completeShapes(result, cloud, points, *normals, centre, params, evidence, progress, cancelled);
     if (cancelled)
         ticker.checkCancel();
 

@@ -9,8 +9,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <set>
 #include <unordered_map>
 #include <unordered_set>
@@ -28,14 +30,24 @@ std::uint64_t cellKey(const Eigen::Vector3d& p, double cell, int dx = 0, int dy 
     return c(p.x(), dx) | c(p.y(), dy) << 21 | c(p.z(), dz) << 42;
 }
 
-//! Whether a point (local) has a cell of `cells` among the 27 around it.
-bool nearCells(const std::unordered_set<std::uint64_t>& cells, const Eigen::Vector3d& p, double cell)
+//! The keys of the 27 cells of side `cell` around p (its own among them).
+std::array<std::uint64_t, 27> neighbourKeys(const Eigen::Vector3d& p, double cell)
 {
+    std::array<std::uint64_t, 27> keys{};
+    std::size_t k = 0;
     for (int dx = -1; dx <= 1; ++dx)
         for (int dy = -1; dy <= 1; ++dy)
             for (int dz = -1; dz <= 1; ++dz)
-                if (cells.count(cellKey(p, cell, dx, dy, dz)))
-                    return true;
+                keys[k++] = cellKey(p, cell, dx, dy, dz);
+    return keys;
+}
+
+//! Whether a point (local) has a cell of `cells` among the 27 around it.
+bool nearCells(const std::unordered_set<std::uint64_t>& cells, const Eigen::Vector3d& p, double cell)
+{
+    for (std::uint64_t key : neighbourKeys(p, cell))
+        if (cells.count(key))
+            return true;
     return false;
 }
 
@@ -348,7 +360,8 @@ std::size_t mergeSurfaceParts(std::vector<DetectedPrimitive>& shapes, const Surf
     std::size_t merges = 0;
     for (bool merged = true; merged;) {
         merged = false;
-        for (std::size_t h = 0; h < shapes.size() && !merged; ++h)
+        for (std::size_t h = 0; h < shapes.size() && !merged; ++h) {
+            std::optional<std::unordered_set<std::uint64_t>> hostCells; // built when a part first needs it
             for (std::size_t p = 0; p < shapes.size() && !merged; ++p) {
                 evidence.checkCancel();
                 DetectedPrimitive& host = shapes[h];
@@ -358,10 +371,11 @@ std::size_t mergeSurfaceParts(std::vector<DetectedPrimitive>& shapes, const Surf
                 const double needed = host.primitive.kind == part.primitive.kind ? 0.5 : 0.9;
                 if (shareOnSurface(host.primitive, part.inliers, evidence) < needed)
                     continue;
-                const std::unordered_set<std::uint64_t> hostCells = cellsOf(host.inliers, evidence);
+                if (!hostCells)
+                    hostCells = cellsOf(host.inliers, evidence);
                 bool touch = false;
                 for (std::uint32_t i : part.inliers)
-                    if ((touch = nearCells(hostCells, evidence.points[i], evidence.linkDistance)))
+                    if ((touch = nearCells(*hostCells, evidence.points[i], evidence.linkDistance)))
                         break;
                 const bool hiddenGap = !touch && mergeApart && gapUnseen(host.primitive, host.inliers, part.inliers, evidence);
                 PrimitiveRefinement joint;
@@ -386,9 +400,8 @@ std::size_t mergeSurfaceParts(std::vector<DetectedPrimitive>& shapes, const Surf
                 std::sort(both.begin(), both.end());
                 host.inliers = std::move(both);
                 host.primitive = joint.primitive;
-                host.rms = joint.rms;
                 host.uncertainty = joint.uncertainty;
-                measureShape(host, evidence);
+                measureShape(host, evidence); // its RMS too
                 notes.push_back(std::string("a ") + partKind + " of " + std::to_string(partPoints) + " points joined a " +
                                 primitiveKindName(host.primitive.kind) + (touch ? " it touches" : " across a gap no scanner saw into"));
                 // The grown shape may now touch, or fit, one it was apart from:
@@ -403,6 +416,7 @@ std::size_t mergeSurfaceParts(std::vector<DetectedPrimitive>& shapes, const Surf
                 ++merges;
                 merged = true;
             }
+        }
     }
     return merges;
 }
@@ -435,10 +449,8 @@ std::size_t splitWhereShapesMeet(const std::vector<DetectedPrimitive>& shapes, c
     const double cell = evidence.linkDistance;
     std::unordered_set<std::uint64_t> bandCells;
     for (std::uint32_t i : inBand)
-        for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dz = -1; dz <= 1; ++dz)
-                    bandCells.insert(cellKey(evidence.points[i], cell, dx, dy, dz));
+        for (std::uint64_t key : neighbourKeys(evidence.points[i], cell))
+            bandCells.insert(key);
     std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> anchors;
     for (std::size_t i = 0; i < owner.size(); ++i)
         if (owner[i] >= 0 && !inBand.count(static_cast<std::uint32_t>(i))) {
@@ -454,20 +466,18 @@ std::size_t splitWhereShapesMeet(const std::vector<DetectedPrimitive>& shapes, c
         const Eigen::Vector3d& p = evidence.points[i];
         double best = std::numeric_limits<double>::infinity();
         int nearestShape = owner[i];
-        for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dz = -1; dz <= 1; ++dz) {
-                    const auto found = anchors.find(cellKey(p, cell, dx, dy, dz));
-                    if (found == anchors.end())
-                        continue;
-                    for (std::uint32_t j : found->second) {
-                        const double d = (evidence.points[j] - p).squaredNorm();
-                        if (d < best && std::find(on[k].begin(), on[k].end(), owner[j]) != on[k].end()) {
-                            best = d;
-                            nearestShape = owner[j];
-                        }
-                    }
+        for (std::uint64_t key : neighbourKeys(p, cell)) {
+            const auto found = anchors.find(key);
+            if (found == anchors.end())
+                continue;
+            for (std::uint32_t j : found->second) {
+                const double d = (evidence.points[j] - p).squaredNorm();
+                if (d < best && std::find(on[k].begin(), on[k].end(), owner[j]) != on[k].end()) {
+                    best = d;
+                    nearestShape = owner[j];
                 }
+            }
+        }
         if (nearestShape != owner[i])
             moves.emplace_back(i, nearestShape);
     }
@@ -503,14 +513,14 @@ std::size_t growByAdjacency(const std::vector<DetectedPrimitive>& shapes, const 
 {
     constexpr int kMaxPasses = 30;
     std::size_t changed = 0;
+    std::vector<std::pair<int, double>> near; // the shapes next to a point that it lies within epsilon of (its own first)
     for (int pass = 0; pass < kMaxPasses; ++pass) {
         evidence.checkCancel();
         std::size_t changedThisPass = 0;
         for (std::uint32_t i : contested) {
             const Eigen::Vector3d& p = evidence.points[i];
             const int current = growth.owner[i];
-            // The shapes next to the point that it lies within epsilon of (its own first).
-            std::vector<std::pair<int, double>> near;
+            near.clear();
             if (current >= 0)
                 near.emplace_back(current, distanceWithin(shapes[std::size_t(current)].primitive, i, evidence));
             for (std::size_t s = 0; s < shapes.size(); ++s) {
@@ -574,13 +584,9 @@ std::size_t joinHiddenParts(const std::vector<DetectedPrimitive>& shapes, const 
                 const std::vector<std::uint32_t>& here = free.at(key);
                 group.insert(group.end(), here.begin(), here.end());
                 const Eigen::Vector3d& p = evidence.points[here.front()];
-                for (int dx = -1; dx <= 1; ++dx)
-                    for (int dy = -1; dy <= 1; ++dy)
-                        for (int dz = -1; dz <= 1; ++dz) {
-                            const std::uint64_t next = cellKey(p, evidence.linkDistance, dx, dy, dz);
-                            if (free.count(next) && visited.insert(next).second)
-                                stack.push_back(next);
-                        }
+                for (std::uint64_t next : neighbourKeys(p, evidence.linkDistance))
+                    if (free.count(next) && visited.insert(next).second)
+                        stack.push_back(next);
             }
             std::sort(group.begin(), group.end()); // the cells' hash order out of the samples taken
             if (group.size() < kSmallestGroup || !gapUnseen(shapes[s].primitive, shapes[s].inliers, group, evidence))
@@ -609,6 +615,12 @@ std::size_t dropUnseeable(std::vector<DetectedPrimitive>& shapes, const SurfaceE
         evidence.checkCancel();
         const Primitive& surface = shape.primitive;
         const bool twoSided = surface.kind == PrimitiveKind::Plane;
+        // The inside of a sphere, a cylinder, a cone (convex) faces a scanner
+        // standing in it (a tunnel, a hopper seen from above its rim), the
+        // outside one standing out of it; a plane faces both sides.
+        std::vector<double> side;
+        for (const ScannerView& view : evidence.views)
+            side.push_back(twoSided ? 0.0 : signedDistance(surface, view.position()) >= 0 ? 1.0 : -1.0);
         std::vector<char> keep(shape.inliers.size(), 0);
         tbb::parallel_for(std::size_t(0), shape.inliers.size(), [&](std::size_t k) {
             const Eigen::Vector3d x = evidence.centre + evidence.points[shape.inliers[k]];
@@ -617,13 +629,10 @@ std::size_t dropUnseeable(std::vector<DetectedPrimitive>& shapes, const SurfaceE
             // tripod is met at 88 degrees and still returns; the facing test
             // is for the back of a curved shape, where mixed pixels land.
             bool facing = twoSided;
-            for (const ScannerView& view : evidence.views) {
+            for (std::size_t v = 0; v < evidence.views.size(); ++v) {
+                const ScannerView& view = evidence.views[v];
                 const Eigen::Vector3d toScanner = (view.position() - x).normalized();
-                // The inside of a sphere, a cylinder, a cone (convex) faces a
-                // scanner standing in it (a tunnel, a hopper seen from above its
-                // rim), the outside one standing out of it.
-                const double side = twoSided ? 0.0 : signedDistance(surface, view.position()) >= 0 ? 1.0 : -1.0;
-                const double c = twoSided ? std::abs(toScanner.dot(outward)) : side * toScanner.dot(outward);
+                const double c = twoSided ? std::abs(toScanner.dot(outward)) : side[v] * toScanner.dot(outward);
                 if (c <= (twoSided ? 0.0 : grazing))
                     continue;
                 facing = true;
@@ -761,7 +770,6 @@ std::size_t claimPoints(std::vector<DetectedPrimitive>& shapes, const SurfaceEvi
             const PrimitiveRefinement refit = refinePrimitive(positionsOf(shape.inliers, evidence), evidence.centre, shape.primitive);
             if (refit.rms <= evidence.epsilon) {
                 shape.primitive = refit.primitive;
-                shape.rms = refit.rms;
                 shape.uncertainty = refit.uncertainty;
             }
         } catch (const Error&) {
