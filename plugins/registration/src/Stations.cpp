@@ -30,12 +30,15 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 //! between the stations, a wrong one that fits the walls of a hall that
 //! repeats itself puts its clutter there.
 constexpr double kFreeSpaceWeight = 10;
-//! How far a station's own vertical may be from another's: 10 degrees,
-//! twice a tripod scanner's compensator range.
 //! Where the stations are is where the surveyor put them: a candidate from
 //! there keeps a tenth of its score in hand (scores may be negative).
 constexpr double kWhereTheyAreBonus = 0.1;
+//! How far a station's own vertical may be from another's: 10 degrees,
+//! twice a tripod scanner's compensator range.
 constexpr double kMaxStationTilt = 10 * M_PI / 180;
+//! Two scanners whose verticals are this close (1 degree: a compensator
+//! levels to a few thousandths) are searched for by turns about it.
+constexpr double kLevelledSearchTilt = M_PI / 180;
 
 //! One station: its cloud, the surface others are matched on, and its
 //! sampled points in station coordinates relative to the world origin.
@@ -375,6 +378,15 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
     if (params.anyStart) {
         GlobalAlignmentParams global;
         global.constraint = params.constraint;
+        // Two scanners whose verticals agree are levelled tripods: the
+        // search turns one about that vertical only (two matches make a
+        // motion, and a match whose normals lean differently is no match),
+        // which finds the pose where a 6-DOF search among sparse, repeated
+        // descriptors settles on a symmetry of the site. The adjustment
+        // keeps its own degrees of freedom for the levelling's residue.
+        if (params.constraint.dof == Dof::Six && stations[a].scanner && stations[b].scanner &&
+            stations[a].up.dot(stations[b].up) >= std::cos(kLevelledSearchTilt))
+            global.constraint = DofConstraint{Dof::Four, stations[a].up};
         global.seed = params.seed + 31 * a + b;
         global.alternatives = 4;
         try {
