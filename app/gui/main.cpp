@@ -24,7 +24,8 @@ int main(int argc, char** argv)
     QCommandLineOption screenshot("screenshot", "Load FILEs, save the view to PNG and quit.", "png");
     parser.addOption(screenshot);
     QCommandLineOption measure("measure-view",
-                               "Load FILEs, print the view's timings (full render, render while moving, threshold update) and quit.");
+                               "Load FILEs, print the view's timings (first picture, everything drawn slice by slice, longest "
+                               "event-loop turn, render while moving, threshold update) and quit.");
     parser.addOption(measure);
     parser.addPositionalArgument("FILE", "Clouds or meshes to open", "[FILE...]");
     parser.process(app);
@@ -33,7 +34,7 @@ int main(int argc, char** argv)
     scandiff::gui::MainWindow window(registry);
     window.show();
     const QStringList files = parser.positionalArguments();
-    const bool quiet = parser.isSet(screenshot);
+    const bool quiet = parser.isSet(screenshot) || parser.isSet(measure); // no questions (global shift) in unattended runs
     QTimer::singleShot(0, &window, [&] {
         const int loaded = files.isEmpty() ? 0 : window.openFiles(files, quiet);
         if (parser.isSet(measure)) {

@@ -684,6 +684,105 @@ private slots:
         window.view()->setMoving(false);
     }
 
+    void aLargeCloudAtRestIsDrawnInSlicesOfTheBudgetAndAMoveStartsAgain()
+    {
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
+        gui::CloudView& view = *window.view();
+        // Five million points: a full frame froze the workbench on Mesa's
+        // software renderer for seconds (33 s at 2 x 20 M).
+        constexpr std::size_t kSide = 2237;
+        PointCloud terrain;
+        terrain.resize(kSide * kSide);
+        for (std::size_t i = 0; i < kSide; ++i)
+            for (std::size_t j = 0; j < kSide; ++j)
+                terrain.positions()[i * kSide + j] = {0.02f * i, 0.02f * j, static_cast<float>(3 * std::sin(0.01 * i) * std::cos(0.013 * j))};
+        const std::size_t points = terrain.size();
+        window.document().add("terrain", std::move(terrain));
+        constexpr std::size_t kBudget = 400'000;
+        view.setInteractiveBudget(kBudget);
+        const std::size_t slices = (points + kBudget - 1) / kBudget;
+        QTRY_COMPARE(view.interactiveStride(), slices); // the view shows what the document holds
+        const std::size_t chunks = (points + (1u << 18) - 1) >> 18; // each chunk rounds its share of a slice up
+        const gui::CloudView::Refinement& r = view.refinement();
+
+        // A cloud added is drawn decimated at once, at rest a moment later.
+        QTRY_VERIFY_WITH_TIMEOUT(view.refinement().starts >= 1, 5000);
+        QTRY_VERIFY_WITH_TIMEOUT(!view.refinement().refining, 300000);
+        // At rest: the decimated picture at once, the rest slice by slice.
+        view.render();
+        QCOMPARE(r.slices, slices);
+        QCOMPARE(r.slicesDrawn, std::size_t(1));
+        QVERIFY(r.refining);
+        QVERIFY(r.pointsDrawn <= kBudget + chunks);
+        // Left alone, it draws every point once, never more than the budget a frame.
+        QTRY_VERIFY_WITH_TIMEOUT(!view.refinement().refining, 300000);
+        QCOMPARE(r.slicesDrawn, slices);
+        QCOMPARE(r.pointsDrawn, points);
+        QVERIFY2(r.largestSlice <= kBudget + chunks, std::to_string(r.largestSlice).c_str());
+        // The slices add up to the full picture: on every pixel a point
+        // covers, the same colour, but where points tie in depth (the order of
+        // drawing differs: a neighbour of a nearly equal colour may win).
+        // Seen from close enough that the points stand apart on the screen
+        // (about 3 pixels between them), a slice missing shows.
+        gui::CameraState close;
+        close.focalPoint = {22, 22, 0};
+        close.position = {22, 22, 100};
+        close.parallel = true;
+        close.parallelScale = 2.25;
+        view.setCamera(close);
+        QCOMPARE(r.slicesDrawn, std::size_t(1));
+        const QImage coarse = view.shownPicture();
+        QTRY_VERIFY_WITH_TIMEOUT(!view.refinement().refining, 300000);
+        QCOMPARE(r.slicesDrawn, slices);
+        const QImage refined = view.shownPicture();
+        view.setInteractiveBudget(points);
+        view.render();
+        QVERIFY(!view.refinement().refining);
+        const QImage full = view.shownPicture();
+        QCOMPARE(refined.size(), full.size());
+        const auto apart = [](QRgb f, QRgb g) {
+            return std::max({std::abs(qRed(f) - qRed(g)), std::abs(qGreen(f) - qGreen(g)), std::abs(qBlue(f) - qBlue(g))}) > 24;
+        };
+        std::size_t differ = 0, covered = 0, coarseDiffer = 0;
+        for (int y = 0; y < full.height(); ++y)
+            for (int x = 0; x < full.width(); ++x) {
+                const QRgb f = full.pixel(x, y);
+                if (f == full.pixel(1, y)) // the background's gradient, row by row
+                    continue;
+                ++covered;
+                differ += apart(f, refined.pixel(x, y));
+                coarseDiffer += apart(f, coarse.pixel(x, y));
+            }
+        QVERIFY2(covered > std::size_t(full.width() * full.height() / 5), std::to_string(covered).c_str());
+        QVERIFY2(coarseDiffer > covered / 2, (std::to_string(coarseDiffer) + " of " + std::to_string(covered)).c_str());
+        QVERIFY2(differ <= covered / 1000, (std::to_string(differ) + " of " + std::to_string(covered)).c_str());
+
+        // A camera move stops the slices; the next rest starts from the decimated picture.
+        view.setInteractiveBudget(kBudget);
+        view.render();
+        QTRY_VERIFY_WITH_TIMEOUT(view.refinement().slicesDrawn >= 3, 60000);
+        const std::size_t starts = r.starts;
+        view.setMoving(true);
+        QVERIFY(!r.refining);
+        const std::size_t drawnBefore = r.slicesDrawn;
+        QTest::qWait(100);
+        QCOMPARE(r.slicesDrawn, drawnBefore);
+        view.setMoving(false);
+        QCOMPARE(r.starts, starts + 1);
+        QCOMPARE(r.slicesDrawn, std::size_t(1));
+        QVERIFY(r.refining);
+        // A colour change stops them too, and starts them again once the changes stop.
+        QTRY_VERIFY_WITH_TIMEOUT(view.refinement().slicesDrawn >= 2, 60000);
+        const EntityId id = window.document().ids().front();
+        window.document().setNeutral(id, true);
+        QVERIFY(!r.refining);
+        QTRY_VERIFY_WITH_TIMEOUT(view.refinement().starts == starts + 2, 5000);
+        QTRY_VERIFY_WITH_TIMEOUT(!view.refinement().refining, 300000);
+        QCOMPARE(r.pointsDrawn, points);
+    }
+
     void quittingAsksAboutUnsavedWork()
     {
         Workbench workbench;

@@ -26,19 +26,16 @@ vtkSmartPointer<vtkPoints> pointsOver(const float* xyz, std::size_t count)
     return points;
 }
 
-//! Vertex cells for every stride-th point, as two flat 32-bit arrays (half the
-//! memory of VTK's default 64-bit ids; a cloud above 2^31 points is refused by
-//! the view before this).
-vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride)
+vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride, std::size_t first)
 {
-    const auto n = static_cast<vtkIdType>((count + stride - 1) / stride);
+    const auto n = static_cast<vtkIdType>(first < count ? (count - first + stride - 1) / stride : 0);
     vtkNew<vtkTypeInt32Array> offsets;
     vtkNew<vtkTypeInt32Array> connectivity;
     offsets->SetNumberOfValues(n + 1);
     connectivity->SetNumberOfValues(n);
     for (vtkIdType i = 0; i < n; ++i) {
         offsets->SetValue(i, static_cast<std::int32_t>(i));
-        connectivity->SetValue(i, static_cast<std::int32_t>(i * static_cast<vtkIdType>(stride)));
+        connectivity->SetValue(i, static_cast<std::int32_t>(static_cast<vtkIdType>(first) + i * static_cast<vtkIdType>(stride)));
     }
     offsets->SetValue(n, static_cast<std::int32_t>(n));
     auto cells = vtkSmartPointer<vtkCellArray>::New();

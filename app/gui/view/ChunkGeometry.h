@@ -19,10 +19,11 @@ namespace scandiff::gui {
 //! VTK points reading `count` xyz triples at `xyz` in place (no copy; VTK does not free them).
 vtkSmartPointer<vtkPoints> pointsOver(const float* xyz, std::size_t count);
 
-//! Vertex cells for every stride-th point, as two flat 32-bit arrays (half the
-//! memory of VTK's default 64-bit ids; a cloud above 2^31 points is refused by
-//! the view before this).
-vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride);
+//! Vertex cells for every stride-th point from `first` on, as two flat 32-bit
+//! arrays (half the memory of VTK's default 64-bit ids; a cloud above 2^31
+//! points is refused by the view before this). The `stride` sets of firsts
+//! 0 .. stride - 1 hold every point once: the view's slices.
+vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride, std::size_t first = 0);
 
 //! A gridded cloud's cells (DEM of difference, raster) as flat squares on
 //! the ground plane at each cell's height: four corners per cell (float, about

@@ -6,6 +6,7 @@
 #include <scandiff/core/distance/DemOfDifference.h>
 
 #include <QElapsedTimer>
+#include <QResizeEvent>
 #include <QTimer>
 #include <QVBoxLayout>
 #include <QVTKOpenGLNativeWidget.h>
@@ -54,6 +55,7 @@
 #include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkVariant.h>
+#include <vtkImageData.h>
 #include <vtkWindowToImageFilter.h>
 
 #include <algorithm>
@@ -76,15 +78,16 @@ constexpr const char* kDiscardHidden = "//VTK::Light::Impl\n  if (gl_FragData[0]
 //! actor each: a renderer (software ones above all) then works on bounded
 //! buffers, as CloudCompare draws its clouds chunk by chunk. A chunk's VTK
 //! arrays are views on the entity's positions and RGBA colours (no copies); its
-//! decimated twin shares them and holds every stride-th vertex only.
+//! decimated twin shares them and holds every stride-th vertex only, and its
+//! slice (the picture refined at rest) the vertices of the slice being drawn.
 struct CloudView::Shown
 {
     struct Chunk
     {
         std::size_t begin = 0, count = 0;
-        vtkSmartPointer<vtkPolyData> full, decimated;
+        vtkSmartPointer<vtkPolyData> full, decimated, slice;
         vtkSmartPointer<vtkFloatArray> normals; //!< a view on the cloud's normals, when it has some
-        vtkSmartPointer<vtkPolyDataMapper> fullMapper, decimatedMapper;
+        vtkSmartPointer<vtkPolyDataMapper> fullMapper, decimatedMapper, sliceMapper;
         vtkSmartPointer<vtkUnsignedCharArray> colours;
         vtkSmartPointer<vtkActor> actor;
         std::size_t decimatedStride = 0;
@@ -119,12 +122,15 @@ struct CloudView::Scene
     std::map<EntityId, Shown> shown;
     std::optional<Eigen::Vector3d> sceneOrigin;
     float pointSize = 2.0f;
-    std::size_t budget = 1'500'000;
+    //! A start a software renderer (Mesa's, on a machine without a GPU) draws
+    //! in about a quarter of a second; the first frames measure the machine.
+    std::size_t budget = 300'000;
     bool adaptiveBudget = true;
     std::size_t stride = 1;
     bool moving = false;
     bool settling = false; //!< decimated after a colour change, until the settle timer fires
     bool renderPending = false;
+    Refinement refinement;
     bool pickMode = false;
     // Measurements: one polydata of paths and marks, and a label per measurement.
     vtkNew<vtkPolyData> annotations;
@@ -188,6 +194,11 @@ CloudView::CloudView(QWidget* parent) : QWidget(parent), scene_(std::make_unique
         if (scene_->settling)
             setMoving(false);
     });
+    // One slice per event-loop turn: whatever the user did meanwhile is served first.
+    sliceTimer_ = new QTimer(this);
+    sliceTimer_->setSingleShot(true);
+    sliceTimer_->setInterval(0);
+    connect(sliceTimer_, &QTimer::timeout, this, &CloudView::drawNextSlice);
     widget_ = new QVTKOpenGLNativeWidget(this);
     auto* layout = new QVBoxLayout(this);
     layout->setContentsMargins(0, 0, 0, 0);
@@ -1019,13 +1030,14 @@ void CloudView::updateStride()
 
 void CloudView::setMoving(bool moving)
 {
+    stopRefinement();
     scene_->moving = moving;
     scene_->settling = false;
     settleTimer_->stop();
     for (auto& [id, s] : scene_->shown)
-        setDecimated(s, moving);
+        setDecimated(s, moving || refinesInSlices());
     if (!moving)
-        render(); // full detail at rest
+        render(); // full detail at rest, at once or slice by slice
 }
 
 void CloudView::setDecimated(Shown& s, bool moving)
@@ -1196,24 +1208,153 @@ void CloudView::render()
         scene_->window->Render();
         return;
     }
-    // Full-detail frames tell how many points this machine draws per second;
-    // the decimated frames are sized to stay near 20 per second (a GPU draws
-    // tens of millions of points in that time, Mesa's software renderer about
-    // a hundred thousand).
+    if (refinesInSlices()) {
+        startRefinement();
+        return;
+    }
+    stopRefinement();
+    std::size_t drawn = 0;
+    for (auto& [id, s] : scene_->shown) {
+        setDecimated(s, false);
+        if (s.isCloud && s.chunks.front().actor->GetVisibility())
+            drawn += s.pointCount;
+    }
+    timedRender(drawn);
+}
+
+void CloudView::timedRender(std::size_t points)
+{
+    // Frames tell how many points this machine draws per second; a frame is
+    // sized to stay near 20 per second (a GPU draws tens of millions of
+    // points in that time, Mesa's software renderer about a hundred
+    // thousand). The budget grows at most fourfold a frame: a frame of few
+    // points measures the frame's fixed costs more than the points.
     QElapsedTimer clock;
     clock.start();
     scene_->window->Render();
     const double seconds = clock.nsecsElapsed() / 1e9;
-    std::size_t drawn = 0;
-    for (const auto& [id, s] : scene_->shown)
-        if (s.isCloud && s.chunks.front().actor->GetVisibility())
-            drawn += s.pointCount;
-    if (scene_->adaptiveBudget && drawn > 100'000 && seconds > 0.005) {
+    if (scene_->adaptiveBudget && points >= 50'000 && seconds > 0.005) {
         constexpr double kFrameSeconds = 0.05;
-        const auto budget = static_cast<std::size_t>(drawn / seconds * kFrameSeconds);
-        scene_->budget = std::max<std::size_t>(budget, 100'000);
+        const auto budget = static_cast<std::size_t>(points / seconds * kFrameSeconds);
+        scene_->budget = std::clamp<std::size_t>(budget, 100'000, 4 * scene_->budget);
         updateStride();
     }
+}
+
+bool CloudView::refinesInSlices() const { return scene_->stride > 1 && !scene_->eyeDomeLighting; }
+
+const CloudView::Refinement& CloudView::refinement() const { return scene_->refinement; }
+
+void CloudView::stopRefinement()
+{
+    sliceTimer_->stop();
+    scene_->refinement.refining = false;
+}
+
+void CloudView::startRefinement()
+{
+    stopRefinement();
+    Refinement& r = scene_->refinement;
+    r.slices = scene_->stride;
+    r.slicesDrawn = 1;
+    r.pointsDrawn = 0;
+    ++r.starts;
+    // Slice 0 is the decimated picture, drawn in full (background and all).
+    for (auto& [id, s] : scene_->shown) {
+        setDecimated(s, true);
+        if (!s.isCloud)
+            continue;
+        for (const auto& c : s.chunks)
+            if (c.actor->GetVisibility())
+                r.pointsDrawn += c.raster ? c.count : (c.count + r.slices - 1) / r.slices;
+    }
+    r.largestSlice = r.pointsDrawn;
+    timedRender(r.pointsDrawn);
+    r.refining = r.slices > 1;
+    if (r.refining)
+        sliceTimer_->start();
+}
+
+void CloudView::drawNextSlice()
+{
+    Refinement& r = scene_->refinement;
+    if (!r.refining || scene_->moving)
+        return;
+    const std::size_t slice = r.slicesDrawn;
+    const bool last = slice + 1 >= r.slices;
+    // Only the slice's points are drawn over the picture: what else it shows
+    // (meshes, grids, drawings, labels) is on it already.
+    std::vector<vtkProp*> resting;
+    std::size_t points = 0;
+    for (auto& [id, s] : scene_->shown) {
+        for (auto& c : s.chunks) {
+            if (!c.actor->GetVisibility())
+                continue;
+            if (!s.isCloud || c.raster) {
+                c.actor->VisibilityOff();
+                resting.push_back(c.actor);
+                continue;
+            }
+            if (!c.slice) {
+                c.slice = vtkSmartPointer<vtkPolyData>::New();
+                c.slice->SetPoints(c.full->GetPoints());
+                c.slice->GetPointData()->SetScalars(c.colours);
+                if (c.normals)
+                    c.slice->GetPointData()->SetNormals(c.normals);
+                c.sliceMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+                c.sliceMapper->SetInputData(c.slice);
+                c.sliceMapper->SetColorModeToDirectScalars();
+                c.sliceMapper->ScalarVisibilityOn();
+            }
+            c.sliceMapper->SetClippingPlanes(c.fullMapper->GetClippingPlanes());
+            c.slice->SetVerts(vertexCells(c.count, r.slices, slice));
+            points += slice < c.count ? (c.count - slice + r.slices - 1) / r.slices : 0;
+            c.actor->SetMapper(c.sliceMapper);
+        }
+        if (s.labels && s.labels->GetVisibility()) {
+            s.labels->VisibilityOff();
+            resting.push_back(s.labels);
+        }
+    }
+    for (vtkProp* prop : {static_cast<vtkProp*>(scene_->annotationActor.Get())})
+        if (prop->GetVisibility()) {
+            prop->VisibilityOff();
+            resting.push_back(prop);
+        }
+    for (const auto& label : scene_->labels)
+        if (label->GetVisibility()) {
+            label->VisibilityOff();
+            resting.push_back(label);
+        }
+    // The overlays (colour and scale bars) once more over the last slice only:
+    // drawn over themselves at each slice, their texts would thicken.
+    scene_->overlay->SetDraw(last);
+    scene_->renderer->PreserveColorBufferOn();
+    scene_->renderer->PreserveDepthBufferOn();
+    timedRender(points);
+    scene_->renderer->PreserveColorBufferOff();
+    scene_->renderer->PreserveDepthBufferOff();
+    scene_->overlay->SetDraw(true);
+    for (vtkProp* prop : resting)
+        prop->VisibilityOn();
+    for (auto& [id, s] : scene_->shown)
+        for (auto& c : s.chunks)
+            if (s.isCloud && !c.raster && c.decimatedMapper)
+                c.actor->SetMapper(c.decimatedMapper);
+    r.slicesDrawn = slice + 1;
+    r.pointsDrawn += points;
+    r.largestSlice = std::max(r.largestSlice, points);
+    r.refining = !last;
+    if (r.refining)
+        sliceTimer_->start();
+}
+
+void CloudView::resizeEvent(QResizeEvent* event)
+{
+    QWidget::resizeEvent(event);
+    // The widget redraws a resized window itself, from the decimated clouds.
+    if (refinesInSlices() && !scene_->moving)
+        renderSoon();
 }
 
 void CloudView::renderSoon()
@@ -1231,6 +1372,7 @@ void CloudView::renderInteractively()
 {
     // A threshold drag or a colour change redraws at once with the decimated
     // clouds, and in full once the changes stop for a moment.
+    stopRefinement();
     if (scene_->stride <= 1) {
         render();
         return;
@@ -1247,8 +1389,12 @@ void CloudView::renderInteractively()
 
 bool CloudView::saveScreenshot(const QString& path)
 {
-    if (scene_->moving)
-        setMoving(false); // a picture shows every point
+    // A picture shows every point: one full frame, however long it takes.
+    stopRefinement();
+    scene_->moving = scene_->settling = false;
+    settleTimer_->stop();
+    for (auto& [id, s] : scene_->shown)
+        setDecimated(s, false);
     scene_->window->Render();
     vtkNew<vtkWindowToImageFilter> grab;
     grab->SetInput(scene_->window);
@@ -1258,7 +1404,27 @@ bool CloudView::saveScreenshot(const QString& path)
     writer->SetFileName(path.toStdString().c_str());
     writer->SetInputConnection(grab->GetOutputPort());
     writer->Write();
+    for (auto& [id, s] : scene_->shown)
+        setDecimated(s, refinesInSlices()); // the next frame at rest is refined again
     return writer->GetErrorCode() == 0;
+}
+
+QImage CloudView::shownPicture() const
+{
+    vtkNew<vtkWindowToImageFilter> grab;
+    grab->SetInput(scene_->window);
+    grab->ShouldRerenderOff();
+    grab->ReadFrontBufferOff();
+    grab->SetInputBufferTypeToRGB();
+    grab->Update();
+    vtkImageData* image = grab->GetOutput();
+    int size[3] = {0, 0, 0};
+    image->GetDimensions(size);
+    QImage picture(size[0], size[1], QImage::Format_RGB888);
+    const auto* pixels = static_cast<const std::uint8_t*>(image->GetScalarPointer());
+    for (int y = 0; y < size[1]; ++y) // VTK's rows run bottom-up
+        std::copy_n(pixels + 3 * static_cast<std::size_t>(y) * size[0], 3 * size[0], picture.scanLine(size[1] - 1 - y));
+    return picture;
 }
 
 QSurfaceFormat CloudView::defaultSurfaceFormat() { return QVTKOpenGLNativeWidget::defaultFormat(); }

@@ -14,6 +14,7 @@
 
 #include <QSurfaceFormat>
 #include <QColor>
+#include <QImage>
 #include <QWidget>
 
 #include <array>
@@ -107,10 +108,11 @@ public:
     CameraState camera() const;
     void setCamera(const CameraState& state);
 
-    //! Points drawn while the camera moves or a threshold is dragged: clouds are
-    //! decimated by one common stride so their total stays below it. By default
-    //! it adapts to the machine (what it draws in 1/20 s, measured on full
-    //! frames); setting it turns the adaptation off.
+    //! Points drawn in one frame: while the camera moves or a threshold is
+    //! dragged, clouds are decimated by one common stride so their total stays
+    //! below it; at rest, the full picture is drawn in slices of that size (see
+    //! Refinement). By default it adapts to the machine (what it draws in 1/20
+    //! s, measured on each frame); setting it turns the adaptation off.
     void setInteractiveBudget(std::size_t points);
     std::size_t interactiveBudget() const;
     //! The stride used while moving (1 = no decimation); for tests.
@@ -121,6 +123,23 @@ public:
     bool shownFrame(EntityId id, Eigen::Vector3d& offset, Eigen::Vector3f& firstPosition) const;
     //! Switches the decimated drawing on or off as a camera move would.
     void setMoving(bool moving);
+    //! The picture at rest when the clouds hold more points than one frame's
+    //! budget: the decimated frame first (slice 0: every stride-th point),
+    //! then slices 1 .. stride - 1 (every stride-th point from the slice's
+    //! number on) drawn over it one per event-loop turn, without clearing, so
+    //! that no frame on the GUI thread draws more than the budget and menus,
+    //! clicks and camera moves are served between slices. A move, a colour or
+    //! threshold change stops it; the next rest starts again from slice 0.
+    struct Refinement
+    {
+        std::size_t slices = 0;       //!< in the picture being refined (its stride)
+        std::size_t slicesDrawn = 0;  //!< slice 0 included
+        std::size_t pointsDrawn = 0;  //!< by those slices
+        std::size_t largestSlice = 0; //!< points of the largest slice drawn
+        std::size_t starts = 0;       //!< refinements started since the view was made
+        bool refining = false;        //!< slices remain and are scheduled
+    };
+    const Refinement& refinement() const;
 
     //! Scissors: left clicks draw a polygon on the screen, a right click (or
     //! finishScissors) closes it and emits polygonDrawn; turning the mode off
@@ -152,6 +171,9 @@ public:
 
     //! Renders now and saves the view to a PNG.
     bool saveScreenshot(const QString& path);
+    //! The picture on screen now, as drawn so far (nothing drawn again): for
+    //! tests of what the slices add up to.
+    QImage shownPicture() const;
     //! Renders now (in full at rest).
     void render();
     //! One render at the next event-loop turn, however many changes ask for it.
@@ -179,7 +201,17 @@ private:
     //! Clips every chunk's mappers to the box's six faces (or none).
     void applyClipping();
     void setDecimated(Shown& shown, bool moving);
+    //! Whether the clouds at rest are drawn in slices (more points than the
+    //! budget; Eye-Dome Lighting's passes redraw the whole frame, so not then).
+    bool refinesInSlices() const;
+    void startRefinement();
+    void drawNextSlice();
+    void stopRefinement();
+    //! One frame, timed: the budget follows what the machine draws in 1/20 s.
+    void timedRender(std::size_t points);
+    void resizeEvent(QResizeEvent* event) override;
     QTimer* settleTimer_ = nullptr;
+    QTimer* sliceTimer_ = nullptr;
     bool pickAtDevicePixel(int x, int y);
     struct Scene;
     QVTKOpenGLNativeWidget* widget_;
