@@ -406,8 +406,7 @@ void CloudView::addEntity(const Document::Item& item)
                 makeRasterGeometry(*c.full, points, begin, c.count, *rasterCell);
                 c.colours->SetNumberOfTuples(static_cast<vtkIdType>(4 * c.count));
             } else {
-                c.full->SetPoints(pointsOver(xyz + 3 * begin, c.count));
-                c.full->SetVerts(vertexCells(c.count, 1));
+                c.full->SetPoints(pointsOver(xyz + 3 * begin, c.count)); // its vertices when drawn in full (setDecimated)
                 c.colours->SetArray(s.rgba.data() + 4 * begin, static_cast<vtkIdType>(4 * c.count), /*save*/ 1);
             }
             c.full->GetPointData()->SetScalars(c.colours);
@@ -436,6 +435,7 @@ void CloudView::addEntity(const Document::Item& item)
         }
     }
     updateStride();
+    setDecimated(s, scene_->moving || refinesInSlices());
     refreshEntity(item);
     if (scene_->clipping)
         applyClipping();
@@ -1048,6 +1048,13 @@ void CloudView::setDecimated(Shown& s, bool moving)
     for (auto& c : s.chunks) {
         if (c.raster)
             continue; // one quad per cell: already light
+        // A vertex list of every point (8 bytes a point) exists only while
+        // the chunk is drawn in full: a cloud refined in slices never is,
+        // but for a screenshot.
+        if (!decimate && c.full->GetNumberOfVerts() == 0)
+            c.full->SetVerts(vertexCells(c.count, 1));
+        else if (decimate && c.full->GetNumberOfVerts() > 0)
+            c.full->SetVerts(vtkSmartPointer<vtkCellArray>::New());
         if (decimate && c.decimatedStride != scene_->stride) {
             c.decimated = vtkSmartPointer<vtkPolyData>::New();
             c.decimated->SetPoints(c.full->GetPoints());

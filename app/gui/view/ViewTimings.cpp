@@ -11,6 +11,9 @@
 #include <QElapsedTimer>
 
 #include <algorithm>
+#include <fstream>
+#include <string>
+#include <utility>
 
 #include <iomanip>
 #include <iostream>
@@ -29,6 +32,22 @@ template <class F> double averageMilliseconds(F&& f)
     for (int i = 0; i < kRepeats; ++i)
         f();
     return clock.nsecsElapsed() / 1e6 / kRepeats;
+}
+
+//! Resident memory now and at its peak (MB), from /proc (Linux).
+std::pair<double, double> residentMegabytes()
+{
+    std::ifstream status("/proc/self/status");
+    double now = 0, peak = 0;
+    std::string key;
+    while (status >> key) {
+        double kilobytes = 0;
+        if (key == "VmRSS:" && status >> kilobytes)
+            now = kilobytes / 1024;
+        else if (key == "VmHWM:" && status >> kilobytes)
+            peak = kilobytes / 1024;
+    }
+    return {now, peak};
 }
 
 } // namespace
@@ -89,7 +108,10 @@ int measureView(MainWindow& window)
         int step = 0;
         threshold = averageMilliseconds([&] { range->setRange(r.min + (r.max - r.min) * 0.05 * (++step % 10), r.max); });
     }
+    const auto [resident, peak] = residentMegabytes();
     std::cout << std::fixed << std::setprecision(1) << "points " << points << "\n"
+              << "resident MB " << resident << " (" << resident * 1048576 / static_cast<double>(points) << " bytes a point), peak "
+              << peak << "\n"
               << "first picture ms " << first << " (slice 0 of " << slices << ")\n"
               << "everything drawn ms " << everything << "\n"
               << "longest event-loop turn ms " << longest << "\n"
