@@ -698,13 +698,22 @@ private slots:
         for (std::size_t i = 0; i < kSide; ++i)
             for (std::size_t j = 0; j < kSide; ++j)
                 terrain.positions()[i * kSide + j] = {0.02f * i, 0.02f * j, static_cast<float>(3 * std::sin(0.01 * i) * std::cos(0.013 * j))};
-        const std::size_t points = terrain.size();
+        // A roof 7 m above the terrain's crests, 1 x 4 m at 5 mm: the slices
+        // drawn later must not paint the terrain over it.
+        PointCloud roof;
+        roof.resize(200 * 800);
+        for (std::size_t i = 0; i < 200; ++i)
+            for (std::size_t j = 0; j < 800; ++j)
+                roof.positions()[i * 800 + j] = {21.0f + 0.005f * i, 20.0f + 0.005f * j, 10.0f};
+        const std::size_t points = terrain.size() + roof.size();
+        // Each chunk rounds its share of a slice up.
+        const std::size_t chunks = ((terrain.size() + (1u << 18) - 1) >> 18) + ((roof.size() + (1u << 18) - 1) >> 18);
         window.document().add("terrain", std::move(terrain));
+        window.document().add("roof", std::move(roof));
         constexpr std::size_t kBudget = 400'000;
         view.setInteractiveBudget(kBudget);
         const std::size_t slices = (points + kBudget - 1) / kBudget;
         QTRY_COMPARE(view.interactiveStride(), slices); // the view shows what the document holds
-        const std::size_t chunks = (points + (1u << 18) - 1) >> 18; // each chunk rounds its share of a slice up
         const gui::CloudView::Refinement& r = view.refinement();
 
         // A cloud added is drawn decimated at once, at rest a moment later.
@@ -725,7 +734,8 @@ private slots:
         // covers, the same colour, but where points tie in depth (the order of
         // drawing differs: a neighbour of a nearly equal colour may win).
         // Seen from close enough that the points stand apart on the screen
-        // (about 3 pixels between them), a slice missing shows.
+        // (about 3 pixels between them), a slice missing shows; the roof in
+        // the middle of the view shows a slice drawn through what hides it.
         gui::CameraState close;
         close.focalPoint = {22, 22, 0};
         close.position = {22, 22, 100};
@@ -775,8 +785,7 @@ private slots:
         QVERIFY(r.refining);
         // A colour change stops them too, and starts them again once the changes stop.
         QTRY_VERIFY_WITH_TIMEOUT(view.refinement().slicesDrawn >= 2, 60000);
-        const EntityId id = window.document().ids().front();
-        window.document().setNeutral(id, true);
+        window.document().setNeutral(window.document().ids().front(), true);
         QVERIFY(!r.refining);
         QTRY_VERIFY_WITH_TIMEOUT(view.refinement().starts == starts + 2, 5000);
         QTRY_VERIFY_WITH_TIMEOUT(!view.refinement().refining, 300000);

@@ -208,6 +208,9 @@ CloudView::CloudView(QWidget* parent) : QWidget(parent), scene_(std::make_unique
     scene_->window->SetNumberOfLayers(2);
     scene_->overlay->SetLayer(1);
     scene_->overlay->InteractiveOff();
+    // Its props are flat and need no depth: the clouds' depth is kept for the
+    // slices drawn over the picture at rest (drawNextSlice).
+    scene_->overlay->PreserveDepthBufferOn();
     scene_->overlay->SetActiveCamera(scene_->renderer->GetActiveCamera());
     scene_->window->AddRenderer(scene_->overlay);
     scene_->renderer->GradientBackgroundOn();
@@ -542,6 +545,7 @@ void CloudView::clear()
     scene_->scalarBar->VisibilityOff();
     legend_ = {};
     setAnnotations(std::vector<Annotation>(annotations_)); // the frame is gone: redrawn once a cloud sets one
+    updateStride();
     render();
 }
 
@@ -691,6 +695,15 @@ void CloudView::setClippingBox(bool on)
             moved->SetClientData(this);
             moved->SetCallback([](vtkObject*, unsigned long, void* self, void*) { static_cast<CloudView*>(self)->applyClipping(); });
             scene_->clipWidget->AddObserver(vtkCommand::InteractionEvent, moved);
+            // Dragging the box is a move like the camera's: decimated while it
+            // lasts, refined at rest (the widget's own frames draw what is set).
+            auto dragged = vtkSmartPointer<vtkCallbackCommand>::New();
+            dragged->SetClientData(this);
+            dragged->SetCallback([](vtkObject*, unsigned long event, void* self, void*) {
+                static_cast<CloudView*>(self)->setMoving(event == vtkCommand::StartInteractionEvent);
+            });
+            scene_->clipWidget->AddObserver(vtkCommand::StartInteractionEvent, dragged);
+            scene_->clipWidget->AddObserver(vtkCommand::EndInteractionEvent, dragged);
         }
         // Around what is shown.
         double bounds[6];
@@ -1290,16 +1303,23 @@ void CloudView::drawNextSlice()
     const std::size_t slice = r.slicesDrawn;
     const bool last = slice + 1 >= r.slices;
     // Only the slice's points are drawn over the picture: what else it shows
-    // (meshes, grids, drawings, labels) is on it already.
+    // (meshes, grids, drawings, labels, the clipping box) is on it already,
+    // and is drawn once more over the last slice, so that what stands in
+    // front of the points (labels, the box) stays in front.
     std::vector<vtkProp*> resting;
+    const auto rest = [&](vtkProp* prop) {
+        if (!last && prop->GetVisibility()) {
+            prop->VisibilityOff();
+            resting.push_back(prop);
+        }
+    };
     std::size_t points = 0;
     for (auto& [id, s] : scene_->shown) {
         for (auto& c : s.chunks) {
             if (!c.actor->GetVisibility())
                 continue;
             if (!s.isCloud || c.raster) {
-                c.actor->VisibilityOff();
-                resting.push_back(c.actor);
+                rest(c.actor);
                 continue;
             }
             if (!c.slice) {
@@ -1318,21 +1338,14 @@ void CloudView::drawNextSlice()
             points += slice < c.count ? (c.count - slice + r.slices - 1) / r.slices : 0;
             c.actor->SetMapper(c.sliceMapper);
         }
-        if (s.labels && s.labels->GetVisibility()) {
-            s.labels->VisibilityOff();
-            resting.push_back(s.labels);
-        }
+        if (s.labels)
+            rest(s.labels);
     }
-    for (vtkProp* prop : {static_cast<vtkProp*>(scene_->annotationActor.Get())})
-        if (prop->GetVisibility()) {
-            prop->VisibilityOff();
-            resting.push_back(prop);
-        }
+    rest(scene_->annotationActor);
     for (const auto& label : scene_->labels)
-        if (label->GetVisibility()) {
-            label->VisibilityOff();
-            resting.push_back(label);
-        }
+        rest(label);
+    if (scene_->clipping)
+        rest(scene_->clipBox);
     // The overlays (colour and scale bars) once more over the last slice only:
     // drawn over themselves at each slice, their texts would thicken.
     scene_->overlay->SetDraw(last);
@@ -1354,13 +1367,16 @@ void CloudView::drawNextSlice()
     r.refining = !last;
     if (r.refining)
         sliceTimer_->start();
+    else if (!refinesInSlices())
+        renderSoon(); // the budget grew past the scene meanwhile: one full frame now
 }
 
 void CloudView::resizeEvent(QResizeEvent* event)
 {
     QWidget::resizeEvent(event);
-    // The widget redraws a resized window itself, from the decimated clouds.
-    if (refinesInSlices() && !scene_->moving)
+    // The widget redraws a resized window itself, from what the actors hold
+    // (the decimated clouds after slices): the picture at rest again.
+    if (!scene_->moving)
         renderSoon();
 }
 

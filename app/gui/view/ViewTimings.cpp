@@ -88,7 +88,7 @@ int measureView(MainWindow& window)
     double first = 0, longest = 0, everything = 0;
     refine(first, longest, everything); // uploads buffers and compiles shaders, and measures the machine
     refine(first, longest, everything);
-    const std::size_t slices = view.refinement().refining || view.interactiveStride() > 1 ? view.refinement().slicesDrawn : 1;
+    const std::size_t slices = view.refinement().starts > 0 ? view.refinement().slicesDrawn : 1;
     view.setMoving(true);
     const double moving = averageMilliseconds([&] { view.render(); });
     view.setMoving(false);
