@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "view/CloudView.h"
 #include "view/ChunkGeometry.h"
+#include "view/CloudViewScene.h"
 
 #include <scandiff/core/Log.h>
 #include <scandiff/core/distance/DemOfDifference.h>
 
-#include <QElapsedTimer>
 #include <QResizeEvent>
 #include <QTimer>
 #include <QVBoxLayout>
@@ -74,86 +74,6 @@ constexpr const char* kDiscardHidden = "//VTK::Light::Impl\n  if (gl_FragData[0]
 
 } // namespace
 
-//! One shown entity, drawn as chunks of at most kChunkPoints points, one
-//! actor each: a renderer (software ones above all) then works on bounded
-//! buffers, as CloudCompare draws its clouds chunk by chunk. A chunk's VTK
-//! arrays are views on the entity's positions and RGBA colours (no copies); its
-//! decimated twin shares them and holds every stride-th vertex only, and its
-//! slice (the picture refined at rest) the vertices of the slice being drawn.
-struct CloudView::Shown
-{
-    struct Chunk
-    {
-        std::size_t begin = 0, count = 0;
-        vtkSmartPointer<vtkPolyData> full, decimated, slice;
-        vtkSmartPointer<vtkFloatArray> normals; //!< a view on the cloud's normals, when it has some
-        vtkSmartPointer<vtkPolyDataMapper> fullMapper, decimatedMapper, sliceMapper;
-        vtkSmartPointer<vtkUnsignedCharArray> colours;
-        vtkSmartPointer<vtkActor> actor;
-        std::size_t decimatedStride = 0;
-        //! A gridded cloud's chunk: four corners per point (its cell), colours
-        //! copied from the entity's RGBA at each refresh, never decimated.
-        bool raster = false;
-    };
-    bool isCloud = true;
-    std::size_t pointCount = 0;
-    float ownPointSize = 0; //!< the entity's own point size; 0: the view's
-    bool documentVisible = true; //!< its tick in the tree; the view may still hide it (setShownHere)
-    std::vector<std::uint8_t> rgba; //!< 4 bytes per point, what the chunks' colour arrays show
-    std::vector<Chunk> chunks;
-    //! A drawing's texts (stone ids), placed so that they never overlap: as
-    //! many as the view has room for, more as one zooms in.
-    vtkSmartPointer<vtkActor2D> labels;
-};
-
-struct CloudView::Scene
-{
-    vtkNew<vtkGenericOpenGLRenderWindow> window;
-    vtkNew<vtkRenderer> renderer;
-    //! The flat overlays (colour bar, scale bar, scissors) on a layer of their
-    //! own, drawn after the clouds: the Eye-Dome Lighting pass of the main
-    //! layer must not shade them.
-    vtkNew<vtkRenderer> overlay;
-    vtkNew<vtkScalarBarActor> scalarBar;
-    vtkNew<vtkLookupTable> scalarBarTable;
-    vtkNew<vtkPointPicker> picker;
-    //! For gridded clouds: a click inside a cell picks the cell, whatever its size on screen.
-    vtkNew<vtkCellPicker> cellPicker;
-    std::map<EntityId, Shown> shown;
-    std::optional<Eigen::Vector3d> sceneOrigin;
-    float pointSize = 2.0f;
-    //! A start a software renderer (Mesa's, on a machine without a GPU) draws
-    //! in about a quarter of a second; the first frames measure the machine.
-    std::size_t budget = 300'000;
-    bool adaptiveBudget = true;
-    std::size_t stride = 1;
-    bool moving = false;
-    bool settling = false; //!< decimated after a colour change, until the settle timer fires
-    bool renderPending = false;
-    Refinement refinement;
-    bool pickMode = false;
-    // Measurements: one polydata of paths and marks, and a label per measurement.
-    vtkNew<vtkPolyData> annotations;
-    vtkNew<vtkActor> annotationActor;
-    std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels;
-    bool eyeDomeLighting = false;
-    vtkSmartPointer<vtkEDLShading> edl;
-    vtkNew<vtkBoxWidget2> clipWidget;
-    vtkNew<vtkBoxRepresentation> clipBox;
-    bool clipping = false;
-    // The scale bar: a line of a round length (1, 2 or 5 x 10^k m) about a
-    // fifth of the view wide, its length written above it, sized before each
-    // frame from the camera (at the focal point's depth in perspective).
-    bool scaleBarShown = true;
-    vtkNew<vtkPolyData> scaleBarLine;
-    vtkNew<vtkActor2D> scaleBarActor;
-    vtkNew<vtkTextActor> scaleBarText;
-    // Scissors: the polygon being drawn, in widget pixels, and its outline on screen.
-    bool scissorsMode = false;
-    std::vector<Eigen::Vector2d> scissors;
-    vtkNew<vtkPolyData> scissorsOutline;
-    vtkNew<vtkActor2D> scissorsActor;
-};
 
 
 //! In pick mode, a left click picks a point and stops there (no rotation).
@@ -1240,135 +1160,6 @@ void CloudView::render()
             drawn += s.pointCount;
     }
     timedRender(drawn);
-}
-
-void CloudView::timedRender(std::size_t points)
-{
-    // Frames tell how many points this machine draws per second; a frame is
-    // sized to stay near 20 per second (a GPU draws tens of millions of
-    // points in that time, Mesa's software renderer about a hundred
-    // thousand). The budget grows at most fourfold a frame: a frame of few
-    // points measures the frame's fixed costs more than the points.
-    QElapsedTimer clock;
-    clock.start();
-    scene_->window->Render();
-    const double seconds = clock.nsecsElapsed() / 1e9;
-    if (scene_->adaptiveBudget && points >= 50'000 && seconds > 0.005) {
-        constexpr double kFrameSeconds = 0.05;
-        const auto budget = static_cast<std::size_t>(points / seconds * kFrameSeconds);
-        scene_->budget = std::clamp<std::size_t>(budget, 100'000, 4 * scene_->budget);
-        updateStride();
-    }
-}
-
-bool CloudView::refinesInSlices() const { return scene_->stride > 1 && !scene_->eyeDomeLighting; }
-
-const CloudView::Refinement& CloudView::refinement() const { return scene_->refinement; }
-
-void CloudView::stopRefinement()
-{
-    sliceTimer_->stop();
-    scene_->refinement.refining = false;
-}
-
-void CloudView::startRefinement()
-{
-    stopRefinement();
-    Refinement& r = scene_->refinement;
-    r.slices = scene_->stride;
-    r.slicesDrawn = 1;
-    r.pointsDrawn = 0;
-    ++r.starts;
-    // Slice 0 is the decimated picture, drawn in full (background and all).
-    for (auto& [id, s] : scene_->shown) {
-        setDecimated(s, true);
-        if (!s.isCloud)
-            continue;
-        for (const auto& c : s.chunks)
-            if (c.actor->GetVisibility())
-                r.pointsDrawn += c.raster ? c.count : (c.count + r.slices - 1) / r.slices;
-    }
-    r.largestSlice = r.pointsDrawn;
-    timedRender(r.pointsDrawn);
-    r.refining = r.slices > 1;
-    if (r.refining)
-        sliceTimer_->start();
-}
-
-void CloudView::drawNextSlice()
-{
-    Refinement& r = scene_->refinement;
-    if (!r.refining || scene_->moving)
-        return;
-    const std::size_t slice = r.slicesDrawn;
-    const bool last = slice + 1 >= r.slices;
-    // Only the slice's points are drawn over the picture: what else it shows
-    // (meshes, grids, drawings, labels, the clipping box) is on it already,
-    // and is drawn once more over the last slice, so that what stands in
-    // front of the points (labels, the box) stays in front.
-    std::vector<vtkProp*> resting;
-    const auto rest = [&](vtkProp* prop) {
-        if (!last && prop->GetVisibility()) {
-            prop->VisibilityOff();
-            resting.push_back(prop);
-        }
-    };
-    std::size_t points = 0;
-    for (auto& [id, s] : scene_->shown) {
-        for (auto& c : s.chunks) {
-            if (!c.actor->GetVisibility())
-                continue;
-            if (!s.isCloud || c.raster) {
-                rest(c.actor);
-                continue;
-            }
-            if (!c.slice) {
-                c.slice = vtkSmartPointer<vtkPolyData>::New();
-                c.slice->SetPoints(c.full->GetPoints());
-                c.slice->GetPointData()->SetScalars(c.colours);
-                if (c.normals)
-                    c.slice->GetPointData()->SetNormals(c.normals);
-                c.sliceMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-                c.sliceMapper->SetInputData(c.slice);
-                c.sliceMapper->SetColorModeToDirectScalars();
-                c.sliceMapper->ScalarVisibilityOn();
-            }
-            c.sliceMapper->SetClippingPlanes(c.fullMapper->GetClippingPlanes());
-            c.slice->SetVerts(vertexCells(c.count, r.slices, slice));
-            points += slice < c.count ? (c.count - slice + r.slices - 1) / r.slices : 0;
-            c.actor->SetMapper(c.sliceMapper);
-        }
-        if (s.labels)
-            rest(s.labels);
-    }
-    rest(scene_->annotationActor);
-    for (const auto& label : scene_->labels)
-        rest(label);
-    if (scene_->clipping)
-        rest(scene_->clipBox);
-    // The overlays (colour and scale bars) once more over the last slice only:
-    // drawn over themselves at each slice, their texts would thicken.
-    scene_->overlay->SetDraw(last);
-    scene_->renderer->PreserveColorBufferOn();
-    scene_->renderer->PreserveDepthBufferOn();
-    timedRender(points);
-    scene_->renderer->PreserveColorBufferOff();
-    scene_->renderer->PreserveDepthBufferOff();
-    scene_->overlay->SetDraw(true);
-    for (vtkProp* prop : resting)
-        prop->VisibilityOn();
-    for (auto& [id, s] : scene_->shown)
-        for (auto& c : s.chunks)
-            if (s.isCloud && !c.raster && c.decimatedMapper)
-                c.actor->SetMapper(c.decimatedMapper);
-    r.slicesDrawn = slice + 1;
-    r.pointsDrawn += points;
-    r.largestSlice = std::max(r.largestSlice, points);
-    r.refining = !last;
-    if (r.refining)
-        sliceTimer_->start();
-    else if (!refinesInSlices())
-        renderSoon(); // the budget grew past the scene meanwhile: one full frame now
 }
 
 void CloudView::resizeEvent(QResizeEvent* event)

@@ -1,0 +1,116 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+//! What a CloudView holds (private to view/): its VTK scene and, per shown
+//! entity, its chunks. Shared by CloudView.cpp and ViewRefinement.cpp.
+
+#include "view/CloudView.h"
+
+#include <vtkActor.h>
+#include <vtkActor2D.h>
+#include <vtkBillboardTextActor3D.h>
+#include <vtkBoxRepresentation.h>
+#include <vtkBoxWidget2.h>
+#include <vtkCellPicker.h>
+#include <vtkEDLShading.h>
+#include <vtkFloatArray.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkLookupTable.h>
+#include <vtkNew.h>
+#include <vtkPointPicker.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkSmartPointer.h>
+#include <vtkTextActor.h>
+#include <vtkUnsignedCharArray.h>
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <vector>
+
+namespace scandiff::gui {
+
+//! One shown entity, drawn as chunks of at most kChunkPoints points, one
+//! actor each: a renderer (software ones above all) then works on bounded
+//! buffers, as CloudCompare draws its clouds chunk by chunk. A chunk's VTK
+//! arrays are views on the entity's positions and RGBA colours (no copies); its
+//! decimated twin shares them and holds every stride-th vertex only, and its
+//! slice (the picture refined at rest) the vertices of the slice being drawn.
+struct CloudView::Shown
+{
+    struct Chunk
+    {
+        std::size_t begin = 0, count = 0;
+        vtkSmartPointer<vtkPolyData> full, decimated, slice;
+        vtkSmartPointer<vtkFloatArray> normals; //!< a view on the cloud's normals, when it has some
+        vtkSmartPointer<vtkPolyDataMapper> fullMapper, decimatedMapper, sliceMapper;
+        vtkSmartPointer<vtkUnsignedCharArray> colours;
+        vtkSmartPointer<vtkActor> actor;
+        std::size_t decimatedStride = 0;
+        //! A gridded cloud's chunk: four corners per point (its cell), colours
+        //! copied from the entity's RGBA at each refresh, never decimated.
+        bool raster = false;
+    };
+    bool isCloud = true;
+    std::size_t pointCount = 0;
+    float ownPointSize = 0; //!< the entity's own point size; 0: the view's
+    bool documentVisible = true; //!< its tick in the tree; the view may still hide it (setShownHere)
+    std::vector<std::uint8_t> rgba; //!< 4 bytes per point, what the chunks' colour arrays show
+    std::vector<Chunk> chunks;
+    //! A drawing's texts (stone ids), placed so that they never overlap: as
+    //! many as the view has room for, more as one zooms in.
+    vtkSmartPointer<vtkActor2D> labels;
+};
+
+struct CloudView::Scene
+{
+    vtkNew<vtkGenericOpenGLRenderWindow> window;
+    vtkNew<vtkRenderer> renderer;
+    //! The flat overlays (colour bar, scale bar, scissors) on a layer of their
+    //! own, drawn after the clouds: the Eye-Dome Lighting pass of the main
+    //! layer must not shade them.
+    vtkNew<vtkRenderer> overlay;
+    vtkNew<vtkScalarBarActor> scalarBar;
+    vtkNew<vtkLookupTable> scalarBarTable;
+    vtkNew<vtkPointPicker> picker;
+    //! For gridded clouds: a click inside a cell picks the cell, whatever its size on screen.
+    vtkNew<vtkCellPicker> cellPicker;
+    std::map<EntityId, Shown> shown;
+    std::optional<Eigen::Vector3d> sceneOrigin;
+    float pointSize = 2.0f;
+    //! A start a software renderer (Mesa's, on a machine without a GPU) draws
+    //! in about a quarter of a second; the first frames measure the machine.
+    std::size_t budget = 300'000;
+    bool adaptiveBudget = true;
+    std::size_t stride = 1;
+    bool moving = false;
+    bool settling = false; //!< decimated after a colour change, until the settle timer fires
+    bool renderPending = false;
+    Refinement refinement;
+    bool pickMode = false;
+    // Measurements: one polydata of paths and marks, and a label per measurement.
+    vtkNew<vtkPolyData> annotations;
+    vtkNew<vtkActor> annotationActor;
+    std::vector<vtkSmartPointer<vtkBillboardTextActor3D>> labels;
+    bool eyeDomeLighting = false;
+    vtkSmartPointer<vtkEDLShading> edl;
+    vtkNew<vtkBoxWidget2> clipWidget;
+    vtkNew<vtkBoxRepresentation> clipBox;
+    bool clipping = false;
+    // The scale bar: a line of a round length (1, 2 or 5 x 10^k m) about a
+    // fifth of the view wide, its length written above it, sized before each
+    // frame from the camera (at the focal point's depth in perspective).
+    bool scaleBarShown = true;
+    vtkNew<vtkPolyData> scaleBarLine;
+    vtkNew<vtkActor2D> scaleBarActor;
+    vtkNew<vtkTextActor> scaleBarText;
+    // Scissors: the polygon being drawn, in widget pixels, and its outline on screen.
+    bool scissorsMode = false;
+    std::vector<Eigen::Vector2d> scissors;
+    vtkNew<vtkPolyData> scissorsOutline;
+    vtkNew<vtkActor2D> scissorsActor;
+};
+
+} // namespace scandiff::gui
