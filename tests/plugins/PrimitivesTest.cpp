@@ -723,22 +723,22 @@ TEST(Primitives, PartsOfOneSurfaceAreJoinedAcrossWhatNoScannerSawAndKeptApartWhe
             const PrimitiveKind kind = result.primitives[static_cast<std::size_t>(largest->first)].primitive.kind;
             EXPECT_EQ(kind, label == 1 ? PrimitiveKind::Cylinder : PrimitiveKind::Plane) << "seed " << seed << " label " << label;
         }
+        // The points of one label, and how many of them a shape holds.
+        const auto heldOf = [&](int label) {
+            std::pair<std::size_t, std::size_t> counts{0, 0};
+            for (std::size_t i = 0; i < scene.label.size(); ++i)
+                if (scene.label[i] == label) {
+                    ++counts.first;
+                    counts.second += result.primitiveId[i] >= 0;
+                }
+            return counts;
+        };
         // No shape holds the returns behind the column.
-        std::size_t behind = 0, held = 0;
-        for (std::size_t i = 0; i < scene.label.size(); ++i)
-            if (scene.label[i] == 5) {
-                ++behind;
-                held += result.primitiveId[i] >= 0;
-            }
+        const auto [behind, held] = heldOf(5);
         EXPECT_GT(behind, 100u);
         EXPECT_EQ(held, 0u) << "seed " << seed << ": of " << behind << " returns behind the column";
         // Nor the returns on the plates' plane where the scanner saw the floor through.
-        std::size_t past = 0, kept = 0;
-        for (std::size_t i = 0; i < scene.label.size(); ++i)
-            if (scene.label[i] == 6) {
-                ++past;
-                kept += result.primitiveId[i] >= 0;
-            }
+        const auto [past, kept] = heldOf(6);
         EXPECT_GT(past, 20u);
         EXPECT_EQ(kept, 0u) << "seed " << seed << ": of " << past << " returns past plate 2";
         // The two plates are two shapes.
