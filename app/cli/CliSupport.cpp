@@ -128,6 +128,8 @@ std::map<std::string, CLI::Option*> addParameterOptions(CLI::App& command, const
         else
             option = command.add_option_function<std::string>("--" + name, [userText, name](const std::string& v) { (*userText)[name] = v; },
                                                               parameterHelp(p));
+        if (p.type == ParameterType::Text && p.commandLineValues > 1)
+            option->expected(p.commandLineValues);
         if (p.required)
             option->required();
         options[name] = option;
@@ -147,6 +149,35 @@ ThreadLimit::ThreadLimit(int threads)
 }
 
 ThreadLimit::~ThreadLimit() = default;
+
+void checkOutputFile(const std::filesystem::path& file, const io::FormatRegistry* formats)
+{
+    const std::filesystem::path folder = file.parent_path().empty() ? std::filesystem::path(".") : file.parent_path();
+    std::error_code error;
+    if (!std::filesystem::is_directory(folder, error))
+        throw Error(ErrorCode::Io, "cannot write " + file.string() + ": the folder " + folder.string() + " does not exist");
+    if (::access(folder.c_str(), W_OK) != 0)
+        throw Error(ErrorCode::Io, "cannot write " + file.string() + ": the folder " + folder.string() + " is not writable");
+    if (std::filesystem::is_directory(file, error))
+        throw Error(ErrorCode::Io, "cannot write " + file.string() + ": it is a folder");
+    if (formats) {
+        const io::FormatHandler& handler = formats->forPath(file); // throws for an unknown extension
+        if (!handler.writeCloud && !handler.writeMesh && !handler.writeClouds)
+            throw Error(ErrorCode::Unsupported, "cannot write " + file.string() + ": scandiff reads " + handler.name + " but does not write it");
+    }
+}
+
+void prepareOutputFolder(const std::filesystem::path& folder)
+{
+    std::error_code error;
+    if (std::filesystem::exists(folder, error) && !std::filesystem::is_directory(folder, error))
+        throw Error(ErrorCode::Io, "output folder " + folder.string() + " is a file");
+    std::filesystem::create_directories(folder, error);
+    if (error || !std::filesystem::is_directory(folder))
+        throw Error(ErrorCode::Io, "cannot create the output folder " + folder.string() + (error ? ": " + error.message() : ""));
+    if (::access(folder.c_str(), W_OK) != 0)
+        throw Error(ErrorCode::Io, "the output folder " + folder.string() + " is not writable");
+}
 
 void printStatistics(std::ostream& out, const std::string& label, const DistanceStatistics& s)
 {

@@ -77,6 +77,15 @@ private:
     std::unique_ptr<tbb::global_control> control_;
 };
 
+//! Checks, before any computation, that `file` can be written: its folder
+//! exists and is writable, it is not a folder, and (with `formats`) its
+//! extension names a format scandiff writes. Throws Error(Io or Unsupported)
+//! naming the file, so a long run never ends on a refused output.
+void checkOutputFile(const std::filesystem::path& file, const io::FormatRegistry* formats = nullptr);
+//! Creates an output folder (and its parents) when missing; throws
+//! Error(Io) when it cannot or when the path names a file.
+void prepareOutputFolder(const std::filesystem::path& folder);
+
 //! "label: N values, mean ..., std ..., min ..., max ..., RMS ..." on one line.
 void printStatistics(std::ostream& out, const std::string& label, const DistanceStatistics& statistics);
 

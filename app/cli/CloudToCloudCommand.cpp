@@ -39,6 +39,8 @@ void addCloudToCloudCommand(CLI::App& app, const PluginRegistry& registry, Strea
     c->callback([args, &registry, streams] {
         const ThreadLimit threadLimit(args->threads);
         const ParameterValues values = resolveParameters(cloudToCloudParameters(), *args->values, "c2c");
+        if (!args->output.empty())
+            checkOutputFile(args->output, &registry.formats);
 
         TerminalProgress progress;
         const io::ReadOptions readOptions = args->read.toOptions(&progress);

@@ -37,6 +37,8 @@ void addCloudToMeshCommand(CLI::App& app, const PluginRegistry& registry, Stream
         // Parameters are checked before the (possibly long) reads.
         const CloudToMeshParams params = cloudToMeshSettings(resolveParameters(cloudToMeshParameters(), *args->values, "c2m"));
         const ThreadLimit threadLimit(args->threads);
+        if (!args->output.empty())
+            checkOutputFile(args->output, &registry.formats);
 
         TerminalProgress progress;
         io::ReadOptions meshOptions;

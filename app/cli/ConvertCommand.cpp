@@ -21,6 +21,7 @@ void addConvertCommand(CLI::App& app, const PluginRegistry& registry, Streams st
     args->read.addTo(*command);
     args->write.addTo(*command);
     command->callback([args, &registry, streams] {
+        checkOutputFile(args->output, &registry.formats);
         TerminalProgress progress;
         const io::FormatHandler& source = registry.formats.forPath(args->input);
         const io::FormatHandler& target = registry.formats.forPath(args->output);

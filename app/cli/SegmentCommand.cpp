@@ -37,6 +37,13 @@ struct ExportFlags
             ->check(CLI::PositiveNumber);
         command.add_option("--cloud-format", cloudFormat, "Extension of the region clouds (default ply)");
     }
+
+    //! The folder created and the region clouds' format checked before anything is read.
+    void prepare(const io::FormatRegistry& formats) const
+    {
+        prepareOutputFolder(outDir);
+        checkOutputFile(std::filesystem::path(outDir) / ("regions." + cloudFormat), &formats);
+    }
 };
 
 //! The segmentation options: the declared parameters, with `range` taking the
@@ -106,6 +113,7 @@ void addSegmentCommand(CLI::App& app, const PluginRegistry& registry, Streams st
         const ThreadLimit threadLimit(args->threads);
         // Parameters are checked before the (possibly long) reads.
         const ParameterValues values = resolveParameters(segmentationParameters(), *args->values, "segment");
+        args->exportFlags.prepare(registry.formats);
         TerminalProgress progress;
         const io::ReadOptions readOptions = args->read.toOptions(&progress);
         PointCloud cloud = io::readPointCloud(registry.formats, args->input, readOptions);
@@ -225,6 +233,7 @@ void addCompareCommand(CLI::App& app, const PluginRegistry& registry, Streams st
                                                         " is an M3C2 option; add --method m3c2");
         if (m3c2 && !m3c2Tool)
             throw Error(ErrorCode::Unsupported, "compare: this build has no m3c2 tool");
+        args->exportFlags.prepare(registry.formats);
         TerminalProgress progress;
         const io::ReadOptions readOptions = args->read.toOptions(&progress);
         const io::WriteOptions write = args->write.toOptions(&progress);

@@ -85,6 +85,26 @@ std::filesystem::path outputPath(const ToolSpec& tool, const OutputSpec& spec, c
                                      extensionFor(spec, output.data, primary.extension().string()));
 }
 
+//! Every place an output will go, checked (and --out-dir created) before the
+//! inputs are read: a refused output must not cost the run.
+void checkOutputPlaces(const ToolSpec& tool, const OutputPlaces& places, const std::string& report, const io::FormatRegistry& formats)
+{
+    const auto isEntity = [](const OutputSpec& spec) { return spec.kind == DataKind::Cloud || spec.kind == DataKind::Mesh; };
+    if (!places.directory.empty())
+        prepareOutputFolder(places.directory);
+    if (!places.primary.empty()) {
+        const OutputSpec& first = tool.outputs.front();
+        checkOutputFile(places.primary, isEntity(first) && !first.repeated ? &formats : nullptr);
+    }
+    for (const auto& spec : tool.outputs) {
+        const auto own = places.byRole.find(spec.role);
+        if (own != places.byRole.end() && !own->second.empty())
+            checkOutputFile(own->second, isEntity(spec) ? &formats : nullptr);
+    }
+    if (!report.empty())
+        checkOutputFile(report);
+}
+
 //! The run as JSON: what --report writes (tables and matrices by role).
 nlohmann::json reportJson(const ToolSpec& tool, const ToolResult& result, double seconds)
 {
@@ -223,7 +243,7 @@ void addOneTool(CLI::App& app, const ToolSpec& tool, const PluginRegistry& regis
     if (!tool.outputs.empty()) {
         command->add_option("-o,--output", args->output, outputHelp(tool));
         command->add_option("--out-dir", args->places.directory,
-                            "Write every output into this existing folder: DIR/ROLE.ext, one file per entity of a repeated output");
+                            "Write every output into this folder (created when missing): DIR/ROLE.ext, one file per entity of a repeated output");
         for (const auto& o : tool.outputs)
             if (&o != &tool.outputs.front() && !o.repeated)
                 command->add_option("--" + o.role + "-out", args->places.byRole[o.role], "Write the " + o.label + " to this file");
@@ -239,6 +259,9 @@ void addOneTool(CLI::App& app, const ToolSpec& tool, const PluginRegistry& regis
         const ThreadLimit threadLimit(args->threads);
         // Parameters are checked before the (possibly long) reading of the inputs.
         const ParameterValues values = toolPtr->resolve(*args->values);
+        OutputPlaces places = args->places;
+        places.primary = args->output;
+        checkOutputPlaces(*toolPtr, places, args->report, registry.formats);
         TerminalProgress progress;
         LoadedInputs loaded;
         loadInputs(*toolPtr, args->inputs, registry, args->read.toOptions(&progress), loaded);
@@ -248,10 +271,6 @@ void addOneTool(CLI::App& app, const ToolSpec& tool, const PluginRegistry& regis
         streams.out << toolPtr->name << ": " << result.summary << " [" << std::fixed << std::setprecision(3) << seconds << " s]\n";
         streams.out.unsetf(std::ios::floatfield);
         const io::WriteOptions writeOptions = args->write.toOptions(&progress);
-        OutputPlaces places = args->places;
-        places.primary = args->output;
-        if (!places.directory.empty() && !std::filesystem::is_directory(places.directory))
-            throw Error(ErrorCode::Io, "--out-dir " + places.directory + " is not an existing folder");
         if (!args->report.empty()) {
             // Written first: the outputs below may move data out of the result.
             io::AtomicFile file(args->report);

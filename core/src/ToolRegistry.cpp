@@ -115,6 +115,13 @@ ParameterSpec ParameterSpec::asRequired() const
     return s;
 }
 
+ParameterSpec ParameterSpec::takingValues(int count) const
+{
+    ParameterSpec s = *this;
+    s.commandLineValues = count;
+    return s;
+}
+
 ParameterSpec ParameterSpec::withSuggestions(std::vector<std::string> values) const
 {
     ParameterSpec s = *this;

@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include <iomanip>
 #include <random>
 #include <sstream>
 
@@ -180,4 +181,127 @@ TEST(ProcessingCli, SectionsWriteSlabsATableAndADxfDrawing)
             ++slabs;
         }
     EXPECT_EQ(slabs, 5u); // middles at 0.1, 2.1, 4.1, 6.1, 8.1 m of a 10 m terrain
+}
+
+TEST(ProcessingCli, FilterByValueKeepsExactlyThePointsABruteForceKeeps)
+{
+    // Draws over the values fields hold: small integers (classes), signed
+    // distances, GPS times whose microseconds only a double keeps; holes
+    // without a value; bounds inside, on and around the values.
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    for (std::uint32_t seed = 1; seed <= 24; ++seed) {
+        std::mt19937 rng(seed);
+        PointCloud cloud;
+        cloud.name = "draw";
+        cloud.setOrigin({512000.0 * (seed % 3), 5423000.0 * (seed % 2), 0});
+        const std::size_t n = 500 + seed * 37;
+        cloud.resize(n);
+        ScalarField& field = cloud.addField("value");
+        const int kind = static_cast<int>(seed % 3);
+        if (kind == 2)
+            field.keepDoubles();
+        std::uniform_real_distribution<double> unit(0.0, 1.0);
+        for (std::size_t i = 0; i < n; ++i) {
+            cloud.positions()[i] = Eigen::Vector3f(static_cast<float>(i), 0.0f, 0.0f);
+            if (unit(rng) < 0.05)
+                continue; // no value
+            const double v = kind == 0 ? std::floor(unit(rng) * 10) : kind == 1 ? (unit(rng) - 0.5) * 0.2
+                                                                                 : 1.4e9 + std::round(unit(rng) * 3.6e9) * 1e-6;
+            field.setValue(i, v);
+        }
+        const std::string path = (dir / "draw.ply").string();
+        io::writePointCloud(registry.formats, cloud, path);
+        const PointCloud read = io::readPointCloud(registry.formats, path);
+        const ScalarField& f = *read.field("value");
+        // Bounds: two of the values themselves (bounds are included), or drawn.
+        std::vector<std::size_t> withValue;
+        for (std::size_t i = 0; i < n; ++i)
+            if (f.hasValue(i))
+                withValue.push_back(i);
+        double a = f.value(withValue[rng() % withValue.size()]), b = f.value(withValue[rng() % withValue.size()]);
+        if (seed % 4 == 0)
+            a = f.range().min + (f.range().max - f.range().min) * unit(rng);
+        if (a > b)
+            std::swap(a, b);
+        const bool outside = seed % 2 == 1;
+        std::ostringstream low, high;
+        low << std::setprecision(17) << a;
+        high << std::setprecision(17) << b;
+        std::vector<std::string> args = {"filter", path, "--field", "value", "--range", low.str(), high.str(), "-o", (dir / "kept.ply").string()};
+        if (outside)
+            args.push_back("--outside");
+        const test::CliRun r = test::runCliInProcess(registry, args);
+        ASSERT_EQ(r.status, 0) << r.err;
+        std::vector<double> expected;
+        for (std::size_t i : withValue) {
+            const double v = f.value(i);
+            if ((v >= a && v <= b) != outside)
+                expected.push_back(v);
+        }
+        const PointCloud kept = io::readPointCloud(registry.formats, dir / "kept.ply");
+        ASSERT_EQ(kept.size(), expected.size()) << "seed " << seed;
+        const ScalarField& keptField = *kept.field("value");
+        for (std::size_t k = 0; k < expected.size(); ++k)
+            ASSERT_EQ(keptField.value(k), expected[k]) << "seed " << seed << " point " << k; // in order, every bit
+    }
+    // Bounds the wrong way round, one bound, a field the cloud lacks: clear errors, nothing written.
+    const std::string input = terrain(registry, dir / "t.ply", 1, 0).string();
+    const auto out = (dir / "none.ply").string();
+    test::CliRun r = test::runCliInProcess(registry, {"filter", input, "--field", "intensity", "--range", "5", "1", "-o", out});
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find("lower bound is above"), std::string::npos) << r.err;
+    r = test::runCliInProcess(registry, {"filter", input, "--field", "nothing", "--range", "1", "5", "-o", out});
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("has no field 'nothing'"), std::string::npos) << r.err;
+    r = test::runCliInProcess(registry, {"filter", input, "--field", "intensity", "--range", "1", "-o", out});
+    EXPECT_NE(r.status, 0);
+    EXPECT_FALSE(std::filesystem::exists(out));
+    // The negative bounds of a signed distance are values, not options.
+    r = test::runCliInProcess(registry, {"filter", input, "--field", "intensity", "--range", "-1", "9", "-o", out});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(io::readPointCloud(registry.formats, out).size(), 300u); // values 0..9 of i % 100, 30 points each
+}
+
+TEST(ProcessingCli, OutputPlacesAreCheckedOrCreatedBeforeTheInputsAreRead)
+{
+    // The input does not exist: a command that checks its outputs first
+    // reports the output, not the input.
+    const PluginRegistry registry = makePluginRegistry();
+    const auto dir = test::tempDir();
+    const std::string missingInput = (dir / "missing.ply").string();
+    const std::string noFolder = (dir / "no" / "such" / "out.ply").string();
+    const std::vector<std::vector<std::string>> commands = {
+        {"normals", missingInput, "--radius", "0.5", "-o", noFolder},
+        {"c2c", "--reference", missingInput, "--compared", missingInput, "-o", noFolder},
+        {"c2m", "--reference", missingInput, "--compared", missingInput, "-o", noFolder},
+        {"convert", missingInput, noFolder},
+        {"field-histogram", missingInput, "--field", "f", "--report", noFolder + ".json"},
+    };
+    for (const auto& command : commands) {
+        const test::CliRun r = test::runCliInProcess(registry, command);
+        EXPECT_NE(r.status, 0) << command.front();
+        EXPECT_NE(r.err.find("does not exist"), std::string::npos) << command.front() << ": " << r.err;
+        EXPECT_EQ(r.err.find("missing.ply"), std::string::npos) << command.front() << ": " << r.err;
+    }
+    // A format scandiff does not write, refused as early.
+    test::CliRun r = test::runCliInProcess(registry, {"subsample", missingInput, "--spatial", "1", "-o", (dir / "out.unknown").string()});
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("unknown"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("missing.ply"), std::string::npos) << r.err;
+
+    // --out-dir is created, parents and all, for the registry's tools and for segment.
+    const std::string input = terrain(registry, dir / "t.ply", 2, 0).string();
+    const auto created = dir / "new" / "folder";
+    r = test::runCliInProcess(registry, {"sections", input, "--axis", "x", "--thickness", "0.2", "--step", "4", "--out-dir", created.string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(std::filesystem::exists(created / "sections.dxf"));
+    r = test::runCliInProcess(registry, {"segment", input, "--field", "intensity", "--range", "90", "99", "--out-dir", (dir / "s" / "t").string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(std::filesystem::exists(dir / "s" / "t" / "regions.csv"));
+    // A file where the folder should be: refused, the file untouched.
+    r = test::runCliInProcess(registry, {"sections", input, "--axis", "x", "--thickness", "0.2", "--step", "4", "--out-dir", input});
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("is a file"), std::string::npos) << r.err;
+    EXPECT_EQ(io::readPointCloud(registry.formats, input).size(), 3000u);
 }

@@ -58,12 +58,12 @@ TEST(GeoTiff, ADemOfDifferenceReadsBackWithItsGridBandsAndNodata)
     EXPECT_DOUBLE_EQ(transform[3], 5400003.0); // the top edge, north up
     EXPECT_DOUBLE_EQ(transform[5], -0.5);
     ASSERT_EQ(GDALGetRasterCount(dataset), 5);
-    int differenceBand = 0;
+    // Band 1 is the difference: what QGIS and gdaldem show without being told.
+    const std::vector<std::string> bandNames = {fields::kDodDifference, fields::kDodLod, fields::kDodSignificant, fields::kZReference,
+                                                fields::kZCompared};
     for (int b = 1; b <= 5; ++b)
-        if (std::string(GDALGetDescription(GDALGetRasterBand(dataset, b))) == fields::kDodDifference)
-            differenceBand = b;
-    ASSERT_GT(differenceBand, 0);
-    GDALRasterBandH band = GDALGetRasterBand(dataset, differenceBand);
+        EXPECT_EQ(std::string(GDALGetDescription(GDALGetRasterBand(dataset, b))), bandNames[static_cast<std::size_t>(b - 1)]);
+    GDALRasterBandH band = GDALGetRasterBand(dataset, 1);
     int hasNoData = 0;
     EXPECT_TRUE(std::isnan(GDALGetRasterNoDataValue(band, &hasNoData)));
     EXPECT_TRUE(hasNoData);

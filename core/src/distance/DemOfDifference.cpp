@@ -266,8 +266,10 @@ DemOfDifferenceResult demOfDifference(const PointCloud* reference, const PointCl
     cells.resize(kept.size());
     const char* names[] = {fields::kRasterCol,    fields::kRasterRow, fields::kZReference,     fields::kZCompared,
                            fields::kDodDifference, fields::kDodLod,   fields::kDodSignificant};
-    for (const char* name : names)
-        cells.addField(ScalarField(name, kept.size()));
+    // The difference is the first field after the cell's place, so that it is
+    // a GeoTIFF's band 1: the band QGIS and gdaldem show unless told otherwise.
+    for (int k : {0, 1, 4, 5, 6, 2, 3})
+        cells.addField(ScalarField(names[k], kept.size()));
     ScalarField* f[7];
     for (int k = 0; k < 7; ++k)
         f[k] = cells.field(names[k]);

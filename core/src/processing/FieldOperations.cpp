@@ -333,4 +333,25 @@ Table fieldHistogram(const ScalarField& field, int bins, std::optional<std::pair
     return table;
 }
 
+FilterByValueResult filterByValue(const PointCloud& cloud, const FilterByValueParams& params)
+{
+    const ScalarField* field = cloud.field(params.field);
+    if (!field)
+        throw Error(ErrorCode::InvalidArgument, "filter: cloud '" + cloud.name + "' has no field '" + params.field + "'");
+    if (!(params.low <= params.high))
+        throw Error(ErrorCode::InvalidArgument, "filter: the range's lower bound is above its upper bound");
+    FilterByValueResult result;
+    for (std::size_t i = 0; i < field->size(); ++i) {
+        if (!field->hasValue(i)) {
+            ++result.withoutValue;
+            continue;
+        }
+        const double v = field->value(i);
+        const bool inside = v >= params.low && v <= params.high;
+        if (inside != params.outside)
+            result.kept.push_back(i);
+    }
+    return result;
+}
+
 } // namespace scandiff

@@ -80,6 +80,9 @@ struct ParameterSpec
     //! field's histogram (its threshold range), so the value tuned live on
     //! the view is the one the tool runs with.
     std::string thresholdOfField;
+    //! Text only: how many values the command-line option takes at once
+    //! ("--range A B": 2); they arrive joined by ';' as repeated values do.
+    int commandLineValues = 1;
 
     static ParameterSpec integer(std::string name, std::string label, std::string description, std::int64_t defaultValue,
                                  std::int64_t minimum, std::int64_t maximum, std::string unit = {});
@@ -107,6 +110,8 @@ struct ParameterSpec
     ParameterSpec withZeroMeaning(std::string meaning) const;
     //! The same declaration, a threshold on the field `fieldParameter` names (see `thresholdOfField`).
     ParameterSpec asThresholdOf(std::string fieldParameter) const;
+    //! The same declaration, its option taking `count` values (see `commandLineValues`).
+    ParameterSpec takingValues(int count) const;
 
     //! Parses user text ("12", "0.5", "true", "plane") into a valid value.
     //! Throws Error(InvalidArgument) naming the parameter and its valid range.

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Tools: field (expressions), field-gradient, field-smooth, field-rename,
-// field-delete, field-to-colours, colours-to-field, field-histogram.
+// field-delete, field-to-colours, colours-to-field, field-histogram, filter.
 #include "processing/tools/ToolGroups.h"
 
 #include <scandiff/core/ColourScale.h>
@@ -9,9 +9,21 @@
 #include <scandiff/core/processing/FieldOperations.h>
 #include <scandiff/core/segmentation/FastMarching.h>
 
+#include <sstream>
+
 namespace scandiff::detail {
 
 namespace {
+
+//! The words of `text` between blanks.
+std::vector<std::string> splitWords(const std::string& text)
+{
+    std::vector<std::string> words;
+    std::istringstream stream(text);
+    for (std::string word; stream >> word;)
+        words.push_back(word);
+    return words;
+}
 
 const ScalarField& fieldOf(const PointCloud& cloud, const std::string& name, const std::string& tool)
 {
@@ -244,6 +256,47 @@ void addHistogramTool(ToolRegistry& registry)
     registry.add(std::move(tool));
 }
 
+void addFilterTool(ToolRegistry& registry)
+{
+    ToolSpec tool = oneCloudTool("filter", "Filter by value", "Scalar fields",
+                                 "Keeps the points whose value of a field lies in [A, B] (bounds included), or with --outside "
+                                 "the points outside it (CloudCompare's Filter by value). Points without a value are left out "
+                                 "either way.",
+                                 newCloud("Filtered cloud"));
+    tool.parameters = {
+        fieldParameter("The field"),
+        ParameterSpec::text("range", "Range", "A B: the bounds, in the field's units (also 'A,B')").asRequired().takingValues(2),
+        ParameterSpec::boolean("outside", "Keep outside", "Keep the points outside [A, B] instead", false),
+    };
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver*) {
+        const PointCloud& input = inputs.cloud();
+        // "A B", "A,B" or, from the command line's two values, "A;B".
+        std::vector<double> bounds;
+        std::istringstream words(values.text("range"));
+        for (std::string word; std::getline(words, word, ';');)
+            for (const std::string& part : splitWords(word))
+                for (double v : parseNumberList(part, "the range"))
+                    bounds.push_back(v);
+        if (bounds.size() != 2)
+            throw Error(ErrorCode::InvalidArgument, "filter: --range takes two values A B");
+        FilterByValueParams params;
+        params.field = fieldOf(input, values.text("field"), "filter").name();
+        params.low = bounds[0];
+        params.high = bounds[1];
+        params.outside = values.boolean("outside");
+        const FilterByValueResult filtered = filterByValue(input, params);
+        PointCloud out = input.subset(filtered.kept);
+        out.name = input.name + "_filtered";
+        ToolResult result;
+        result.summary = describe("kept ", filtered.kept.size(), " of ", input.size(), " points with ", params.field,
+                                  params.outside ? " outside [" : " in [", params.low, ", ", params.high, "]",
+                                  filtered.withoutValue ? describe(" (", filtered.withoutValue, " without a value left out)") : "");
+        result.add("output", std::move(out));
+        return result;
+    };
+    registry.add(std::move(tool));
+}
+
 } // namespace
 
 void registerFieldTools(ToolRegistry& registry)
@@ -256,6 +309,7 @@ void registerFieldTools(ToolRegistry& registry)
     addToColoursTool(registry);
     addFromColoursTool(registry);
     addHistogramTool(registry);
+    addFilterTool(registry);
 }
 
 } // namespace scandiff::detail

@@ -59,4 +59,22 @@ ScalarField fieldFromColours(const PointCloud& cloud, ColourChannel channel, con
 //! Error(InvalidArgument) for bins < 1 or low >= high.
 Table fieldHistogram(const ScalarField& field, int bins, std::optional<std::pair<double, double>> range = std::nullopt);
 
+//! CloudCompare's "filter by value": which points keep, or with `outside`
+//! lose, a value of the field in [low, high] (bounds included, compared on
+//! the exact values a double-valued field keeps). A point without a value is
+//! in neither set: a filter never invents a value for it.
+struct FilterByValueParams
+{
+    std::string field;
+    double low = 0.0, high = 0.0;
+    bool outside = false;
+};
+struct FilterByValueResult
+{
+    std::vector<std::size_t> kept; //!< in cloud order
+    std::size_t withoutValue = 0;  //!< points left out for having no value
+};
+//! Throws Error(InvalidArgument) for a missing field or low > high.
+FilterByValueResult filterByValue(const PointCloud& cloud, const FilterByValueParams& params);
+
 } // namespace scandiff
