@@ -348,6 +348,53 @@ FastMarchingResult fastMarching(const PointCloud& cloud, const std::vector<std::
     return result;
 }
 
+namespace {
+
+double medianOf(std::vector<double>& values)
+{
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+}
+
+//! Which regions are the field's noise rather than a change (see
+//! PropagationResult::backgroundRegions); `ceiling` receives median + 3 sigma.
+std::vector<bool> backgroundRegions(const ScalarField& field, const CellGrid& grid, const std::vector<std::uint32_t>& indices,
+                                    const std::vector<std::size_t>& regionOfCell, const std::vector<std::size_t>& regionPoints,
+                                    const PropagationParams& params, double& ceiling)
+{
+    std::vector<double> all;
+    all.reserve(field.size());
+    for (std::size_t i = 0; i < field.size(); ++i)
+        if (field.hasValue(i))
+            all.push_back(field.value(i));
+    const double median = medianOf(all);
+    for (double& v : all)
+        v = std::abs(v - median);
+    const double sigma = 1.4826 * medianOf(all);
+    ceiling = median + 3.0 * sigma;
+
+    std::vector<std::vector<double>> values(regionPoints.size());
+    for (std::size_t c = 0; c < regionOfCell.size(); ++c) {
+        const std::size_t r = regionOfCell[c];
+        if (r == 0 || regionPoints[r] < params.minPoints)
+            continue;
+        for (std::size_t s = grid.firstSorted[c]; s < grid.firstSorted[c + 1]; ++s)
+            if (field.hasValue(indices[s]))
+                values[r].push_back(field.value(indices[s]));
+    }
+    std::vector<bool> background(regionPoints.size(), false);
+    for (std::size_t r = 1; r < values.size(); ++r) {
+        if (values[r].empty())
+            continue;
+        const double regionMedian = medianOf(values[r]);
+        background[r] = regionMedian < params.minSeedValue && regionMedian <= ceiling;
+    }
+    return background;
+}
+
+} // namespace
+
 PropagationResult propagationSegmentation(const PointCloud& cloud, const std::string& fieldName, const PropagationParams& params,
                                           ProgressObserver* progress)
 {
@@ -439,13 +486,21 @@ PropagationResult propagationSegmentation(const PointCloud& cloud, const std::st
         regionPoints.push_back(points);
     }
 
-    // Ids by decreasing size, small regions dropped.
+    // Ids by decreasing size; small regions dropped, background left out.
+    const std::vector<bool> background =
+        backgroundRegions(field, grid, indices, regionOfCell, regionPoints, params, result.noiseCeiling);
     std::vector<std::size_t> regions;
     for (std::size_t r = 1; r < regionPoints.size(); ++r) {
-        if (regionPoints[r] >= params.minPoints)
-            regions.push_back(r);
-        else
+        if (regionPoints[r] < params.minPoints) {
             ++result.droppedRegions;
+        } else if (background[r]) {
+            ++result.backgroundRegions;
+            result.backgroundPoints += regionPoints[r];
+            if (params.keepBackground)
+                regions.push_back(r);
+        } else {
+            regions.push_back(r);
+        }
     }
     std::stable_sort(regions.begin(), regions.end(), [&](std::size_t a, std::size_t b) { return regionPoints[a] > regionPoints[b]; });
     std::vector<std::size_t> idOf(regionPoints.size(), 0);

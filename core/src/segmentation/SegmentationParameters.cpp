@@ -104,6 +104,11 @@ const std::vector<ParameterSpec>& segmentationParameters()
                                 1e30)
                 .asOptional()
                 .onlyWith("propagate"),
+            ParameterSpec::boolean("keep-background", "Keep background regions",
+                                   "propagate: also keep the regions whose values are the field's noise (a noise value above "
+                                   "the seed value started them); left out by default",
+                                   false)
+                .onlyWith("propagate"),
             ParameterSpec::real("stop-speed", "Stop speed", "propagate: the front does not cross where the speed falls below this",
                                 propagation.stopSpeed, 1e-12, 1.0)
                 .onlyWith("propagate"),
@@ -188,6 +193,7 @@ SegmentationRun runSegmentation(const PointCloud& cloud, const ParameterValues& 
         p.stopSpeed = values.real("stop-speed");
         p.level = static_cast<int>(values.integer("level"));
         p.minPoints = static_cast<std::size_t>(values.integer("min-points"));
+        p.keepBackground = values.boolean("keep-background");
         p.gradient.radius = values.real("gradient-radius");
         if (values.has("smoothing"))
             p.gradient.smoothingSigma = values.real("smoothing");
@@ -199,6 +205,11 @@ SegmentationRun runSegmentation(const PointCloud& cloud, const ParameterValues& 
                 << r.level << "): " << r.regionCount << " regions";
         if (r.droppedRegions)
             summary << " (" << r.droppedRegions << " smaller than " << p.minPoints << " points dropped)";
+        if (r.backgroundRegions)
+            summary << "; " << r.backgroundRegions << (r.backgroundRegions == 1 ? " region" : " regions") << " of "
+                    << r.backgroundPoints << " points whose values are the field's noise (median below the seed value and "
+                    << r.noiseCeiling << ", the field's median + 3 sigma): background, "
+                    << (p.keepBackground ? "kept as asked" : "left out (keep-background keeps it)");
         run.fields.push_back(std::move(r.regionId));
         run.fields.push_back(std::move(r.arrivalTime));
         run.fields.push_back(std::move(r.gradient));

@@ -100,6 +100,9 @@ struct PropagationParams
     GradientParams gradient;
     //! Regions with fewer points are dropped (points left without a region), >= 1.
     std::size_t minPoints = 1;
+    //! Keep the regions whose values are the field's noise (see
+    //! PropagationResult::backgroundRegions) instead of leaving them out.
+    bool keepBackground = false;
 };
 
 struct PropagationResult
@@ -110,6 +113,16 @@ struct PropagationResult
     std::size_t regionCount = 0;
     std::vector<std::size_t> regionSizes; //!< points of region id r at index r-1
     std::size_t droppedRegions = 0;       //!< smaller than minPoints
+    //! Regions that are background, not change: one noise value above the
+    //! seed value starts a region, and on a flat field the front then crosses
+    //! the whole unchanged surface. A region is background when its median
+    //! value is below the seed value and within the field's noise: at most
+    //! the field's median + 3 sigma (sigma = 1.4826 x the median absolute
+    //! deviation, robust while changes are a minority). Left out (their
+    //! points without a region) unless keepBackground.
+    std::size_t backgroundRegions = 0;
+    std::size_t backgroundPoints = 0;
+    double noiseCeiling = 0.0; //!< the field's median + 3 sigma
     int level = 0;
     double cellSize = 0.0;
 };

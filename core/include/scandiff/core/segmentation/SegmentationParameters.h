@@ -22,7 +22,7 @@ namespace scandiff {
 
 //! field, absolute, range, above, kmeans, stat-test, neighbours, confidence, calibration,
 //! chi2-threshold, fit-box, noise, components, level, connectivity, min-points,
-//! propagate, alpha, min-seed, stop-speed, gradient-radius, smoothing,
+//! propagate, alpha, min-seed, keep-background, stop-speed, gradient-radius, smoothing,
 //! report-field, outline-cell, region-epoch, column-height, volume-cell.
 const std::vector<ParameterSpec>& segmentationParameters();
 
