@@ -13,6 +13,7 @@ PointCloud PointCloud::clone() const
     copy.name = name;
     copy.origin_ = origin_;
     copy.positions_ = positions_;
+    copy.residuals_ = residuals_;
     copy.colors_ = colors_;
     copy.normals_ = normals_;
     copy.fields_ = fields_;
@@ -26,14 +27,20 @@ PointCloud PointCloud::clone() const
 void PointCloud::shiftOrigin(const Eigen::Vector3d& newOrigin)
 {
     const Eigen::Vector3d delta = origin_ - newOrigin;
-    for (auto& p : positions_)
-        p = (p.cast<double>() + delta).cast<float>();
+    for (std::size_t i = 0; i < positions_.size(); ++i) {
+        const Eigen::Vector3d exact = (i < residuals_.size() ? exactLocalPosition(i) : positions_[i].cast<double>()) + delta;
+        positions_[i] = exact.cast<float>();
+        if (i < residuals_.size())
+            residuals_[i] = (exact - positions_[i].cast<double>()).cast<float>();
+    }
     origin_ = newOrigin;
 }
 
 void PointCloud::resize(std::size_t n)
 {
     positions_.resize(n, Eigen::Vector3f::Zero());
+    if (!residuals_.empty())
+        residuals_.resize(n, Eigen::Vector3f::Zero());
     if (!colors_.empty())
         colors_.resize(n);
     if (!normals_.empty())
@@ -153,6 +160,11 @@ PointCloud PointCloud::subset(const std::vector<std::size_t>& indices) const
                                                         std::to_string(positions_.size()) + " points of '" + name + "'");
         out.positions_.push_back(positions_[i]);
     }
+    if (!residuals_.empty()) {
+        out.residuals_.reserve(indices.size());
+        for (std::size_t i : indices)
+            out.residuals_.push_back(residuals_[i]);
+    }
     if (hasColors()) {
         out.colors_.reserve(indices.size());
         for (std::size_t i : indices)
@@ -177,6 +189,8 @@ std::size_t PointCloud::removeNonFinitePoints()
             continue;
         if (kept != i) {
             positions_[kept] = positions_[i];
+            if (!residuals_.empty())
+                residuals_[kept] = residuals_[i];
             if (!colors_.empty())
                 colors_[kept] = colors_[i];
             if (!normals_.empty())
@@ -188,6 +202,8 @@ std::size_t PointCloud::removeNonFinitePoints()
     }
     if (kept != n) {
         positions_.resize(kept);
+        if (!residuals_.empty())
+            residuals_.resize(kept);
         if (!colors_.empty())
             colors_.resize(kept);
         if (!normals_.empty())
@@ -209,6 +225,8 @@ void PointCloud::checkConsistency() const
         complain("colours", colors_.size());
     if (!normals_.empty() && normals_.size() != n)
         complain("normals", normals_.size());
+    if (!residuals_.empty() && residuals_.size() != n)
+        complain("position residuals", residuals_.size());
     for (const auto& f : fields_)
         if (f.size() != n)
             complain("scalar field '" + f.name() + "'", f.size());

@@ -373,6 +373,8 @@ std::string findCrs(const MappedFile& file, const LasHeader& h)
 struct PointOutputs
 {
     Eigen::Vector3f* positions = nullptr;
+    //! What the floats miss of the grid's coordinates, when the cloud keeps it.
+    Eigen::Vector3f* positionResiduals = nullptr;
     Rgb8* colors = nullptr;
     float* intensity = nullptr;
     float* returnNumber = nullptr;
@@ -431,9 +433,11 @@ DecodedFacts decodeRange(const char* records, std::size_t recordLength, std::siz
             if (field)
                 field[i] = value;
         };
-        out.positions[i] = Eigen::Vector3f(static_cast<float>(load<std::int32_t>(p) * sx + tx),
-                                           static_cast<float>(load<std::int32_t>(p + 4) * sy + ty),
-                                           static_cast<float>(load<std::int32_t>(p + 8) * sz + tz));
+        const Eigen::Vector3d local(load<std::int32_t>(p) * sx + tx, load<std::int32_t>(p + 4) * sy + ty,
+                                    load<std::int32_t>(p + 8) * sz + tz);
+        out.positions[i] = local.cast<float>();
+        if (out.positionResiduals)
+            out.positionResiduals[i] = (local - out.positions[i].cast<double>()).cast<float>();
         put(out.intensity, load<std::uint16_t>(p + 12));
         const auto returns = static_cast<unsigned char>(p[14]);
         if constexpr (Extended) {
@@ -935,6 +939,24 @@ void parseLazRecords(const MappedFile& file, const LasHeader& h, const LazLayout
     }
 }
 
+//! Whether a float around `origin` can miss the file's grid by half a step or
+//! more somewhere in the file's box (then the reader keeps each point's
+//! residual, see PointCloud::positionResiduals): a float's rounding at a
+//! distance d from the origin is at most d / 2^24. A box the header does not
+//! give (non-finite, inverted) is taken as the worst case.
+bool floatsMissTheGrid(const LasHeader& h, const Eigen::Vector3d& origin)
+{
+    for (int a = 0; a < 3; ++a) {
+        if (!(std::isfinite(h.min[a]) && std::isfinite(h.max[a]) && h.min[a] <= h.max[a]))
+            return true;
+        const double reach = std::max(std::abs(h.min[a] - origin[a]), std::abs(h.max[a] - origin[a]));
+        // A quarter step: the header's box may be rounded, the test stays on the safe side.
+        if (reach * 0x1p-24 >= 0.25 * std::abs(h.scale[a]))
+            return true;
+    }
+    return false;
+}
+
 //! The whole file, or with `range` the records of that range (a LAZ file's
 //! chunks that hold them are decoded whole).
 Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<RecordRange> range = std::nullopt)
@@ -1014,6 +1036,8 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
         tbb::parallel_invoke(
             [&] {
                 cloud.resize(count);
+                if (floatsMissTheGrid(h, cloud.origin()))
+                    cloud.positionResiduals().resize(count);
                 if (formatHasRgb(format))
                     cloud.enableColors();
             },
@@ -1052,6 +1076,8 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     };
     PointOutputs out;
     out.positions = cloud.positions().data();
+    if (!cloud.positionResiduals().empty())
+        out.positionResiduals = cloud.positionResiduals().data();
     out.colors = cloud.hasColors() ? cloud.enableColors().data() : nullptr;
     out.intensity = values("intensity");
     out.returnNumber = values("return_number");

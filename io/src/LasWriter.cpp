@@ -309,9 +309,10 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
         std::fill(buffer.begin(), buffer.end(), '\0');
         char* p = buffer.data();
         for (std::size_t i = begin; i < end; ++i) {
-            const Eigen::Vector3f& local = positions[i];
-            if (!local.allFinite())
+            if (!positions[i].allFinite())
                 continue;
+            // With the file's exact coordinates where a float misses its grid.
+            const Eigen::Vector3d local = cloud.exactLocalPosition(i);
             for (int a = 0; a < 3; ++a) {
                 const std::int32_t raw = clampRound<std::int32_t>((shift[a] + local[a]) * inverseScale[a]);
                 store<std::int32_t>(p + 4 * a, raw);

@@ -1799,7 +1799,8 @@ private:
     {
         switch (c.kind) {
         case ColumnKind::Coordinate:
-            return c.type == PlyType::Float64 ? cloud_->origin()[c.index] + static_cast<double>(cloud_->positions()[i][c.index])
+            // Doubles with what a float misses of a file's exact coordinates (PointCloud::positionResiduals).
+            return c.type == PlyType::Float64 ? cloud_->exactGlobalPosition(i)[c.index]
                                               : static_cast<double>(cloud_->positions()[i][c.index]);
         case ColumnKind::Color: {
             const Rgb8& rgb = cloud_->colors()[i];

@@ -94,7 +94,12 @@ PointCloud mergeClouds(const std::vector<const PointCloud*>& clouds, ProgressObs
         merged.setCrsWkt(clouds.front()->crsWkt());
     else
         logWarning("merge: the clouds are in different coordinate reference systems; the merged cloud has none");
+    bool exact = false; // a cloud keeps its file's exact coordinates: the merge keeps them all
+    for (const PointCloud* c : clouds)
+        exact = exact || !c->positionResiduals().empty();
     merged.resize(total);
+    if (exact)
+        merged.positionResiduals().assign(total, Eigen::Vector3f::Zero());
     if (colours)
         merged.enableColors();
     if (normals)
@@ -113,7 +118,10 @@ PointCloud mergeClouds(const std::vector<const PointCloud*>& clouds, ProgressObs
         const Eigen::Vector3d shift = c.origin() - merged.origin();
         const std::size_t n = c.size();
         forEachPoint(n, [&](std::size_t i) {
-            merged.positions()[at + i] = (c.positions()[i].cast<double>() + shift).cast<float>();
+            const Eigen::Vector3d local = (exact ? c.exactLocalPosition(i) : c.positions()[i].cast<double>()) + shift;
+            merged.positions()[at + i] = local.cast<float>();
+            if (exact)
+                merged.positionResiduals()[at + i] = (local - merged.positions()[at + i].cast<double>()).cast<float>();
             source.values()[at + i] = static_cast<float>(k);
         });
         if (colours)
@@ -199,6 +207,7 @@ PointCloud transformCloud(const PointCloud& cloud, const Eigen::Matrix4d& matrix
         throw Error(ErrorCode::InvalidArgument, "transform: the matrix is singular (it would flatten the cloud)");
     PointCloud out = cloud.clone();
     out.setSourceGrid(std::nullopt); // moved points leave the file's grid
+    out.dropPositionResiduals();     // and the file's exact coordinates
     // The moved cloud's bounds from the moved corners of its box, for its origin.
     BoundingBox moved;
     const BoundingBox box = cloud.bounds();

@@ -81,6 +81,38 @@ public:
     std::vector<Eigen::Vector3f>& positions() { return positions_; }
     Eigen::Vector3d globalPosition(std::size_t i) const { return origin_ + positions_[i].cast<double>(); }
 
+    //! What the float positions miss of the exact coordinates a file gave, per
+    //! point: exact local = p + r on each axis, in double. Empty unless a
+    //! reader keeps them, which it does only where a float cannot give the
+    //! file's value back: a LAS grid finer than the float's step at that
+    //! distance from the origin (laspy's 1_4_w_evlr.las: a scale of 1.2e-6
+    //! ft, 2,000 ft from the origin where a float's step is 1.2e-4). Writers
+    //! use exactLocalPosition(), so such a file goes back to the same
+    //! integers. 12 bytes a point, only for such files. A residual counts only
+    //! while it is below half the float's last digit (the float view is still
+    //! the rounding of that value): a position changed since wins, and a
+    //! transformation drops them.
+    const std::vector<Eigen::Vector3f>& positionResiduals() const { return residuals_; }
+    std::vector<Eigen::Vector3f>& positionResiduals() { return residuals_; }
+    void dropPositionResiduals()
+    {
+        residuals_.clear();
+        residuals_.shrink_to_fit();
+    }
+    //! The local position with its residual, in double (see positionResiduals()).
+    Eigen::Vector3d exactLocalPosition(std::size_t i) const
+    {
+        Eigen::Vector3d p = positions_[i].cast<double>();
+        if (i < residuals_.size())
+            for (int a = 0; a < 3; ++a) {
+                const float f = positions_[i][a], r = residuals_[i][a];
+                if (f + r == f)
+                    p[a] += static_cast<double>(r);
+            }
+        return p;
+    }
+    Eigen::Vector3d exactGlobalPosition(std::size_t i) const { return origin_ + exactLocalPosition(i); }
+
     //! Resizes positions and every attribute present (new entries: 0 / NaN).
     void resize(std::size_t n);
     void reserve(std::size_t n);
@@ -148,6 +180,7 @@ public:
 private:
     Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
     std::vector<Eigen::Vector3f> positions_;
+    std::vector<Eigen::Vector3f> residuals_; //!< see positionResiduals()
     std::vector<Rgb8> colors_;
     std::vector<Eigen::Vector3f> normals_;
     std::vector<ScalarField> fields_;
