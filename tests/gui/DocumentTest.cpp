@@ -10,6 +10,7 @@
 #include "widgets/RangeEditor.h"
 
 #include <QComboBox>
+#include <QDoubleSpinBox>
 #include <QPushButton>
 #include <QCheckBox>
 #include <QSignalSpy>
@@ -303,6 +304,61 @@ private slots:
         QVERIFY(!document.contains(child));
         QVERIFY(!tree.entityRow(child));
         QCOMPARE(tree.topLevelItemCount(), 0);
+    }
+
+    void aTypedBoundSetsBothEndsOfASymmetricRange()
+    {
+        // Issue 50, defect 2: Symmetric ticked, 0.02 typed as the maximum: the
+        // minimum becomes -0.02 at once (it stayed at -11.909).
+        gui::Document document;
+        PointCloud cloud = fourPoints();
+        cloud.field("d")->setValue(0, -11.5); // exact in the float view
+        cloud.field("d")->setValue(2, 5.0);
+        const EntityId id = document.add("signed", std::move(cloud));
+        gui::FieldDisplay display = document.fieldDisplay(id, "d");
+        display.symmetric = true;
+        document.setFieldDisplay(id, "d", display);
+        gui::ScalarFieldPanel panel(document);
+        panel.showEntity(id);
+        QCOMPARE(panel.colourRangeEditor()->low(), -11.5);
+        QCOMPARE(panel.colourRangeEditor()->high(), 11.5);
+        panel.colourRangeEditor()->highBox()->setValue(0.02);
+        const auto range = [&] { return gui::colourRange(*document.item(id).points().field("d"), document.fieldDisplay(id, "d")); };
+        QCOMPARE(range().first, -0.02);
+        QCOMPARE(range().second, 0.02);
+        QCOMPARE(document.fieldDisplay(id, "d").colourLow, -0.02);
+        QCOMPARE(panel.colourRangeEditor()->low(), -0.02);
+        QCOMPARE(panel.colourRangeEditor()->high(), 0.02);
+        // The minimum typed sets the maximum the same way, and so does a drag of one end.
+        panel.colourRangeEditor()->lowBox()->setValue(-3.0);
+        QCOMPARE(range().second, 3.0);
+        QCOMPARE(panel.colourRangeEditor()->high(), 3.0);
+        panel.colourRangeEditor()->setRange(-3.0, 0.5);
+        QCOMPARE(range().first, -0.5);
+        QCOMPARE(panel.colourRangeEditor()->low(), -0.5);
+    }
+
+    void aSplitPartShowsTheColourRangeItIsColouredWith()
+    {
+        // Issue 50, defect 6: a part whose values all lie above its parent's
+        // colour range showed 0.5133..0.5133 while its bar showed the range.
+        gui::Document document;
+        gui::SplitController splits(document);
+        const EntityId id = document.add("four", fourPoints());
+        gui::FieldDisplay display = document.fieldDisplay(id, "d");
+        display.colourLow = 0.0;
+        display.colourHigh = 1.0;
+        document.setFieldDisplay(id, "d", display);
+        const EntityId part = splits.split(id, "d", 1.5, 2.0).first;
+        QVERIFY(part != gui::kNoEntity);
+        QCOMPARE(document.item(part).points().size(), std::size_t(1)); // value 2, above the colour range
+        gui::ScalarFieldPanel panel(document);
+        panel.showEntity(part);
+        const auto [low, high] = gui::colourRange(*document.item(part).points().field("d"), document.fieldDisplay(part, "d"));
+        QCOMPARE(low, 0.0);
+        QCOMPARE(high, 1.0);
+        QCOMPARE(panel.colourRangeEditor()->low(), low);
+        QCOMPARE(panel.colourRangeEditor()->high(), high);
     }
 
     void panelThresholdsAndSplit()

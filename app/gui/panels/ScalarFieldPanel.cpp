@@ -210,9 +210,10 @@ void ScalarFieldPanel::refresh()
         range_->setRange(std::max(lo, display.low), std::min(hi, display.high));
         histogram_->setHistogram(computeHistogram(field->values().data(), field->size(), field->offset(), kHistogramBins));
         const auto [cmin, cmax] = colourRange(*field, display);
-        // The colour editor spans the field, and -m..m when symmetric.
-        const bool symmetric = display.symmetric || display.scale.symmetric();
-        colours_->setBounds(symmetric ? std::min(lo, cmin) : lo, symmetric ? std::max(hi, cmax) : hi);
+        // The colour editor spans the field and the colour range (-m..m when
+        // symmetric; a split part's values may all lie outside the range its
+        // parent coloured with, and the editor must still show that range).
+        colours_->setBounds(std::min(lo, cmin), std::max(hi, cmax));
         colours_->setRange(cmin, cmax);
         symmetric_->setChecked(display.symmetric);
         histogram_->setColouring(display.scale, cmin, cmax);
@@ -278,10 +279,25 @@ void ScalarFieldPanel::onColourRangeEdited(double low, double high)
     if (!activeField() || updating_)
         return;
     FieldDisplay display = document_.fieldDisplay(entity_, activeField()->name());
+    if (display.symmetric || display.scale.symmetric()) {
+        // Symmetric around 0: the bound the user just typed or dragged sets
+        // both (typing 0.02 as the maximum makes the minimum -0.02).
+        const auto [previousLow, previousHigh] = colourRange(*activeField(), display);
+        const bool lowMoved = low != previousLow, highMoved = high != previousHigh;
+        const double m = highMoved && !lowMoved ? std::abs(high)
+                         : lowMoved && !highMoved ? std::abs(low)
+                                                  : std::max(std::abs(low), std::abs(high));
+        low = -m;
+        high = m;
+    }
     display.colourLow = low;
     display.colourHigh = high;
     updating_ = true; // as for the thresholds: no rebuild while dragging
     document_.setFieldDisplay(entity_, activeField()->name(), display);
+    if (colours_->low() != low || colours_->high() != high) {
+        colours_->setBounds(std::min(colours_->minimum(), low), std::max(colours_->maximum(), high));
+        colours_->setRange(low, high);
+    }
     updating_ = false;
     const auto [cmin, cmax] = colourRange(*activeField(), display);
     histogram_->setColouring(display.scale, cmin, cmax);

@@ -55,6 +55,9 @@ RangeEditor::RangeEditor(QWidget* parent)
         showRangeInBoxes();
         emit rangeChanged(low, high);
     });
+    // A typed bound counts once it is complete (Enter or leaving the box), not at each digit.
+    lowBox_->setKeyboardTracking(false);
+    highBox_->setKeyboardTracking(false);
     connect(lowBox_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, &RangeEditor::lowBoxEdited);
     connect(highBox_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, &RangeEditor::highBoxEdited);
 
