@@ -52,7 +52,6 @@ std::shared_ptr<std::map<std::string, std::string>> addSegmentationOptions(CLI::
 {
     auto values = std::make_shared<std::map<std::string, std::string>>();
     auto options = addParameterOptions(command, segmentationParameters(), values);
-    options.at("range")->expected(2);
     for (const char* a : {"range", "above", "kmeans", "stat-test"})
         for (const char* b : {"range", "above", "kmeans", "stat-test", "propagate"})
             if (std::string(a) != b)

@@ -401,7 +401,10 @@ private slots:
         QSignalSpy finished(&merge, &gui::ToolController::finished);
         QVERIFY(merge.run(gui::ToolInputChoice{{"input", {id, meshId}}}, {}));
         QCOMPARE(document.item(document.ids().back()).points().size(), std::size_t(800));
-        QVERIFY(finished.at(0).at(0).toString().contains("scandiff-cli merge plane plane_mesh"));
+        // Entities in no file: named as the files to export them to, and said so.
+        const QString logged = finished.at(0).at(0).toString();
+        QVERIFY2(logged.contains("scandiff-cli merge plane.ply plane_mesh.ply -o plane_merge.ply"), qPrintable(logged));
+        QVERIFY2(logged.contains("export plane.ply, plane_mesh.ply first"), qPrintable(logged));
     }
 
     void controllerReportsInvalidParameters()

@@ -10,6 +10,7 @@
 
 #include <scandiff/io/DxfReader.h>
 #include <scandiff/io/E57.h>
+#include "controllers/CommandLine.h"
 #include "controllers/GlobalShiftDialog.h"
 #include "panels/ConsolePanel.h"
 #include "tools/MeasurePanel.h"
@@ -47,6 +48,12 @@
 #include <QMenuBar>
 #include <QSignalSpy>
 #include <QStandardPaths>
+#include <QProcess>
+#include <QRegularExpression>
+#include <QTemporaryDir>
+#include <QDir>
+#include <QFile>
+#include <QFileInfo>
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QtTest>
@@ -117,6 +124,65 @@ private slots:
         QVERIFY(!dialog.values().count("max-dist"));
         dialog.form()->enabler("max-dist")->setChecked(true);
         QCOMPARE(dialog.values().at("max-dist"), std::string("1"));
+    }
+
+    void theLoggedCommandsRunAsIsAndGiveTheSameNumbers()
+    {
+        // Issue 50, defect 10: the console's "equivalent command line" of C2C
+        // lacked the files. Run from a folder whose name needs quoting, the
+        // logged lines of C2C and of a tool are run by a shell as they are,
+        // with the real scandiff-cli, and give the workbench's numbers.
+        QTemporaryDir temporary;
+        const QString folder = temporary.filePath("survey 2024 (it's here)");
+        QVERIFY(QDir().mkpath(folder));
+        const QString reference = folder + "/site-2019.ply", compared = folder + "/site-2024.ply";
+        QVERIFY(QFile::copy(kReference, reference));
+        QVERIFY(QFile::copy(kCompared, compared));
+        Workbench workbench;
+        gui::MainWindow& window = workbench.window;
+        QCOMPARE(window.openFiles({reference, compared}, true), 2);
+        const EntityId referenceId = window.document().ids()[0], comparedId = window.document().ids()[1];
+        const auto loggedCommand = [](const QString& message) {
+            const QRegularExpressionMatch match = QRegularExpression("\\[(scandiff-cli .*?)\\][: ]").match(message);
+            return match.captured(1);
+        };
+        const auto runInShell = [](const QString& command) {
+            QProcess shell;
+            QProcessEnvironment environment = QProcessEnvironment::systemEnvironment();
+            environment.insert("PATH", QFileInfo(SCANDIFF_CLI).absolutePath() + ":" + environment.value("PATH"));
+            shell.setProcessEnvironment(environment);
+            shell.start("sh", {"-c", command});
+            const bool finished = shell.waitForFinished(120000);
+            return finished && shell.exitStatus() == QProcess::NormalExit && shell.exitCode() == 0 ? QString()
+                                                                                                   : QString(shell.readAllStandardError());
+        };
+        QSignalSpy distanceDone(window.distances(), &gui::DistanceController::finished);
+        QVERIFY(window.distances()->runCloudToCloud(comparedId, referenceId, {{"split-xyz", "true"}, {"knn", "6"}, {"model", "plane"}}));
+        const QString c2c = loggedCommand(distanceDone.at(0).at(0).toString());
+        QVERIFY2(c2c.startsWith("scandiff-cli c2c --reference " + gui::shellQuoted(reference) + " --compared " + gui::shellQuoted(compared) +
+                                 " -o "),
+                 qPrintable(c2c));
+        const QString error = runInShell(c2c);
+        QVERIFY2(error.isEmpty(), qPrintable(c2c + "\n" + error));
+        const PointCloud written = io::readPointCloud(makePluginRegistry().formats, (folder + "/site-2024_c2c.ply").toStdString());
+        const PointCloud& shown = window.document().item(comparedId).points();
+        for (const char* name : {"c2c_distance", "c2c_dz"}) {
+            QVERIFY2(written.field(name), name);
+            QCOMPARE(written.field(name)->values(), shown.field(name)->values());
+        }
+
+        // A tool of the registry, on a file: its line writes what the workbench made.
+        const PluginRegistry registry = makePluginRegistry();
+        gui::ToolController subsample(*registry.tools.find("subsample"), window.document(), nullptr);
+        QSignalSpy toolDone(&subsample, &gui::ToolController::finished);
+        QVERIFY(subsample.run(referenceId, {{"spatial", "0.5"}}));
+        const QString tool = loggedCommand(toolDone.at(0).at(0).toString());
+        QVERIFY2(tool.contains("-o " + gui::shellQuoted(folder + "/site-2019_subsample.ply")), qPrintable(tool));
+        QVERIFY2(!tool.contains("export"), qPrintable(tool));
+        const QString toolError = runInShell(tool);
+        QVERIFY2(toolError.isEmpty(), qPrintable(tool + "\n" + toolError));
+        const PointCloud sparse = io::readPointCloud(registry.formats, (folder + "/site-2019_subsample.ply").toStdString());
+        QCOMPARE(sparse.size(), window.document().item(window.document().ids().back()).points().size());
     }
 
     void everyMenuIsThereOnceWithItsTools()

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "controllers/DistanceController.h"
+#include "controllers/CommandLine.h"
 
 #include "TaskRunner.h"
 #include "tools/ParameterForm.h"
@@ -127,6 +128,15 @@ bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId reference
         emit failed(tr("C2C needs two point clouds"));
         return false;
     }
+    // Before the run: the files as they are now (the run adds fields).
+    const QString command = CommandLine("scandiff-cli c2c")
+                                .word("--reference")
+                                .file(*reference)
+                                .word("--compared")
+                                .file(*compared)
+                                .outputBeside("-o", *compared, "_c2c")
+                                .options(parameters, cloudToCloudParameters())
+                                .text();
     std::optional<CloudToCloudRun> run;
     QElapsedTimer clock;
     clock.start();
@@ -158,7 +168,7 @@ bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId reference
         document_.add(compared->name + tr(" closest points"), std::move(closest), comparedId);
     }
     emit finished(tr("C2C %1 -> %2 [%3] %4; octree level %5; %6 s")
-                      .arg(compared->name, reference->name, commandLineText(parameters), statisticsText(statistics))
+                      .arg(compared->name, reference->name, command, statisticsText(statistics))
                       .arg(forward.level)
                       .arg(seconds, 0, 'f', 3));
     emit resultReady(comparedId);
@@ -174,6 +184,14 @@ bool DistanceController::runCloudToMesh(EntityId comparedId, EntityId referenceI
         emit failed(tr("C2M needs a point cloud and a mesh"));
         return false;
     }
+    const QString command = CommandLine("scandiff-cli c2m")
+                                .word("--reference")
+                                .file(*reference)
+                                .word("--compared")
+                                .file(*compared)
+                                .outputBeside("-o", *compared, "_c2m")
+                                .options(parameters, cloudToMeshParameters())
+                                .text();
     std::optional<CloudToMeshResult> result;
     QElapsedTimer clock;
     clock.start();
@@ -194,7 +212,7 @@ bool DistanceController::runCloudToMesh(EntityId comparedId, EntityId referenceI
     document_.addField(comparedId, std::move(result->distance));
     showReference(referenceId, false);
     emit finished(tr("C2M %1 -> %2 [%3] %4; %5 degenerate triangles; %6 s")
-                      .arg(compared->name, reference->name, commandLineText(parameters), statisticsText(statistics))
+                      .arg(compared->name, reference->name, command, statisticsText(statistics))
                       .arg(result->degenerateTriangles)
                       .arg(seconds, 0, 'f', 3));
     emit resultReady(comparedId);

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "controllers/SegmentationController.h"
+#include "controllers/CommandLine.h"
 
 #include "TaskRunner.h"
 #include "tools/ParameterForm.h"
@@ -125,6 +126,12 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
         emit failed(tr("Segmentation needs a point cloud"));
         return false;
     }
+    CommandLine command("scandiff-cli segment");
+    command.file(*input);
+    if (reference)
+        command.word("--reference").file(*reference);
+    command.outputBeside("--out-dir", *input, "_regions", QString()).options(parameters, segmentationParameters());
+    const QString commandText = command.text();
     QElapsedTimer clock;
     clock.start();
     std::optional<SegmentationRun> run;
@@ -190,7 +197,7 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
     // previous fields alone would leave them describing this run.
     document_.forgetUndo();
     emit finished(tr("segment %1 [%2]: %3; %4 s")
-                      .arg(input->name, commandLineText(parameters), QString::fromStdString(summary))
+                      .arg(input->name, commandText, QString::fromStdString(summary))
                       .arg(clock.elapsed() / 1000.0, 0, 'f', 3));
     emit resultReady(inputId);
     return true;

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "controllers/ToolController.h"
+#include "controllers/CommandLine.h"
 
 #include "TaskRunner.h"
 #include "tools/ParameterForm.h"
@@ -81,21 +82,38 @@ bool ToolController::run(EntityId input, const std::map<std::string, std::string
 
 QString ToolController::commandLine(const ToolInputChoice& inputs, const std::map<std::string, std::string>& parameters) const
 {
-    QStringList parts{"scandiff-cli", QString::fromStdString(tool_.name)};
+    CommandLine command("scandiff-cli " + QString::fromStdString(tool_.name));
+    const Document::Item* first = nullptr;
     for (const InputSpec& spec : tool_.inputs) {
         const auto it = inputs.find(spec.role);
         if (it == inputs.end())
             continue;
         for (EntityId id : it->second) {
             const Document::Item& item = document_.item(id);
-            const QString file = item.sourcePath.isEmpty() ? item.name : item.sourcePath;
-            parts << (spec.role == "input" ? file : QString("--%1 %2").arg(QString::fromStdString(spec.role), file));
+            if (spec.role != "input")
+                command.word("--" + QString::fromStdString(spec.role));
+            command.file(item);
+            if (!first)
+                first = &item;
         }
     }
-    const QString options = commandLineText(parameters);
-    if (!options.isEmpty())
-        parts << options;
-    return parts.join(' ');
+    // Where the outputs go: a folder for a tool of several files, else one file by its kind.
+    if (first && !tool_.outputs.empty()) {
+        const OutputSpec& output = tool_.outputs.front();
+        const bool several = std::any_of(tool_.outputs.begin(), tool_.outputs.end(), [](const OutputSpec& o) { return o.repeated; });
+        const QString suffix = "_" + QString::fromStdString(tool_.name);
+        if (several)
+            command.outputBeside("--out-dir", *first, suffix, QString());
+        else
+            command.outputBeside("-o", *first, suffix,
+                                 output.kind == DataKind::Table       ? ".csv"
+                                 : output.kind == DataKind::Transform ? ".txt"
+                                 : output.kind == DataKind::Drawing   ? ".dxf"
+                                 : output.kind == DataKind::Document  ? ".json"
+                                                                      : ".ply");
+    }
+    command.options(parameters, tool_.parameters);
+    return command.text();
 }
 
 bool ToolController::run(const ToolInputChoice& choice, const std::map<std::string, std::string>& parameters)
@@ -121,6 +139,7 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
         }
     }
     const EntityId firstInput = firstRole.empty() ? kNoEntity : firstRole.front();
+    const QString command = commandLine(choice, parameters); // the inputs as they are before the run
     std::optional<ToolResult> result;
     QElapsedTimer clock;
     clock.start();
@@ -219,7 +238,7 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
     if (!tables.empty())
         emit tablesReady(title, tables);
     emit finished(QString("%1 [%2]: %3; %4 s%5")
-                      .arg(QString::fromStdString(tool_.name), commandLine(choice, parameters),
+                      .arg(QString::fromStdString(tool_.name), command,
                            QString::fromStdString(result->summary))
                       .arg(seconds, 0, 'f', 3)
                       .arg(notes));

@@ -306,18 +306,6 @@ void listFieldsOf(QComboBox* box, const Document::Item* item)
         box->setCurrentText(typed);
 }
 
-QString commandLineText(const std::map<std::string, std::string>& parameters)
-{
-    QStringList parts;
-    for (const auto& [name, value] : parameters) {
-        if (value == "false")
-            continue;
-        parts << (value == "true" ? QString("--%1").arg(QString::fromStdString(name))
-                                  : QString("--%1 %2").arg(QString::fromStdString(name), QString::fromStdString(value)));
-    }
-    return parts.join(' ');
-}
-
 void addFormAndButtons(QDialog& dialog, QVBoxLayout& layout, ParameterForm* form)
 {
     auto* scroll = new QScrollArea(&dialog);

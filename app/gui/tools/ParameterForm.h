@@ -72,10 +72,6 @@ private:
 //! typed before if it is one of them.
 void listFieldsOf(QComboBox* box, const Document::Item* item);
 
-//! Parameter text as `scandiff-cli` options ("--knn 12 --signed"): flags only
-//! when on, so the console's line can be pasted into a batch script.
-QString commandLineText(const std::map<std::string, std::string>& parameters);
-
 //! Puts `form` in a scroll area and OK/Cancel buttons below it, the bottom of
 //! every parameter dialog.
 void addFormAndButtons(QDialog& dialog, QVBoxLayout& layout, ParameterForm* form);

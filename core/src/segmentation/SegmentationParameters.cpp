@@ -42,6 +42,7 @@ const std::vector<ParameterSpec>& segmentationParameters()
                 .asAlternative("method")
                 .onlyWith("!propagate"),
             ParameterSpec::text("range", "Range", "Changed: values in [A, B], given as 'A B' or 'A,B' (§3.2.1)")
+                .takingValues(2)
                 .asAlternative("method")
                 .onlyWith("!propagate"),
             ParameterSpec::integer("kmeans", "K-means classes",
