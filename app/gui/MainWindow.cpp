@@ -101,6 +101,13 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
         updateLegend();
     });
     connect(&document_, &Document::removed, this, [this] { updateLegend(); });
+    // Which clouds are in the frame changes with the camera: the bar follows
+    // once a move has stopped (not at each of its frames).
+    auto* legendTimer = new QTimer(this);
+    legendTimer->setSingleShot(true);
+    legendTimer->setInterval(150);
+    connect(legendTimer, &QTimer::timeout, this, &MainWindow::updateLegend);
+    connect(view_, &CloudView::cameraChanged, legendTimer, qOverload<>(&QTimer::start));
     connect(&document_, &Document::fieldsChanged, this, [this] { updateRegionExport(); });
     connect(tree_, &EntityTree::currentEntityChanged, this, &MainWindow::onCurrentEntityChanged);
     connect(scalarPanel_, &ScalarFieldPanel::splitRequested, splits_, &SplitController::split);
@@ -545,15 +552,31 @@ void MainWindow::setSideBySide(bool on)
 void MainWindow::updateLegend()
 {
     // The bar belongs to what is on screen: the selected entity if it is shown
-    // with a field, else the last added one that is.
-    auto legendFor = [this](EntityId id) {
+    // with a field; else, of the entities in the view's frame with a field, the
+    // selected group's parts first, then the last added. Never a cloud outside
+    // the frame (two LAZ side by side, one zoomed to: not the other's scale).
+    auto legendFor = [this](EntityId id, bool onScreen) {
         const Document::Item* item = document_.find(id);
-        return item && item->display.visible && item->cloud() ? legendOf(item->points(), item->display) : ColourLegend{};
+        if (!item || !item->display.visible || !item->cloud() || (onScreen && !view_->isOnScreen(id)))
+            return ColourLegend{};
+        return legendOf(item->points(), item->display);
     };
-    ColourLegend legend = legendFor(tree_->currentEntity());
+    const EntityId current = tree_->currentEntity();
+    ColourLegend legend = legendFor(current, false);
+    std::vector<EntityId> parts;
+    for (std::vector<EntityId> pending{current}; !pending.empty();) {
+        const EntityId id = pending.back();
+        pending.pop_back();
+        for (EntityId child : document_.children(id)) {
+            parts.push_back(child);
+            pending.push_back(child);
+        }
+    }
+    for (auto it = parts.begin(); !legend.shown && it != parts.end(); ++it)
+        legend = legendFor(*it, true);
     const std::vector<EntityId> ids = document_.ids();
     for (auto it = ids.rbegin(); !legend.shown && it != ids.rend(); ++it)
-        legend = legendFor(*it);
+        legend = legendFor(*it, true);
     view_->setLegend(legend);
 }
 

@@ -185,6 +185,46 @@ private slots:
         QCOMPARE(sparse.size(), window.document().item(window.document().ids().back()).points().size());
     }
 
+    void theColourBarDescribesACloudInTheFrame()
+    {
+        // Issue 50, defect 1: two LAZ clouds side by side, one zoomed to, a
+        // group selected: the bar showed the other cloud's 2..68 over colours
+        // of 2816..37888.
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
+        gui::Document& document = window.document();
+        const auto cloudWith = [](double x0, double low, double high) {
+            PointCloud cloud;
+            cloud.setOrigin({512000 + x0, 5423000, 100});
+            cloud.resize(400);
+            ScalarField& intensity = cloud.addField("intensity");
+            for (std::size_t i = 0; i < cloud.size(); ++i) {
+                cloud.positions()[i] = Eigen::Vector3f(static_cast<float>(i % 20), static_cast<float>(i / 20), 0.0f);
+                intensity.setValue(i, low + (high - low) * static_cast<double>(i) / 399.0);
+            }
+            return cloud;
+        };
+        const EntityId group = document.addGroup("scans.e57");
+        const EntityId bright = document.add("scan 1", cloudWith(0, 2816, 37888), group);
+        const EntityId dim = document.add("other.laz", cloudWith(5000, 2, 68)); // 5 km away, added last
+        window.view()->zoomToEntity(bright);
+        QTest::qWait(300); // the bar follows the camera once it rests
+        window.tree()->selectEntity(group);
+        QCOMPARE(window.view()->legend().min, 2816.0);
+        QCOMPARE(window.view()->legend().max, 37888.0);
+        // Nothing selected that has a field: the cloud in the frame gives the bar, whichever was added last.
+        window.view()->zoomToEntity(dim);
+        QTest::qWait(300);
+        QCOMPARE(window.view()->legend().min, 2.0); // the group's scan is out of the frame now
+        window.view()->zoomToEntity(bright);
+        QTest::qWait(300);
+        QCOMPARE(window.view()->legend().min, 2816.0); // the camera moved: the bar followed, the selection did not change
+        // A selected cloud keeps its own bar wherever the camera is.
+        window.tree()->selectEntity(dim);
+        QCOMPARE(window.view()->legend().min, 2.0);
+    }
+
     void everyMenuIsThereOnceWithItsTools()
     {
         // A tool category named like a built-in submenu (Distances: C2C, C2M)

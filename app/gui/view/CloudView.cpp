@@ -8,6 +8,8 @@
 
 #include <QResizeEvent>
 #include <QTimer>
+
+#include <limits>
 #include <QVBoxLayout>
 #include <QVTKOpenGLNativeWidget.h>
 
@@ -193,6 +195,10 @@ CloudView::CloudView(QWidget* parent) : QWidget(parent), scene_(std::make_unique
     beforeFrame->SetClientData(this);
     beforeFrame->SetCallback([](vtkObject*, unsigned long, void* self, void*) { static_cast<CloudView*>(self)->updateScaleBar(); });
     scene_->renderer->AddObserver(vtkCommand::StartEvent, beforeFrame);
+    auto cameraMoved = vtkSmartPointer<vtkCallbackCommand>::New();
+    cameraMoved->SetClientData(this);
+    cameraMoved->SetCallback([](vtkObject*, unsigned long, void* self, void*) { emit static_cast<CloudView*>(self)->cameraChanged(); });
+    scene_->renderer->GetActiveCamera()->AddObserver(vtkCommand::ModifiedEvent, cameraMoved);
 }
 
 CloudView::~CloudView() = default;
@@ -752,6 +758,39 @@ bool CloudView::isShownHere(EntityId id) const
 {
     const auto it = scene_->shown.find(id);
     return it != scene_->shown.end() && !it->second.chunks.empty() && it->second.chunks.front().actor->GetVisibility();
+}
+
+bool CloudView::isOnScreen(EntityId id) const
+{
+    if (!isShownHere(id))
+        return false;
+    const Eigen::Matrix4d toPixels = globalToWidgetPixels();
+    const Eigen::Vector3d origin = scene_->sceneOrigin.value_or(Eigen::Vector3d::Zero());
+    const double width = widget_->width(), height = widget_->height();
+    for (const auto& c : scene_->shown.at(id).chunks) {
+        double b[6];
+        c.actor->GetBounds(b); // scene coordinates, kept by VTK
+        if (!(b[0] <= b[1]))
+            continue;
+        double left = std::numeric_limits<double>::infinity(), right = -left, top = left, bottom = -left;
+        bool behind = false;
+        for (int corner = 0; corner < 8; ++corner) {
+            const Eigen::Vector4d global(b[corner & 1] + origin.x(), b[2 + ((corner >> 1) & 1)] + origin.y(),
+                                         b[4 + ((corner >> 2) & 1)] + origin.z(), 1.0);
+            const Eigen::Vector4d pixel = toPixels * global;
+            if (pixel.w() <= 0.0) {
+                behind = true; // the camera is among the points: count them as seen
+                break;
+            }
+            left = std::min(left, pixel.x() / pixel.w());
+            right = std::max(right, pixel.x() / pixel.w());
+            top = std::min(top, pixel.y() / pixel.w());
+            bottom = std::max(bottom, pixel.y() / pixel.w());
+        }
+        if (behind || (right >= 0 && left <= width && bottom >= 0 && top <= height))
+            return true;
+    }
+    return false;
 }
 
 void CloudView::followCamera(CloudView& leader)

@@ -82,6 +82,9 @@ public:
     void setShownHere(EntityId id, bool shown);
     //! Whether the entity is drawn in this view (ticked, and not hidden here).
     bool isShownHere(EntityId id) const;
+    //! Whether some of the entity is within the view's frame (shown here, its
+    //! chunks' boxes projected onto the widget): what the colour bar may describe.
+    bool isOnScreen(EntityId id) const;
     //! How many texts of a drawing are labelled in the view (0: none, or not a drawing), and whether they are shown.
     std::size_t labelCount(EntityId id) const;
     bool labelsVisible(EntityId id) const;
@@ -191,6 +194,8 @@ signals:
     //! The view changed these itself (a session restored them): menus follow.
     void pointSizeChanged(float size);
     void projectionChanged(bool parallel);
+    //! The camera moved (a drag, a zoom, a standard view, a restored session).
+    void cameraChanged();
 
 private:
     class PickCommand;
