@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 
@@ -76,7 +77,29 @@ TEST(ContoursCli, ContoursWriteTheDrawingAndTheJsonDocument)
     ASSERT_EQ(json["planes"].size(), 1u);
     const auto& polygon = json["planes"][0]["polygons"][0];
     EXPECT_EQ(polygon["holes"].size(), scene.openings.size());
-    EXPECT_GT(polygon["outer"]["area"].get<double>(), 0.9 * 6 * 4 - 5.0);
+    // Areas against the scene's truth, within a strip half a point spacing
+    // wide along each outline (the outline runs through the outermost points):
+    // the façade 6 x 4 m less the door's notch 0.9 x 1.9 m; the openings.
+    const double halfSpacing = 0.015 / 2;
+    const double outerTruth = 6.0 * 4.0 - 0.9 * 1.9, outerPerimeter = 2 * (6.0 + 4.0) + 2 * 1.9;
+    EXPECT_NEAR(polygon["outer"]["area"].get<double>(), outerTruth, outerPerimeter * halfSpacing);
+    std::vector<double> holeAreas, truthAreas;
+    for (const auto& hole : polygon["holes"])
+        holeAreas.push_back(hole["area"].get<double>());
+    for (const test::Outline& opening : scene.openings) {
+        double twiceArea = 0;
+        for (std::size_t k = 0; k < opening.size(); ++k) {
+            const Eigen::Vector2d& a = opening[k];
+            const Eigen::Vector2d& b = opening[(k + 1) % opening.size()];
+            twiceArea += a.x() * b.y() - b.x() * a.y();
+        }
+        truthAreas.push_back(std::abs(twiceArea) / 2);
+    }
+    std::sort(holeAreas.begin(), holeAreas.end());
+    std::sort(truthAreas.begin(), truthAreas.end());
+    ASSERT_EQ(holeAreas.size(), truthAreas.size());
+    for (std::size_t k = 0; k < holeAreas.size(); ++k)
+        EXPECT_NEAR(holeAreas[k], truthAreas[k], 5.0 * halfSpacing) << "opening " << k; // perimeters of 4-5 m
     EXPECT_TRUE(std::filesystem::exists(out / "contours.csv"));
     // A bad option is the same clear error as anywhere else.
     const test::CliRun bad = test::runCliInProcess(registry, {"contours", (dir / "facade.ply").string(), "--edge-threshold", "-3"});
