@@ -168,6 +168,19 @@ TEST(Primitives, NormalsAreComputedWhenAbsent)
     for (const auto& shape : result.primitives)
         ++found[shape.primitive.kind];
     EXPECT_EQ(found, expected);
+    // Not only the counts: each true shape is found once, as its type, with
+    // most of its points (as with exact normals above).
+    std::set<int> used;
+    for (std::size_t k = 0; k < s.shapes.size(); ++k) {
+        std::size_t shared = 0, total = 0;
+        for (int t : s.truth)
+            total += t == static_cast<int>(k);
+        const DetectedPrimitive* match = bestMatch(result, s, static_cast<int>(k), shared);
+        ASSERT_NE(match, nullptr) << s.shapes[k].label << " not found";
+        EXPECT_EQ(match->primitive.kind, s.shapes[k].truth.kind) << s.shapes[k].label;
+        EXPECT_GT(static_cast<double>(shared), 0.8 * static_cast<double>(total)) << s.shapes[k].label;
+        EXPECT_TRUE(used.insert(match->id).second) << s.shapes[k].label << " shares its shape with another";
+    }
 }
 
 TEST(Primitives, PlanesOnlyStillFindEveryPlane)
