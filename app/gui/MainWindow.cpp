@@ -39,6 +39,8 @@
 #include <QSettings>
 #include <QSplitter>
 #include <QStatusBar>
+#include <QScrollArea>
+#include <QStyle>
 #include <QTimer>
 #include <QToolBar>
 
@@ -157,10 +159,23 @@ template <class Controller> void MainWindow::report(Controller* controller)
 
 void MainWindow::buildDocks()
 {
-    const auto dock = [this](const QString& title, QWidget* widget, Qt::DockWidgetArea area) {
+    const auto dock = [this](const QString& title, QWidget* widget, Qt::DockWidgetArea area, bool scrolls = false) {
         auto* d = new QDockWidget(title, this);
         d->setObjectName(title);
-        d->setWidget(widget);
+        if (scrolls) {
+            // A tall panel scrolls rather than raising the window's minimum
+            // height (the window grew by itself when Measure opened).
+            auto* area = new QScrollArea(d);
+            area->setWidgetResizable(true);
+            area->setFrameShape(QFrame::NoFrame);
+            area->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+            area->setWidget(widget);
+            // As wide as the panel needs: only its height scrolls.
+            area->setMinimumWidth(widget->minimumSizeHint().width() + area->style()->pixelMetric(QStyle::PM_ScrollBarExtent));
+            d->setWidget(area);
+        } else {
+            d->setWidget(widget);
+        }
         addDockWidget(area, d);
         return d;
     };
@@ -170,10 +185,13 @@ void MainWindow::buildDocks()
     console_ = new ConsolePanel(this);
     QDockWidget* entitiesDock = dock(tr("Entities"), tree_, Qt::LeftDockWidgetArea);
     dock(tr("Properties"), properties_, Qt::LeftDockWidgetArea);
-    QDockWidget* scalarDock = dock(tr("Scalar field"), scalarPanel_, Qt::RightDockWidgetArea);
+    QDockWidget* scalarDock = dock(tr("Scalar field"), scalarPanel_, Qt::RightDockWidgetArea, true);
     QDockWidget* consoleDock = dock(tr("Console"), console_, Qt::BottomDockWidgetArea);
     measure_ = new MeasurePanel(document_, this);
-    QDockWidget* measureDock = dock(tr("Measure"), measure_, Qt::RightDockWidgetArea);
+    QDockWidget* measureDock = dock(tr("Measure"), measure_, Qt::RightDockWidgetArea, true);
+    // A tab beside the scalar field's: stacked under it, the two panels'
+    // minimum heights made the window grow by itself when Measure opened.
+    tabifyDockWidget(scalarDock, measureDock);
     measureDock->hide(); // until View > Measure
     // Wide enough for names, UTM coordinates and field ranges at 1680 px.
     resizeDocks({entitiesDock, scalarDock}, {340, 360}, Qt::Horizontal);
@@ -314,8 +332,16 @@ void MainWindow::buildMenus()
     measure->setShortcut(QKeySequence(tr("M")));
     measure->setToolTip(tr("Click points: a distance (with dX, dY, dZ), an angle, a polygon's area"));
     connect(measure, &QAction::toggled, this, [this](bool on) {
-        if (on)
-            findChild<QDockWidget*>("Measure")->show();
+        if (on) {
+            // A tab beside the scalar field's, even when a layout saved by an
+            // earlier version stacked them (that made the window grow).
+            QDockWidget* panel = findChild<QDockWidget*>("Measure");
+            QDockWidget* scalar = findChild<QDockWidget*>("Scalar field");
+            if (scalar && !panel->isFloating() && tabifiedDockWidgets(panel).isEmpty() && dockWidgetArea(scalar) == dockWidgetArea(panel))
+                tabifyDockWidget(scalar, panel);
+            panel->show();
+            panel->raise(); // its tab in front
+        }
         measure_->setMeasuring(on);
     });
     connect(measure_, &MeasurePanel::measuringChanged, this, [this, measure](bool on) {

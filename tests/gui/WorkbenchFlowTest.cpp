@@ -18,6 +18,7 @@
 #include "controllers/FileController.h"
 #include "controllers/SegmentationController.h"
 #include "controllers/SessionController.h"
+#include "controllers/SplitController.h"
 #include "controllers/FileController.h"
 #include "panels/EntityTree.h"
 #include "panels/PropertiesPanel.h"
@@ -223,6 +224,76 @@ private slots:
         // A selected cloud keeps its own bar wherever the camera is.
         window.tree()->selectEntity(dim);
         QCOMPARE(window.view()->legend().min, 2.0);
+    }
+
+    void resultsOnAHiddenCloudAreShownAndTheDialogsOfferWhatMeansSomething()
+    {
+        // Issue 50, defects 4, 9, 12 and 11.
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
+        gui::Document& document = window.document();
+
+        // 12: an RGB LAZ (point format 3, with intensity) opens in its colours.
+        QCOMPARE(window.openFiles({SCANDIFF_SAMPLE_DATA_DIR "/laz/simple.laz"}, true), 1);
+        const EntityId laz = document.ids().back();
+        QVERIFY(document.item(laz).points().hasColors());
+        QVERIFY(document.item(laz).points().field("intensity"));
+        QVERIFY(document.item(laz).display.activeField.empty());
+
+        // 4: split, the parent hidden; segmenting the parent shows it with its regions.
+        QCOMPARE(window.openFiles({kReference, kCompared}, true), 2);
+        const EntityId reference = document.ids()[document.ids().size() - 2], compared = document.ids().back();
+        QVERIFY(window.distances()->runCloudToCloud(compared, reference, {}));
+        QVERIFY(window.splits()->split(compared, "c2c_distance", 0.2, 100.0).first != gui::kNoEntity);
+        QVERIFY(!document.item(compared).display.visible);
+        QSignalSpy segmented(window.segmentation(), &gui::SegmentationController::finished);
+        QVERIFY(window.segmentation()->run(compared, reference,
+                                            {{"field", "c2c_distance"}, {"above", "0.2"}, {"components", "true"}, {"min-points", "50"}}));
+        QVERIFY(document.item(compared).display.visible);
+        QVERIFY(window.view()->isShownHere(compared));
+        for (EntityId child : document.children(compared)) // the split's parts no longer draw over the regions
+            QVERIFY(!document.item(child).display.visible);
+        QVERIFY2(segmented.last().at(0).toString().contains("was hidden"), qPrintable(segmented.last().at(0).toString()));
+        // The same for a tool that updates its hidden input, and for C2C on a hidden cloud.
+        document.setVisible(compared, false);
+        QVERIFY(window.toolController("normals")->run(compared, {{"radius", "2"}}));
+        QVERIFY(document.item(compared).display.visible);
+        document.setVisible(compared, false);
+        QVERIFY(window.distances()->runCloudToCloud(compared, reference, {}));
+        QVERIFY(document.item(compared).display.visible);
+
+        // 9: the other epoch is never the segmented cloud itself; refused if asked for.
+        gui::SegmentationDialog dialog(document, compared);
+        auto* others = dialog.findChild<QComboBox*>("reference");
+        QVERIFY(others);
+        QCOMPARE(others->findData(compared), -1);
+        QVERIFY(others->findData(reference) >= 0);
+        QSignalSpy refused(window.segmentation(), &gui::SegmentationController::failed);
+        QVERIFY(!window.segmentation()->run(compared, compared, {{"field", "c2c_distance"}, {"above", "0.2"}}));
+        QCOMPARE(refused.count(), 1);
+
+        // 5: no value of the Properties panel is cut (a global shift, a box corner, a path).
+        window.tree()->selectEntity(reference);
+        QApplication::processEvents();
+        gui::PropertiesPanel* properties = window.properties();
+        QCOMPARE(properties->textElideMode(), Qt::ElideNone);
+        QVERIFY(!properties->value("Global shift").isEmpty());
+        for (int r = 0; r < properties->topLevelItemCount(); ++r) {
+            const QTreeWidgetItem* row = properties->topLevelItem(r);
+            const int needed = properties->fontMetrics().horizontalAdvance(row->text(1));
+            QVERIFY2(properties->columnWidth(1) >= needed, qPrintable(row->text(0) + ": " + row->text(1)));
+        }
+
+        // 11: opening the Measure panel does not grow the window.
+        window.resize(1200, 700);
+        QApplication::processEvents();
+        const QSize before = window.size();
+        window.findChild<QAction*>("measureAction")->setChecked(true);
+        QTest::qWait(100);
+        QCOMPARE(window.size(), before);
+        QVERIFY(window.findChild<QDockWidget*>("Measure")->isVisible());
+        window.findChild<QAction*>("measureAction")->setChecked(false);
     }
 
     void everyMenuIsThereOnceWithItsTools()

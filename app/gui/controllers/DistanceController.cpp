@@ -159,6 +159,7 @@ bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId reference
             document_.addField(comparedId, std::move(**extra));
     const DistanceStatistics statistics = forward.statistics;
     document_.addField(comparedId, std::move(forward.distance)); // last: the active field
+    const bool revealed = document_.revealResult(comparedId);
     const bool reverse = run->reverse.has_value();
     if (reverse)
         document_.addField(referenceId, std::move(run->reverse->distance));
@@ -167,10 +168,11 @@ bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId reference
         PointCloud closest = std::move(*forward.closest);
         document_.add(compared->name + tr(" closest points"), std::move(closest), comparedId);
     }
-    emit finished(tr("C2C %1 -> %2 [%3] %4; octree level %5; %6 s")
+    emit finished(tr("C2C %1 -> %2 [%3] %4; octree level %5; %6 s%7")
                       .arg(compared->name, reference->name, command, statisticsText(statistics))
                       .arg(forward.level)
-                      .arg(seconds, 0, 'f', 3));
+                      .arg(seconds, 0, 'f', 3)
+                      .arg(revealed ? tr("; %1 was hidden: shown with its distances").arg(compared->name) : QString()));
     emit resultReady(comparedId);
     return true;
 }
@@ -210,11 +212,13 @@ bool DistanceController::runCloudToMesh(EntityId comparedId, EntityId referenceI
     const DistanceStatistics statistics = result->statistics;
     const Document::UndoGroup group(document_, tr("C2M"));
     document_.addField(comparedId, std::move(result->distance));
+    const bool revealed = document_.revealResult(comparedId);
     showReference(referenceId, false);
-    emit finished(tr("C2M %1 -> %2 [%3] %4; %5 degenerate triangles; %6 s")
+    emit finished(tr("C2M %1 -> %2 [%3] %4; %5 degenerate triangles; %6 s%7")
                       .arg(compared->name, reference->name, command, statisticsText(statistics))
                       .arg(result->degenerateTriangles)
-                      .arg(seconds, 0, 'f', 3));
+                      .arg(seconds, 0, 'f', 3)
+                      .arg(revealed ? tr("; %1 was hidden: shown with its distances").arg(compared->name) : QString()));
     emit resultReady(comparedId);
     return true;
 }

@@ -5,6 +5,7 @@
 #include "TaskRunner.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/distance/DemOfDifference.h>
 #include <scandiff/io/DxfWriter.h>
 #include <scandiff/io/FileIO.h>
 
@@ -114,6 +115,13 @@ std::vector<EntityId> FileController::open(const QStringList& paths, bool quiet)
                 const QString name = QString::fromStdString(pointsOf(entity).name);
                 loaded.push_back(document_.add(name, std::move(entity), group, absolute));
             }
+        }
+        // A cloud that has colours opens in its colours, as in CloudCompare
+        // (an RGB LAZ is not shown by its intensity); a grid keeps its main field.
+        for (EntityId id : loaded) {
+            const Document::Item& item = document_.item(id);
+            if (item.sourcePath == absolute && item.cloud() && item.cloud()->hasColors() && !mainGridField(*item.cloud()))
+                document_.setActiveField(id, std::string());
         }
         remember(absolute);
         emit finished(tr("opened %1: %2 %3%4 in %5 s")

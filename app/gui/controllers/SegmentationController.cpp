@@ -41,17 +41,26 @@ SegmentationDialog::SegmentationDialog(const Document& document, EntityId input,
     input_->setObjectName("input");
     reference_ = new QComboBox(this);
     reference_->setObjectName("reference");
-    reference_->addItem(tr("(none: no volume)"), kNoEntity);
     for (EntityId id : document.ids()) {
         const Document::Item& item = document.item(id);
-        if (!item.cloud())
-            continue;
-        if (!item.points().fields().empty())
+        if (item.cloud() && !item.points().fields().empty())
             input_->addItem(item.name, id);
-        reference_->addItem(item.name, id);
     }
     if (const int i = input_->findData(input); i >= 0)
         input_->setCurrentIndex(i);
+    // The other epoch: any cloud but the one segmented (kept when still offered).
+    const auto listOtherEpochs = [this, &document] {
+        const EntityId chosen = reference();
+        reference_->clear();
+        reference_->addItem(tr("(none: no volume)"), kNoEntity);
+        for (EntityId id : document.ids())
+            if (id != this->input() && document.item(id).cloud())
+                reference_->addItem(document.item(id).name, id);
+        if (const int i = reference_->findData(chosen); i >= 0)
+            reference_->setCurrentIndex(i);
+    };
+    listOtherEpochs();
+    connect(input_, qOverload<int>(&QComboBox::currentIndexChanged), this, listOtherEpochs);
     entities->addRow(tr("Cloud"), input_);
     entities->addRow(tr("Other epoch (volume)"), reference_);
     layout->addLayout(entities);
@@ -87,7 +96,10 @@ SegmentationDialog::SegmentationDialog(const Document& document, EntityId input,
 }
 
 EntityId SegmentationDialog::input() const { return input_->currentData().isValid() ? input_->currentData().toInt() : kNoEntity; }
-EntityId SegmentationDialog::reference() const { return reference_->currentData().toInt(); }
+EntityId SegmentationDialog::reference() const
+{
+    return reference_->currentData().isValid() ? reference_->currentData().toInt() : kNoEntity;
+}
 std::map<std::string, std::string> SegmentationDialog::values() const { return form_->values(); }
 
 SegmentationController::SegmentationController(const PluginRegistry& registry, Document& document, QWidget* parentWindow)
@@ -124,6 +136,10 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
     const Document::Item* reference = document_.find(referenceId);
     if (!input || !input->cloud()) {
         emit failed(tr("Segmentation needs a point cloud"));
+        return false;
+    }
+    if (referenceId == inputId) {
+        emit failed(tr("The other epoch must be another cloud: a cloud has no volume of change against itself"));
         return false;
     }
     CommandLine command("scandiff-cli segment");
@@ -193,12 +209,14 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
     reports_[inputId] = std::move(report);
     distanceFields_[inputId] = distanceField;
     document_.setActiveField(inputId, "region_id");
+    const bool revealed = document_.revealResult(inputId);
     // The regions, report and export state live here; bringing back the
     // previous fields alone would leave them describing this run.
     document_.forgetUndo();
-    emit finished(tr("segment %1 [%2]: %3; %4 s")
+    emit finished(tr("segment %1 [%2]: %3; %4 s%5")
                       .arg(input->name, commandText, QString::fromStdString(summary))
-                      .arg(clock.elapsed() / 1000.0, 0, 'f', 3));
+                      .arg(clock.elapsed() / 1000.0, 0, 'f', 3)
+                      .arg(revealed ? tr("; %1 was hidden: shown with its regions").arg(input->name) : QString()));
     emit resultReady(inputId);
     return true;
 }

@@ -192,6 +192,8 @@ bool ToolController::run(const ToolInputChoice& choice, const std::map<std::stri
                 document_.replaceData(firstRole[k], std::move(entity));
                 last = firstRole[k];
                 updatedInputs = true;
+                if (document_.revealResult(last))
+                    notes += tr("; %1 was hidden: shown with the result").arg(document_.item(last).name);
                 continue;
             }
             const std::string& dataName = pointsOf(entity).name;

@@ -245,6 +245,22 @@ void Document::setVisible(EntityId id, bool visible)
             setVisible(child, visible);
 }
 
+bool Document::revealResult(EntityId id)
+{
+    const Item* item = find(id);
+    if (!item || item->display.visible)
+        return false;
+    for (std::vector<EntityId> pending = children(id); !pending.empty();) {
+        const EntityId child = pending.back();
+        pending.pop_back();
+        setVisible(child, false);
+        for (EntityId grandChild : children(child))
+            pending.push_back(grandChild);
+    }
+    setVisible(id, true);
+    return true;
+}
+
 void Document::setActiveField(EntityId id, const std::string& fieldName)
 {
     Item* item = findMutable(id);

@@ -130,6 +130,11 @@ public:
     //! Adds (or replaces) a scalar field of a cloud and makes it active.
     void addField(EntityId id, ScalarField field);
     void setVisible(EntityId id, bool visible);
+    //! Shows an entity a tool has just put its result on when it was hidden
+    //! (a parent after a split), hiding its shown descendants (the split's
+    //! parts) so that the result is what the view draws. Returns whether it
+    //! was hidden, for the tool's message.
+    bool revealResult(EntityId id);
     //! Empty name: colours / height. Unknown names are ignored.
     void setActiveField(EntityId id, const std::string& fieldName);
     void setFieldDisplay(EntityId id, const std::string& fieldName, const FieldDisplay& display);

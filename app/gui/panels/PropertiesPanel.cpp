@@ -41,8 +41,13 @@ PropertiesPanel::PropertiesPanel(const Document& document, QWidget* parent) : QT
 {
     setColumnCount(2);
     setHeaderLabels({tr("Property"), tr("Value")});
+    // No value is cut: a global shift, a box corner or a path is read whole
+    // (the panel scrolls sideways when it is narrower than a value).
     header()->setSectionResizeMode(0, QHeaderView::ResizeToContents);
-    setTextElideMode(Qt::ElideMiddle); // a long path keeps its file name in sight
+    header()->setSectionResizeMode(1, QHeaderView::ResizeToContents);
+    header()->setStretchLastSection(false);
+    setTextElideMode(Qt::ElideNone);
+    setHorizontalScrollMode(QAbstractItemView::ScrollPerPixel);
     setRootIsDecorated(true);
     connect(&document_, &Document::fieldsChanged, this, [this](EntityId id) {
         if (id == entity_)
