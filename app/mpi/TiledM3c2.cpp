@@ -64,6 +64,10 @@ public:
         if (job.values.has("raster-cell"))
             throw Error(ErrorCode::Unsupported, "scandiff-mpi m3c2: --raster-cell is not supported on tiles; rasterise the "
                                                 "output with scandiff-cli rasterize");
+        if (params_.projectionScale == 0.0 || std::find(params_.normalScales.begin(), params_.normalScales.end(), 0.0) != params_.normalScales.end())
+            throw Error(ErrorCode::Unsupported, "scandiff-mpi m3c2: give --normal-scale and --projection-scale; guessing them "
+                                                "(0) reads both whole epochs, which no rank holds: scandiff-cli m3c2-scales "
+                                                "--reference R --compared C guesses them");
         using Kind = NormalOrientation::Kind;
         if (params_.orientation.kind == Kind::MinimumSpanningTree || params_.orientation.kind == Kind::None)
             throw Error(ErrorCode::InvalidArgument, "m3c2: orient the normals by a direction, the sensor or the centroid");

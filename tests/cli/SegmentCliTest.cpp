@@ -143,11 +143,11 @@ TEST(SegmentCli, CompareByM3c2WritesRegionsCorePointsAndRaster)
                                            "0.1", "--out-dir", out.string()});
     EXPECT_NE(bad.status, 0);
     EXPECT_NE(bad.err.find("--method m3c2"), std::string::npos) << bad.err;
-    // M3C2's required scales are still required with --method m3c2.
+    // M3C2's required maximum depth is still required with --method m3c2 (its scales may be guessed).
     bad = test::runCliInProcess(registry, {"compare", "--method", "m3c2", "--reference", reference, "--compared", compared,
                                            "--out-dir", out.string()});
     EXPECT_NE(bad.status, 0);
-    EXPECT_NE(bad.err.find("normal-scale"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("max-depth"), std::string::npos) << bad.err;
 }
 
 TEST(SegmentCli, SegmentWithEachMethodOnTheDistances)

@@ -159,6 +159,47 @@ private slots:
         QCOMPARE(panel.colourRangeEditor()->high(), 58.0);
     }
 
+    void flagsAndLabelsAreCategoriesInTheViewTheBarAndTheHistogram()
+    {
+        // Issue 50, defect 8: the histogram drew labels on a rainbow and the
+        // significance flag on a 0-1 ramp.
+        gui::Document document;
+        PointCloud cloud;
+        cloud.resize(6);
+        cloud.addField("m3c2_significant").values() = {0, 1, 1, 0, std::nanf(""), 1};
+        cloud.addField("region_id").values() = {1, 2, 3, 2, 1, 7};
+        cloud.addField("distance").values() = {0, 1, 1, 0, 0.5f, 1};
+        const EntityId id = document.add("cores", std::move(cloud));
+        const PointCloud& points = document.item(id).points();
+        QVERIFY(gui::isFlagField(*points.field("m3c2_significant")));
+        QVERIFY(!gui::isFlagField(*points.field("distance"))); // a 0.5 among them: a measure
+        QVERIFY(!gui::isFlagField(*points.field("region_id")));
+        document.setActiveField(id, "m3c2_significant");
+        std::vector<std::uint8_t> rgba(24);
+        const gui::ColourLegend legend = gui::colourEntity(points, document.item(id).display, rgba.data());
+        auto colourOf = [&](std::size_t i) { return std::array<std::uint8_t, 3>{rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]}; };
+        QCOMPARE(colourOf(0), gui::categoryColour(false, 0));
+        QCOMPARE(colourOf(1), gui::categoryColour(false, 1));
+        QVERIFY(colourOf(0) != colourOf(1));
+        QCOMPARE(legend.categories.size(), std::size_t(2)); // two swatches, not a ramp
+        QCOMPARE(legend.categories[1].second, colourOf(1));
+        // The histogram's bars in the points' colours, for the flag and for labels.
+        gui::ScalarFieldPanel panel(document);
+        panel.showEntity(id);
+        QVERIFY(panel.histogram()->categorical());
+        const auto asQColor = [](const std::array<std::uint8_t, 3>& c) { return QColor(c[0], c[1], c[2]); };
+        QCOMPARE(panel.histogram()->colourOfValue(1.0), asQColor(colourOf(1)));
+        QCOMPARE(panel.histogram()->colourOfValue(0.02), asQColor(colourOf(0)));
+        document.setActiveField(id, "region_id");
+        panel.showEntity(id);
+        QVERIFY(panel.histogram()->categorical());
+        QCOMPARE(panel.histogram()->colourOfValue(7.0), asQColor(gui::labelColour(7)));
+        QCOMPARE(panel.histogram()->colourOfValue(3.0), asQColor(gui::labelColour(3)));
+        document.setActiveField(id, "distance");
+        panel.showEntity(id);
+        QVERIFY(!panel.histogram()->categorical()); // a measure: the scale again
+    }
+
     void labelsGetDistinctColoursAndNeutralIsGrey()
     {
         gui::Document document;

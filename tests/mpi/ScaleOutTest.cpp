@@ -323,7 +323,7 @@ TEST_F(ScaleOut, M3c2AndC2mBadOptionsGiveTheCliErrors)
 {
     const std::string m3c2 = " m3c2 --reference " + file("reference.ply") + " --compared " + file("compared.ply");
     const std::string c2m = " c2m --reference " + file("mesh.ply") + " --compared " + file("compared.ply");
-    for (const std::string& bad : {m3c2 + " --projection-scale 1 --max-depth 1", // no normal scale
+    for (const std::string& bad : {m3c2 + " --normal-scale -1 --projection-scale 1 --max-depth 1", // a negative scale
                                    m3c2 + " --normal-scale 1 --projection-scale 1 --max-depth 1 --orientation mst",
                                    m3c2 + " --normal-scale 1 --normal-scales 1,x --projection-scale 1 --max-depth 1",
                                    c2m + " --clamp", c2m + " --octree-level 40",

@@ -217,6 +217,16 @@ void ScalarFieldPanel::refresh()
         colours_->setRange(cmin, cmax);
         symmetric_->setChecked(display.symmetric);
         histogram_->setColouring(display.scale, cmin, cmax);
+        // Labels and flags: each bar in the colour its points are drawn in.
+        if (isCategoricalField(*field)) {
+            const bool label = isLabelField(*field);
+            histogram_->setCategoryColour([label](long value) {
+                const auto c = categoryColour(label, value);
+                return QColor(c[0], c[1], c[2]);
+            });
+        } else {
+            histogram_->setCategoryColour({});
+        }
         histogram_->setMarkedRange(range_->low(), range_->high());
         std::vector<std::pair<double, QString>> references;
         for (const auto& [value, label] : display.marks)

@@ -45,6 +45,30 @@ bool isLabelField(const ScalarField& field)
     return true;
 }
 
+bool isFlagField(const ScalarField& field)
+{
+    bool any = false;
+    for (std::size_t i = 0; i < field.size(); ++i)
+        if (field.hasValue(i)) {
+            const double v = field.value(i);
+            if (v != 0.0 && v != 1.0)
+                return false;
+            any = true;
+        }
+    return any;
+}
+
+bool isCategoricalField(const ScalarField& field) { return isLabelField(field) || isFlagField(field); }
+
+std::array<std::uint8_t, 3> categoryColour(bool isLabel, long value)
+{
+    // Two of Kelly's colours, the farthest apart for most colour visions.
+    static constexpr std::array<std::uint8_t, 3> kNo{0, 103, 165}, kYes{190, 0, 50};
+    if (!isLabel && (value == 0 || value == 1))
+        return value == 1 ? kYes : kNo;
+    return labelColour(value);
+}
+
 std::array<std::uint8_t, 3> labelColour(long value)
 {
     static constexpr std::array<std::uint8_t, 3> kKelly[] = {
@@ -67,10 +91,11 @@ std::vector<long> labelsPresent(const ScalarField& field, std::size_t limit)
     return {values.begin(), values.end()};
 }
 
-//! Colours a label field: each value its labelColour, the thresholds as for any field.
+//! Colours a categorical field: each value its categoryColour, the thresholds as for any field.
 void colourLabels(const ScalarField& field, const FieldDisplay& display, FieldColouring::Outside outside, std::uint8_t* rgba)
 {
     const FieldColouring how;
+    const bool label = isLabelField(field);
     for (std::size_t i = 0; i < field.size(); ++i) {
         std::uint8_t* c = rgba + 4 * i;
         if (!field.hasValue(i)) {
@@ -85,7 +110,8 @@ void colourLabels(const ScalarField& field, const FieldDisplay& display, FieldCo
                 c[0] = how.greyColour[0], c[1] = how.greyColour[1], c[2] = how.greyColour[2], c[3] = 255;
             continue;
         }
-        const auto colour = labelColour(std::lround(v));
+        const long value = std::lround(v);
+        const auto colour = categoryColour(label, value);
         c[0] = colour[0], c[1] = colour[1], c[2] = colour[2], c[3] = 255;
     }
 }
@@ -106,9 +132,9 @@ ColourLegend legendOf(const PointCloud& points, const DisplayState& display)
     const FieldDisplay fieldDisplay = it == display.fields.end() ? FieldDisplay{} : it->second;
     legend.scale = fieldDisplay.scale;
     std::tie(legend.min, legend.max) = colourRange(*field, fieldDisplay);
-    if (isLabelField(*field))
+    if (isCategoricalField(*field))
         for (long value : labelsPresent(*field, kLegendCategories))
-            legend.categories.emplace_back(value, labelColour(value));
+            legend.categories.emplace_back(value, categoryColour(*field, value));
     return legend;
 }
 
@@ -120,7 +146,7 @@ ColourLegend colourEntity(const PointCloud& points, const DisplayState& display,
     if (field) {
         const auto it = display.fields.find(field->name());
         const FieldDisplay fieldDisplay = it == display.fields.end() ? FieldDisplay{} : it->second;
-        if (isLabelField(*field)) {
+        if (isCategoricalField(*field)) {
             colourLabels(*field, fieldDisplay, display.outside, rgba);
             return legendOf(points, display);
         }

@@ -34,6 +34,22 @@ struct ColourLegend
 //! would be two shades of blue.
 bool isLabelField(const ScalarField& field);
 
+//! Whether a field is a yes/no flag: it has values and every one is 0 or 1
+//! (changed, m3c2_significant, dod_significant...). Drawn in two colours, not
+//! on a ramp where 0.5 would mean something.
+bool isFlagField(const ScalarField& field);
+
+//! Labels or a flag: drawn, legended and histogrammed by category.
+bool isCategoricalField(const ScalarField& field);
+
+//! The colour of `value` of a categorical field: a flag's 0 blue and 1 red
+//! (unchanged / changed), a label's labelColour.
+std::array<std::uint8_t, 3> categoryColour(bool isLabel, long value);
+inline std::array<std::uint8_t, 3> categoryColour(const ScalarField& field, long value)
+{
+    return categoryColour(isLabelField(field), value);
+}
+
 //! The colour of label `value`: 19 colours of high mutual contrast in turn
 //! (Kelly's list of 1965, without its white, black and grey, which the
 //! background, the greyed points and the no-value points use), so

@@ -38,6 +38,25 @@ void HistogramWidget::setColouring(const ColourScale& scale, double colourMin, d
     update();
 }
 
+void HistogramWidget::setCategoryColour(std::function<QColor(long)> colour)
+{
+    categoryColour_ = std::move(colour);
+    update();
+}
+
+QColor HistogramWidget::colourOfValue(double value) const
+{
+    if (categoryColour_)
+        return categoryColour_(std::lround(value));
+    double t;
+    if (!(colourMax_ > colourMin_))
+        t = value < colourMin_ ? 0.0 : value > colourMax_ ? 1.0 : 0.5;
+    else
+        t = (value - colourMin_) / (colourMax_ - colourMin_);
+    const auto c = scale_.colourAt(t);
+    return QColor(c[0], c[1], c[2]);
+}
+
 void HistogramWidget::setMarkedRange(double low, double high)
 {
     if (std::isnan(low) || std::isnan(high))
@@ -134,16 +153,7 @@ void HistogramWidget::paintEvent(QPaintEvent*)
     } else {
         const std::size_t most = *std::max_element(counts.begin(), counts.end());
         const double top = logarithmic_ ? std::log1p(static_cast<double>(most)) : static_cast<double>(most);
-        const bool degenerateColour = !(colourMax_ > colourMin_);
-        auto colourOf = [&](double value) {
-            double t;
-            if (degenerateColour)
-                t = value < colourMin_ ? 0.0 : value > colourMax_ ? 1.0 : 0.5;
-            else
-                t = (value - colourMin_) / (colourMax_ - colourMin_);
-            const auto c = scale_.colourAt(t);
-            return QColor(c[0], c[1], c[2]);
-        };
+        auto colourOf = [&](double value) { return colourOfValue(value); };
         const double binWidth = (histogram_.max - histogram_.min) / static_cast<double>(counts.size());
         for (std::size_t i = 0; i < counts.size(); ++i) {
             if (counts[i] == 0)
@@ -187,6 +197,8 @@ void HistogramWidget::paintEvent(QPaintEvent*)
 
     // The colour range's ends, dashed: beyond them the bars keep the end colours.
     for (double value : {colourMin_, colourMax_}) {
+        if (categorical())
+            break; // categories have no range
         if (!(value > axisMin() && value < axisMax()))
             continue;
         const int x = xOfValue(value);

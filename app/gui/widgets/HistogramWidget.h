@@ -8,8 +8,10 @@
 
 #include "colour/ColourScale.h"
 
+#include <QColor>
 #include <QWidget>
 
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -23,6 +25,13 @@ public:
 
     void setHistogram(Histogram histogram);
     void setColouring(const ColourScale& scale, double colourMin, double colourMax);
+    //! Categories (labels, yes/no flags): each bar in the colour of the
+    //! integer value at its centre, as the points of that value are drawn;
+    //! the colour range is then not marked. An empty function: the scale.
+    void setCategoryColour(std::function<QColor(long)> colour);
+    bool categorical() const { return static_cast<bool>(categoryColour_); }
+    //! The colour a bar centred on `value` is drawn in.
+    QColor colourOfValue(double value) const;
     //! Swapped if low > high. Markers outside the histogram's span are not drawn,
     //! but the shading still covers the part of the span outside [low, high].
     void setMarkedRange(double low, double high);
@@ -72,6 +81,7 @@ private:
     double markedHigh_ = std::numeric_limits<double>::infinity();
     bool logarithmic_ = false;
     std::vector<std::pair<double, QString>> references_;
+    std::function<QColor(long)> categoryColour_;
     Marker dragging_ = Marker::None;
 };
 

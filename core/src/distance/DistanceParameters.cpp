@@ -223,15 +223,19 @@ CloudToMeshParams cloudToMeshSettings(const ParameterValues& values)
 const std::vector<ParameterSpec>& m3c2Parameters()
 {
     static const std::vector<ParameterSpec> parameters = {
-        ParameterSpec::real("normal-scale", "Normal scale D", "Diameter of the reference neighbourhood the normal is fitted on",
-                            1.0, 1e-6, 1e6, "m")
-            .asRequired(),
+        ParameterSpec::real("normal-scale", "Normal scale D",
+                            "Diameter of the reference neighbourhood the normal is fitted on; 0: guessed from the roughness "
+                            "(D / sigma(D) >= 25, Lague et al. 2013)",
+                            0.0, 0.0, 1e6, "m")
+            .withZeroMeaning("guessed"),
         ParameterSpec::text("normal-scales", "Normal scales",
                             "Several diameters D1,D2,D3 (multi-scale normal: the most planar is kept); replaces the normal scale")
             .asOptional(),
-        ParameterSpec::real("projection-scale", "Projection scale d", "Diameter of the cylinder each epoch is averaged in",
-                            1.0, 1e-6, 1e6, "m")
-            .asRequired(),
+        ParameterSpec::real("projection-scale", "Projection scale d",
+                            "Diameter of the cylinder each epoch is averaged in; 0: guessed from the point spacing (30 points "
+                            "of each epoch in the median cylinder)",
+                            0.0, 0.0, 1e6, "m")
+            .withZeroMeaning("guessed"),
         ParameterSpec::real("max-depth", "Maximum depth", "Half-length of the cylinder along the normal", 1.0, 1e-6, 1e6, "m")
             .asRequired(),
         ParameterSpec::real("registration-error", "Registration error", "Added to the level of detection", 0.0, 0.0, 1e6, "m"),

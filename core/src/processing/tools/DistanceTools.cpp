@@ -175,7 +175,19 @@ void registerDistanceTools(ToolRegistry& registry)
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
         const PointCloud& reference = inputs.cloud("reference");
         const PointCloud& compared = inputs.cloud("compared");
-        const M3c2Params params = m3c2Settings(values);
+        M3c2Params params = m3c2Settings(values);
+        // A scale of 0 is guessed from the epochs, as CloudCompare's "guess parameters".
+        std::string guessed;
+        const bool guessNormal = params.normalScales.size() == 1 && params.normalScales.front() == 0.0;
+        if (guessNormal || params.projectionScale == 0.0) {
+            const M3c2ScaleGuess guess = guessM3c2Scales(reference, compared, {}, progress);
+            if (guessNormal)
+                params.normalScales = {guess.normalScale};
+            if (params.projectionScale == 0.0)
+                params.projectionScale = guess.projectionScale;
+            guessed = describe(" (guessed: normal scale ", params.normalScales.front(), ", projection scale ", params.projectionScale,
+                               " m; spacing ", guess.spacing, " m)");
+        }
         if (inputs.has("core-points") && values.has("core-spacing"))
             throw Error(ErrorCode::InvalidArgument, "m3c2: give core points or a core spacing, not both");
         M3c2Result m;
@@ -192,7 +204,7 @@ void registerDistanceTools(ToolRegistry& registry)
         ToolResult result;
         result.summary = describe("M3C2 at ", m.corePoints.size(), " core points: ", m.measuredCount, " measured, ",
                                   m.significantCount, " significant changes",
-                                  m.withoutNormal ? describe(", ", m.withoutNormal, " without a normal") : std::string());
+                                  m.withoutNormal ? describe(", ", m.withoutNormal, " without a normal") : std::string(), guessed);
         std::optional<PointCloud> cells;
         if (values.has("raster-cell")) {
             RasteriseParams raster;
@@ -207,6 +219,47 @@ void registerDistanceTools(ToolRegistry& registry)
         return result;
     };
     registry.add(std::move(tool));
+
+    ToolSpec scales;
+    scales.name = "m3c2-scales";
+    scales.title = "M3C2 scales (guess)";
+    scales.category = "Distances";
+    scales.description =
+        "Guesses M3C2's scales from the two epochs, as CloudCompare's plugin does (Guess params), on the criteria of Lague, "
+        "Brodu and Leroux (2013): the projection scale d from the point spacing, so that the median cylinder holds 30 points "
+        "of each epoch, and the normal scale D from the roughness, D / sigma(D) >= 25; both rounded up to two digits. "
+        "m3c2 uses them when its scales are 0.";
+    scales.inputs = {InputSpec{"reference", "Reference", "The first epoch", DataKind::Cloud, false, false},
+                     InputSpec{"compared", "Compared", "The second epoch", DataKind::Cloud, false, false}};
+    scales.outputs = {OutputSpec{"output", "Guessed scales", DataKind::Table, false}};
+    scales.parameters = {
+        ParameterSpec::integer("points-per-cylinder", "Points per cylinder", "In the median cylinder, in each epoch", 30, 3, 100000),
+        ParameterSpec::real("roughness-ratio", "Roughness ratio", "D / sigma(D) at the median sample", 25.0, 1.0, 1e6),
+        ParameterSpec::integer("samples", "Samples", "Reference points the criteria are measured at", 2000, 10, 10000000),
+    };
+    scales.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        M3c2ScaleGuessParams params;
+        params.pointsPerCylinder = static_cast<std::size_t>(values.integer("points-per-cylinder"));
+        params.roughnessRatio = values.real("roughness-ratio");
+        params.samples = static_cast<std::size_t>(values.integer("samples"));
+        const M3c2ScaleGuess guess = guessM3c2Scales(inputs.cloud("reference"), inputs.cloud("compared"), params, progress);
+        Table table;
+        table.columns = {"quantity", "value"};
+        table.rows = {{std::string("normal_scale"), guess.normalScale},
+                      {std::string("projection_scale"), guess.projectionScale},
+                      {std::string("spacing"), guess.spacing},
+                      {std::string("median_points_reference"), guess.medianPointsReference},
+                      {std::string("median_points_compared"), guess.medianPointsCompared},
+                      {std::string("median_roughness_ratio"), guess.medianRoughnessRatio}};
+        ToolResult result;
+        result.summary = describe("normal scale ", guess.normalScale, " m, projection scale ", guess.projectionScale, " m (spacing ",
+                                  guess.spacing, " m; ", guess.medianPointsReference, " and ", guess.medianPointsCompared,
+                                  " points in the median cylinder; D / sigma(D) ", guess.medianRoughnessRatio,
+                                  guess.roughnessRatioReached ? ")" : ", rougher than asked at 5 d, the widest tried)");
+        result.add("output", std::move(table));
+        return result;
+    };
+    registry.add(std::move(scales));
     registerRasterTools(registry);
 }
 

@@ -93,4 +93,32 @@ M3c2Result m3c2(const PointCloud& reference, const PointCloud& compared, const P
 M3c2Result m3c2OnParts(const PointCloud& reference, const PointCloud& compared, const PointCloud& corePoints,
                        const M3c2Params& params, ProgressObserver* progress = nullptr);
 
+//! What guessM3c2Scales() aims for (Lague, Brodu and Leroux 2013, §3.2-3.3).
+struct M3c2ScaleGuessParams
+{
+    std::size_t samples = 2000;          //!< reference points the criteria are measured at (every k-th)
+    std::size_t pointsPerCylinder = 30;  //!< in the median cylinder, in each epoch
+    double roughnessRatio = 25.0;        //!< D / sigma(D) at the median sample
+};
+
+struct M3c2ScaleGuess
+{
+    double spacing = 0.0;                //!< median distance to the nearest point, the sparser epoch's
+    double projectionScale = 0.0;        //!< d: the smallest whose median ball holds pointsPerCylinder in both epochs
+    double normalScale = 0.0;            //!< D: the smallest multiple of d with D / sigma(D) >= the ratio
+    double medianPointsReference = 0.0;  //!< in a ball of diameter d at the median sample
+    double medianPointsCompared = 0.0;
+    double medianRoughnessRatio = 0.0;   //!< D / sigma(D) at the median sample
+    bool roughnessRatioReached = false;  //!< false: D is the largest tried (5 d), rougher than asked
+};
+
+//! M3C2's projection and normal scales from the epochs themselves (CloudCompare's
+//! "guess parameters"): d from the point spacing so that a cylinder holds
+//! enough points of each epoch for a level of detection, D from the
+//! roughness so that the normal is stable; both rounded up to two significant
+//! digits. Throws Error(InvalidData) for empty clouds or coinciding points,
+//! Error(InvalidArgument) for parameters out of range, Error(Cancelled).
+M3c2ScaleGuess guessM3c2Scales(const PointCloud& reference, const PointCloud& compared, const M3c2ScaleGuessParams& params = {},
+                               ProgressObserver* progress = nullptr);
+
 } // namespace scandiff
