@@ -296,6 +296,51 @@ private slots:
         window.findChild<QAction*>("measureAction")->setChecked(false);
     }
 
+    void aMeasurementStaysBetweenTheNearAndFarPlanes()
+    {
+        // Issue 50, defect 7: a measurement on a cloud hidden since (a parent
+        // after a split) was outside the view after reopening a session, until
+        // Zoom to all: the near and far planes were fitted to the shown clouds only.
+        QTemporaryDir dir;
+        Workbench workbench;
+        QVERIFY(workbench.shown());
+        gui::MainWindow& window = workbench.window;
+        gui::Document& document = window.document();
+        const auto plane = [](double z) {
+            PointCloud cloud;
+            cloud.setOrigin({512000, 5423000, 0});
+            for (int i = 0; i < 40; ++i)
+                for (int j = 0; j < 40; ++j)
+                    cloud.positions().emplace_back(static_cast<float>(i * 0.5), static_cast<float>(j * 0.5), static_cast<float>(z));
+            return cloud;
+        };
+        document.add("ground", plane(0.0));
+        const EntityId deep = document.add("deep", plane(-100.0));
+        window.measure()->setMeasuring(true);
+        window.measure()->addPick(deep, 0);
+        window.measure()->addPick(deep, 1599);
+        window.measure()->setMeasuring(false);
+        const std::vector<Eigen::Vector3d> measured = window.measure()->measurements().front();
+        QCOMPARE(measured.size(), std::size_t(2));
+        document.setVisible(deep, false);
+        const auto betweenThePlanes = [&](const Eigen::Vector3d& p) {
+            const Eigen::Vector4d v = window.view()->globalToWidgetPixels() * Eigen::Vector4d(p.x(), p.y(), p.z(), 1.0);
+            return v.w() > 0 && v.z() / v.w() >= -1.0 && v.z() / v.w() <= 1.0;
+        };
+        window.view()->setStandardView(gui::StandardView::Iso); // the camera fitted to the ground alone
+        QApplication::processEvents();
+        for (const Eigen::Vector3d& p : measured)
+            QVERIFY2(betweenThePlanes(p), "after a standard view");
+        const QString session = dir.filePath("measured.scandiff");
+        QVERIFY(window.sessions()->save(session));
+        document.clear();
+        QVERIFY(window.sessions()->restore(session));
+        QApplication::processEvents();
+        QCOMPARE(window.measure()->measurements().front().size(), std::size_t(2));
+        for (const Eigen::Vector3d& p : window.measure()->measurements().front())
+            QVERIFY2(betweenThePlanes(p), "after the session is reopened");
+    }
+
     void everyMenuIsThereOnceWithItsTools()
     {
         // A tool category named like a built-in submenu (Distances: C2C, C2M)

@@ -336,10 +336,11 @@ bool SessionController::restore(const QString& qpath)
         document_.setVisible(id, e.visible);
     }
     view_.setPointSize(pointSize);
-    if (camera)
-        view_.setCamera(*camera);
+    // The measurements first: the camera's near and far planes take them in.
     if (measure_)
         measure_->setMeasurements(std::move(measurements));
+    if (camera)
+        view_.setCamera(*camera);
     document_.markAllSaved(); // derived entities are in the session's data folder
     emit finished(tr("opened session %1 (%2 entities)").arg(qpath).arg(document_.size()));
     return true;

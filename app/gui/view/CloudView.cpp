@@ -478,6 +478,7 @@ void CloudView::clear()
 void CloudView::resetCamera()
 {
     scene_->renderer->ResetCamera();
+    resetClippingRange();
     // Decimated first, full detail once nothing else happens: opening big
     // files shows each cloud at once instead of an empty window while a
     // software renderer draws millions of points.
@@ -495,6 +496,7 @@ void CloudView::zoomToEntity(EntityId id)
     double bounds[6];
     box.GetBounds(bounds);
     scene_->renderer->ResetCamera(bounds);
+    resetClippingRange();
     render();
 }
 
@@ -539,7 +541,7 @@ void CloudView::setParallelProjection(bool parallel)
         scene_->renderer->GetActiveCamera()->SetParallelProjection(parallel);
         emit projectionChanged(parallel);
     }
-    scene_->renderer->ResetCameraClippingRange();
+    resetClippingRange();
     render();
 }
 
@@ -602,7 +604,30 @@ void CloudView::setAnnotations(const std::vector<Annotation>& annotations)
         scene_->renderer->AddActor(scene_->annotationActor);
     }
     scene_->annotations->Modified();
+    resetClippingRange();
     renderSoon();
+}
+
+void CloudView::resetClippingRange()
+{
+    // The measurements count for the near and far planes (not for "zoom to
+    // all"): one taken on a cloud hidden since, or restored with a session
+    // before its clouds are shown, stays drawn wherever the camera is.
+    double bounds[6];
+    scene_->renderer->ComputeVisiblePropBounds(bounds);
+    if (annotationCount_ > 0 && scene_->annotations->GetNumberOfPoints() > 0) {
+        double marks[6];
+        scene_->annotations->GetBounds(marks);
+        const bool none = !(bounds[0] <= bounds[1]);
+        for (int a = 0; a < 3; ++a) {
+            bounds[2 * a] = none ? marks[2 * a] : std::min(bounds[2 * a], marks[2 * a]);
+            bounds[2 * a + 1] = none ? marks[2 * a + 1] : std::max(bounds[2 * a + 1], marks[2 * a + 1]);
+        }
+    }
+    if (bounds[0] <= bounds[1])
+        scene_->renderer->ResetCameraClippingRange(bounds);
+    else
+        scene_->renderer->ResetCameraClippingRange();
 }
 
 void CloudView::setClippingBox(bool on)
@@ -976,7 +1001,7 @@ void CloudView::setCamera(const CameraState& s)
         emit projectionChanged(s.parallel);
     }
     c->SetParallelScale(s.parallelScale);
-    scene_->renderer->ResetCameraClippingRange();
+    resetClippingRange();
     render();
 }
 
@@ -1008,8 +1033,10 @@ void CloudView::setMoving(bool moving)
     settleTimer_->stop();
     for (auto& [id, s] : scene_->shown)
         setDecimated(s, moving || refinesInSlices());
-    if (!moving)
+    if (!moving) {
+        resetClippingRange(); // the measurements too, once the move is over
         render(); // full detail at rest, at once or slice by slice
+    }
 }
 
 void CloudView::setDecimated(Shown& s, bool moving)

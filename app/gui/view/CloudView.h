@@ -206,6 +206,8 @@ private:
     //! Clips every chunk's mappers to the box's six faces (or none).
     void applyClipping();
     void setDecimated(Shown& shown, bool moving);
+    //! The near and far planes around what is shown and the measurements.
+    void resetClippingRange();
     //! Whether the clouds at rest are drawn in slices (more points than the
     //! budget; Eye-Dome Lighting's passes redraw the whole frame, so not then).
     bool refinesInSlices() const;
