@@ -221,13 +221,18 @@ void MainWindow::buildMenus()
     file->addAction(tr("&Quit"), this, &QWidget::close)->setShortcut(QKeySequence::Quit);
 
     QMenu* edit = menuBar()->addMenu(tr("&Edit"));
-    // One level of undo for a deletion, a tool's change of an entity, a computed field.
+    // Undo and redo histories: deletions, tools' changes and outputs, fields, splits, the scissors.
     QAction* undo = edit->addAction(tr("Undo"), &document_, &Document::undo);
     undo->setObjectName("undoAction");
     undo->setShortcut(QKeySequence::Undo);
-    const auto followUndo = [this, undo] {
+    QAction* redo = edit->addAction(tr("Redo"), &document_, &Document::redo);
+    redo->setObjectName("redoAction");
+    redo->setShortcuts({QKeySequence::Redo, QKeySequence(tr("Ctrl+Y"))});
+    const auto followUndo = [this, undo, redo] {
         undo->setEnabled(document_.canUndo());
         undo->setText(document_.undoText());
+        redo->setEnabled(document_.canRedo());
+        redo->setText(document_.redoText());
     };
     connect(&document_, &Document::undoChanged, undo, followUndo);
     followUndo();

@@ -320,6 +320,78 @@ private slots:
         QVERIFY(!document.canUndo());
     }
 
+    void undoAndRedoAreHistoriesThatCoverSplitsAndTheScissors()
+    {
+        // Issue 50, defect 3: one level of undo, and the scissors could not be undone.
+        gui::Document document;
+        gui::SplitController splits(document);
+        const EntityId id = document.add("four", fourPoints());
+        QVERIFY(!document.canUndo() && !document.canRedo());
+        // Three actions, undone in turn and redone in turn, every value back.
+        document.addField(id, ScalarField("first", 4));
+        ScalarField second("second", 4);
+        second.setValue(2, 7.5);
+        document.addField(id, std::move(second));
+        document.remove(id);
+        QVERIFY(!document.contains(id));
+        document.undo();
+        QVERIFY(document.contains(id));
+        QCOMPARE(document.redoText(), QString("Redo delete 'four'"));
+        document.undo();
+        QVERIFY(!document.item(id).points().field("second"));
+        document.undo();
+        QVERIFY(!document.item(id).points().field("first"));
+        QVERIFY(!document.canUndo());
+        document.redo();
+        document.redo();
+        QCOMPARE(document.item(id).points().field("second")->value(2), 7.5);
+        QVERIFY(document.item(id).points().field("first"));
+        document.redo();
+        QVERIFY(!document.contains(id));
+        QVERIFY(!document.canRedo());
+        document.undo();
+        QVERIFY(document.contains(id));
+        // A new action after an undo empties the redo history.
+        document.undo();
+        QVERIFY(document.canRedo());
+        document.addField(id, ScalarField("third", 4));
+        QVERIFY(!document.canRedo());
+
+        // The clipping box's extraction (the scissors' path): undone, its parts
+        // go and the cloud is shown again; redone, the same parts come back.
+        CropBox box;
+        box.centre = Eigen::Vector3d(0.5, 0, 0);
+        box.size = Eigen::Vector3d(1.2, 1, 1);
+        QCOMPARE(splits.extractInBox(box), 1);
+        const std::vector<EntityId> parts = document.children(id);
+        QCOMPARE(parts.size(), std::size_t(2));
+        QVERIFY(!document.item(id).display.visible);
+        QCOMPARE(document.undoText(), QString("Undo extract in the clipping box"));
+        document.undo();
+        QVERIFY(document.children(id).empty());
+        QVERIFY(document.item(id).display.visible);
+        document.redo();
+        QCOMPARE(document.children(id), parts);
+        QCOMPARE(document.item(parts.front()).points().size(), std::size_t(3)); // x = 0, 1 and the fourth point at the origin
+        QVERIFY(!document.item(id).display.visible);
+        // A split by field range too.
+        document.undo();
+        const EntityId inside = splits.split(id, "d", 1.5, 2.0).first;
+        QVERIFY(inside != gui::kNoEntity);
+        document.undo();
+        QVERIFY(!document.contains(inside));
+        QVERIFY(document.item(id).display.visible);
+        // The history is bounded: the oldest actions go.
+        for (std::size_t k = 0; k < gui::Document::kUndoLevels + 5; ++k)
+            document.addField(id, ScalarField("f" + std::to_string(k), 4));
+        std::size_t levels = 0;
+        while (document.canUndo()) {
+            document.undo();
+            ++levels;
+        }
+        QCOMPARE(levels, gui::Document::kUndoLevels);
+    }
+
     void treeMirrorsTheDocument()
     {
         gui::Document document;

@@ -28,6 +28,7 @@ std::pair<EntityId, EntityId> SplitController::split(EntityId id, const std::str
             return {kNoEntity, kNoEntity};
         }
         const QString name = item->name;
+        const Document::UndoGroup group(document_, tr("split %1").arg(name)); // the parts go, the parent comes back
         const QString range = QString("[%1, %2]").arg(low, 0, 'g', 6).arg(high, 0, 'g', 6);
         const std::size_t insideCount = parts.inside.size(), outsideCount = parts.outside.size();
         // The parts keep the field's display (scale, thresholds) so they look as they did.
@@ -85,6 +86,7 @@ int SplitController::cutVisibleClouds(const QString& what, const QString& inside
 {
     int cut = 0;
     EntityId lastInside = kNoEntity;
+    const Document::UndoGroup group(document_, what); // one undo for every cloud it cut
     for (EntityId id : document_.ids()) {
         const Document::Item* item = document_.find(id);
         if (!item || !item->cloud() || !item->display.visible)

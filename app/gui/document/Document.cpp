@@ -33,8 +33,16 @@ EntityId Document::add(QString name, io::Entity entity, EntityId parent, QString
         item->display.activeField = main ? main->name() : cloud->fields().front().name();
     }
     const EntityId id = item->id;
+    const QString addedName = item->name;
     items_.push_back(std::move(item));
     emit added(id);
+    if (groupDepth_ > 0) { // a tool's outputs, a split's parts: undone with their action
+        UndoStep step;
+        step.kind = UndoKind::Addition;
+        step.name = addedName;
+        step.id = id;
+        remember(std::move(step));
+    }
     return id;
 }
 
@@ -49,8 +57,16 @@ EntityId Document::addDrawing(QString name, Drawing drawing, EntityId parent, QS
     item->sourcePath = std::move(sourcePath);
     item->unsaved = item->sourcePath.isEmpty();
     const EntityId id = item->id;
+    const QString addedName = item->name;
     items_.push_back(std::move(item));
     emit added(id);
+    if (groupDepth_ > 0) { // a tool's outputs, a split's parts: undone with their action
+        UndoStep step;
+        step.kind = UndoKind::Addition;
+        step.name = addedName;
+        step.id = id;
+        remember(std::move(step));
+    }
     return id;
 }
 
@@ -64,8 +80,16 @@ EntityId Document::addGroup(QString name, EntityId parent, QString sourcePath)
     item->parent = contains(parent) ? parent : kNoEntity;
     item->sourcePath = std::move(sourcePath);
     const EntityId id = item->id;
+    const QString addedName = item->name;
     items_.push_back(std::move(item));
     emit added(id);
+    if (groupDepth_ > 0) { // a tool's outputs, a split's parts: undone with their action
+        UndoStep step;
+        step.kind = UndoKind::Addition;
+        step.name = addedName;
+        step.id = id;
+        remember(std::move(step));
+    }
     return id;
 }
 
@@ -110,7 +134,7 @@ void Document::removeWithoutUndo(EntityId id, std::vector<std::unique_ptr<Item>>
 void Document::clear()
 {
     items_.clear();
-    remember({});
+    forgetUndo();
     emit cleared();
 }
 
@@ -238,6 +262,14 @@ void Document::addField(EntityId id, ScalarField field)
 
 void Document::setVisible(EntityId id, bool visible)
 {
+    if (const Item* item = find(id); item && groupDepth_ > 0 && item->display.visible != visible) {
+        UndoStep step; // a parent a split hides comes back with the undo
+        step.kind = UndoKind::Visibility;
+        step.name = item->name;
+        step.id = id;
+        step.previousVisible = item->display.visible;
+        remember(std::move(step));
+    }
     setDisplayMember(id, &DisplayState::visible, visible);
     // A group's checkbox is its scans'.
     if (const Item* item = find(id); item && item->isGroup())
@@ -336,80 +368,126 @@ void Document::markAllSaved()
 
 Document::UndoGroup::UndoGroup(Document& document, QString text) : document_(document)
 {
-    if (document_.groupDepth_++ == 0) {
-        document_.undo_.clear();
-        document_.groupText_ = std::move(text);
-        emit document_.undoChanged();
+    if (document_.groupDepth_++ == 0 && !document_.reverting_) {
+        document_.undoStack_.push_back(UndoAction{std::move(text), {}});
+        document_.redoStack_.clear();
     }
 }
 
 Document::UndoGroup::~UndoGroup()
 {
-    if (--document_.groupDepth_ == 0) {
-        if (document_.undo_.empty())
-            document_.groupText_.clear();
+    if (--document_.groupDepth_ == 0 && !document_.reverting_) {
+        if (!document_.undoStack_.empty() && document_.undoStack_.back().steps.empty())
+            document_.undoStack_.pop_back(); // nothing to undo: no entry in the menu
         emit document_.undoChanged();
     }
 }
 
 void Document::remember(UndoStep step)
 {
-    if (undoing_)
+    if (step.kind == UndoKind::None)
         return;
-    if (groupDepth_ == 0) {
-        undo_.clear();
-        groupText_.clear();
+    if (reverting_) {
+        reverted_.push_back(std::move(step));
+        return;
     }
-    if (step.kind != UndoKind::None)
-        undo_.push_back(std::move(step));
+    if (groupDepth_ == 0 || undoStack_.empty()) {
+        undoStack_.push_back(UndoAction{QString(), {}});
+        redoStack_.clear();
+    }
+    undoStack_.back().steps.push_back(std::move(step));
+    if (undoStack_.size() > kUndoLevels)
+        undoStack_.erase(undoStack_.begin()); // the oldest goes, with the data it held
     emit undoChanged();
 }
 
 void Document::forgetUndo()
 {
-    undo_.clear();
-    groupText_.clear();
+    undoStack_.clear();
+    redoStack_.clear();
     emit undoChanged();
+}
+
+QString Document::describe(const UndoAction& action)
+{
+    if (!action.text.isEmpty())
+        return action.text;
+    if (action.steps.empty())
+        return QString();
+    const UndoStep& step = action.steps.back();
+    switch (step.kind) {
+    case UndoKind::Removal: return tr("delete '%1'").arg(step.name);
+    case UndoKind::Addition: return tr("add '%1'").arg(step.name);
+    case UndoKind::Replacement: return tr("the change of '%1'").arg(step.name);
+    case UndoKind::Field: return tr("field %1 of '%2'").arg(QString::fromStdString(step.fieldName), step.name);
+    case UndoKind::Visibility: return tr("showing '%1'").arg(step.name);
+    case UndoKind::None: break;
+    }
+    return QString();
 }
 
 QString Document::undoText() const
 {
-    if (undo_.empty())
-        return tr("Undo");
-    if (!groupText_.isEmpty())
-        return tr("Undo %1").arg(groupText_);
-    const UndoStep& step = undo_.back();
-    switch (step.kind) {
-    case UndoKind::Removal: return tr("Undo delete '%1'").arg(step.name);
-    case UndoKind::Replacement: return tr("Undo the change of '%1'").arg(step.name);
-    case UndoKind::Field: return tr("Undo field %1 of '%2'").arg(QString::fromStdString(step.fieldName), step.name);
-    case UndoKind::None: break;
-    }
-    return tr("Undo");
+    return undoStack_.empty() ? tr("Undo") : tr("Undo %1").arg(describe(undoStack_.back())).trimmed();
+}
+
+QString Document::redoText() const
+{
+    return redoStack_.empty() ? tr("Redo") : tr("Redo %1").arg(describe(redoStack_.back())).trimmed();
 }
 
 void Document::undo()
 {
-    std::vector<UndoStep> steps = std::move(undo_);
-    undo_.clear();
-    groupText_.clear();
-    undoing_ = true;
-    for (auto it = steps.rbegin(); it != steps.rend(); ++it) // newest first
-        undoStep(*it);
-    undoing_ = false;
+    if (undoStack_.empty() || groupDepth_ > 0)
+        return;
+    UndoAction action = std::move(undoStack_.back());
+    undoStack_.pop_back();
+    redoStack_.push_back(revert(std::move(action)));
     emit undoChanged();
 }
 
-void Document::undoStep(UndoStep& step)
+void Document::redo()
 {
+    if (redoStack_.empty() || groupDepth_ > 0)
+        return;
+    UndoAction action = std::move(redoStack_.back());
+    redoStack_.pop_back();
+    undoStack_.push_back(revert(std::move(action)));
+    emit undoChanged();
+}
+
+Document::UndoAction Document::revert(UndoAction action)
+{
+    // Newest first; each reverted step gives the step that makes it again,
+    // kept in the order made so that reverting those is the forward order.
+    UndoAction inverse{describe(action), {}}; // named as the action the user made, both ways
+    reverting_ = true;
+    for (auto it = action.steps.rbegin(); it != action.steps.rend(); ++it)
+        inverse.steps.push_back(revertStep(*it));
+    reverting_ = false;
+    reverted_.clear();
+    return inverse;
+}
+
+Document::UndoStep Document::revertStep(UndoStep& step)
+{
+    UndoStep inverse;
+    inverse.name = step.name;
     switch (step.kind) {
-    case UndoKind::Removal:
+    case UndoKind::Removal: {
         // Parents first (they were removed last), each with its id, parent and display.
+        inverse.kind = UndoKind::Addition;
+        inverse.id = step.removed.empty() ? kNoEntity : step.removed.back()->id;
         for (auto it = step.removed.rbegin(); it != step.removed.rend(); ++it) {
             const EntityId id = (*it)->id;
             items_.push_back(std::move(*it));
             emit added(id);
         }
+        break;
+    }
+    case UndoKind::Addition:
+        inverse.kind = UndoKind::Removal;
+        removeWithoutUndo(step.id, inverse.removed);
         break;
     case UndoKind::Replacement:
         if (Item* item = findMutable(step.id)) {
@@ -417,7 +495,13 @@ void Document::undoStep(UndoStep& step)
             // point size and the like stay as the user has set them since.
             const bool visible = item->display.visible, neutral = item->display.neutral;
             const float pointSize = item->display.pointSize;
+            const DisplayState current = item->display;
+            reverted_.clear();
             replaceData(step.id, std::move(*step.previousData));
+            if (!reverted_.empty()) {
+                inverse = std::move(reverted_.back()); // the data it replaced
+                inverse.previousDisplay = current;
+            }
             item->display = step.previousDisplay;
             item->display.visible = visible;
             item->display.neutral = neutral;
@@ -428,6 +512,12 @@ void Document::undoStep(UndoStep& step)
     case UndoKind::Field:
         if (Item* item = findMutable(step.id); item && item->cloud()) {
             auto& cloud = std::get<PointCloud>(item->entity);
+            inverse.kind = UndoKind::Field;
+            inverse.id = step.id;
+            inverse.fieldName = step.fieldName;
+            inverse.previousDisplay = item->display;
+            if (const ScalarField* current = cloud.field(step.fieldName))
+                inverse.previousField = *current;
             if (step.previousField)
                 cloud.addField(std::move(*step.previousField));
             else
@@ -445,8 +535,17 @@ void Document::undoStep(UndoStep& step)
             emit displayChanged(step.id);
         }
         break;
+    case UndoKind::Visibility:
+        if (const Item* item = find(step.id)) {
+            inverse.kind = UndoKind::Visibility;
+            inverse.id = step.id;
+            inverse.previousVisible = item->display.visible;
+            setDisplayMember(step.id, &DisplayState::visible, step.previousVisible);
+        }
+        break;
     case UndoKind::None: break;
     }
+    return inverse;
 }
 
 } // namespace scandiff::gui

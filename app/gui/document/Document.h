@@ -145,22 +145,26 @@ public:
     FieldDisplay fieldDisplay(EntityId id, const std::string& fieldName) const;
     void rename(EntityId id, const QString& name);
 
-    //! One level of undo for what changes data: a removal (with the entity's
-    //! descendants), a replacement of an entity's data (a tool that moved or
-    //! edited it), a field added or recomputed. The next such change replaces
-    //! it; clear() forgets it. What was undone is restored with its id, place
-    //! in the tree and display.
-    bool canUndo() const { return !undo_.empty(); }
-    //! "Undo delete 'site-2019'", for the menu.
+    //! An undo history, and its redo, of what changes data: a removal (with
+    //! the entity's descendants), a replacement of an entity's data (a tool
+    //! that moved or edited it), a field added or recomputed; inside an
+    //! UndoGroup also the entities added (a tool's outputs, a split's or the
+    //! scissors' parts) and the visibility changed (the parent they hide). Up
+    //! to kUndoLevels actions; a new action empties the redo history; clear()
+    //! forgets both. What is undone or redone comes back with its id, place in
+    //! the tree and display.
+    static constexpr std::size_t kUndoLevels = 20;
+    bool canUndo() const { return !undoStack_.empty(); }
+    bool canRedo() const { return !redoStack_.empty(); }
+    //! "Undo delete 'site-2019'", "Redo Cut by polygon", for the menu.
     QString undoText() const;
+    QString redoText() const;
     void undo();
-    //! Forgets what undo() would do (a controller whose own state would no
-    //! longer match the data it brought back).
+    void redo();
+    //! Forgets the undo and redo histories (a controller whose own state would
+    //! no longer match the data they would bring back).
     void forgetUndo();
 
-    //! The changes made while it lives form one undo step named `text` (a
-    //! deletion of several entities, a tool's outputs, a distance run's fields),
-    //! undone together, newest first. Nests: the outermost group counts.
     class UndoGroup
     {
     public:
@@ -189,7 +193,7 @@ signals:
     void cleared();
     void aboutToReplaceData(EntityId id);
     void dataReplaced(EntityId id);
-    //! What undo() would do changed.
+    //! What undo() or redo() would do changed.
     void undoChanged();
 
 private:
@@ -197,24 +201,35 @@ private:
     //! Sets one member of an entity's display state; signals only a real change.
     template <class Value> void setDisplayMember(EntityId id, Value DisplayState::*member, const Value& value);
     void removeWithoutUndo(EntityId id, std::vector<std::unique_ptr<Item>>& taken);
-    enum class UndoKind { None, Removal, Replacement, Field };
+    enum class UndoKind { None, Removal, Addition, Replacement, Field, Visibility };
     struct UndoStep
     {
         UndoKind kind = UndoKind::None;
         QString name;                                //!< the entity's, for the menu
         std::vector<std::unique_ptr<Item>> removed;  //!< Removal: the entity and its descendants, children first
-        EntityId id = kNoEntity;                     //!< Replacement, Field
+        EntityId id = kNoEntity;                     //!< Addition, Replacement, Field, Visibility
         std::optional<io::Entity> previousData;      //!< Replacement
         DisplayState previousDisplay;                //!< Replacement, Field
         std::string fieldName;                       //!< Field
         std::optional<ScalarField> previousField;    //!< Field: the one it replaced, if any
+        bool previousVisible = true;                 //!< Visibility
+    };
+    //! One user action: its steps in the order made, and its menu text.
+    struct UndoAction
+    {
+        QString text;
+        std::vector<UndoStep> steps;
     };
     void remember(UndoStep step);
-    void undoStep(UndoStep& step);
-    std::vector<UndoStep> undo_; //!< one user action: its steps in the order made
-    QString groupText_;          //!< the open group's name, else empty
+    //! Reverts one step; returns the step that makes it again.
+    UndoStep revertStep(UndoStep& step);
+    //! Reverts an action's steps newest first; returns the action that makes them again.
+    UndoAction revert(UndoAction action);
+    static QString describe(const UndoAction& action);
+    std::vector<UndoAction> undoStack_, redoStack_;
     int groupDepth_ = 0;
-    bool undoing_ = false;
+    bool reverting_ = false;
+    std::vector<UndoStep> reverted_; //!< while reverting: the steps a reverting change would remember
     // unique_ptr keeps each entity in place while the vector grows: the view and
     // running tools may hold references to it.
     std::vector<std::unique_ptr<Item>> items_;
