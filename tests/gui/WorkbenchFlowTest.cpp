@@ -123,8 +123,21 @@ private slots:
             QVERIFY2(fromDialog.all().at(name) == value, name.c_str());
         // An optional value is off until its checkbox is ticked.
         QVERIFY(!dialog.values().count("max-dist"));
+        // Issue 50, defect 9: an option that does nothing in this state is not
+        // offered: clamping without a maximum distance, the model's neighbours
+        // without a model, a sensor's step, field of view and range without a sensor.
+        QVERIFY(!dialog.form()->isShown("clamp"));
+        QVERIFY(!dialog.values().count("clamp"));
+        for (const char* name : {"sensor-step", "sensor-fov", "sensor-range"})
+            QVERIFY2(!dialog.form()->isShown(name), name);
         dialog.form()->enabler("max-dist")->setChecked(true);
         QCOMPARE(dialog.values().at("max-dist"), std::string("1"));
+        QVERIFY(dialog.form()->isShown("clamp"));
+        dialog.form()->setValue("model", "none");
+        QVERIFY(!dialog.form()->isShown("knn"));
+        QVERIFY(!dialog.values().count("knn"));
+        dialog.form()->setValue("model", "plane");
+        QVERIFY(dialog.form()->isShown("knn"));
     }
 
     void theLoggedCommandsRunAsIsAndGiveTheSameNumbers()
@@ -344,8 +357,8 @@ private slots:
     void everyMenuIsThereOnceWithItsTools()
     {
         // A tool category named like a built-in submenu (Distances: C2C, C2M)
-        // joins it: one Tools > Distances holding C2C, C2M, M3C2, the DEM of
-        // difference and the 2.5D volume.
+        // joins it: one Tools > Distances holding C2C, C2M, M3C2, its scales'
+        // guess, the DEM of difference and the 2.5D volume.
         Workbench workbench;
         QMenu* tools = nullptr;
         for (QAction* a : workbench.window.menuBar()->actions())
@@ -366,7 +379,8 @@ private slots:
         QStringList entries;
         for (QAction* a : distances->actions())
             entries << a->text().remove('&');
-        QVERIFY2(entries.size() == 5 && entries.count("M3C2...") == 1 && entries.count("DEM of difference...") == 1,
+        QVERIFY2(entries.size() == 6 && entries.count("M3C2...") == 1 && entries.count("M3C2 scales (guess)...") == 1 &&
+                     entries.count("DEM of difference...") == 1,
                  qPrintable(entries.join(", ")));
     }
 

@@ -50,6 +50,26 @@ const DetectedPrimitive* bestMatch(const PrimitiveDetectionResult& result, const
     return best;
 }
 
+//! Shape k of the scene found, as its type, with more than 80 % of its points,
+//! by a detected shape no other true shape took (recorded in `used`); null
+//! (a failure added) when nothing holds its points.
+const DetectedPrimitive* foundOnce(const PrimitiveDetectionResult& result, const test::PrimitiveScene& s, std::size_t k,
+                                   std::set<int>& used)
+{
+    std::size_t shared = 0, total = 0;
+    for (int t : s.truth)
+        total += t == static_cast<int>(k);
+    const DetectedPrimitive* match = bestMatch(result, s, static_cast<int>(k), shared);
+    if (!match) {
+        ADD_FAILURE() << s.shapes[k].label << " not found";
+        return nullptr;
+    }
+    EXPECT_EQ(match->primitive.kind, s.shapes[k].truth.kind) << s.shapes[k].label;
+    EXPECT_GT(static_cast<double>(shared), 0.8 * static_cast<double>(total)) << s.shapes[k].label;
+    EXPECT_TRUE(used.insert(match->id).second) << s.shapes[k].label << " shares its shape with another";
+    return match;
+}
+
 double uncertainty(const DetectedPrimitive& shape, const std::string& name)
 {
     for (const auto& [key, value] : shape.uncertainty)
@@ -84,14 +104,8 @@ TEST(Primitives, EveryShapeOfTheAnalyticSceneIsFoundOnceWithItsType)
     const test::PrimitiveScene& s = scene();
     std::set<int> used;
     for (std::size_t k = 0; k < s.shapes.size(); ++k) {
-        std::size_t shared = 0, total = 0;
-        for (int t : s.truth)
-            total += t == static_cast<int>(k);
-        const DetectedPrimitive* match = bestMatch(result, s, static_cast<int>(k), shared);
-        ASSERT_NE(match, nullptr) << s.shapes[k].label << " not found";
-        EXPECT_EQ(match->primitive.kind, s.shapes[k].truth.kind) << s.shapes[k].label;
-        EXPECT_GT(static_cast<double>(shared), 0.8 * static_cast<double>(total)) << s.shapes[k].label;
-        EXPECT_TRUE(used.insert(match->id).second) << s.shapes[k].label << " shares its shape with another";
+        const DetectedPrimitive* match = foundOnce(result, s, k, used);
+        ASSERT_NE(match, nullptr);
         const Primitive& got = match->primitive;
         const Primitive& truth = s.shapes[k].truth;
         switch (truth.kind) {
@@ -171,16 +185,8 @@ TEST(Primitives, NormalsAreComputedWhenAbsent)
     // Not only the counts: each true shape is found once, as its type, with
     // most of its points (as with exact normals above).
     std::set<int> used;
-    for (std::size_t k = 0; k < s.shapes.size(); ++k) {
-        std::size_t shared = 0, total = 0;
-        for (int t : s.truth)
-            total += t == static_cast<int>(k);
-        const DetectedPrimitive* match = bestMatch(result, s, static_cast<int>(k), shared);
-        ASSERT_NE(match, nullptr) << s.shapes[k].label << " not found";
-        EXPECT_EQ(match->primitive.kind, s.shapes[k].truth.kind) << s.shapes[k].label;
-        EXPECT_GT(static_cast<double>(shared), 0.8 * static_cast<double>(total)) << s.shapes[k].label;
-        EXPECT_TRUE(used.insert(match->id).second) << s.shapes[k].label << " shares its shape with another";
-    }
+    for (std::size_t k = 0; k < s.shapes.size(); ++k)
+        foundOnce(result, s, k, used);
 }
 
 TEST(Primitives, PlanesOnlyStillFindEveryPlane)

@@ -436,23 +436,17 @@ QString Document::redoText() const
     return redoStack_.empty() ? tr("Redo") : tr("Redo %1").arg(describe(redoStack_.back())).trimmed();
 }
 
-void Document::undo()
-{
-    if (undoStack_.empty() || groupDepth_ > 0)
-        return;
-    UndoAction action = std::move(undoStack_.back());
-    undoStack_.pop_back();
-    redoStack_.push_back(revert(std::move(action)));
-    emit undoChanged();
-}
+void Document::undo() { revertLast(undoStack_, redoStack_); }
 
-void Document::redo()
+void Document::redo() { revertLast(redoStack_, undoStack_); }
+
+void Document::revertLast(std::vector<UndoAction>& from, std::vector<UndoAction>& to)
 {
-    if (redoStack_.empty() || groupDepth_ > 0)
+    if (from.empty() || groupDepth_ > 0)
         return;
-    UndoAction action = std::move(redoStack_.back());
-    redoStack_.pop_back();
-    undoStack_.push_back(revert(std::move(action)));
+    UndoAction action = std::move(from.back());
+    from.pop_back();
+    to.push_back(revert(std::move(action)));
     emit undoChanged();
 }
 

@@ -225,6 +225,8 @@ private:
     UndoStep revertStep(UndoStep& step);
     //! Reverts an action's steps newest first; returns the action that makes them again.
     UndoAction revert(UndoAction action);
+    //! Reverts the last action of `from` and puts its inverse on `to` (undo, redo).
+    void revertLast(std::vector<UndoAction>& from, std::vector<UndoAction>& to);
     static QString describe(const UndoAction& action);
     std::vector<UndoAction> undoStack_, redoStack_;
     int groupDepth_ = 0;

@@ -252,8 +252,8 @@ std::map<std::string, std::string> ParameterForm::values() const
     for (const ParameterSpec& p : parameters_) {
         if (p.optional && !enablers_.at(p.name)->isChecked())
             continue;
-        if (p.optional && !conditionHolds(p))
-            continue; // switched on, but in a part that does not apply
+        if (!conditionHolds(p))
+            continue; // in a part that does not apply: its default, not a hidden value
         out[p.name] = editorText(p, editors_.at(p.name));
     }
     return out;

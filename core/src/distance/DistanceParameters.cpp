@@ -26,7 +26,8 @@ ParameterSpec maxDistanceParameter()
 ParameterSpec clampParameter()
 {
     return ParameterSpec::boolean("clamp", "Clamp to maximum", "With a maximum distance: farther points get the maximum instead of NaN",
-                                  false);
+                                  false)
+        .onlyWith("max-dist");
 }
 
 ParameterSpec octreeLevelParameter(const std::string& automatic)
@@ -78,10 +79,12 @@ const std::vector<ParameterSpec>& cloudToCloudParameters()
             ParameterSpec::choice("model", "Local model", "Model of the reference around each nearest neighbour (thesis 000 §2.3.2)",
                                   {"none", "plane", "delaunay", "quadric"}, localModelName(defaults.model)),
             ParameterSpec::integer("knn", "Model neighbours", "Local model fitted on the k nearest reference points", defaults.neighbours,
-                                   3, 500, "points"),
+                                   3, 500, "points")
+                .onlyWith("!model=none"),
             ParameterSpec::real("radius", "Model radius", "Local model fitted on the reference points within this radius instead of knn",
                                 0.5, kSmallestDistance, 1e9, "m")
-                .asOptional(),
+                .asOptional()
+                .onlyWith("!model=none"),
             ParameterSpec::boolean("split-xyz", "Split X/Y/Z", "Also output c2c_dx, c2c_dy, c2c_dz", defaults.splitComponents),
             ParameterSpec::boolean("signed", "Signed distances", "Sign by the reference normals or the local model's normal",
                                    defaults.signedDistances),
@@ -96,10 +99,14 @@ const std::vector<ParameterSpec>& cloudToCloudParameters()
                                 "visibility test")
                 .asOptional(),
             ParameterSpec::text("sensor-step", "Sensor angular step", "Depth-map step DEG or YAWDEG,PITCHDEG (default: from the data)")
-                .asOptional(),
-            ParameterSpec::text("sensor-fov", "Sensor field of view", "YAWMIN,YAWMAX,PITCHMIN,PITCHMAX in degrees").asOptional(),
+                .asOptional()
+                .onlyWith("sensor"),
+            ParameterSpec::text("sensor-fov", "Sensor field of view", "YAWMIN,YAWMAX,PITCHMIN,PITCHMAX in degrees")
+                .asOptional()
+                .onlyWith("sensor"),
             ParameterSpec::real("sensor-range", "Sensor range", "Maximum range of the scanner", 100.0, kSmallestDistance, 1e9, "m")
-                .asOptional(),
+                .asOptional()
+                .onlyWith("sensor"),
             ParameterSpec::real("visibility-tolerance", "Visibility tolerance", "Depth-map tolerance", defaults.visibility.tolerance, 0.0,
                                 1e9, "m"),
             octreeLevelParameter("from the reference's cell populations"),
