@@ -258,7 +258,11 @@ void MainWindow::buildMenus()
     connect(view_, &CloudView::clippingBoxChanged, extract, &QAction::setEnabled);
     edit->addSeparator();
     edit->addAction(tr("&Delete selected"), this, [this] {
-        for (EntityId id : tree_->selectedEntities(false))
+        const std::vector<EntityId> ids = tree_->selectedEntities(false);
+        const Document::UndoGroup group(document_, ids.size() == 1 && document_.find(ids.front())
+                                                       ? tr("delete '%1'").arg(document_.item(ids.front()).name)
+                                                       : tr("delete of %1 entities").arg(ids.size()));
+        for (EntityId id : ids)
             document_.remove(id);
     })->setShortcut(QKeySequence::Delete);
     edit->addAction(tr("&Rename..."), this, [this] {
@@ -595,7 +599,7 @@ void MainWindow::updateLegend()
     const EntityId current = tree_->currentEntity();
     ColourLegend legend = legendFor(current, false);
     std::vector<EntityId> parts;
-    for (std::vector<EntityId> pending{current}; !pending.empty();) {
+    for (std::vector<EntityId> pending{current}; current != kNoEntity && !pending.empty();) {
         const EntityId id = pending.back();
         pending.pop_back();
         for (EntityId child : document_.children(id)) {

@@ -946,6 +946,9 @@ void parseLazRecords(const MappedFile& file, const LasHeader& h, const LazLayout
 //! give (non-finite, inverted) is taken as the worst case.
 bool floatsMissTheGrid(const LasHeader& h, const Eigen::Vector3d& origin)
 {
+    // A box of zeros is one the writer left unset (chooseOrigin reads it so too).
+    if (h.min.isZero() && h.max.isZero())
+        return true;
     for (int a = 0; a < 3; ++a) {
         if (!(std::isfinite(h.min[a]) && std::isfinite(h.max[a]) && h.min[a] <= h.max[a]))
             return true;

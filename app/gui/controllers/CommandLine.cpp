@@ -19,7 +19,7 @@ QString shellQuoted(const QString& word)
     return "'" + quoted + "'";
 }
 
-CommandLine::CommandLine(const QString& command) { words_ << command; }
+CommandLine::CommandLine(const Document& document, const QString& command) : document_(document) { words_ << command; }
 
 CommandLine& CommandLine::word(const QString& text)
 {
@@ -29,7 +29,10 @@ CommandLine& CommandLine::word(const QString& text)
 
 CommandLine& CommandLine::file(const Document::Item& item)
 {
-    if (!item.sourcePath.isEmpty() && !item.unsaved) {
+    // A scan of a multi-scan file shares the file with its group: the file is not it.
+    const Document::Item* parent = document_.find(item.parent);
+    const bool partOfItsFile = parent && parent->isGroup() && parent->sourcePath == item.sourcePath;
+    if (!item.sourcePath.isEmpty() && !item.unsaved && !partOfItsFile) {
         words_ << shellQuoted(item.sourcePath);
         return *this;
     }

@@ -25,12 +25,13 @@ QString shellQuoted(const QString& word);
 class CommandLine
 {
 public:
-    explicit CommandLine(const QString& command);
+    CommandLine(const Document& document, const QString& command);
     //! A bare word (a subcommand, an option name).
     CommandLine& word(const QString& text);
-    //! The entity's file, quoted. An entity in no file, or changed since it
-    //! was read (a derived cloud, a computed field), is named NAME.ply and
-    //! listed: the command then runs once the user has exported it so.
+    //! The entity's file, quoted. An entity in no file of its own (a derived
+    //! cloud, one scan of a multi-scan E57), or changed since it was read (a
+    //! computed field), is named NAME.ply and listed: the command then runs
+    //! once the user has exported it so.
     CommandLine& file(const Document::Item& item);
     //! A file beside `item`'s own (its folder, else the current one), named
     //! after it: STEM + suffix + extension ("_c2c", ".ply").
@@ -45,6 +46,7 @@ public:
     QString text() const;
 
 private:
+    const Document& document_;
     QStringList words_;
     QStringList toExport_;
 };

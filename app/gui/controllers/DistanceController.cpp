@@ -129,7 +129,7 @@ bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId reference
         return false;
     }
     // Before the run: the files as they are now (the run adds fields).
-    const QString command = CommandLine("scandiff-cli c2c")
+    const QString command = CommandLine(document_, "scandiff-cli c2c")
                                 .word("--reference")
                                 .file(*reference)
                                 .word("--compared")
@@ -186,7 +186,7 @@ bool DistanceController::runCloudToMesh(EntityId comparedId, EntityId referenceI
         emit failed(tr("C2M needs a point cloud and a mesh"));
         return false;
     }
-    const QString command = CommandLine("scandiff-cli c2m")
+    const QString command = CommandLine(document_, "scandiff-cli c2m")
                                 .word("--reference")
                                 .file(*reference)
                                 .word("--compared")

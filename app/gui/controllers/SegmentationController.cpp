@@ -142,7 +142,7 @@ bool SegmentationController::run(EntityId inputId, EntityId referenceId, const s
         emit failed(tr("The other epoch must be another cloud: a cloud has no volume of change against itself"));
         return false;
     }
-    CommandLine command("scandiff-cli segment");
+    CommandLine command(document_, "scandiff-cli segment");
     command.file(*input);
     if (reference)
         command.word("--reference").file(*reference);

@@ -82,7 +82,7 @@ bool ToolController::run(EntityId input, const std::map<std::string, std::string
 
 QString ToolController::commandLine(const ToolInputChoice& inputs, const std::map<std::string, std::string>& parameters) const
 {
-    CommandLine command("scandiff-cli " + QString::fromStdString(tool_.name));
+    CommandLine command(document_, "scandiff-cli " + QString::fromStdString(tool_.name));
     const Document::Item* first = nullptr;
     for (const InputSpec& spec : tool_.inputs) {
         const auto it = inputs.find(spec.role);

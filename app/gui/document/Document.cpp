@@ -368,10 +368,10 @@ void Document::markAllSaved()
 
 Document::UndoGroup::UndoGroup(Document& document, QString text) : document_(document)
 {
-    if (document_.groupDepth_++ == 0 && !document_.reverting_) {
+    // The redo history goes once the group records something (in remember()):
+    // a run that changes nothing (a table, a cut of nothing) keeps it.
+    if (document_.groupDepth_++ == 0 && !document_.reverting_)
         document_.undoStack_.push_back(UndoAction{std::move(text), {}});
-        document_.redoStack_.clear();
-    }
 }
 
 Document::UndoGroup::~UndoGroup()
@@ -391,10 +391,10 @@ void Document::remember(UndoStep step)
         reverted_.push_back(std::move(step));
         return;
     }
-    if (groupDepth_ == 0 || undoStack_.empty()) {
+    if (groupDepth_ == 0 || undoStack_.empty())
         undoStack_.push_back(UndoAction{QString(), {}});
-        redoStack_.clear();
-    }
+    if (undoStack_.back().steps.empty())
+        redoStack_.clear(); // a new action: what was undone can no longer be redone
     undoStack_.back().steps.push_back(std::move(step));
     if (undoStack_.size() > kUndoLevels)
         undoStack_.erase(undoStack_.begin()); // the oldest goes, with the data it held
@@ -455,11 +455,18 @@ Document::UndoAction Document::revert(UndoAction action)
     // Newest first; each reverted step gives the step that makes it again,
     // kept in the order made so that reverting those is the forward order.
     UndoAction inverse{describe(action), {}}; // named as the action the user made, both ways
+    struct Reverting // back to recording however a step ends (a throw included)
+    {
+        Document& document;
+        ~Reverting()
+        {
+            document.reverting_ = false;
+            document.reverted_.clear();
+        }
+    } reverting{*this};
     reverting_ = true;
     for (auto it = action.steps.rbegin(); it != action.steps.rend(); ++it)
         inverse.steps.push_back(revertStep(*it));
-    reverting_ = false;
-    reverted_.clear();
     return inverse;
 }
 

@@ -798,22 +798,24 @@ bool CloudView::isOnScreen(EntityId id) const
         if (!(b[0] <= b[1]))
             continue;
         double left = std::numeric_limits<double>::infinity(), right = -left, top = left, bottom = -left;
-        bool behind = false;
+        int behind = 0;
         for (int corner = 0; corner < 8; ++corner) {
             const Eigen::Vector4d global(b[corner & 1] + origin.x(), b[2 + ((corner >> 1) & 1)] + origin.y(),
                                          b[4 + ((corner >> 2) & 1)] + origin.z(), 1.0);
             const Eigen::Vector4d pixel = toPixels * global;
             if (pixel.w() <= 0.0) {
-                behind = true; // the camera is among the points: count them as seen
-                break;
+                ++behind;
+                continue;
             }
             left = std::min(left, pixel.x() / pixel.w());
             right = std::max(right, pixel.x() / pixel.w());
             top = std::min(top, pixel.y() / pixel.w());
             bottom = std::max(bottom, pixel.y() / pixel.w());
         }
-        if (behind || (right >= 0 && left <= width && bottom >= 0 && top <= height))
-            return true;
+        if (behind == 8)
+            continue; // wholly behind the camera
+        if (behind > 0 || (right >= 0 && left <= width && bottom >= 0 && top <= height))
+            return true; // some behind, some in front: the camera is among the points
     }
     return false;
 }

@@ -117,7 +117,7 @@ M3c2ScaleGuess guessM3c2Scales(const PointCloud& reference, const PointCloud& co
     // median sample holds enough in both epochs.
     const double start = 2.0 * guess.spacing * std::sqrt(static_cast<double>(params.pointsPerCylinder) / 3.14159265358979323846);
     for (double factor : {1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0}) {
-        const double d = roundedUp(start * factor);
+        const double d = params.projectionScale ? *params.projectionScale : roundedUp(start * factor);
         std::vector<double> inReference, inOther;
         for (const auto& m : momentsAround(referenceTree, samples, d / 2))
             inReference.push_back(m.count);
@@ -126,7 +126,8 @@ M3c2ScaleGuess guessM3c2Scales(const PointCloud& reference, const PointCloud& co
         guess.projectionScale = d;
         guess.medianPointsReference = median(std::move(inReference));
         guess.medianPointsCompared = median(std::move(inOther));
-        if (std::min(guess.medianPointsReference, guess.medianPointsCompared) >= static_cast<double>(params.pointsPerCylinder))
+        if (params.projectionScale ||
+            std::min(guess.medianPointsReference, guess.medianPointsCompared) >= static_cast<double>(params.pointsPerCylinder))
             break;
     }
     ticker.step();

@@ -72,6 +72,7 @@ PointCloud unrollCloud(const PointCloud& cloud, const Primitive& s, double start
     const AxisFrame f = frameOf(s, startAngleDegrees);
     const std::size_t n = cloud.size();
     PointCloud out = cloud.clone();
+    out.dropPositionResiduals(); // its positions are rewritten below
     out.removeNormals();
     out.name = cloud.name + "_unrolled";
     ScalarField deviation(fields::kUnrollDeviation, n), angle(fields::kUnrollAngle, n);
@@ -111,6 +112,7 @@ PointCloud rollCloud(const PointCloud& unrolled, const Primitive& s, double star
     const AxisFrame f = frameOf(s, startAngleDegrees);
     const std::size_t n = unrolled.size();
     PointCloud out = unrolled.clone();
+    out.dropPositionResiduals(); // its positions are rewritten below
     out.removeNormals();
     out.name = unrolled.name + "_rolled";
     std::vector<Eigen::Vector3d> global(n);

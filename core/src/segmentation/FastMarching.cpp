@@ -368,6 +368,10 @@ std::vector<bool> backgroundRegions(const ScalarField& field, const CellGrid& gr
     for (std::size_t i = 0; i < field.size(); ++i)
         if (field.hasValue(i))
             all.push_back(field.value(i));
+    if (all.empty() || regionPoints.size() <= 1) {
+        ceiling = std::numeric_limits<double>::quiet_NaN();
+        return std::vector<bool>(regionPoints.size(), false);
+    }
     const double median = medianOf(all);
     for (double& v : all)
         v = std::abs(v - median);

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -105,8 +106,9 @@ public:
         Eigen::Vector3d p = positions_[i].cast<double>();
         if (i < residuals_.size())
             for (int a = 0; a < 3; ++a) {
+                // Below half the float's last digit (inclusive: a tie rounds to even).
                 const float f = positions_[i][a], r = residuals_[i][a];
-                if (f + r == f)
+                if (std::abs(r) <= 0.5f * (std::nextafter(std::abs(f), HUGE_VALF) - std::abs(f)))
                     p[a] += static_cast<double>(r);
             }
         return p;

@@ -176,11 +176,16 @@ void registerDistanceTools(ToolRegistry& registry)
         const PointCloud& reference = inputs.cloud("reference");
         const PointCloud& compared = inputs.cloud("compared");
         M3c2Params params = m3c2Settings(values);
+        if (inputs.has("core-points") && values.has("core-spacing"))
+            throw Error(ErrorCode::InvalidArgument, "m3c2: give core points or a core spacing, not both");
         // A scale of 0 is guessed from the epochs, as CloudCompare's "guess parameters".
         std::string guessed;
         const bool guessNormal = params.normalScales.size() == 1 && params.normalScales.front() == 0.0;
         if (guessNormal || params.projectionScale == 0.0) {
-            const M3c2ScaleGuess guess = guessM3c2Scales(reference, compared, {}, progress);
+            M3c2ScaleGuessParams guessing;
+            if (params.projectionScale != 0.0)
+                guessing.projectionScale = params.projectionScale; // D from the d the user gave
+            const M3c2ScaleGuess guess = guessM3c2Scales(reference, compared, guessing, progress);
             if (guessNormal)
                 params.normalScales = {guess.normalScale};
             if (params.projectionScale == 0.0)
@@ -188,8 +193,7 @@ void registerDistanceTools(ToolRegistry& registry)
             guessed = describe(" (guessed: normal scale ", params.normalScales.front(), ", projection scale ", params.projectionScale,
                                " m; spacing ", guess.spacing, " m)");
         }
-        if (inputs.has("core-points") && values.has("core-spacing"))
-            throw Error(ErrorCode::InvalidArgument, "m3c2: give core points or a core spacing, not both");
+
         M3c2Result m;
         if (inputs.has("core-points")) {
             m = m3c2(reference, compared, inputs.cloud("core-points"), params, progress);

@@ -99,6 +99,8 @@ struct M3c2ScaleGuessParams
     std::size_t samples = 2000;          //!< reference points the criteria are measured at (every k-th)
     std::size_t pointsPerCylinder = 30;  //!< in the median cylinder, in each epoch
     double roughnessRatio = 25.0;        //!< D / sigma(D) at the median sample
+    //! The projection scale when the user gave it: only D is sought, from it.
+    std::optional<double> projectionScale;
 };
 
 struct M3c2ScaleGuess
