@@ -119,6 +119,26 @@ void DistanceController::runInteractively(DistanceKind kind, EntityId current)
         runCloudToMesh(dialog.compared(), dialog.reference(), dialog.values());
 }
 
+namespace {
+
+//! The console's command of a distance run ("c2c", "c2m"): both files, the
+//! output beside the compared one, the options as the dialog gave them.
+QString distanceCommand(const Document& document, const QString& tool, const Document::Item& reference,
+                        const Document::Item& compared, const std::map<std::string, std::string>& parameters,
+                        const std::vector<ParameterSpec>& specs)
+{
+    return CommandLine(document, "scandiff-cli " + tool)
+        .word("--reference")
+        .file(reference)
+        .word("--compared")
+        .file(compared)
+        .outputBeside("-o", compared, "_" + tool)
+        .options(parameters, specs)
+        .text();
+}
+
+} // namespace
+
 bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId referenceId,
                                          const std::map<std::string, std::string>& parameters)
 {
@@ -129,14 +149,7 @@ bool DistanceController::runCloudToCloud(EntityId comparedId, EntityId reference
         return false;
     }
     // Before the run: the files as they are now (the run adds fields).
-    const QString command = CommandLine(document_, "scandiff-cli c2c")
-                                .word("--reference")
-                                .file(*reference)
-                                .word("--compared")
-                                .file(*compared)
-                                .outputBeside("-o", *compared, "_c2c")
-                                .options(parameters, cloudToCloudParameters())
-                                .text();
+    const QString command = distanceCommand(document_, "c2c", *reference, *compared, parameters, cloudToCloudParameters());
     std::optional<CloudToCloudRun> run;
     QElapsedTimer clock;
     clock.start();
@@ -186,14 +199,7 @@ bool DistanceController::runCloudToMesh(EntityId comparedId, EntityId referenceI
         emit failed(tr("C2M needs a point cloud and a mesh"));
         return false;
     }
-    const QString command = CommandLine(document_, "scandiff-cli c2m")
-                                .word("--reference")
-                                .file(*reference)
-                                .word("--compared")
-                                .file(*compared)
-                                .outputBeside("-o", *compared, "_c2m")
-                                .options(parameters, cloudToMeshParameters())
-                                .text();
+    const QString command = distanceCommand(document_, "c2m", *reference, *compared, parameters, cloudToMeshParameters());
     std::optional<CloudToMeshResult> result;
     QElapsedTimer clock;
     clock.start();

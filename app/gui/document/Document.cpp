@@ -15,6 +15,22 @@ const PointCloud& Document::Item::points() const
     return std::get<PointCloud>(entity);
 }
 
+EntityId Document::insert(std::unique_ptr<Item> item)
+{
+    const EntityId id = item->id;
+    const QString addedName = item->name;
+    items_.push_back(std::move(item));
+    emit added(id);
+    if (groupDepth_ > 0) { // a tool's outputs, a split's parts: undone with their action
+        UndoStep step;
+        step.kind = UndoKind::Addition;
+        step.name = addedName;
+        step.id = id;
+        remember(std::move(step));
+    }
+    return id;
+}
+
 EntityId Document::add(QString name, io::Entity entity, EntityId parent, QString sourcePath, Properties properties)
 {
     auto item = std::make_unique<Item>();
@@ -32,18 +48,7 @@ EntityId Document::add(QString name, io::Entity entity, EntityId parent, QString
         const ScalarField* main = mainGridField(*cloud);
         item->display.activeField = main ? main->name() : cloud->fields().front().name();
     }
-    const EntityId id = item->id;
-    const QString addedName = item->name;
-    items_.push_back(std::move(item));
-    emit added(id);
-    if (groupDepth_ > 0) { // a tool's outputs, a split's parts: undone with their action
-        UndoStep step;
-        step.kind = UndoKind::Addition;
-        step.name = addedName;
-        step.id = id;
-        remember(std::move(step));
-    }
-    return id;
+    return insert(std::move(item));
 }
 
 EntityId Document::addDrawing(QString name, Drawing drawing, EntityId parent, QString sourcePath)
@@ -56,18 +61,7 @@ EntityId Document::addDrawing(QString name, Drawing drawing, EntityId parent, QS
     item->parent = contains(parent) ? parent : kNoEntity;
     item->sourcePath = std::move(sourcePath);
     item->unsaved = item->sourcePath.isEmpty();
-    const EntityId id = item->id;
-    const QString addedName = item->name;
-    items_.push_back(std::move(item));
-    emit added(id);
-    if (groupDepth_ > 0) { // a tool's outputs, a split's parts: undone with their action
-        UndoStep step;
-        step.kind = UndoKind::Addition;
-        step.name = addedName;
-        step.id = id;
-        remember(std::move(step));
-    }
-    return id;
+    return insert(std::move(item));
 }
 
 EntityId Document::addGroup(QString name, EntityId parent, QString sourcePath)
@@ -79,18 +73,7 @@ EntityId Document::addGroup(QString name, EntityId parent, QString sourcePath)
     item->group = true;
     item->parent = contains(parent) ? parent : kNoEntity;
     item->sourcePath = std::move(sourcePath);
-    const EntityId id = item->id;
-    const QString addedName = item->name;
-    items_.push_back(std::move(item));
-    emit added(id);
-    if (groupDepth_ > 0) { // a tool's outputs, a split's parts: undone with their action
-        UndoStep step;
-        step.kind = UndoKind::Addition;
-        step.name = addedName;
-        step.id = id;
-        remember(std::move(step));
-    }
-    return id;
+    return insert(std::move(item));
 }
 
 std::vector<EntityId> Document::children(EntityId id) const

@@ -198,6 +198,8 @@ signals:
 
 private:
     Item* findMutable(EntityId id);
+    //! Puts a new entity in the document (an undo step inside an UndoGroup); returns its id.
+    EntityId insert(std::unique_ptr<Item> item);
     //! Sets one member of an entity's display state; signals only a real change.
     template <class Value> void setDisplayMember(EntityId id, Value DisplayState::*member, const Value& value);
     void removeWithoutUndo(EntityId id, std::vector<std::unique_ptr<Item>>& taken);
