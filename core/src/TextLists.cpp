@@ -40,4 +40,17 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
     return values;
 }
 
+std::vector<double> parseNumberWords(const std::string& text, const std::string& what)
+{
+    std::string commas = text;
+    for (char& c : commas)
+        if (c == ';' || c == ' ' || c == '\t')
+            c = ',';
+    std::string list;
+    for (const std::string& part : splitList(commas, ','))
+        if (!part.empty())
+            list += (list.empty() ? "" : ",") + part;
+    return parseNumberList(list, what);
+}
+
 } // namespace scandiff

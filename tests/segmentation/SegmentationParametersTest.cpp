@@ -64,6 +64,12 @@ TEST(SegmentationParameters, RunsEachMethodAndNamesItsFields)
 
     run = runSegmentation(c, resolve({{"field", "d"}, {"range", "0.5;2"}}));
     EXPECT_EQ(run.regionCount, 1u); // no components: one region of every changed point
+    // The range as its description gives it and the workbench's dialog fills
+    // it from the panel's thresholds ("A B"), and as "A,B": the same run.
+    for (const char* text : {"0.5 2", "0.5,2", " 0.5  2 "}) {
+        const SegmentationRun same = runSegmentation(c, resolve({{"field", "d"}, {"range", text}}));
+        EXPECT_EQ(same.changedCount, run.changedCount) << text;
+    }
     run = runSegmentation(c, resolve({{"field", "d"}, {"kmeans", "2"}}));
     EXPECT_EQ(run.changedCount, 50u);
     EXPECT_EQ(run.centres.size(), 2u);

@@ -222,7 +222,7 @@ SegmentationRun runSegmentation(const PointCloud& cloud, const ParameterValues& 
     if (values.has("range") || values.has("above")) {
         double low = 0.0, high = kInf;
         if (values.has("range")) {
-            const std::vector<double> range = numbers(values.text("range"), "range");
+            const std::vector<double> range = parseNumberWords(values.text("range"), "range");
             if (range.size() != 2)
                 throw Error(ErrorCode::InvalidArgument, "range: expected two values A B");
             low = range[0];

@@ -15,4 +15,9 @@ std::vector<std::string> splitList(const std::string& text, char separator);
 //! when a part is not a finite number.
 std::vector<double> parseNumberList(const std::string& text, const std::string& what);
 
+//! Numbers between commas, semicolons or blanks, as a range is typed in a
+//! dialog ("0.1 0.5"), on the command line (its values joined by ';') or in a
+//! list ("0.1,0.5"). Throws as parseNumberList does.
+std::vector<double> parseNumberWords(const std::string& text, const std::string& what);
+
 } // namespace scandiff

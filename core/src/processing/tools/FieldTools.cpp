@@ -9,21 +9,10 @@
 #include <scandiff/core/processing/FieldOperations.h>
 #include <scandiff/core/segmentation/FastMarching.h>
 
-#include <sstream>
 
 namespace scandiff::detail {
 
 namespace {
-
-//! The words of `text` between blanks.
-std::vector<std::string> splitWords(const std::string& text)
-{
-    std::vector<std::string> words;
-    std::istringstream stream(text);
-    for (std::string word; stream >> word;)
-        words.push_back(word);
-    return words;
-}
 
 const ScalarField& fieldOf(const PointCloud& cloud, const std::string& name, const std::string& tool)
 {
@@ -270,13 +259,7 @@ void addFilterTool(ToolRegistry& registry)
     };
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver*) {
         const PointCloud& input = inputs.cloud();
-        // "A B", "A,B" or, from the command line's two values, "A;B".
-        std::vector<double> bounds;
-        std::istringstream words(values.text("range"));
-        for (std::string word; std::getline(words, word, ';');)
-            for (const std::string& part : splitWords(word))
-                for (double v : parseNumberList(part, "the range"))
-                    bounds.push_back(v);
+        const std::vector<double> bounds = parseNumberWords(values.text("range"), "the range");
         if (bounds.size() != 2)
             throw Error(ErrorCode::InvalidArgument, "filter: --range takes two values A B");
         FilterByValueParams params;
