@@ -79,9 +79,12 @@ bool stonesRow(const stonewall::StoneWallParams& p, const Options& o, const std:
 {
     const auto start = std::chrono::steady_clock::now();
     const stonewall::StoneWallScene scene = stonewall::make(p);
-    const StoneTrial t = runStones(scene, o.set);
+    std::map<std::string, std::string> options = o.set;
+    options.erase("svg-joints"); // the SVG's points coloured by stone_joint, not by stone
+    const StoneTrial t = runStones(scene, options);
     if (!o.svgDir.empty())
-        writeWallSvg(o.svgDir + "/stones-" + label + ".svg", scene.frame, scene.stoneTruth, t.rings, &scene.cloud, 400);
+        writeWallSvg(o.svgDir + "/stones-" + label + ".svg", scene.frame, scene.stoneTruth, t.rings, &scene.cloud, 400,
+                     o.set.count("svg-joints") ? &t.jointOfPoint : t.stoneOfPoint.size() == scene.cloud.size() ? &t.stoneOfPoint : nullptr);
     std::size_t merged = 0, jagged = 0, several = 0;
     for (const auto& m : t.score.stones) {
         merged += m.iou < 0.8;
@@ -89,6 +92,18 @@ bool stonesRow(const stonewall::StoneWallParams& p, const Options& o, const std:
         several += m.polygonsAbove > 1;
     }
     std::printf("    wrong stones: %zu with IoU < 0.8, %zu within IoU but beyond 3 cm, %zu in several polygons\n", merged, jagged, several);
+    if (o.verbose)
+        std::printf("    %s\n", t.report.c_str());
+    if (o.verbose)
+        std::printf("    called stone: faces %.2f %% of %zu, arrises %.2f %% of %zu, joints %.2f %% of %zu\n",
+                    100.0 * t.calledStone[0] / std::max<std::size_t>(1, t.truthParts[0]), t.truthParts[0],
+                    100.0 * t.calledStone[1] / std::max<std::size_t>(1, t.truthParts[1]), t.truthParts[1],
+                    100.0 * t.calledStone[2] / std::max<std::size_t>(1, t.truthParts[2]), t.truthParts[2]);
+    if (o.verbose)
+        for (int part = 0; part < 3; ++part)
+            std::printf("    %s: parting off the joint lines %.2f %%, on a joint line %.2f %%\n", part == 0 ? "faces" : part == 1 ? "arrises" : "joints",
+                        100.0 * t.calledParting[part] / std::max<std::size_t>(1, t.truthParts[part]),
+                        100.0 * t.calledJoint[part] / std::max<std::size_t>(1, t.truthParts[part]));
     std::printf("%s %s | %zu pts, %zu polygons | %s | %.1f s%s\n", label.c_str(), stonewall::describe(p).c_str(), t.points,
                 t.polygons, t.score.summary().c_str(), seconds(start), t.score.meetsIssueTarget ? "" : "  FAIL");
     std::fflush(stdout);

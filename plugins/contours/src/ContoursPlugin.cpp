@@ -317,10 +317,12 @@ ToolSpec stonesTool()
     tool.title = "Stones";
     tool.category = "Contours";
     tool.description =
-        "Draws a masonry wall stone by stone from the intensity of its scan (thesis 003): the points are classified into stone "
-        "and joint by a threshold (the iterative inter-means threshold of the thesis when none is given) with the stones darker "
-        "or brighter, isolated stone points are removed, and each group of stone points separated by joints becomes one closed "
-        "polygon in the wall's best-fit plane (alpha shape); small and nested contours are dropped. Gives the points with "
+        "Draws a masonry wall stone by stone from its scan (thesis 003): the points are classified into stone and joint by "
+        "their intensity, starting from a threshold (the iterative inter-means threshold of the thesis when none is given) "
+        "with the stones darker or brighter, then by the two classes' levels around each point and the point's offset from "
+        "the stone faces around it (the joints' recess); isolated stone points are removed, stone points bridging a joint are "
+        "given to the nearest stone, and each group of stone points separated by joints becomes one closed polygon in the "
+        "wall's best-fit plane; small and nested contours are dropped. Gives the points with "
         "stone_id and stone_class, the polygons as a drawing (a polyline and an id label per stone) and a table (area, perimeter, "
         "centroid, plane residual).";
     tool.parameters = {
@@ -335,14 +337,27 @@ ToolSpec stonesTool()
                             0.0, -1e30, 1e30)
             .asOptional()
             .asThresholdOf("field"),
+        ParameterSpec::boolean("local-levels", "Local levels",
+                               "The stone and joint intensity levels and the faces' surface taken over a window around each "
+                               "point, the points classified again until the classes settle (intensity falls across a wall seen "
+                               "obliquely); off: the threshold alone on the whole wall, as thesis 003",
+                               defaults.localLevels),
+        ParameterSpec::boolean("relief", "Relief",
+                               "Each point's offset from the stone faces around it votes with its intensity (joints are usually "
+                               "recessed); used when the joints stand apart from the faces by half the faces' noise",
+                               defaults.relief)
+            .onlyWith("local-levels"),
+        ParameterSpec::real("window", "Window", "Side of the square around each point for the local levels", 0.0, 0.0, 1e9, "m")
+            .withZeroMeaning("automatic (30 point spacings, at least 0.15 m)")
+            .onlyWith("local-levels"),
         ParameterSpec::choice("method", "Method",
                               "classify: every point by the threshold, isolated points removed; grow: regions grown on intensity "
                               "from stone seeds (thesis 003 §II.2), one per stone",
                               {"classify", "grow"}, "classify"),
         ParameterSpec::real("alpha", "Alpha", "Largest circumradius of a stone's triangles (alpha-shape radius)", 0.0, 0.0, 1e9, "m")
-            .withZeroMeaning("automatic (knee of the sorted circumradii)"),
+            .withZeroMeaning("automatic (longest edges at their knee, in the spacing where each triangle lies)"),
         ParameterSpec::real("min-area", "Smallest stone", "Contours smaller than this are dropped", 0.0, 0.0, 1e12, "m²")
-            .withZeroMeaning("automatic (100 x the squared point spacing)"),
+            .withZeroMeaning("automatic (25 x the squared point spacing, or a twentieth of the median stone if larger)"),
         ParameterSpec::real("cleaning-radius", "Cleaning radius", "classify: radius of the isolated-point test", 0.0, 0.0, 1e9, "m")
             .withZeroMeaning("automatic (2 x the point spacing)")
             .onlyWith("method=classify"),
@@ -373,6 +388,9 @@ ToolSpec stonesTool()
         if (values.has("threshold"))
             params.threshold = values.real("threshold");
         params.method = parseStoneMethod(values.text("method"));
+        params.localLevels = values.boolean("local-levels");
+        params.relief = values.boolean("relief");
+        params.window = values.real("window");
         params.alpha = values.real("alpha");
         params.minStoneArea = values.real("min-area");
         params.cleaningRadius = values.real("cleaning-radius");
@@ -382,13 +400,15 @@ ToolSpec stonesTool()
         const StoneWallResult wall = extractStones(cloud, params, progress);
 
         PointCloud labelled = cloud.clone();
-        for (const char* name : {"stone_id", "stone_class"})
+        for (const char* name : {"stone_id", "stone_class", "stone_joint"})
             labelled.addField(name);
         std::vector<float>& id = labelled.field("stone_id")->values();
         std::vector<float>& cls = labelled.field("stone_class")->values();
+        std::vector<float>& joint = labelled.field("stone_joint")->values();
         for (std::size_t i = 0; i < cloud.size(); ++i) {
             id[i] = static_cast<float>(wall.stoneOfPoint[i]);
             cls[i] = wall.stoneClass[i];
+            joint[i] = wall.jointLine[i] ? 2.0f : wall.partingPoint[i] ? 1.0f : 0.0f;
         }
         Drawing drawing;
         Table table;
@@ -409,8 +429,12 @@ ToolSpec stonesTool()
         std::ostringstream summary;
         summary << wall.stones.size() << " stones; threshold " << wall.threshold
                 << (wall.thresholdIterations ? " (inter-means, " + std::to_string(wall.thresholdIterations) + " iterations)" : "")
-                << ", point spacing " << wall.spacing << " m, alpha " << wall.alpha << " m; " << wall.isolatedRemoved
-                << " isolated points removed, " << wall.smallDropped << " small and " << wall.nestedDropped
+                << ", point spacing " << wall.spacing << " m, outline threshold " << wall.alpha << " m; ";
+        if (wall.classificationRounds)
+            summary << "classes settled in " << wall.classificationRounds << " rounds, joints " << wall.jointOffset * 1e3
+                    << " mm off the faces (noise " << wall.reliefNoise * 1e3 << " mm, relief " << (wall.reliefUsed ? "used" : "not used") << "); ";
+        summary << wall.isolatedRemoved << " isolated points removed, " << wall.bridgePointsReassigned
+                << " points bridging joints given to the nearest stone, " << wall.smallDropped << " small and " << wall.nestedDropped
                 << " nested contours dropped; wall plane RMS " << wall.wall.rms << " m; mean intensity of the stones "
                 << wall.stoneMean << ", of the joints " << wall.jointMean;
         result.summary = summary.str();

@@ -4,6 +4,9 @@
 #include <scandiff/plugins/contours/StoneWall.h>
 #include <scandiff/plugins/contours/Vectorisation.h>
 
+#include "StoneEvidence.h"
+#include "StoneRegions.h"
+
 #include <scandiff/core/Error.h>
 #include <scandiff/core/segmentation/RunningMoments.h>
 #include <scandiff/octree/Octree.h>
@@ -228,139 +231,93 @@ StoneMethod parseStoneMethod(const std::string& name)
     throw Error(ErrorCode::InvalidArgument, "stones: method '" + name + "': expected classify or grow");
 }
 
-StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params, ProgressObserver* progress)
+namespace {
+
+//! Step 1: the points' stone or joint class, by the thesis's threshold alone
+//! or by the local levels of intensity and relief.
+StoneEvidence classifyPoints(const std::vector<Eigen::Vector2d>& uv, const std::vector<double>& height, const std::vector<float>& intensity,
+                             double spacing, const StoneParams& params, ProgressTicker& ticker)
 {
-    const ScalarField* field = cloud.field(params.field);
-    if (!field)
-        throw Error(ErrorCode::InvalidArgument, "stones: the cloud has no field '" + params.field + "'");
-    if (params.cleaningRadius < 0 || params.alpha < 0 || params.minStoneArea < 0 || params.growRadius < 0 || params.growVariance < 0 ||
-        params.cleaningNeighbours < 0)
-        throw Error(ErrorCode::InvalidArgument, "stones: radii, areas, tolerances and counts must be >= 0");
-    const std::size_t n = cloud.size();
-    if (n < 3)
-        throw Error(ErrorCode::InvalidData, "stones: the wall has " + std::to_string(n) + " points, at least 3 are needed");
-    std::vector<float> intensity(n); // absolute values (a field may store them around an offset)
-    for (std::size_t i = 0; i < n; ++i)
-        intensity[i] = static_cast<float>(field->value(i));
-    ProgressTicker ticker(progress, "Stones", 2 * n);
+    StoneEvidenceParams evidence;
+    evidence.polarity = params.polarity;
+    evidence.threshold = params.threshold;
+    evidence.relief = params.relief;
+    evidence.window = params.window;
+    if (params.localLevels)
+        return classifyStonePoints(uv, height, intensity, spacing, evidence, ticker);
+    evidence.relief = false;
+    StoneEvidence out = classifyStonePoints(uv, height, intensity, spacing, evidence, ticker);
+    // The thesis's classification: the threshold alone, on the whole wall.
+    for (std::size_t i = 0; i < intensity.size(); ++i)
+        out.stone[i] = std::isfinite(intensity[i]) &&
+                       (out.polarity == StonePolarity::Dark ? intensity[i] <= out.threshold : intensity[i] > out.threshold);
+    out.iterations = 0;
+    return out;
+}
 
-    StoneWallResult result;
-    std::vector<Eigen::Vector3d> global(n);
-    for (std::size_t i = 0; i < n; ++i)
-        global[i] = cloud.globalPosition(i);
-    result.wall = fitPlaneFrame(global);
-    std::vector<Eigen::Vector2d> uv(n);
-    for (std::size_t i = 0; i < n; ++i)
-        uv[i] = result.wall.toPlane(global[i]);
-    ticker.checkCancel();
-
-    // 1. Classification by intensity (thesis 003 §II.1.3).
-    if (params.threshold) {
-        result.threshold = *params.threshold;
-    } else {
-        const InterMeansThreshold found = interMeansThreshold(intensity);
-        result.threshold = found.threshold;
-        result.thresholdIterations = found.iterations;
-    }
-    StonePolarity polarity = params.polarity;
-    if (polarity == StonePolarity::Auto) {
-        std::size_t below = 0, above = 0;
-        for (float v : intensity)
-            if (std::isfinite(v))
-                (v <= result.threshold ? below : above) += 1;
-        polarity = below >= above ? StonePolarity::Dark : StonePolarity::Bright;
-    }
-    result.polarity = polarity;
-    result.stoneClass.assign(n, 0);
-    double sums[2] = {0, 0};
-    std::size_t counts[2] = {0, 0};
-    for (std::size_t i = 0; i < n; ++i) {
-        const float v = intensity[i];
-        result.stoneClass[i] = std::isfinite(v) && (polarity == StonePolarity::Dark ? v <= result.threshold : v > result.threshold);
-        if (std::isfinite(v)) {
-            sums[result.stoneClass[i]] += v;
-            ++counts[result.stoneClass[i]];
+//! The grow method's tolerance: the one given, else the stone class's variance.
+double growTolerance(const StoneParams& params, const std::vector<float>& intensity, const std::vector<std::uint8_t>& stoneClass)
+{
+    if (params.growVariance > 0)
+        return params.growVariance;
+    double sum = 0, sumSquares = 0;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < intensity.size(); ++i)
+        if (stoneClass[i]) {
+            sum += intensity[i];
+            sumSquares += static_cast<double>(intensity[i]) * intensity[i];
+            ++count;
         }
+    if (count < 3)
+        throw Error(ErrorCode::InvalidData, "stones: fewer than 3 points on the stone side of the threshold");
+    const double tau = sumSquares / count - (sum / count) * (sum / count);
+    return tau > 0 ? tau : 1e-12;
+}
+
+//! The smallest stone by default: 25 squared spacings (a patch of five by
+//! five points), or a twentieth of the median part above that, whichever is
+//! larger: where a joint is wide or faint, a few of its points classified
+//! stone make a sliver along it, and a wall's stones rarely differ twentyfold.
+double automaticMinimumArea(const OutlineResult& parts, double spacing)
+{
+    const double floor = 25.0 * spacing * spacing;
+    std::vector<double> areas;
+    for (const OutlinePart& part : parts.parts) {
+        const double area = signedArea(part.outer);
+        if (area >= floor)
+            areas.push_back(area);
     }
-    result.jointMean = counts[0] ? sums[0] / static_cast<double>(counts[0]) : result.threshold;
-    result.stoneMean = counts[1] ? sums[1] / static_cast<double>(counts[1]) : result.threshold;
+    if (areas.empty())
+        return floor;
+    std::nth_element(areas.begin(), areas.begin() + static_cast<std::ptrdiff_t>(areas.size() / 2), areas.end());
+    return std::max(floor, areas[areas.size() / 2] / 20.0);
+}
 
-    const std::vector<Eigen::Vector3f> planar = planarPoints(uv);
-    const octree::Octree tree(planar.data(), n);
-    result.spacing = medianSpacing(tree, planar);
-    ticker.checkCancel();
-
-    // 2. Stone points: cleaned classification, or regions grown on intensity.
-    std::vector<std::int32_t> labels(n, -1);
-    if (params.method == StoneMethod::Classify) {
-        const double radius = params.cleaningRadius > 0 ? params.cleaningRadius : 2.0 * result.spacing;
-        std::vector<std::uint8_t> isolated(n, 0);
-        tree.withinRadiusBatch(planar.data(), n, static_cast<float>(radius),
-                               [&](std::uint32_t q, const octree::Neighbour* nb, std::size_t count) {
-                                   if (!result.stoneClass[q])
-                                       return;
-                                   int stones = 0;
-                                   for (std::size_t k = 0; k < count; ++k)
-                                       stones += nb[k].index != q && result.stoneClass[nb[k].index];
-                                   isolated[q] = stones < params.cleaningNeighbours;
-                               });
-        for (std::size_t i = 0; i < n; ++i) {
-            result.isolatedRemoved += isolated[i];
-            labels[i] = result.stoneClass[i] && !isolated[i] ? 0 : -1;
-        }
-        ticker.step(n);
-    } else {
-        double tau = params.growVariance;
-        if (tau <= 0) {
-            double sum = 0, sumSquares = 0;
-            std::size_t count = 0;
-            for (std::size_t i = 0; i < n; ++i)
-                if (result.stoneClass[i]) {
-                    sum += intensity[i];
-                    sumSquares += static_cast<double>(intensity[i]) * intensity[i];
-                    ++count;
-                }
-            if (count < 3)
-                throw Error(ErrorCode::InvalidData, "stones: fewer than 3 points on the stone side of the threshold");
-            tau = sumSquares / count - (sum / count) * (sum / count);
-            if (!(tau > 0))
-                tau = 1e-12;
-        }
-        labels = growOnIntensity(tree, planar, intensity, result.stoneClass,
-                                 params.growRadius > 0 ? params.growRadius : 2.0 * result.spacing, tau, ticker);
-    }
-    ticker.checkCancel();
-
-    // 3. Contours: the alpha shape of the stone points, a part per stone.
-    std::vector<std::uint32_t> kept;
-    std::vector<Eigen::Vector2d> stoneUv;
-    OutlineParams outline;
-    outline.method = OutlineMethod::Alpha;
-    outline.threshold = params.alpha;
-    for (std::uint32_t i = 0; i < n; ++i)
-        if (labels[i] >= 0) {
-            kept.push_back(i);
-            stoneUv.push_back(uv[i]);
-            if (params.method == StoneMethod::Grow)
-                outline.labels.push_back(labels[i]);
-        }
-    const OutlineResult parts = extractOutlines(stoneUv, outline);
-    result.alpha = parts.threshold;
-    ticker.checkCancel();
-
-    // 4. Small and nested contours dropped, the others in reading order.
-    const double minArea = params.minStoneArea > 0 ? params.minStoneArea : 100.0 * result.spacing * result.spacing;
-    std::vector<Eigen::Vector2d> centre;
-    const std::vector<std::size_t> accepted = selectStones(parts, minArea, result, centre);
+//! Step 4: a stone per accepted part, its outline vectorised at the spacing
+//! where it lies, its points and plane residual counted.
+void drawStones(const OutlineResult& parts, const std::vector<std::size_t>& accepted, const std::vector<Eigen::Vector2d>& centre,
+                const std::vector<std::uint32_t>& kept, const std::vector<float>& localSpacing, const std::vector<Eigen::Vector3d>& global,
+                const StoneParams& params, StoneWallResult& result)
+{
     std::vector<std::int32_t> stoneOfPart(parts.parts.size(), -1);
+    std::vector<std::vector<float>> spacings(parts.parts.size());
+    for (std::size_t k = 0; k < kept.size(); ++k)
+        if (parts.partOfPoint[k] >= 0)
+            spacings[static_cast<std::size_t>(parts.partOfPoint[k])].push_back(localSpacing[kept[k]]);
     for (std::size_t p : accepted) {
         const OutlinePart& part = parts.parts[p];
         Stone stone;
         stone.outline2d = part.outer;
         if (params.vectorise) {
+            std::vector<float>& s = spacings[p];
+            double spacing = result.spacing;
+            if (!s.empty()) {
+                std::nth_element(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(s.size() / 2), s.end());
+                spacing = std::max(static_cast<double>(s[s.size() / 2]), 1e-9);
+            }
             VectoriseParams vector;
-            vector.tolerance = 1.5 * result.spacing;
-            vector.edgeOffset = 0.5 * result.spacing;
+            vector.tolerance = 1.5 * spacing;
+            vector.edgeOffset = 0.5 * spacing;
             vector.arcs = false; // a stone's sides are straight: its rounded corners are the outline's, not the stone's
             Ring2d drawn = vectoriseRing(part.outer, vector).vertices;
             if (drawn.size() >= 3 && std::abs(signedArea(drawn)) > 0.5 * std::abs(signedArea(part.outer)))
@@ -374,7 +331,7 @@ StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params
         stoneOfPart[p] = static_cast<std::int32_t>(result.stones.size());
         result.stones.push_back(std::move(stone));
     }
-    result.stoneOfPoint.assign(n, -1);
+    result.stoneOfPoint.assign(global.size(), -1);
     std::vector<double> sumSquares(result.stones.size(), 0.0);
     for (std::size_t k = 0; k < kept.size(); ++k) {
         const std::int32_t part = parts.partOfPoint[k];
@@ -388,6 +345,97 @@ StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params
     }
     for (std::size_t s = 0; s < result.stones.size(); ++s)
         result.stones[s].planeRms = result.stones[s].points ? std::sqrt(sumSquares[s] / static_cast<double>(result.stones[s].points)) : 0.0;
+}
+
+} // namespace
+
+StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params, ProgressObserver* progress)
+{
+    const ScalarField* field = cloud.field(params.field);
+    if (!field)
+        throw Error(ErrorCode::InvalidArgument, "stones: the cloud has no field '" + params.field + "'");
+    if (params.cleaningRadius < 0 || params.alpha < 0 || params.minStoneArea < 0 || params.growRadius < 0 || params.growVariance < 0 ||
+        params.cleaningNeighbours < 0 || !(params.window >= 0))
+        throw Error(ErrorCode::InvalidArgument, "stones: radii, areas, windows, tolerances and counts must be >= 0");
+    const std::size_t n = cloud.size();
+    if (n < 3)
+        throw Error(ErrorCode::InvalidData, "stones: the wall has " + std::to_string(n) + " points, at least 3 are needed");
+    std::vector<float> intensity(n); // absolute values (a field may store them around an offset)
+    std::vector<std::uint8_t> known(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        intensity[i] = static_cast<float>(field->value(i));
+        known[i] = std::isfinite(intensity[i]);
+    }
+    ProgressTicker ticker(progress, "Stones", 3 * n);
+
+    StoneWallResult result;
+    std::vector<Eigen::Vector3d> global(n);
+    for (std::size_t i = 0; i < n; ++i)
+        global[i] = cloud.globalPosition(i);
+    result.wall = fitPlaneFrame(global);
+    std::vector<Eigen::Vector2d> uv(n);
+    std::vector<double> height(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        uv[i] = result.wall.toPlane(global[i]);
+        height[i] = (global[i] - result.wall.origin).dot(result.wall.normal);
+    }
+    const std::vector<Eigen::Vector3f> planar = planarPoints(uv);
+    const octree::Octree tree(planar.data(), n);
+    result.spacing = medianSpacing(tree, planar);
+    ticker.checkCancel();
+
+    // 1. Stone or joint, point by point (thesis 003 §II.1.3, with local levels and relief).
+    const StoneEvidence evidence = classifyPoints(uv, height, intensity, result.spacing, params, ticker);
+    result.threshold = evidence.threshold;
+    result.thresholdIterations = evidence.thresholdIterations;
+    result.polarity = evidence.polarity;
+    result.stoneMean = evidence.stoneMean;
+    result.jointMean = evidence.jointMean;
+    result.jointOffset = evidence.jointOffset;
+    result.reliefNoise = evidence.reliefNoise;
+    result.reliefUsed = evidence.reliefUsed;
+    result.classificationRounds = evidence.iterations;
+    result.stoneClass = evidence.stone;
+
+    // 2. Stone points grouped stone by stone: cleaned and split where a joint
+    // is bridged, or regions grown on intensity.
+    StoneRegionParams regionParams;
+    regionParams.cleaningRadius = params.cleaningRadius;
+    regionParams.cleaningNeighbours = params.cleaningNeighbours;
+    StoneRegions regions = separateStones(tree, planar, result.stoneClass, known, evidence.recessed, regionParams, ticker);
+    result.isolatedRemoved = regions.isolatedRemoved;
+    result.bridgePointsReassigned = regions.setAside;
+    result.partingPoint = std::move(regions.parting);
+    result.jointLine = std::move(regions.joint);
+    std::vector<std::int32_t> labels = std::move(regions.label);
+    if (params.method == StoneMethod::Grow)
+        labels = growOnIntensity(tree, planar, intensity, result.stoneClass,
+                                 params.growRadius > 0 ? params.growRadius : 2.0 * result.spacing,
+                                 growTolerance(params, intensity, result.stoneClass), ticker);
+    ticker.step(n);
+
+    // 3. Contours: a part per stone, from the triangles joining its own points
+    // (the longest edge relative to the spacing where it lies, or the alpha radius given).
+    std::vector<std::uint32_t> kept;
+    std::vector<Eigen::Vector2d> stoneUv;
+    OutlineParams outline;
+    outline.method = params.alpha > 0 ? OutlineMethod::Alpha : OutlineMethod::LongEdges;
+    outline.threshold = params.alpha;
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (labels[i] >= 0) {
+            kept.push_back(i);
+            stoneUv.push_back(uv[i]);
+            outline.labels.push_back(labels[i]);
+        }
+    const OutlineResult parts = extractOutlines(stoneUv, outline);
+    result.alpha = parts.threshold;
+    ticker.checkCancel();
+
+    // 4. Small and nested contours dropped, the others in reading order, drawn.
+    const double minArea = params.minStoneArea > 0 ? params.minStoneArea : automaticMinimumArea(parts, result.spacing);
+    std::vector<Eigen::Vector2d> centre;
+    const std::vector<std::size_t> accepted = selectStones(parts, minArea, result, centre);
+    drawStones(parts, accepted, centre, kept, regions.spacing, global, params, result);
     ticker.step(n);
     return result;
 }

@@ -101,6 +101,12 @@ struct StoneTrial
     stonewall::StoneWallScore score;
     std::size_t points = 0;
     std::size_t polygons = 0;
+    //! The tool's stone_class against the truth, per kind of point (face,
+    //! arris, joint): how many of each it called stone.
+    std::size_t truthParts[3] = {0, 0, 0}, calledStone[3] = {0, 0, 0}, calledParting[3] = {0, 0, 0}, calledJoint[3] = {0, 0, 0};
+    std::string report; //!< the tool's summary
+    std::vector<int> stoneOfPoint; //!< the tool's stone_id per point (-1: none)
+    std::vector<int> jointOfPoint; //!< the tool's stone_joint per point
 };
 
 inline StoneTrial runStones(const stonewall::StoneWallScene& scene, const std::map<std::string, std::string>& options)
@@ -114,16 +120,34 @@ inline StoneTrial runStones(const stonewall::StoneWallScene& scene, const std::m
             drawing = &std::get<Drawing>(output.data);
     StoneTrial trial;
     trial.points = scene.cloud.size();
+    trial.report = result.summary;
     trial.rings = drawing ? closedRings(*drawing) : std::vector<wallsurvey::Ring3>{};
     trial.polygons = trial.rings.size();
     trial.score = stonewall::scorePolygons(scene, trial.rings);
+    if (const PointCloud* labelled = std::get_if<PointCloud>(&result.find("stones")->data))
+        if (const ScalarField* stoneClass = labelled->field("stone_class")) {
+            if (const ScalarField* id = labelled->field("stone_id"))
+                for (std::size_t i = 0; i < labelled->size(); ++i)
+                    trial.stoneOfPoint.push_back(static_cast<int>(id->value(i)));
+            for (std::size_t i = 0; i < scene.part.size() && i < labelled->size(); ++i) {
+                const auto part = static_cast<std::size_t>(scene.part[i]);
+                ++trial.truthParts[part];
+                trial.calledStone[part] += stoneClass->value(i) > 0.5;
+                if (const ScalarField* joint = labelled->field("stone_joint")) {
+                    trial.calledParting[part] += joint->value(i) == 1.0;
+                    trial.calledJoint[part] += joint->value(i) == 2.0;
+                    trial.jointOfPoint.push_back(static_cast<int>(joint->value(i)));
+                }
+            }
+        }
     return trial;
 }
 
 //! An SVG of rings over the truth in a wall's frame (truth green, rings red,
 //! the wall's points grey when given): to look at a trial that failed.
 inline void writeWallSvg(const std::string& path, const wallsurvey::WallFrame& frame, const std::vector<wallsurvey::Polygon2>& truth,
-                         const std::vector<wallsurvey::Ring3>& rings, const PointCloud* points = nullptr, double pixelsPerMetre = 100)
+                         const std::vector<wallsurvey::Ring3>& rings, const PointCloud* points = nullptr, double pixelsPerMetre = 100,
+                         const std::vector<int>* pointLabels = nullptr)
 {
     double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
     for (const auto& p : truth)
@@ -140,8 +164,10 @@ inline void writeWallSvg(const std::string& path, const wallsurvey::WallFrame& f
     if (points)
         for (std::size_t i = 0; i < points->size(); ++i) {
             const Eigen::Vector3d w = frame.toWall(points->globalPosition(i));
+            static const char* palette[] = {"#e6194b", "#3cb44b", "#ffe119", "#4363d8", "#f58231", "#911eb4", "#46f0f0", "#f032e6"};
+            const char* colour = !pointLabels ? "#bbb" : (*pointLabels)[i] < 0 ? "#000" : palette[(*pointLabels)[i] % 8];
             if (std::abs(w.z()) < 0.05 && w.x() > x0 && w.x() < x1 && w.y() > y0 && w.y() < y1)
-                std::fprintf(f, "<circle cx='%.1f' cy='%.1f' r='0.6' fill='#bbb'/>\n", px(w.x()), py(w.y()));
+                std::fprintf(f, "<circle cx='%.1f' cy='%.1f' r='0.6' fill='%s'/>\n", px(w.x()), py(w.y()), colour);
         }
     const auto path2 = [&](const wallsurvey::Polygon2& p, const char* colour, double width) {
         std::fprintf(f, "<polygon fill='none' stroke='%s' stroke-width='%.1f' points='", colour, width);

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! Stone-by-stone drawing of a wall from the intensity of its scan (thesis 003,
-//! Boucher 2015): the points are classified into stone and joint by intensity,
-//! isolated stone points removed, and each group of stone points separated by
+//! Stone-by-stone drawing of a wall from its scan (thesis 003, Boucher 2015):
+//! the points are classified into stone and joint by their intensity and their
+//! relief (the joints' recess), isolated stone points removed, stone points
+//! bridging a joint set aside, and each group of stone points separated by
 //! joints becomes one closed polygon in the wall's best-fit plane.
 
 #include <scandiff/core/PointCloud.h>
@@ -43,6 +44,16 @@ struct StoneParams
     std::string field = "intensity";
     StonePolarity polarity = StonePolarity::Auto;
     std::optional<double> threshold; //!< absent: the inter-means threshold
+    //! true: the classes' intensity levels and the stone faces' surface taken
+    //! over a window around each point, the points classified again until the
+    //! classes settle (the threshold is the start); false: the threshold alone
+    //! on the whole wall, as the thesis.
+    bool localLevels = true;
+    //! With local levels: each point's offset from the stone faces around it
+    //! votes too (joints are usually recessed), when the joints stand apart
+    //! from the faces by at least half the faces' noise.
+    bool relief = true;
+    double window = 0.0; //!< side of the local window (m); 0: max(0.15 m, 30 point spacings)
     StoneMethod method = StoneMethod::Classify;
     //! Cleaning: a stone point with fewer than `cleaningNeighbours` other stone
     //! points within `cleaningRadius` (0: 2 x the point spacing) is a joint
@@ -50,9 +61,13 @@ struct StoneParams
     double cleaningRadius = 0.0;
     int cleaningNeighbours = 3;
     //! Largest circumradius of a stone's triangles (alpha-shape radius, thesis
-    //! 003 §III.1.1); 0: at the knee of the sorted circumradii.
+    //! 003 §III.1.1); 0: a triangle is kept while its longest edge is within
+    //! the knee of those edges measured in the spacing where each lies (the
+    //! density of a scan falls across a wall seen obliquely: one radius for
+    //! the whole wall riddles its far end with holes).
     double alpha = 0.0;
-    //! Smallest stone polygon (m²); 0: 100 x the squared point spacing.
+    //! Smallest stone polygon (m²); 0: 25 x the squared point spacing, or a
+    //! twentieth of the median stone's area when that is larger.
     double minStoneArea = 0.0;
     //! Grow: neighbourhood radius R (0: 2 x the point spacing, thesis 003
     //! §II.2.1) and intensity variance tolerance tau (0: the variance of the
@@ -86,9 +101,16 @@ struct StoneWallResult
     StonePolarity polarity = StonePolarity::Dark; //!< the one used (Auto resolved)
     double stoneMean = 0.0, jointMean = 0.0; //!< the two classes' mean intensities (the histogram's modes)
     double spacing = 0.0;        //!< median distance of a point to its nearest neighbour
-    double alpha = 0.0;          //!< the one used
+    double alpha = 0.0;          //!< the outline's threshold: the alpha radius given, or the longest edge at the median spacing
+    double jointOffset = 0.0;    //!< the joints' median offset from the stone faces (m, along the wall's normal; local levels only)
+    double reliefNoise = 0.0;    //!< robust standard deviation of the stone points' offsets from their faces (m)
+    bool reliefUsed = false;
+    int classificationRounds = 0; //!< rounds of the local classification (0: the threshold alone)
+    std::size_t bridgePointsReassigned = 0; //!< stone points near a joint, given to the nearest stone's core
     std::vector<std::int32_t> stoneOfPoint; //!< -1: joint, isolated, or in a dropped contour
     std::vector<std::uint8_t> stoneClass;   //!< 1: classified stone (before cleaning), 0: joint or no intensity
+    std::vector<std::uint8_t> partingPoint; //!< 1: joint class or set back from the faces
+    std::vector<std::uint8_t> jointLine;    //!< 1: on a joint, as the parting points line up (gaps in them included)
     std::size_t isolatedRemoved = 0, smallDropped = 0, nestedDropped = 0;
     std::vector<Stone> stones; //!< in order of their centroid: rows from the top, left to right
 };
