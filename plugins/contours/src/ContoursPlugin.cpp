@@ -431,10 +431,10 @@ ToolSpec stonesTool()
                 << (wall.thresholdIterations ? " (inter-means, " + std::to_string(wall.thresholdIterations) + " iterations)" : "")
                 << ", point spacing " << wall.spacing << " m, outline threshold " << wall.alpha << " m; ";
         if (wall.classificationRounds)
-            summary << "classes settled in " << wall.classificationRounds << " rounds, joints " << wall.jointOffset * 1e3
+            summary << "classification rounds " << wall.classificationRounds << ", joints " << wall.jointOffset * 1e3
                     << " mm off the faces (noise " << wall.reliefNoise * 1e3 << " mm, relief " << (wall.reliefUsed ? "used" : "not used") << "); ";
-        summary << wall.isolatedRemoved << " isolated points removed, " << wall.bridgePointsReassigned
-                << " points bridging joints given to the nearest stone, " << wall.smallDropped << " small and " << wall.nestedDropped
+        summary << wall.isolatedRemoved << " isolated points removed, " << wall.pointsNearJoints
+                << " stone points near joints given to the nearest stone's core, " << wall.smallDropped << " small and " << wall.nestedDropped
                 << " nested contours dropped; wall plane RMS " << wall.wall.rms << " m; mean intensity of the stones "
                 << wall.stoneMean << ", of the joints " << wall.jointMean;
         result.summary = summary.str();

@@ -8,6 +8,7 @@
 #include "StoneRegions.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/geometry/PlanarRings.h>
 #include <scandiff/core/segmentation/RunningMoments.h>
 #include <scandiff/octree/Octree.h>
 
@@ -320,7 +321,8 @@ void drawStones(const OutlineResult& parts, const std::vector<std::size_t>& acce
             vector.edgeOffset = 0.5 * spacing;
             vector.arcs = false; // a stone's sides are straight: its rounded corners are the outline's, not the stone's
             Ring2d drawn = vectoriseRing(part.outer, vector).vertices;
-            if (drawn.size() >= 3 && std::abs(signedArea(drawn)) > 0.5 * std::abs(signedArea(part.outer)))
+            // A bow-tie is no stone: where the pieces' corners cross, the ring as scanned is kept.
+            if (drawn.size() >= 3 && std::abs(signedArea(drawn)) > 0.5 * std::abs(signedArea(part.outer)) && !crossesItself(drawn))
                 stone.outline2d = std::move(drawn);
         }
         for (const Eigen::Vector2d& q : stone.outline2d)
@@ -404,7 +406,7 @@ StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params
     regionParams.cleaningNeighbours = params.cleaningNeighbours;
     StoneRegions regions = separateStones(tree, planar, result.stoneClass, known, evidence.recessed, regionParams, ticker);
     result.isolatedRemoved = regions.isolatedRemoved;
-    result.bridgePointsReassigned = regions.setAside;
+    result.pointsNearJoints = regions.setAside;
     result.partingPoint = std::move(regions.parting);
     result.jointLine = std::move(regions.joint);
     std::vector<std::int32_t> labels = std::move(regions.label);

@@ -106,7 +106,7 @@ struct StoneWallResult
     double reliefNoise = 0.0;    //!< robust standard deviation of the stone points' offsets from their faces (m)
     bool reliefUsed = false;
     int classificationRounds = 0; //!< rounds of the local classification (0: the threshold alone)
-    std::size_t bridgePointsReassigned = 0; //!< stone points near a joint, given to the nearest stone's core
+    std::size_t pointsNearJoints = 0; //!< stone points near a joint, given to the nearest stone's core
     std::vector<std::int32_t> stoneOfPoint; //!< -1: joint, isolated, or in a dropped contour
     std::vector<std::uint8_t> stoneClass;   //!< 1: classified stone (before cleaning), 0: joint or no intensity
     std::vector<std::uint8_t> partingPoint; //!< 1: joint class or set back from the faces
