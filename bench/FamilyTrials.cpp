@@ -84,7 +84,7 @@ bool stonesRow(const stonewall::StoneWallParams& p, const Options& o, const std:
     const StoneTrial t = runStones(scene, options);
     if (!o.svgDir.empty())
         writeWallSvg(o.svgDir + "/stones-" + label + ".svg", scene.frame, scene.stoneTruth, t.rings, &scene.cloud, 400,
-                     o.set.count("svg-joints") ? &t.jointOfPoint : t.stoneOfPoint.size() == scene.cloud.size() ? &t.stoneOfPoint : nullptr);
+                     o.set.count("svg-joints") && t.jointOfPoint.size() == scene.cloud.size() ? &t.jointOfPoint : t.stoneOfPoint.size() == scene.cloud.size() ? &t.stoneOfPoint : nullptr);
     std::size_t merged = 0, jagged = 0, several = 0;
     for (const auto& m : t.score.stones) {
         merged += m.iou < 0.8;

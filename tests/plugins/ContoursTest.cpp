@@ -318,6 +318,34 @@ TEST(Stones, BadInputIsAClearError)
     PointCloud flat = scene.cloud.clone();
     std::fill(flat.field("intensity")->values().begin(), flat.field("intensity")->values().end(), 7.0f);
     EXPECT_EQ(test::errorCodeOf([&] { extractStones(flat, StoneParams{}); }), ErrorCode::InvalidData);
+    StoneParams thesis;
+    thesis.localLevels = false;
+    EXPECT_EQ(test::errorCodeOf([&] { extractStones(flat, thesis); }), ErrorCode::InvalidData);
+    // Every intensity NaN: nothing to classify, a clear error.
+    PointCloud blind = scene.cloud.clone();
+    std::fill(blind.field("intensity")->values().begin(), blind.field("intensity")->values().end(), std::nanf(""));
+    EXPECT_EQ(test::errorCodeOf([&] { extractStones(blind, StoneParams{}); }), ErrorCode::InvalidData);
+    // The thesis's classification with a threshold below every value: one
+    // class, no stone and no error, the means at the threshold for the empty one.
+    thesis.threshold = -1e9;
+    thesis.polarity = StonePolarity::Dark;
+    const StoneWallResult none = extractStones(scene.cloud, thesis);
+    EXPECT_TRUE(none.stones.empty());
+    EXPECT_EQ(none.stoneMean, -1e9);
+    // A handful of points, duplicates among them: an answer, not a crash.
+    PointCloud few = scene.cloud.subset(std::vector<std::size_t>{0, 1, 2, 3, 4, 5, 5, 5, 6, 7});
+    EXPECT_NO_THROW(extractStones(few, StoneParams{}));
+    // More cleaning neighbours than the twelve nearest hold: counted in a
+    // radius of two median spacings, where at most about 13 others lie, so
+    // 40 leaves every point isolated, and 13 fewer than all of them.
+    StoneParams many;
+    many.cleaningNeighbours = 40;
+    const StoneWallResult cleaned = extractStones(scene.cloud, many);
+    EXPECT_TRUE(cleaned.stones.empty());
+    many.cleaningNeighbours = 13;
+    const StoneWallResult some = extractStones(scene.cloud, many);
+    EXPECT_GT(some.isolatedRemoved, 0u);
+    EXPECT_LT(some.isolatedRemoved, scene.cloud.size() / 2);
 }
 
 TEST(Contours, TheFacadeOpeningsAreFoundWithTheirCorners)

@@ -80,6 +80,7 @@ TEST(PlanarRings, RingsThatCrossOrFoldBackAreNotSimple)
     EXPECT_TRUE(crossesItself(shifted({{0, 0}, {1, 1}, {1, 0}, {0, 1}})));                  // bow-tie
     EXPECT_TRUE(crossesItself(shifted({{0, 0}, {2, 0}, {2, 2}, {1, 0}, {0, 2}})));          // a vertex on another edge
     EXPECT_TRUE(crossesItself(shifted({{0, 0}, {2, 0}, {1, 0}, {1, 1}})));                  // an edge folding back
+    EXPECT_TRUE(crossesItself(shifted({{0, 0}, {2, 0}, {1, 0}})));                          // only the fold-back test sees it
     EXPECT_FALSE(crossesItself(R{{0, 0}, {1, 0}}));
 }
 

@@ -351,8 +351,9 @@ ToolSpec stonesTool()
             .withZeroMeaning("automatic (30 point spacings, at least 0.15 m)")
             .onlyWith("local-levels"),
         ParameterSpec::choice("method", "Method",
-                              "classify: every point by the threshold, isolated points removed; grow: regions grown on intensity "
-                              "from stone seeds (thesis 003 §II.2), one per stone",
+                              "classify: every point classified (threshold, local levels, relief), isolated points removed, "
+                              "stones parted along their joints; grow: regions grown on intensity from stone seeds (thesis 003 "
+                              "§II.2), one per stone",
                               {"classify", "grow"}, "classify"),
         ParameterSpec::real("alpha", "Alpha", "Largest circumradius of a stone's triangles (alpha-shape radius)", 0.0, 0.0, 1e9, "m")
             .withZeroMeaning("automatic (longest edges at their knee, in the spacing where each triangle lies)"),
@@ -373,7 +374,7 @@ ToolSpec stonesTool()
             .onlyWith("method=grow"),
         ParameterSpec::boolean("vectorise", "Vectorise outlines",
                                "Each stone's outline as straight pieces and arcs with corners at their intersections (as "
-                               "contours --vectorise), its edges half a spacing out; off: the alpha shape's ring",
+                               "contours --vectorise), its edges half a spacing out; off: the ring of the stone's triangles",
                                true),
     };
     tool.outputs = {OutputSpec{"stones", "Cloud with stone_id", DataKind::Cloud, true},

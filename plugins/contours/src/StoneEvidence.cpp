@@ -36,10 +36,14 @@ struct CellGrid
             min = min.cwiseMin(q);
             max = max.cwiseMax(q);
         }
-        // A wall of 100 m at 5 cm cells is 2,000 columns; the cap only guards
-        // against a window given far too small for the wall.
+        // A wall of 100 m x 20 m at 5 cm cells is 800,000 cells; the caps only
+        // guard against a window given far too small for the wall, or a
+        // stray point far away stretching the box: at most 20,000 cells a
+        // side and 4 million in all.
         const Eigen::Vector2d extent = max - min;
-        size = std::max(size, std::max(extent.x(), extent.y()) / 20000.0);
+        size = std::max({size, std::max(extent.x(), extent.y()) / 20000.0, std::sqrt(extent.x() * extent.y() / 4.0e6)});
+        if (!(size > 0) || !std::isfinite(size))
+            size = 1.0; // every point at one place: one cell
         columns = static_cast<int>(extent.x() / size) + 1;
         rows = static_cast<int>(extent.y() / size) + 1;
         const std::size_t cells = static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows);
@@ -213,6 +217,20 @@ void startFromTheReliefIfClearer(const CellGrid& grid, const std::vector<double>
         stone = std::move(byRelief);
 }
 
+//! Each class's mean intensity as classified (the threshold when a class is empty).
+void classMeans(const std::vector<float>& intensity, StoneEvidence& out)
+{
+    double sums[2] = {0, 0};
+    std::size_t counts[2] = {0, 0};
+    for (std::size_t i = 0; i < intensity.size(); ++i)
+        if (std::isfinite(intensity[i])) {
+            sums[out.stone[i]] += intensity[i];
+            ++counts[out.stone[i]];
+        }
+    out.jointMean = counts[0] ? sums[0] / static_cast<double>(counts[0]) : out.threshold;
+    out.stoneMean = counts[1] ? sums[1] / static_cast<double>(counts[1]) : out.threshold;
+}
+
 } // namespace
 
 StoneEvidence classifyStonePoints(const std::vector<Eigen::Vector2d>& uv, const std::vector<double>& height,
@@ -221,12 +239,19 @@ StoneEvidence classifyStonePoints(const std::vector<Eigen::Vector2d>& uv, const 
 {
     const std::size_t n = uv.size();
     StoneEvidence out;
+    bool oneIntensity = false; // a field of one value: only the relief can part the points
     if (params.threshold) {
         out.threshold = *params.threshold;
     } else {
-        const InterMeansThreshold found = interMeansThreshold(intensity);
-        out.threshold = found.threshold;
-        out.thresholdIterations = found.iterations;
+        try {
+            const InterMeansThreshold found = interMeansThreshold(intensity);
+            out.threshold = found.threshold;
+            out.thresholdIterations = found.iterations;
+        } catch (const Error&) {
+            if (!params.localLevels || !params.relief)
+                throw;
+            oneIntensity = true;
+        }
     }
     out.polarity = params.polarity;
     if (out.polarity == StonePolarity::Auto) {
@@ -239,7 +264,12 @@ StoneEvidence classifyStonePoints(const std::vector<Eigen::Vector2d>& uv, const 
     out.stone.assign(n, 0);
     for (std::size_t i = 0; i < n; ++i) {
         const float v = intensity[i];
-        out.stone[i] = std::isfinite(v) && (out.polarity == StonePolarity::Dark ? v <= out.threshold : v > out.threshold);
+        out.stone[i] = std::isfinite(v) && (oneIntensity || (out.polarity == StonePolarity::Dark ? v <= out.threshold : v > out.threshold));
+    }
+    out.recessed.assign(n, 0);
+    if (!params.localLevels) {
+        classMeans(intensity, out);
+        return out; // the thesis's classification: the threshold alone, on the whole wall
     }
 
     const double window = params.window > 0 ? params.window : std::max(0.15, 30.0 * spacing);
@@ -302,15 +332,13 @@ StoneEvidence classifyStonePoints(const std::vector<Eigen::Vector2d>& uv, const 
             changed += isStone != out.stone[i];
             out.stone[i] = isStone;
         }
-        out.stoneMean = levels.stoneGlobal;
-        out.jointMean = levels.jointGlobal;
         out.intensitySeparation = (levels.stoneGlobal - levels.jointGlobal) / intensitySigma;
         ticker.step(n / kRounds);
         if (changed * 2000 < n)
             break; // fewer than one point in 2,000 moved: the classes have settled
     }
     out.iterations = std::min(out.iterations, kRounds);
-    out.recessed.assign(n, 0);
+    classMeans(intensity, out);
     if (out.reliefUsed) {
         const double direction = out.jointOffset > 0 ? 1.0 : -1.0;
         const double cut = std::max(0.5 * std::abs(out.jointOffset), 2.5 * out.reliefNoise);

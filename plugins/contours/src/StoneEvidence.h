@@ -21,7 +21,11 @@ struct StoneEvidenceParams
 {
     StonePolarity polarity = StonePolarity::Auto;
     std::optional<double> threshold; //!< the starting split; absent: inter-means
-    bool relief = true;              //!< use the points' offset from the stone faces
+    //! false: the threshold alone on the whole wall (thesis 003); the rest unused.
+    bool localLevels = true;
+    //! Use the points' offset from the stone faces (with local levels); with
+    //! it, a field of one intensity starts from the relief instead of failing.
+    bool relief = true;
     //! Side of the square over which the two classes' levels and the faces'
     //! surface are taken (m); 0: max(0.15 m, 30 point spacings).
     double window = 0.0;
@@ -51,8 +55,9 @@ struct StoneEvidence
 
 //! `uv`: the points in the wall's plane; `height`: their signed distance to
 //! it; `spacing`: the median distance between neighbouring points. Throws
-//! Error(InvalidData) when fewer than two distinct intensities exist or one
-//! class is empty.
+//! Error(InvalidData) when neither the intensities nor the relief part the
+//! points into two classes (with local levels), or, by the threshold alone,
+//! when fewer than two distinct intensities exist and none is given.
 StoneEvidence classifyStonePoints(const std::vector<Eigen::Vector2d>& uv, const std::vector<double>& height,
                                   const std::vector<float>& intensity, double spacing, const StoneEvidenceParams& params,
                                   ProgressTicker& ticker);

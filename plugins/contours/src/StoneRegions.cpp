@@ -3,7 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
+#include <numeric>
 #include <queue>
 #include <utility>
 
@@ -65,35 +65,44 @@ NeighbourLists nearestNeighbours(const octree::Octree& tree, const std::vector<E
     return lists;
 }
 
-//! Groups of `members` linked by `linked(i, j)` through the lists: each
-//! member gets its group's number in `group` (-1 elsewhere); returns the count.
-int groupsOf(const NeighbourLists& lists, const std::vector<std::uint8_t>& members, const std::function<bool(std::uint32_t, std::size_t)>& linked,
-             std::vector<std::int32_t>& group)
+//! Groups of `members` linked through the neighbour lists: i and j join
+//! when either lists the other within `link` times the larger of their two
+//! spacings (union-find: the groups do not depend on the order points are
+//! visited in, nor on which of the two lists the other). Each member gets
+//! its group's number in `group` (-1 elsewhere), numbered from 0.
+void groupsOf(const NeighbourLists& lists, const std::vector<std::uint8_t>& members, const std::vector<float>& spacing, float link,
+              std::vector<std::int32_t>& group)
 {
     const std::size_t n = members.size();
-    group.assign(n, -1);
-    int groups = 0;
-    std::vector<std::uint32_t> stack;
-    for (std::uint32_t seed = 0; seed < n; ++seed) {
-        if (!members[seed] || group[seed] >= 0)
+    std::vector<std::uint32_t> parent(n);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto root = [&](std::uint32_t i) {
+        while (parent[i] != i)
+            i = parent[i] = parent[parent[i]];
+        return i;
+    };
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (!members[i])
             continue;
-        group[seed] = groups;
-        stack.push_back(seed);
-        while (!stack.empty()) {
-            const std::uint32_t at = stack.back();
-            stack.pop_back();
-            const std::uint32_t* nb = lists.of(at);
-            for (std::size_t k = 0; k < kNeighbours; ++k) {
-                const std::uint32_t j = nb[k];
-                if (j == UINT32_MAX || !members[j] || group[j] >= 0 || !linked(at, k))
-                    continue;
-                group[j] = groups;
-                stack.push_back(j);
-            }
+        for (std::size_t k = 0; k < kNeighbours; ++k) {
+            const std::uint32_t j = lists.of(i)[k];
+            if (j == UINT32_MAX || !members[j] || lists.distancesOf(i)[k] > link * std::max(spacing[i], spacing[j]))
+                continue;
+            const std::uint32_t a = root(i), b = root(j);
+            if (a != b)
+                parent[std::max(a, b)] = std::min(a, b);
         }
-        ++groups;
     }
-    return groups;
+    group.assign(n, -1);
+    std::vector<std::int32_t> number(n, -1);
+    std::int32_t groups = 0;
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (members[i]) {
+            const std::uint32_t r = root(i);
+            if (number[r] < 0)
+                number[r] = groups++;
+            group[i] = number[r];
+        }
 }
 
 //! Whether point i is on the scan's edge: its twelve nearest neighbours
@@ -181,8 +190,16 @@ StoneRegions separateStones(const octree::Octree& tree, const std::vector<Eigen:
     // 1. Isolated stone points are joint points (thesis 003's cleaning).
     std::vector<std::uint8_t> stone = stoneClass;
     std::vector<std::uint8_t> isolated(n, 0);
-    if (params.cleaningRadius > 0) {
-        tree.withinRadiusBatch(planar.data(), n, static_cast<float>(params.cleaningRadius),
+    // The twelve nearest hold the automatic radius (two spacings); asked for
+    // more neighbours than that, the radius is the median spacing's, searched.
+    float cleaningRadius = static_cast<float>(params.cleaningRadius);
+    if (cleaningRadius <= 0 && static_cast<std::size_t>(params.cleaningNeighbours) > kNeighbours) {
+        std::vector<float> spacings(out.spacing);
+        std::nth_element(spacings.begin(), spacings.begin() + static_cast<std::ptrdiff_t>(n / 2), spacings.end());
+        cleaningRadius = 2.0f * spacings[n / 2];
+    }
+    if (cleaningRadius > 0) {
+        tree.withinRadiusBatch(planar.data(), n, cleaningRadius,
                                [&](std::uint32_t q, const octree::Neighbour* nb, std::size_t count) {
                                    if (!stoneClass[q])
                                        return;
@@ -217,14 +234,8 @@ StoneRegions separateStones(const octree::Octree& tree, const std::vector<Eigen:
     // of the wall's edge, or of a hole (the shadow of a groove seen
     // obliquely), leaves a passage between two stones' cores there.
     for (std::size_t i = 0; i < n; ++i)
-        if (!joint[i] && onEdge(planar, lists, i)) {
+        if (!joint[i] && onEdge(planar, lists, i))
             joint[i] = 1;
-            ++out.edgePoints;
-        }
-    for (std::size_t i = 0; i < n; ++i) {
-        out.strayPartingPoints += parting[i] && !joint[i];
-        out.bridgePoints += stone[i] && joint[i];
-    }
 
     // 3. Cores: stone points clear of every joint point by 1.5 spacings, grouped.
     std::vector<std::uint8_t> core(n, 0);
@@ -240,7 +251,7 @@ StoneRegions separateStones(const octree::Octree& tree, const std::vector<Eigen:
     }
     ticker.checkCancel();
     std::vector<std::int32_t> group;
-    out.regions = groupsOf(lists, core, [&](std::uint32_t i, std::size_t k) { return lists.distancesOf(i)[k] <= kCoreLink * out.spacing[i]; }, group);
+    groupsOf(lists, core, out.spacing, kCoreLink, group);
 
     // 4. The stone points set aside go to the nearest core, through stone points.
     using Reach = std::pair<float, std::uint32_t>;

@@ -6,9 +6,10 @@
 //! stones into one region (the "stone-to-stone junctions" thesis 003 §III.2.1
 //! removes by hand before meshing). Here the joints are found as lines of
 //! parting points (joint class, or set back from the faces), gaps included;
-//! every stone point closer than one and a half spacings to a joint is set
-//! aside, the rest (the stones' cores) are grouped, and the points set aside
-//! that are not on a joint go back to the nearest core through stone points. Internal to the contours plugin; extractStones() calls it.
+//! every stone point on a joint or closer than one and a half spacings to one
+//! is set aside, the rest (the stones' cores) are grouped, and the stone
+//! points set aside go back to the nearest core through stone points (those
+//! on a joint line too: a stone's side seen in its groove is the stone's). Internal to the contours plugin; extractStones() calls it.
 
 #include <scandiff/core/Progress.h>
 #include <scandiff/octree/Octree.h>
@@ -36,11 +37,7 @@ struct StoneRegions
     std::vector<std::uint8_t> parting; //!< per point: 1 for a joint-class or recessed point
     std::vector<float> spacing;      //!< per point: the spacing where it lies (its 8th neighbour's distance / sqrt 2: a square grid's step)
     std::size_t isolatedRemoved = 0; //!< stone points left out as isolated
-    std::size_t strayPartingPoints = 0; //!< joint-class or recessed points on no joint line (a dark return or a noisy range on a stone)
-    std::size_t edgePoints = 0;         //!< points on the scan's edge (its border and holes), parting like a joint
-    std::size_t bridgePoints = 0;       //!< stone-class points on a joint line (where a joint is bridged)
     std::size_t setAside = 0;        //!< stone points near a joint, given back to the nearest core
-    int regions = 0;
 };
 
 //! `planar`: the points in the wall's plane (z = 0), the octree built on them;

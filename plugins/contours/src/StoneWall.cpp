@@ -242,18 +242,10 @@ StoneEvidence classifyPoints(const std::vector<Eigen::Vector2d>& uv, const std::
     StoneEvidenceParams evidence;
     evidence.polarity = params.polarity;
     evidence.threshold = params.threshold;
+    evidence.localLevels = params.localLevels;
     evidence.relief = params.relief;
     evidence.window = params.window;
-    if (params.localLevels)
-        return classifyStonePoints(uv, height, intensity, spacing, evidence, ticker);
-    evidence.relief = false;
-    StoneEvidence out = classifyStonePoints(uv, height, intensity, spacing, evidence, ticker);
-    // The thesis's classification: the threshold alone, on the whole wall.
-    for (std::size_t i = 0; i < intensity.size(); ++i)
-        out.stone[i] = std::isfinite(intensity[i]) &&
-                       (out.polarity == StonePolarity::Dark ? intensity[i] <= out.threshold : intensity[i] > out.threshold);
-    out.iterations = 0;
-    return out;
+    return classifyStonePoints(uv, height, intensity, spacing, evidence, ticker);
 }
 
 //! The grow method's tolerance: the one given, else the stone class's variance.
@@ -368,7 +360,7 @@ StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params
         intensity[i] = static_cast<float>(field->value(i));
         known[i] = std::isfinite(intensity[i]);
     }
-    ProgressTicker ticker(progress, "Stones", 3 * n);
+    ProgressTicker ticker(progress, "Stones", 4 * n);
 
     StoneWallResult result;
     std::vector<Eigen::Vector3d> global(n);
@@ -405,8 +397,10 @@ StoneWallResult extractStones(const PointCloud& cloud, const StoneParams& params
     regionParams.cleaningRadius = params.cleaningRadius;
     regionParams.cleaningNeighbours = params.cleaningNeighbours;
     StoneRegions regions = separateStones(tree, planar, result.stoneClass, known, evidence.recessed, regionParams, ticker);
-    result.isolatedRemoved = regions.isolatedRemoved;
-    result.pointsNearJoints = regions.setAside;
+    if (params.method == StoneMethod::Classify) { // grow keeps only the spacings of this step
+        result.isolatedRemoved = regions.isolatedRemoved;
+        result.pointsNearJoints = regions.setAside;
+    }
     result.partingPoint = std::move(regions.parting);
     result.jointLine = std::move(regions.joint);
     std::vector<std::int32_t> labels = std::move(regions.label);

@@ -78,7 +78,7 @@ struct StoneParams
     //! pieces and arcs, corners at their intersections, the edges moved half
     //! a spacing out where the joint begins): the alpha shape's boundary
     //! zigzags by a spacing and rounds every corner, 3 cm and more off the
-    //! stone's edge at its corners. Off: the alpha shape's ring.
+    //! stone's edge at its corners. Off: the ring of the stone's triangles.
     bool vectorise = true;
 };
 
