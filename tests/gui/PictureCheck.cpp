@@ -2,6 +2,8 @@
 // Checks the workbench's screenshot of the demo cloud as a person would look
 // at it: the cloud is there, in its colours, framed by "zoom to all".
 // Usage: scandiff_picture_check PICTURE.png; exit status 0 when it holds.
+//        scandiff_picture_check --legend PICTURE.png: a cloud coloured by a
+//        scalar field, its colour bar drawn whole (below).
 //
 // The background is a grey gradient; the demo cloud (PCL's region-growing
 // tutorial, one colour per region) is saturated colours. The picture must
@@ -13,11 +15,53 @@
 
 #include <cstdio>
 #include <set>
+#include <string>
+
+namespace {
+
+bool light(const QColor& c) { return c.valueF() > 0.75 && c.hsvSaturationF() < 0.25; }
+
+//! The colour bar of a view coloured by a field: a tall column of saturated
+//! pixels in the right third, and its title and labels (light text) drawn
+//! whole: none of their pixels within 3 columns of the right edge, where
+//! VTK's labels used to run off ("c2c_distanc", "3.789e").
+int checkLegend(const QImage& picture, const char* name)
+{
+    int barColumn = -1;
+    for (int x = picture.width() - 1; x >= picture.width() * 2 / 3 && barColumn < 0; --x) {
+        int saturated = 0;
+        for (int y = 0; y < picture.height(); ++y)
+            saturated += picture.pixelColor(x, y).hsvSaturationF() > 0.6 && picture.pixelColor(x, y).valueF() > 0.4;
+        if (saturated >= picture.height() / 2)
+            barColumn = x;
+    }
+    int lightAtEdge = 0, lightBesideBar = 0;
+    for (int y = 0; y < picture.height(); ++y)
+        for (int x = picture.width() * 2 / 3; x < picture.width(); ++x)
+            if (light(picture.pixelColor(x, y)))
+                (x >= picture.width() - 3 ? lightAtEdge : lightBesideBar) += 1;
+    std::printf("%s: colour bar at column %d, %d light pixels beside it, %d at the right edge\n", name, barColumn, lightBesideBar, lightAtEdge);
+    if (barColumn < 0 || lightBesideBar < 50 || lightAtEdge > 0) {
+        std::fprintf(stderr, "%s: the colour bar is missing or its text is cut at the view's edge\n", name);
+        return 1;
+    }
+    return 0;
+}
+
+} // namespace
 
 int main(int argc, char** argv)
 {
+    if (argc == 3 && std::string(argv[1]) == "--legend") {
+        const QImage picture(argv[2]);
+        if (picture.isNull()) {
+            std::fprintf(stderr, "%s: no picture\n", argv[2]);
+            return 1;
+        }
+        return checkLegend(picture, argv[2]);
+    }
     if (argc != 2) {
-        std::fprintf(stderr, "usage: %s PICTURE.png\n", argv[0]);
+        std::fprintf(stderr, "usage: %s [--legend] PICTURE.png\n", argv[0]);
         return 2;
     }
     const QImage picture(argv[1]);

@@ -141,13 +141,18 @@ CloudView::CloudView(QWidget* parent) : QWidget(parent), scene_(std::make_unique
 
     scene_->scalarBar->SetLookupTable(scene_->scalarBarTable);
     scene_->scalarBar->SetNumberOfLabels(6);
-    scene_->scalarBar->SetMaximumWidthInPixels(90);
-    scene_->scalarBar->SetPosition(0.90, 0.1);
-    scene_->scalarBar->SetWidth(0.08);
+    // The labels on the bar's left and the frame wide enough for them and the
+    // title: on its right, VTK draws them past the view's edge ("3.789e",
+    // "c2c_distanc").
+    scene_->scalarBar->SetTextPositionToPrecedeScalarBar();
+    scene_->scalarBar->SetMaximumWidthInPixels(150);
+    scene_->scalarBar->SetPosition(0.84, 0.1);
+    scene_->scalarBar->SetWidth(0.14);
     scene_->scalarBar->SetHeight(0.8);
     scene_->scalarBar->GetLabelTextProperty()->SetFontSize(12);
+    scene_->scalarBar->GetTitleTextProperty()->SetFontSize(13);
     scene_->scalarBar->UnconstrainedFontSizeOn();
-    scene_->scalarBar->SetLabelFormat("%-#8.4g");
+    scene_->scalarBar->SetLabelFormat("%#.4g");
     scene_->scalarBar->VisibilityOff();
     scene_->overlay->AddViewProp(scene_->scalarBar);
     scene_->picker->SetTolerance(0.005);
