@@ -121,7 +121,9 @@ bool onEdge(const std::vector<Eigen::Vector3f>& planar, const NeighbourLists& li
     }
     if (count < 3)
         return true;
-    std::sort(angles, angles + count);
+    for (std::size_t k = 1; k < count; ++k) // insertion sort of at most twelve angles
+        for (std::size_t m = k; m > 0 && angles[m - 1] > angles[m]; --m)
+            std::swap(angles[m - 1], angles[m]);
     float widest = angles[0] + 2.0f * 3.14159265f - angles[count - 1];
     for (std::size_t k = 1; k < count; ++k)
         widest = std::max(widest, angles[k] - angles[k - 1]);
@@ -172,6 +174,78 @@ std::vector<std::uint8_t> jointLines(const octree::Octree& tree, const std::vect
     return onLine;
 }
 
+//! Thesis 003's cleaning: a stone point with fewer than
+//! `cleaningNeighbours` other stone points within the cleaning radius (by
+//! default twice the spacing where it lies, among its twelve nearest; asked
+//! for more neighbours than those hold, twice the median spacing, searched).
+std::vector<std::uint8_t> isolatedStonePoints(const octree::Octree& tree, const std::vector<Eigen::Vector3f>& planar, const NeighbourLists& lists,
+                                              const std::vector<float>& spacing, const std::vector<std::uint8_t>& stoneClass,
+                                              const StoneRegionParams& params)
+{
+    const std::size_t n = planar.size();
+    std::vector<std::uint8_t> isolated(n, 0);
+    float radius = static_cast<float>(params.cleaningRadius);
+    if (radius <= 0 && static_cast<std::size_t>(params.cleaningNeighbours) > kNeighbours) {
+        std::vector<float> spacings(spacing);
+        std::nth_element(spacings.begin(), spacings.begin() + static_cast<std::ptrdiff_t>(n / 2), spacings.end());
+        radius = 2.0f * spacings[n / 2];
+    }
+    if (radius > 0) {
+        tree.withinRadiusBatch(planar.data(), n, radius, [&](std::uint32_t q, const octree::Neighbour* nb, std::size_t count) {
+            if (!stoneClass[q])
+                return;
+            int stones = 0;
+            for (std::size_t k = 0; k < count; ++k)
+                stones += nb[k].index != q && stoneClass[nb[k].index];
+            isolated[q] = stones < params.cleaningNeighbours;
+        });
+        return isolated;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!stoneClass[i])
+            continue;
+        int stones = 0;
+        for (std::size_t k = 0; k < kNeighbours; ++k)
+            stones += lists.of(i)[k] != UINT32_MAX && lists.distancesOf(i)[k] <= 2.0f * spacing[i] && stoneClass[lists.of(i)[k]];
+        isolated[i] = stones < params.cleaningNeighbours;
+    }
+    return isolated;
+}
+
+//! The stone points that are not cores take the group of the nearest core,
+//! the distance walked through stone points (Dijkstra over the neighbour
+//! lists, steps of at most kReturnLink spacings); those no core reaches keep -1.
+void giveBackToCores(const NeighbourLists& lists, const std::vector<std::uint8_t>& stone, const std::vector<std::uint8_t>& core,
+                     const std::vector<float>& spacing, std::vector<std::int32_t>& group)
+{
+    const std::size_t n = stone.size();
+    using Reach = std::pair<float, std::uint32_t>;
+    std::priority_queue<Reach, std::vector<Reach>, std::greater<Reach>> front;
+    std::vector<float> reached(n, std::numeric_limits<float>::infinity());
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (core[i]) {
+            reached[i] = 0.0f;
+            front.push({0.0f, i});
+        }
+    while (!front.empty()) {
+        const auto [distance, at] = front.top();
+        front.pop();
+        if (distance > reached[at])
+            continue;
+        for (std::size_t k = 0; k < kNeighbours; ++k) {
+            const std::uint32_t j = lists.of(at)[k];
+            const float step = lists.distancesOf(at)[k];
+            if (j == UINT32_MAX || !stone[j] || core[j] || step > kReturnLink * std::max(spacing[at], spacing[j]))
+                continue;
+            if (distance + step < reached[j]) {
+                reached[j] = distance + step;
+                group[j] = group[at];
+                front.push({reached[j], j});
+            }
+        }
+    }
+}
+
 } // namespace
 
 StoneRegions separateStones(const octree::Octree& tree, const std::vector<Eigen::Vector3f>& planar, const std::vector<std::uint8_t>& stoneClass,
@@ -189,35 +263,7 @@ StoneRegions separateStones(const octree::Octree& tree, const std::vector<Eigen:
 
     // 1. Isolated stone points are joint points (thesis 003's cleaning).
     std::vector<std::uint8_t> stone = stoneClass;
-    std::vector<std::uint8_t> isolated(n, 0);
-    // The twelve nearest hold the automatic radius (two spacings); asked for
-    // more neighbours than that, the radius is the median spacing's, searched.
-    float cleaningRadius = static_cast<float>(params.cleaningRadius);
-    if (cleaningRadius <= 0 && static_cast<std::size_t>(params.cleaningNeighbours) > kNeighbours) {
-        std::vector<float> spacings(out.spacing);
-        std::nth_element(spacings.begin(), spacings.begin() + static_cast<std::ptrdiff_t>(n / 2), spacings.end());
-        cleaningRadius = 2.0f * spacings[n / 2];
-    }
-    if (cleaningRadius > 0) {
-        tree.withinRadiusBatch(planar.data(), n, cleaningRadius,
-                               [&](std::uint32_t q, const octree::Neighbour* nb, std::size_t count) {
-                                   if (!stoneClass[q])
-                                       return;
-                                   int stones = 0;
-                                   for (std::size_t k = 0; k < count; ++k)
-                                       stones += nb[k].index != q && stoneClass[nb[k].index];
-                                   isolated[q] = stones < params.cleaningNeighbours;
-                               });
-    } else {
-        for (std::size_t i = 0; i < n; ++i) {
-            if (!stoneClass[i])
-                continue;
-            int stones = 0;
-            for (std::size_t k = 0; k < kNeighbours; ++k)
-                stones += lists.of(i)[k] != UINT32_MAX && lists.distancesOf(i)[k] <= 2.0f * out.spacing[i] && stoneClass[lists.of(i)[k]];
-            isolated[i] = stones < params.cleaningNeighbours;
-        }
-    }
+    const std::vector<std::uint8_t> isolated = isolatedStonePoints(tree, planar, lists, out.spacing, stoneClass, params);
     for (std::size_t i = 0; i < n; ++i)
         if (isolated[i]) {
             stone[i] = 0;
@@ -254,31 +300,7 @@ StoneRegions separateStones(const octree::Octree& tree, const std::vector<Eigen:
     groupsOf(lists, core, out.spacing, kCoreLink, group);
 
     // 4. The stone points set aside go to the nearest core, through stone points.
-    using Reach = std::pair<float, std::uint32_t>;
-    std::priority_queue<Reach, std::vector<Reach>, std::greater<Reach>> front;
-    std::vector<float> reached(n, std::numeric_limits<float>::infinity());
-    for (std::uint32_t i = 0; i < n; ++i)
-        if (core[i]) {
-            reached[i] = 0.0f;
-            front.push({0.0f, i});
-        }
-    while (!front.empty()) {
-        const auto [distance, at] = front.top();
-        front.pop();
-        if (distance > reached[at])
-            continue;
-        for (std::size_t k = 0; k < kNeighbours; ++k) {
-            const std::uint32_t j = lists.of(at)[k];
-            const float step = lists.distancesOf(at)[k];
-            if (j == UINT32_MAX || !stone[j] || core[j] || step > kReturnLink * std::max(out.spacing[at], out.spacing[j]))
-                continue;
-            if (distance + step < reached[j]) {
-                reached[j] = distance + step;
-                group[j] = group[at];
-                front.push({reached[j], j});
-            }
-        }
-    }
+    giveBackToCores(lists, stone, core, out.spacing, group);
     for (std::size_t i = 0; i < n; ++i)
         out.setAside += stone[i] && !core[i] && group[i] >= 0;
     out.label = std::move(group);
