@@ -197,6 +197,21 @@ private slots:
         QVERIFY2(toolError.isEmpty(), qPrintable(tool + "\n" + toolError));
         const PointCloud sparse = io::readPointCloud(registry.formats, (folder + "/site-2019_subsample.ply").toStdString());
         QCOMPARE(sparse.size(), window.document().item(window.document().ids().back()).points().size());
+
+        // After File > Export, the entity's file is the exported one: the
+        // distances are in it, not in site-2024.ply it was opened from.
+        const QString exported = folder + "/site-2024 with distances.ply";
+        QVERIFY(window.files()->exportEntity(comparedId, exported));
+        QSignalSpy filterDone(&subsample, &gui::ToolController::finished);
+        QVERIFY(subsample.run(comparedId, {{"spatial", "0.5"}}));
+        const QString again = loggedCommand(filterDone.at(0).at(0).toString());
+        QVERIFY2(again.contains(gui::shellQuoted(exported)) && !again.contains(gui::shellQuoted(compared)), qPrintable(again));
+        const QString againError = runInShell(again);
+        QVERIFY2(againError.isEmpty(), qPrintable(again + "\n" + againError));
+        const PointCloud sparseWithDistances =
+            io::readPointCloud(registry.formats, (folder + "/site-2024_with_distances_subsample.ply").toStdString());
+        QVERIFY(sparseWithDistances.field("c2c_distance"));
+        QCOMPARE(sparseWithDistances.size(), window.document().item(window.document().ids().back()).points().size());
     }
 
     void theColourBarDescribesACloudInTheFrame()

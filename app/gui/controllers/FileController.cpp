@@ -230,7 +230,7 @@ bool FileController::exportEntity(EntityId id, const QString& path)
             emit failed(result.error);
         return false;
     }
-    document_.markSaved(id);
+    document_.markSaved(id, path);
     std::size_t points = item->points().size();
     for (const PointCloud* scan : scans)
         points += scan->size();

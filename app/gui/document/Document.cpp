@@ -3,6 +3,8 @@
 
 #include <scandiff/core/distance/DemOfDifference.h>
 
+#include <QFileInfo>
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -337,10 +339,21 @@ std::vector<EntityId> Document::unsavedIds() const
     return out;
 }
 
-void Document::markSaved(EntityId id)
+void Document::markSaved(EntityId id, const QString& path)
 {
-    if (Item* item = findMutable(id))
-        item->unsaved = false;
+    Item* item = findMutable(id);
+    if (!item)
+        return;
+    item->unsaved = false;
+    if (path.isEmpty())
+        return;
+    item->sourcePath = QFileInfo(path).absoluteFilePath();
+    if (item->isGroup())
+        for (EntityId child : children(id))
+            if (Item* scan = findMutable(child)) {
+                scan->sourcePath = item->sourcePath;
+                scan->unsaved = false;
+            }
 }
 
 void Document::markAllSaved()

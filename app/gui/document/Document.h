@@ -178,8 +178,11 @@ public:
     };
     //! The entities whose work would be lost on quitting, in tree order.
     std::vector<EntityId> unsavedIds() const;
-    //! The entity's data is now in a file (exported).
-    void markSaved(EntityId id);
+    //! The entity's data is now in a file (exported). With a path, that file
+    //! is its file from now on (logged command lines name it, not the file
+    //! it was opened from, which no longer holds the same data); a group's
+    //! scans share it.
+    void markSaved(EntityId id, const QString& path = QString());
     //! Everything is in a file (the session was saved or just opened).
     void markAllSaved();
 
