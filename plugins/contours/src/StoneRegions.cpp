@@ -304,7 +304,7 @@ StoneRegions separateStones(const octree::Octree& tree, const std::vector<Eigen:
     for (std::size_t i = 0; i < n; ++i)
         out.setAside += stone[i] && !core[i] && group[i] >= 0;
     out.label = std::move(group);
-    out.joint = joint;
+    out.joint = std::move(joint);
     out.parting = std::move(parting);
     return out;
 }

@@ -253,17 +253,13 @@ double growTolerance(const StoneParams& params, const std::vector<float>& intens
 {
     if (params.growVariance > 0)
         return params.growVariance;
-    double sum = 0, sumSquares = 0;
-    std::size_t count = 0;
+    RunningMoments stones;
     for (std::size_t i = 0; i < intensity.size(); ++i)
-        if (stoneClass[i]) {
-            sum += intensity[i];
-            sumSquares += static_cast<double>(intensity[i]) * intensity[i];
-            ++count;
-        }
-    if (count < 3)
+        if (stoneClass[i])
+            stones.add(intensity[i]);
+    if (stones.count < 3)
         throw Error(ErrorCode::InvalidData, "stones: fewer than 3 points on the stone side of the threshold");
-    const double tau = sumSquares / count - (sum / count) * (sum / count);
+    const double tau = stones.variance();
     return tau > 0 ? tau : 1e-12;
 }
 
