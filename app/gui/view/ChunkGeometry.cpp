@@ -5,8 +5,11 @@
 #include <vtkCellData.h>
 #include <vtkFloatArray.h>
 #include <vtkNew.h>
+#include <vtkOpenGLPolyDataMapper.h>
+#include <vtkOpenGLVertexBufferObject.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
 #include <vtkTypeInt32Array.h>
 #include <vtkUnsignedCharArray.h>
 
@@ -46,6 +49,17 @@ vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride,
 //! A gridded cloud's cells (DEM of difference, raster) as flat squares on
 //! the ground plane at each cell's height: four corners per cell (float, about
 //! the cloud's origin like its points), and a quad per cell.
+vtkSmartPointer<vtkPolyDataMapper> chunkMapper(vtkPolyData* chunk)
+{
+    auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+    mapper->SetInputData(chunk);
+    mapper->SetColorModeToDirectScalars();
+    mapper->ScalarVisibilityOn();
+    if (auto* openGl = vtkOpenGLPolyDataMapper::SafeDownCast(mapper))
+        openGl->SetVBOShiftScaleMethod(vtkOpenGLVertexBufferObject::DISABLE_SHIFT_SCALE);
+    return mapper;
+}
+
 void makeRasterGeometry(vtkPolyData& polyData, const PointCloud& cloud, std::size_t begin, std::size_t count, double cell)
 {
     vtkNew<vtkPoints> corners;

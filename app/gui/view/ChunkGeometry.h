@@ -13,6 +13,7 @@
 class vtkCellArray;
 class vtkPoints;
 class vtkPolyData;
+class vtkPolyDataMapper;
 
 namespace scandiff::gui {
 
@@ -24,6 +25,14 @@ vtkSmartPointer<vtkPoints> pointsOver(const float* xyz, std::size_t count);
 //! points is refused by the view before this). The `stride` sets of firsts
 //! 0 .. stride - 1 hold every point once: the view's slices.
 vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride, std::size_t first = 0);
+
+//! A mapper drawing a chunk's points in their RGBA colours. The points go to
+//! OpenGL as they are: they are floats about the cloud's origin already (the
+//! view's offset is the actor's), so VTK's shift and scale of the coordinates
+//! adds no precision, and with it on (VTK turns it on for data wider than
+//! about 32 m) VTK packs a copy of every chunk's points that it keeps after
+//! the upload, 12 bytes a point for the session.
+vtkSmartPointer<vtkPolyDataMapper> chunkMapper(vtkPolyData* chunk);
 
 //! A gridded cloud's cells (DEM of difference, raster) as flat squares on
 //! the ground plane at each cell's height: four corners per cell (float, about

@@ -352,10 +352,7 @@ void CloudView::addEntity(const Document::Item& item)
                 c.normals->SetArray(const_cast<float*>(points.normals()[begin].data()), static_cast<vtkIdType>(3 * c.count), 1);
                 c.full->GetPointData()->SetNormals(c.normals);
             }
-            c.fullMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-            c.fullMapper->SetInputData(c.full);
-            c.fullMapper->SetColorModeToDirectScalars();
-            c.fullMapper->ScalarVisibilityOn();
+            c.fullMapper = chunkMapper(c.full);
             c.actor = vtkSmartPointer<vtkActor>::New();
             c.actor->SetPosition(offset.x(), offset.y(), offset.z());
             c.actor->SetMapper(c.fullMapper);
@@ -1068,10 +1065,7 @@ void CloudView::setDecimated(Shown& s, bool moving)
             if (c.normals)
                 c.decimated->GetPointData()->SetNormals(c.normals);
             c.decimated->SetVerts(vertexCells(c.count, scene_->stride));
-            c.decimatedMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-            c.decimatedMapper->SetInputData(c.decimated);
-            c.decimatedMapper->SetColorModeToDirectScalars();
-            c.decimatedMapper->ScalarVisibilityOn();
+            c.decimatedMapper = chunkMapper(c.decimated);
             c.decimatedMapper->SetClippingPlanes(c.fullMapper->GetClippingPlanes()); // the clipping box holds for it too
             c.decimatedStride = scene_->stride;
         }

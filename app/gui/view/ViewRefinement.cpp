@@ -102,10 +102,7 @@ void CloudView::drawNextSlice()
                 c.slice->GetPointData()->SetScalars(c.colours);
                 if (c.normals)
                     c.slice->GetPointData()->SetNormals(c.normals);
-                c.sliceMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-                c.sliceMapper->SetInputData(c.slice);
-                c.sliceMapper->SetColorModeToDirectScalars();
-                c.sliceMapper->ScalarVisibilityOn();
+                c.sliceMapper = chunkMapper(c.slice);
             }
             c.sliceMapper->SetClippingPlanes(c.fullMapper->GetClippingPlanes());
             c.slice->SetVerts(vertexCells(c.count, r.slices, slice));
