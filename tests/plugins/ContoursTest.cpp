@@ -209,6 +209,24 @@ TEST(Outlines, AHoleTouchingTheOutlineCountsAsAHoleInTheMeasures)
     EXPECT_EQ(matching.referenceOfModel[0], 1);
 }
 
+TEST(PolygonMeasures, RingsThatCrossOrFoldBackAreNotSimple)
+{
+    using R = std::vector<Eigen::Vector2d>;
+    const Eigen::Vector2d far(672345.0, 6843210.0); // Lambert-93: the tests hold far from the origin
+    auto shifted = [&](R ring) {
+        for (auto& q : ring)
+            q += far;
+        return ring;
+    };
+    EXPECT_FALSE(crossesItself(shifted({{0, 0}, {1, 0}, {1, 1}, {0, 1}})));
+    EXPECT_FALSE(crossesItself(shifted({{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}))); // concave L
+    EXPECT_TRUE(crossesItself(shifted({{0, 0}, {1, 1}, {1, 0}, {0, 1}})));                  // bow-tie
+    EXPECT_TRUE(crossesItself(shifted({{0, 0}, {2, 0}, {2, 2}, {1, 0}, {0, 2}})));          // a vertex on another edge
+    EXPECT_TRUE(crossesItself(shifted({{0, 0}, {2, 0}, {1, 0}, {1, 1}})));                  // an edge folding back
+    EXPECT_TRUE(crossesItself(shifted({{0, 0}, {2, 0}, {1, 0}})));                          // a fold-back alone
+    EXPECT_FALSE(crossesItself(R{{0, 0}, {1, 0}}));
+}
+
 TEST(Outlines, ThePlaneFrameIsOrthonormalAndExactFarFromTheOrigin)
 {
     const test::WallFrame frame;

@@ -66,24 +66,6 @@ TEST(Outline, SeparatePiecesGetSeparateRingsAndHolesAreFilled)
     EXPECT_EQ(test::errorCodeOf([] { concaveOutline({{0, 0}}, 0.0); }), ErrorCode::InvalidArgument);
 }
 
-TEST(PlanarRings, RingsThatCrossOrFoldBackAreNotSimple)
-{
-    using R = std::vector<Eigen::Vector2d>;
-    const Eigen::Vector2d far(672345.0, 6843210.0); // Lambert-93: the tests hold far from the origin
-    auto shifted = [&](R ring) {
-        for (auto& q : ring)
-            q += far;
-        return ring;
-    };
-    EXPECT_FALSE(crossesItself(shifted({{0, 0}, {1, 0}, {1, 1}, {0, 1}})));
-    EXPECT_FALSE(crossesItself(shifted({{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}))); // concave L
-    EXPECT_TRUE(crossesItself(shifted({{0, 0}, {1, 1}, {1, 0}, {0, 1}})));                  // bow-tie
-    EXPECT_TRUE(crossesItself(shifted({{0, 0}, {2, 0}, {2, 2}, {1, 0}, {0, 2}})));          // a vertex on another edge
-    EXPECT_TRUE(crossesItself(shifted({{0, 0}, {2, 0}, {1, 0}, {1, 1}})));                  // an edge folding back
-    EXPECT_TRUE(crossesItself(shifted({{0, 0}, {2, 0}, {1, 0}})));                          // only the fold-back test sees it
-    EXPECT_FALSE(crossesItself(R{{0, 0}, {1, 0}}));
-}
-
 TEST(RegionReport, MeasuresEachRegion)
 {
     // Region 1: a 1 m square at z = 0.5 (a raised slab); region 2: a tilted

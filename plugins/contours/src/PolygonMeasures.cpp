@@ -7,6 +7,7 @@
 
 #include <CGAL/Boolean_set_operations_2.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_set_2.h>
 #include <CGAL/Polygon_with_holes_2.h>
 
@@ -118,6 +119,17 @@ double directedHausdorff(const Ring2d& from, const Ring2d& to, double step)
 }
 
 } // namespace
+
+bool crossesItself(const Ring2d& ring)
+{
+    if (ring.size() < 3)
+        return false;
+    // Predicates only (no new points): the inexact-constructions kernel is exact here.
+    CGAL::Polygon_2<CGAL::Exact_predicates_inexact_constructions_kernel> polygon;
+    for (const Eigen::Vector2d& q : ring)
+        polygon.push_back({q.x(), q.y()});
+    return !polygon.is_simple();
+}
 
 double polygonArea(const Polygon2d& p)
 {

@@ -2,6 +2,7 @@
 // The stone-wall workflow of thesis 003 (its retained procedure, §IV.2):
 // threshold, classify, clean, contour, in the wall's plane.
 #include <scandiff/plugins/contours/StoneWall.h>
+#include <scandiff/plugins/contours/PolygonMeasures.h>
 #include <scandiff/plugins/contours/Vectorisation.h>
 
 #include "StoneEvidence.h"

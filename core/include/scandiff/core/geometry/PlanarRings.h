@@ -16,11 +16,4 @@ double signedArea(const std::vector<Eigen::Vector2d>& ring);
 //! Even-odd crossing test; a point on the boundary may go either way.
 bool containsPoint(const std::vector<Eigen::Vector2d>& ring, const Eigen::Vector2d& p);
 
-//! Whether two edges that are not neighbours along the ring meet (cross,
-//! touch or overlap), or two neighbours fold back onto each other: a ring
-//! that is not a simple polygon, which a CAD program draws as a bow-tie.
-//! Fewer than 3 vertices: false. Quadratic in the vertices: for outlines
-//! already vectorised, not for raw point rings.
-bool crossesItself(const std::vector<Eigen::Vector2d>& ring);
-
 } // namespace scandiff

@@ -21,6 +21,12 @@ struct Polygon2d
 double intersectionArea(const Polygon2d& a, const Polygon2d& b);
 double polygonArea(const Polygon2d& p); //!< outer minus holes
 
+//! Whether a ring is not a simple polygon (CGAL's exact predicates): two
+//! edges that are not neighbours meet (cross, touch or overlap), or two
+//! neighbours fold back onto each other, or a vertex repeats; what a CAD
+//! program draws as a bow-tie. Fewer than 3 vertices: false.
+bool crossesItself(const Ring2d& ring);
+
 //! Thesis 001 Tab. 5.5 for a model A and a reference R. The thesis's prose
 //! and formulas disagree on two of them; its tables follow the formulas,
 //! which are kept here: branching = |R \ A| / |R ∩ A|, miss = |A \ R| / |R ∩ A|,
