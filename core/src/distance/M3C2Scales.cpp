@@ -7,6 +7,7 @@
 // that the normal's orientation error stays within a few degrees.
 #include <scandiff/core/CloudOctree.h>
 #include <scandiff/core/Error.h>
+#include <scandiff/core/RobustStatistics.h>
 #include <scandiff/core/distance/M3C2.h>
 
 #include <Eigen/Eigenvalues>
@@ -19,15 +20,6 @@
 namespace scandiff {
 
 namespace {
-
-double median(std::vector<double> values)
-{
-    if (values.empty())
-        return 0.0;
-    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    return *middle;
-}
 
 //! Every step-th point of the cloud, so that about `count` are taken.
 std::vector<Eigen::Vector3f> samplesOf(const PointCloud& cloud, std::size_t count)
@@ -49,7 +41,7 @@ double medianSpacing(const PointCloud& cloud, const octree::Octree& tree, std::s
     for (std::size_t i = 0; i < samples.size(); ++i)
         if (std::isfinite(neighbours[2 * i + 1].squaredDistance))
             distances.push_back(std::sqrt(neighbours[2 * i + 1].squaredDistance));
-    return median(std::move(distances));
+    return medianOf(std::move(distances));
 }
 
 //! Per sample, the moments of the cloud's points within `radius`.
@@ -124,8 +116,8 @@ M3c2ScaleGuess guessM3c2Scales(const PointCloud& reference, const PointCloud& co
         for (const auto& m : momentsAround(comparedTree, inCompared, d / 2))
             inOther.push_back(m.count);
         guess.projectionScale = d;
-        guess.medianPointsReference = median(std::move(inReference));
-        guess.medianPointsCompared = median(std::move(inOther));
+        guess.medianPointsReference = medianOf(std::move(inReference));
+        guess.medianPointsCompared = medianOf(std::move(inOther));
         if (params.projectionScale ||
             std::min(guess.medianPointsReference, guess.medianPointsCompared) >= static_cast<double>(params.pointsPerCylinder))
             break;
@@ -146,7 +138,7 @@ M3c2ScaleGuess guessM3c2Scales(const PointCloud& reference, const PointCloud& co
                 ratios.push_back(sigma > 0 ? D / sigma : std::numeric_limits<double>::infinity());
         }
         guess.normalScale = D;
-        guess.medianRoughnessRatio = median(std::move(ratios));
+        guess.medianRoughnessRatio = medianOf(std::move(ratios));
         guess.roughnessRatioReached = guess.medianRoughnessRatio >= params.roughnessRatio;
         if (guess.roughnessRatioReached)
             break;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include <scandiff/core/CloudOctree.h>
 #include <scandiff/core/Error.h>
+#include <scandiff/core/RobustStatistics.h>
 #include <scandiff/core/segmentation/Classification.h>
 #include <scandiff/core/segmentation/FastMarching.h>
 
@@ -350,13 +351,6 @@ FastMarchingResult fastMarching(const PointCloud& cloud, const std::vector<std::
 
 namespace {
 
-double medianOf(std::vector<double>& values)
-{
-    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    return *middle;
-}
-
 //! Which regions are the field's noise rather than a change (see
 //! PropagationResult::backgroundRegions); `ceiling` receives median + 3 sigma.
 std::vector<bool> backgroundRegions(const ScalarField& field, const CellGrid& grid, const std::vector<std::uint32_t>& indices,
@@ -372,10 +366,8 @@ std::vector<bool> backgroundRegions(const ScalarField& field, const CellGrid& gr
         ceiling = std::numeric_limits<double>::quiet_NaN();
         return std::vector<bool>(regionPoints.size(), false);
     }
-    const double median = medianOf(all);
-    for (double& v : all)
-        v = std::abs(v - median);
-    const double sigma = 1.4826 * medianOf(all);
+    const double median = medianInPlace(all);
+    const double sigma = robustSigma(all, median);
     ceiling = median + 3.0 * sigma;
 
     std::vector<std::vector<double>> values(regionPoints.size());
@@ -391,7 +383,7 @@ std::vector<bool> backgroundRegions(const ScalarField& field, const CellGrid& gr
     for (std::size_t r = 1; r < values.size(); ++r) {
         if (values[r].empty())
             continue;
-        const double regionMedian = medianOf(values[r]);
+        const double regionMedian = medianInPlace(values[r]);
         background[r] = regionMedian < params.minSeedValue && regionMedian <= ceiling;
     }
     return background;

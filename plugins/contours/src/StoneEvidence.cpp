@@ -8,6 +8,7 @@
 #include "StoneEvidence.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/RobustStatistics.h>
 
 #include <algorithm>
 #include <cmath>
@@ -74,25 +75,6 @@ struct CellGrid
     }
 };
 
-double median(std::vector<double>& values)
-{
-    if (values.empty())
-        return 0.0;
-    auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    return *middle;
-}
-
-//! 1.4826 x the median absolute deviation from `centre`: a standard
-//! deviation that the other class's stray points do not inflate.
-double robustSigma(const std::vector<double>& values, double centre)
-{
-    std::vector<double> deviations(values.size());
-    for (std::size_t i = 0; i < values.size(); ++i)
-        deviations[i] = std::abs(values[i] - centre);
-    return 1.4826 * median(deviations);
-}
-
 //! The two classes' intensity levels around each cell (means over its 3 x 3
 //! block, drawn towards the wall's level by a few points' weight where a
 //! class is nearly absent from the block).
@@ -150,7 +132,7 @@ std::vector<double> faceHeights(const CellGrid& grid, const std::vector<double>&
                 (stone[i] ? stoneHeights : allHeights).push_back(height[i]);
             }
         });
-        face[c] = median(stoneHeights.empty() ? allHeights : stoneHeights);
+        face[c] = medianInPlace(stoneHeights.empty() ? allHeights : stoneHeights);
     }
     return face;
 }
@@ -165,7 +147,7 @@ double separation(const std::vector<double>& values, const std::vector<std::uint
             parts[inClass[i]].push_back(values[i]);
     if (parts[0].size() < 3 || parts[1].size() < 3)
         return 0.0;
-    const double centre0 = median(parts[0]), centre1 = median(parts[1]);
+    const double centre0 = medianInPlace(parts[0]), centre1 = medianInPlace(parts[1]);
     std::vector<double> deviations;
     for (int k = 0; k < 2; ++k)
         for (double v : parts[k])
@@ -304,7 +286,7 @@ StoneEvidence classifyStonePoints(const std::vector<Eigen::Vector2d>& uv, const 
             if (std::isfinite(intensity[i]))
                 (out.stone[i] ? stoneOffsets : jointOffsets).push_back(offset[i]);
         }
-        const double stoneLevel = median(stoneOffsets), jointLevel = median(jointOffsets);
+        const double stoneLevel = medianInPlace(stoneOffsets), jointLevel = medianInPlace(jointOffsets);
         out.reliefNoise = std::max(robustSigma(stoneOffsets, stoneLevel), 1e-9);
         out.jointOffset = jointLevel - stoneLevel;
         out.faceOffset = stoneLevel;

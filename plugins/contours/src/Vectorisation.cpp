@@ -16,6 +16,7 @@
 #include <scandiff/plugins/contours/Vectorisation.h>
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/RobustStatistics.h>
 
 #include <Eigen/Eigenvalues>
 
@@ -330,7 +331,7 @@ double boundaryScatter(const std::vector<Eigen::Vector2d>& p, double tolerance)
     if (off.empty())
         return tolerance / 3;
     std::nth_element(off.begin(), off.begin() + static_cast<std::ptrdiff_t>(off.size() / 2), off.end());
-    return std::clamp(0.8 * 1.4826 * off[off.size() / 2], tolerance / 10, tolerance / 3);
+    return std::clamp(0.8 * kMadToSigma * off[off.size() / 2], tolerance / 10, tolerance / 3);
 }
 
 //! Steps 1-3: the ring, from its flattest point, cut into the pieces of least

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "RegionGrowing.h"
 
+#include <scandiff/core/RobustStatistics.h>
 #include <scandiff/core/segmentation/RunningMoments.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -162,15 +163,6 @@ std::vector<RansacShape> growPlanarRegions(const std::vector<Eigen::Vector3d>& p
 }
 
 namespace {
-
-double medianOf(std::vector<double> values)
-{
-    if (values.empty())
-        return 0.0;
-    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    return *middle;
-}
 
 //! Members grouped by region label, regions smaller than minPoints dropped,
 //! in the order of their first seed.

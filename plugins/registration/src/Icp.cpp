@@ -5,6 +5,7 @@
 
 #include <scandiff/core/CloudOctree.h>
 #include <scandiff/core/Error.h>
+#include <scandiff/core/RobustStatistics.h>
 #include <scandiff/core/processing/Subsampling.h>
 
 #include <Eigen/Dense>
@@ -22,18 +23,6 @@ namespace {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 //! Moving points of the coarse iterations.
 constexpr std::size_t kCoarsePoints = 4000;
-
-//! The median of |values| (values copied: nth_element reorders).
-double medianAbsolute(std::vector<double> values)
-{
-    if (values.empty())
-        return 0.0;
-    for (double& v : values)
-        v = std::abs(v);
-    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    return *middle;
-}
 
 double kernelWeight(RobustKernel kernel, double u)
 {
@@ -119,15 +108,6 @@ void correspond(const detail::ReferenceSurface& surface, const std::vector<Eigen
                 c.used[i] = 0;
     }
     c.usedCount = static_cast<std::size_t>(std::count(c.used.begin(), c.used.end(), 1));
-}
-
-double percentile(std::vector<double> values, double p)
-{
-    if (values.empty())
-        return std::numeric_limits<double>::quiet_NaN();
-    const auto at = values.begin() + static_cast<std::ptrdiff_t>(std::min(values.size() - 1, static_cast<std::size_t>(p * (values.size() - 1) + 0.5)));
-    std::nth_element(values.begin(), at, values.end());
-    return *at;
 }
 
 //! The sampled moving points on surfaces that do not change (change-robust
@@ -371,7 +351,7 @@ IterationRun runIterations(const detail::ReferenceSurface& surface, const Iterat
         // plain iterations have converged: a scale taken from residuals that
         // are still large with misalignment would down-weight the far points
         // that hold the rotation, and the result could slide into a wrong basin.
-        const double scale = std::max(1.4826 * medianAbsolute(usedResiduals), 1e-12 * length);
+        const double scale = std::max(kMadToSigma * medianAbsolute(usedResiduals), 1e-12 * length);
         kernelScale = scale;
         w.resize(xs.size());
         double sum2 = 0;
@@ -416,7 +396,7 @@ IterationRun runIterations(const detail::ReferenceSurface& surface, const Iterat
             // Thesis 000 §1.4: the threshold shrinks with the residuals (3 robust
             // sigmas), never below the median spacing of the correspondences,
             // never growing back.
-            threshold = std::min(threshold, std::max(3.0 * 1.4826 * medianAbsolute(usedResiduals), medianDistance));
+            threshold = std::min(threshold, std::max(3.0 * kMadToSigma * medianAbsolute(usedResiduals), medianDistance));
         }
         ticker.step();
         // Converged when the step moves the points by less than the tolerance
@@ -491,6 +471,23 @@ Eigen::VectorXd twistAbout(const Eigen::Isometry3d& motion, const Eigen::Vector3
     case Dof::Translation: v << shift; break;
     }
     return v;
+}
+
+//! The report's residual statistics: over the |residuals| of the points
+//! used, of `considered` points.
+void summarise(const std::vector<double>& magnitudes, std::size_t considered, const IcpParams& params, RegistrationReport& report)
+{
+    double sum2 = 0;
+    for (double m : magnitudes)
+        sum2 += m * m;
+    report.rms = magnitudes.empty() ? std::numeric_limits<double>::quiet_NaN() : std::sqrt(sum2 / static_cast<double>(magnitudes.size()));
+    report.median = percentileOf(magnitudes, 0.5);
+    report.p90 = percentileOf(magnitudes, 0.9);
+    report.p95 = percentileOf(magnitudes, 0.95);
+    report.p99 = percentileOf(magnitudes, 0.99);
+    report.overlap = static_cast<double>(magnitudes.size()) / static_cast<double>(std::max<std::size_t>(considered, 1));
+    if (!report.converged)
+        report.notes.push_back("not converged after " + std::to_string(params.maxIterations) + " iterations");
 }
 
 } // namespace
@@ -593,17 +590,29 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
     report.centre = centroid + origin;
     report.degeneracy = degeneracyWarning(normalMatrix, dofCount(params.constraint.dof), params.constraint.axis, report.eigenvalues);
 
+    IcpParams final = params;
+    final.overlap = 1.0; // the trimming of the last iteration is applied as its cutoff
+    const double finalThreshold = std::min(threshold, cutoff);
+    std::vector<double> magnitudes;
+    if (!params.residualOfEveryPoint) {
+        std::vector<Eigen::Vector3d> x(points.x0.size());
+        for (std::size_t i = 0; i < x.size(); ++i)
+            x[i] = motion * points.x0[i];
+        Correspondences last;
+        correspond(surface, x, final, finalThreshold, last, params.maxDistance.value_or(kInfinity));
+        for (std::size_t i = 0; i < x.size(); ++i)
+            if (last.used[i])
+                magnitudes.push_back(std::abs(last.residual[i]));
+        summarise(magnitudes, x.size(), params, report);
+        return result;
+    }
     // Every moving point, moved: its residual, and whether the last
     // iteration's rules keep it. In chunks, each a step of its own stage: on a
     // large cloud this pass (closest points and the reference normals they
     // need) takes longer than all the iterations, and Cancel must be heard.
     const std::size_t n = moving.size();
-    IcpParams final = params;
-    final.overlap = 1.0; // the trimming of the last iteration is applied as its cutoff
-    const double finalThreshold = std::min(threshold, cutoff);
     result.residual = ScalarField(fields::kRegistrationResidual, n);
     result.excluded = ScalarField(fields::kRegistrationExcluded, n);
-    std::vector<double> magnitudes;
     constexpr std::size_t kChunk = 1 << 16;
     ProgressTicker residualTicker(progress, "Registration: residual of every point", (n + kChunk - 1) / kChunk);
     std::vector<Eigen::Vector3d> chunk;
@@ -626,17 +635,7 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
         }
         residualTicker.step();
     }
-    double sum2 = 0;
-    for (double m : magnitudes)
-        sum2 += m * m;
-    report.rms = magnitudes.empty() ? std::numeric_limits<double>::quiet_NaN() : std::sqrt(sum2 / static_cast<double>(magnitudes.size()));
-    report.median = percentile(magnitudes, 0.5);
-    report.p90 = percentile(magnitudes, 0.9);
-    report.p95 = percentile(magnitudes, 0.95);
-    report.p99 = percentile(magnitudes, 0.99);
-    report.overlap = static_cast<double>(magnitudes.size()) / static_cast<double>(n);
-    if (!report.converged)
-        report.notes.push_back("not converged after " + std::to_string(params.maxIterations) + " iterations");
+    summarise(magnitudes, n, params, report);
     return result;
 }
 

@@ -4,6 +4,7 @@
 #include "ReferenceSurface.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/RobustStatistics.h>
 #include <scandiff/core/distance/Visibility.h>
 #include <scandiff/core/processing/Subsampling.h>
 #include <scandiff/plugins/registration/GlobalAlignment.h>
@@ -108,24 +109,6 @@ void match(const Station& from, const Eigen::Isometry3d& fromPose, const Station
         m.distance[i] = d.norm();
         m.residual[i] = m.n[i].dot(d);
     }
-}
-
-double medianOf(std::vector<double> v)
-{
-    if (v.empty())
-        return 0;
-    const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-    std::nth_element(v.begin(), mid, v.end());
-    return *mid;
-}
-
-double percentileOf(std::vector<double> v, double p)
-{
-    if (v.empty())
-        return std::numeric_limits<double>::quiet_NaN();
-    const auto at = v.begin() + static_cast<std::ptrdiff_t>(std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5)));
-    std::nth_element(v.begin(), at, v.end());
-    return *at;
 }
 
 //! The displacement a motion gives a point, and its angle.
@@ -303,6 +286,9 @@ IcpParams pairIcp(const StationParams& params, double spacing)
     icp.seed = params.seed;
     // From within about a feature spacing (any start): the ICP needs no more reach.
     icp.maxDistance = params.anyStart ? std::min(params.maxDistance, 4 * spacing) : params.maxDistance;
+    // A pair's candidates are weighed by their shares; their residuals over
+    // the sample are enough (every station's points are not moved per start).
+    icp.residualOfEveryPoint = false;
     return icp;
 }
 
@@ -434,7 +420,7 @@ PairHypotheses registerPair(const std::vector<Station>& stations, std::size_t a,
         try {
             refined.push_back(detail::icpOnSurface(*stations[b].cloud, *stations[a].surface, icp, nullptr).report);
             fromWhereTheyAre.push_back(start.isIdentity());
-            const double s = 1.4826 * refined.back().median;
+            const double s = kMadToSigma * refined.back().median;
             if (std::isfinite(s) && s > 0)
                 sigma = std::min(sigma, s);
         } catch (const Error& e) {
@@ -504,18 +490,55 @@ struct Placement
     double score = 0; //!< summed over the pairs of placed stations
 };
 
-Placement placeFrom(const std::vector<PairHypotheses>& pairs, const std::vector<std::vector<std::ptrdiff_t>>& index, std::size_t startPair,
-                    std::size_t startCandidate, const std::vector<Station>& stations, double tolerance, double spacing,
-                    const Eigen::Vector3d& worldOrigin)
+//! The placement's scores (candidateShare at one tolerance), each computed
+//! once: the starts of the placement, and each station's candidates scored
+//! against the station they were registered with, ask for the same relative
+//! motions again (a motion and its inverse score alike), up to rounding.
+class PlacementShares
 {
-    const std::size_t count = stations.size();
+public:
+    PlacementShares(const std::vector<Station>& stations, double tolerance, double spacing, const Eigen::Vector3d& worldOrigin)
+        : stations_(stations), tolerance_(tolerance), spacing_(spacing), worldOrigin_(worldOrigin)
+    {
+    }
+
+    double operator()(std::size_t a, std::size_t b, const Eigen::Matrix4d& motion)
+    {
+        const Eigen::Matrix4d m = a < b ? motion : Eigen::Matrix4d(motion.inverse());
+        if (b < a)
+            std::swap(a, b);
+        for (const Known& known : known_)
+            if (known.a == a && known.b == b && (known.motion - m).cwiseAbs().maxCoeff() <= kSameWithinRounding)
+                return known.share;
+        known_.push_back({a, b, m, candidateShare(stations_, a, b, m, tolerance_, spacing_, worldOrigin_)});
+        return known_.back().share;
+    }
+
+private:
+    //! Two motions apart by this (rotation entries, metres) are one.
+    static constexpr double kSameWithinRounding = 1e-9;
+    struct Known
+    {
+        std::size_t a, b;
+        Eigen::Matrix4d motion;
+        double share;
+    };
+    const std::vector<Station>& stations_;
+    double tolerance_, spacing_;
+    Eigen::Vector3d worldOrigin_;
+    std::vector<Known> known_;
+};
+
+Placement placeFrom(const std::vector<PairHypotheses>& pairs, const std::vector<std::vector<std::ptrdiff_t>>& index, std::size_t startPair,
+                    std::size_t startCandidate, std::size_t count, PlacementShares& share)
+{
     Placement placement{std::vector<Eigen::Matrix4d>(count, Eigen::Matrix4d::Identity()), std::vector<bool>(count, false), 0};
     std::vector<Eigen::Matrix4d>& pose = placement.pose;
     std::vector<bool>& placed = placement.placed;
     const PairHypotheses& first = pairs[startPair];
     placed[first.pair.a] = placed[first.pair.b] = true;
     pose[first.pair.b] = first.candidates[startCandidate].matrix;
-    placement.score = candidateShare(stations, first.pair.a, first.pair.b, pose[first.pair.b], tolerance, spacing, worldOrigin);
+    placement.score = share(first.pair.a, first.pair.b, pose[first.pair.b]);
     for (;;) {
         double bestScore = -kInfinity;
         std::size_t bestStation = 0;
@@ -533,7 +556,7 @@ Placement placeFrom(const std::vector<PairHypotheses>& pairs, const std::vector<
                     double score = 0;
                     for (std::size_t q = 0; q < count; ++q)
                         if (placed[q])
-                            score += candidateShare(stations, q, k, pose[q].inverse() * candidate, tolerance, spacing, worldOrigin);
+                            score += share(q, k, pose[q].inverse() * candidate);
                     if (h.fromWhereTheyAre[c])
                         score += kWhereTheyAreBonus * std::abs(score);
                     if (score > bestScore) {
@@ -577,9 +600,10 @@ Placement placeStations(const std::vector<PairHypotheses>& pairs, const std::vec
     const double tolerance = medianOf(tolerances);
     std::sort(starts.begin(), starts.end(), [&](std::size_t p, std::size_t q) { return pairs[p].pair.agreement > pairs[q].pair.agreement; });
     starts.resize(std::min<std::size_t>(3, starts.size()));
+    PlacementShares share(stations, tolerance, spacing, worldOrigin);
     for (std::size_t e : starts) {
         const auto candidate = static_cast<std::size_t>(std::max_element(pairs[e].shares.begin(), pairs[e].shares.end()) - pairs[e].shares.begin());
-        Placement placement = placeFrom(pairs, index, e, candidate, stations, tolerance, spacing, worldOrigin);
+        Placement placement = placeFrom(pairs, index, e, candidate, count, share);
         if (placement.score > best.score)
             best = std::move(placement);
     }
@@ -850,7 +874,7 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
         // by a pair that saw little across it stays slid: the few surfaces
         // across the slide (an end wall, a column) are outliers to the many
         // along it.
-        const double robustScale = std::max(1.4826 * medianOf(magnitudes), 1e-12 * length);
+        const double robustScale = std::max(kMadToSigma * medianOf(magnitudes), 1e-12 * length);
         const double scale = std::max(robustScale, graduatedScale);
         graduatedScale /= 2;
         double sum2 = 0;

@@ -58,6 +58,12 @@ struct IcpParams
     std::size_t normalNeighbours = 12;
     //! The moving cloud's starting motion (global coordinates), identity by default.
     Eigen::Matrix4d initial = Eigen::Matrix4d::Identity();
+    //! The report's residual statistics and the residual fields over every
+    //! moving point (true), or the statistics over the iterations' sample
+    //! only, with no field (false: a caller weighing many candidate motions,
+    //! for which the pass over a 300 k-point station costs more than the
+    //! iterations).
+    bool residualOfEveryPoint = true;
 };
 
 namespace fields {
