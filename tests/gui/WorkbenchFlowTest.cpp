@@ -998,10 +998,19 @@ private slots:
         QTRY_VERIFY_WITH_TIMEOUT(!view.refinement().refining, 300000);
         QCOMPARE(r.slicesDrawn, slices);
         const QImage refined = view.shownPicture();
+        // A click at rest picks among every point, as with every point drawn,
+        // though only a stride-th of them went to OpenGL (the decimated copy).
+        QSignalSpy picked(&view, &gui::CloudView::pointPicked);
+        const int pickX = view.width() / 2 - 37, pickY = view.height() / 2 - 23;
+        QVERIFY(view.pickAt(pickX, pickY));
         view.setInteractiveBudget(points);
         view.render();
         QVERIFY(!view.refinement().refining);
         const QImage full = view.shownPicture();
+        QVERIFY(view.pickAt(pickX, pickY));
+        QCOMPARE(picked.count(), 2);
+        QCOMPARE(picked.at(0).at(0).toInt(), picked.at(1).at(0).toInt());
+        QCOMPARE(picked.at(0).at(1).value<std::size_t>(), picked.at(1).at(1).value<std::size_t>());
         QCOMPARE(refined.size(), full.size());
         const auto apart = [](QRgb f, QRgb g) {
             return std::max({std::abs(qRed(f) - qRed(g)), std::abs(qGreen(f) - qGreen(g)), std::abs(qBlue(f) - qBlue(g))}) > 24;

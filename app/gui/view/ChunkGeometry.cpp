@@ -5,6 +5,7 @@
 #include <vtkCellData.h>
 #include <vtkFloatArray.h>
 #include <vtkNew.h>
+#include <vtkPointData.h>
 #include <vtkOpenGLPolyDataMapper.h>
 #include <vtkOpenGLVertexBufferObject.h>
 #include <vtkPoints.h>
@@ -13,6 +14,9 @@
 #include <vtkTypeInt32Array.h>
 #include <vtkUnsignedCharArray.h>
 
+#include <algorithm>
+#include <array>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -46,9 +50,104 @@ vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride,
     return cells;
 }
 
-//! A gridded cloud's cells (DEM of difference, raster) as flat squares on
-//! the ground plane at each cell's height: four corners per cell (float, about
-//! the cloud's origin like its points), and a quad per cell.
+namespace {
+
+//! `out`'s array named `name` with `components` per point, made when absent.
+template <typename Array>
+Array* ownArray(vtkDataSetAttributes& attributes, const char* name, int components)
+{
+    auto* array = Array::SafeDownCast(attributes.GetArray(name));
+    if (!array) {
+        auto made = vtkSmartPointer<Array>::New();
+        made->SetName(name);
+        made->SetNumberOfComponents(components);
+        attributes.AddArray(made);
+        array = made;
+    }
+    return array;
+}
+
+std::size_t selectedCount(std::size_t count, std::size_t stride, std::size_t first)
+{
+    return first < count ? (count - first + stride - 1) / stride : 0;
+}
+
+} // namespace
+
+void gatherPoints(vtkPolyData& out, const ChunkArrays& chunk, std::size_t stride, std::size_t first)
+{
+    const std::size_t m = selectedCount(chunk.count, stride, first);
+    if (!out.GetPoints() || !vtkFloatArray::SafeDownCast(out.GetPoints()->GetData())) {
+        auto points = vtkSmartPointer<vtkPoints>::New();
+        points->SetDataTypeToFloat();
+        out.SetPoints(points);
+    }
+    auto* positions = vtkFloatArray::SafeDownCast(out.GetPoints()->GetData());
+    positions->SetNumberOfComponents(3);
+    positions->SetNumberOfTuples(static_cast<vtkIdType>(m));
+    float* p = positions->GetPointer(0);
+    for (std::size_t k = 0; k < m; ++k)
+        std::copy_n(chunk.xyz + 3 * (first + k * stride), 3, p + 3 * k);
+    positions->Modified();
+    out.GetPoints()->Modified();
+    if (chunk.normals) {
+        auto* normals = ownArray<vtkFloatArray>(*out.GetPointData(), "normals", 3);
+        normals->SetNumberOfTuples(static_cast<vtkIdType>(m));
+        float* n = normals->GetPointer(0);
+        for (std::size_t k = 0; k < m; ++k)
+            std::copy_n(chunk.normals + 3 * (first + k * stride), 3, n + 3 * k);
+        normals->Modified();
+        out.GetPointData()->SetNormals(normals);
+    }
+    gatherColours(out, chunk, stride, first);
+    out.SetVerts(vertexCells(m, 1));
+}
+
+void gatherColours(vtkPolyData& out, const ChunkArrays& chunk, std::size_t stride, std::size_t first)
+{
+    const std::size_t m = selectedCount(chunk.count, stride, first);
+    auto* colours = ownArray<vtkUnsignedCharArray>(*out.GetPointData(), "display colours", 4);
+    colours->SetNumberOfTuples(static_cast<vtkIdType>(m));
+    std::uint8_t* c = colours->GetPointer(0);
+    for (std::size_t k = 0; k < m; ++k)
+        std::copy_n(chunk.rgba + 4 * (first + k * stride), 4, c + 4 * k);
+    colours->Modified();
+    out.GetPointData()->SetScalars(colours);
+}
+
+vtkSmartPointer<vtkPolyData> pickingGeometry(vtkPoints* points)
+{
+    auto geometry = vtkSmartPointer<vtkPolyData>::New();
+    geometry->SetPoints(points);
+    const vtkIdType n = points->GetNumberOfPoints();
+    std::array<vtkIdType, 6> extreme{};
+    double low[3], high[3];
+    for (int axis = 0; axis < 3; ++axis) {
+        low[axis] = std::numeric_limits<double>::infinity();
+        high[axis] = -low[axis];
+    }
+    for (vtkIdType i = 0; i < n; ++i) {
+        double p[3];
+        points->GetPoint(i, p);
+        for (int axis = 0; axis < 3; ++axis) {
+            if (p[axis] < low[axis]) {
+                low[axis] = p[axis];
+                extreme[2 * axis] = i;
+            }
+            if (p[axis] > high[axis]) {
+                high[axis] = p[axis];
+                extreme[2 * axis + 1] = i;
+            }
+        }
+    }
+    auto cells = vtkSmartPointer<vtkCellArray>::New();
+    if (n > 0)
+        for (vtkIdType i : extreme)
+            cells->InsertNextCell(1, &i);
+    geometry->SetVerts(cells);
+    return geometry;
+}
+
 vtkSmartPointer<vtkPolyDataMapper> chunkMapper(vtkPolyData* chunk)
 {
     auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
@@ -60,6 +159,9 @@ vtkSmartPointer<vtkPolyDataMapper> chunkMapper(vtkPolyData* chunk)
     return mapper;
 }
 
+//! A gridded cloud's cells (DEM of difference, raster) as flat squares on
+//! the ground plane at each cell's height: four corners per cell (float, about
+//! the cloud's origin like its points), and a quad per cell.
 void makeRasterGeometry(vtkPolyData& polyData, const PointCloud& cloud, std::size_t begin, std::size_t count, double cell)
 {
     vtkNew<vtkPoints> corners;

@@ -9,6 +9,7 @@
 #include <vtkSmartPointer.h>
 
 #include <cstddef>
+#include <cstdint>
 
 class vtkCellArray;
 class vtkPoints;
@@ -25,6 +26,32 @@ vtkSmartPointer<vtkPoints> pointsOver(const float* xyz, std::size_t count);
 //! points is refused by the view before this). The `stride` sets of firsts
 //! 0 .. stride - 1 hold every point once: the view's slices.
 vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride, std::size_t first = 0);
+
+//! A chunk of a cloud as the view reads it: `count` points from these
+//! addresses on (the cloud's positions and normals, the view's RGBA).
+struct ChunkArrays
+{
+    const float* xyz = nullptr;
+    const std::uint8_t* rgba = nullptr;
+    const float* normals = nullptr; //!< null when the cloud has none
+    std::size_t count = 0;
+};
+
+//! Every stride-th point of the chunk from `first` on, copied into `out`'s
+//! own arrays (positions, colours, normals) with a vertex each: what a
+//! decimated frame or a slice draws. OpenGL then holds these few points, not
+//! the whole chunk (16 bytes a point in a software renderer's memory, for
+//! the session, when the chunk's own arrays are drawn). The arrays are
+//! reused from one call to the next.
+void gatherPoints(vtkPolyData& out, const ChunkArrays& chunk, std::size_t stride, std::size_t first = 0);
+//! The colours only again, after a recolouring (same stride and first).
+void gatherColours(vtkPolyData& out, const ChunkArrays& chunk, std::size_t stride, std::size_t first = 0);
+
+//! What the point picker reads for a chunk never drawn in full: all its
+//! points (shared, no copy) and a vertex on each of the six extreme ones, so
+//! that its bounds, which VTK takes from the cells, are the chunk's. Never
+//! drawn: OpenGL holds nothing of it.
+vtkSmartPointer<vtkPolyData> pickingGeometry(vtkPoints* points);
 
 //! A mapper drawing a chunk's points in their RGBA colours. The points go to
 //! OpenGL as they are: they are floats about the cloud's origin already (the

@@ -402,6 +402,8 @@ void CloudView::refreshEntity(const Document::Item& item)
                         std::copy_n(&s.rgba[4 * (c.begin + i)], 4, corners + 16 * i + 4 * k);
             }
             c.colours->Modified();
+            if (c.decimated && c.decimatedStride > 0)
+                gatherColours(*c.decimated, c.arrays(s), c.decimatedStride);
         }
     }
     renderInteractively();
@@ -1059,13 +1061,11 @@ void CloudView::setDecimated(Shown& s, bool moving)
         else if (decimate && c.full->GetNumberOfVerts() > 0)
             c.full->SetVerts(vtkSmartPointer<vtkCellArray>::New());
         if (decimate && c.decimatedStride != scene_->stride) {
-            c.decimated = vtkSmartPointer<vtkPolyData>::New();
-            c.decimated->SetPoints(c.full->GetPoints());
-            c.decimated->GetPointData()->SetScalars(c.colours);
-            if (c.normals)
-                c.decimated->GetPointData()->SetNormals(c.normals);
-            c.decimated->SetVerts(vertexCells(c.count, scene_->stride));
-            c.decimatedMapper = chunkMapper(c.decimated);
+            if (!c.decimated) {
+                c.decimated = vtkSmartPointer<vtkPolyData>::New();
+                c.decimatedMapper = chunkMapper(c.decimated);
+            }
+            gatherPoints(*c.decimated, c.arrays(s), scene_->stride);
             c.decimatedMapper->SetClippingPlanes(c.fullMapper->GetClippingPlanes()); // the clipping box holds for it too
             c.decimatedStride = scene_->stride;
         }
@@ -1191,8 +1191,23 @@ bool CloudView::pickAtDevicePixel(int x, int y)
     };
     bool raster = false;
     std::size_t begin = 0;
+    // Among every point of a chunk, not the few its decimated copy draws:
+    // the picker reads the points of the actor's mapper.
+    std::vector<std::pair<vtkActor*, vtkMapper*>> drawing;
+    for (auto& [id, s] : scene_->shown)
+        for (auto& c : s.chunks)
+            if (s.isCloud && !c.raster && c.actor->GetMapper() != c.fullMapper.Get()) {
+                if (!c.pickMapper) {
+                    c.pickMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+                    c.pickMapper->SetInputData(pickingGeometry(c.full->GetPoints()));
+                }
+                drawing.emplace_back(c.actor.Get(), c.actor->GetMapper());
+                c.actor->SetMapper(c.pickMapper);
+            }
     const bool pointHit = scene_->picker->Pick(x, y, 0.0, scene_->renderer) && scene_->picker->GetPointId() >= 0 &&
                           chunkOf(scene_->picker->GetActor(), raster, begin) && !raster;
+    for (auto& [actor, mapper] : drawing)
+        actor->SetMapper(mapper);
     if (pointHit) {
         index = begin + static_cast<std::size_t>(scene_->picker->GetPointId());
     } else {

@@ -3,6 +3,7 @@
 //! What a CloudView holds (private to view/): its VTK scene and, per shown
 //! entity, its chunks. Shared by CloudView.cpp and ViewRefinement.cpp.
 
+#include "view/ChunkGeometry.h"
 #include "view/CloudView.h"
 
 #include <vtkActor.h>
@@ -35,9 +36,11 @@ namespace scandiff::gui {
 //! One shown entity, drawn as chunks of at most kChunkPoints points, one
 //! actor each: a renderer (software ones above all) then works on bounded
 //! buffers, as CloudCompare draws its clouds chunk by chunk. A chunk's VTK
-//! arrays are views on the entity's positions and RGBA colours (no copies); its
-//! decimated twin shares them and holds every stride-th vertex only, and its
-//! slice (the picture refined at rest) the vertices of the slice being drawn.
+//! arrays are views on the entity's positions and RGBA colours (no copies),
+//! drawn only when every point is (a screenshot, Eye-Dome Lighting, a cloud
+//! within the frame budget). Its decimated twin holds copies of every
+//! stride-th point only, and its slice (the picture refined at rest) of the
+//! slice being drawn: what OpenGL is given stays a stride-th of the cloud.
 struct CloudView::Shown
 {
     struct Chunk
@@ -46,12 +49,19 @@ struct CloudView::Shown
         vtkSmartPointer<vtkPolyData> full, decimated, slice;
         vtkSmartPointer<vtkFloatArray> normals; //!< a view on the cloud's normals, when it has some
         vtkSmartPointer<vtkPolyDataMapper> fullMapper, decimatedMapper, sliceMapper;
+        vtkSmartPointer<vtkPolyDataMapper> pickMapper; //!< over pickingGeometry, made at the first pick
         vtkSmartPointer<vtkUnsignedCharArray> colours;
         vtkSmartPointer<vtkActor> actor;
         std::size_t decimatedStride = 0;
         //! A gridded cloud's chunk: four corners per point (its cell), colours
         //! copied from the entity's RGBA at each refresh, never decimated.
         bool raster = false;
+        //! Its points as the gathering reads them (see gatherPoints).
+        ChunkArrays arrays(const Shown& shown) const
+        {
+            return {vtkFloatArray::SafeDownCast(full->GetPoints()->GetData())->GetPointer(0), shown.rgba.data() + 4 * begin,
+                    normals ? normals->GetPointer(0) : nullptr, count};
+        }
     };
     bool isCloud = true;
     std::size_t pointCount = 0;

@@ -98,14 +98,10 @@ void CloudView::drawNextSlice()
             }
             if (!c.slice) {
                 c.slice = vtkSmartPointer<vtkPolyData>::New();
-                c.slice->SetPoints(c.full->GetPoints());
-                c.slice->GetPointData()->SetScalars(c.colours);
-                if (c.normals)
-                    c.slice->GetPointData()->SetNormals(c.normals);
                 c.sliceMapper = chunkMapper(c.slice);
             }
             c.sliceMapper->SetClippingPlanes(c.fullMapper->GetClippingPlanes());
-            c.slice->SetVerts(vertexCells(c.count, r.slices, slice));
+            gatherPoints(*c.slice, c.arrays(s), r.slices, slice);
             points += slice < c.count ? (c.count - slice + r.slices - 1) / r.slices : 0;
             c.actor->SetMapper(c.sliceMapper);
         }
