@@ -180,6 +180,15 @@ PointCloud PointCloud::subset(const std::vector<std::size_t>& indices) const
     return out;
 }
 
+std::size_t PointCloud::heldBytes() const
+{
+    std::size_t bytes = (positions_.capacity() + residuals_.capacity() + normals_.capacity()) * sizeof(Eigen::Vector3f) +
+                        colors_.capacity() * sizeof(Rgb8);
+    for (const ScalarField& field : fields_)
+        bytes += field.heldBytes();
+    return bytes;
+}
+
 std::size_t PointCloud::removeNonFinitePoints()
 {
     const std::size_t n = positions_.size();

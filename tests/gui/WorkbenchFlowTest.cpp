@@ -981,6 +981,15 @@ private slots:
         QCOMPARE(r.slicesDrawn, slices);
         QCOMPARE(r.pointsDrawn, points);
         QVERIFY2(r.largestSlice <= kBudget + chunks, std::to_string(r.largestSlice).c_str());
+        // OpenGL was given the decimated frame's points and the last slice's,
+        // never a whole chunk (a software renderer keeps a copy of what it is
+        // given: 16 bytes a point for the session); the view holds the RGBA
+        // colours and those two copies (positions 12 bytes, colours 4, a
+        // vertex 8, and VTK's spare capacity: at most 32 a point copied).
+        const std::size_t perSlice = points / slices + chunks;
+        QVERIFY2(view.pointsGivenToOpenGl() <= 2 * perSlice, std::to_string(view.pointsGivenToOpenGl()).c_str());
+        QVERIFY2(view.pointsGivenToOpenGl() >= perSlice, std::to_string(view.pointsGivenToOpenGl()).c_str());
+        QVERIFY2(view.heldBytes() <= 4 * points + 2 * 32 * perSlice, std::to_string(view.heldBytes()).c_str());
         // The slices add up to the full picture: on every pixel a point
         // covers, the same colour, but where points tie in depth (the order of
         // drawing differs: a neighbour of a nearly equal colour may win).

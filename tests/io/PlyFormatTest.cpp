@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -211,6 +212,42 @@ TEST_P(PlyEncodingTest, UtmCloudKeepsMillimetres)
     EXPECT_GT(readTime->offset(), 1e9);
     for (std::size_t i = 0; i < 3; ++i)
         EXPECT_NEAR(readTime->value(i), cloud.field("gps_time")->value(i), 1e-4) << i;
+}
+
+TEST(PlyFormat, AScanAsASurveyorHasItCostsThirtyOneBytesAPoint)
+{
+    // A terrestrial scan as scanners export it (and as scandiff-make-scan
+    // writes it): double coordinates far from the origin, RGB, intensity,
+    // classification and GPS time in double. Held: positions 12 bytes,
+    // colours 3, intensity and class 4 each as floats, GPS time 4 + 4 (its
+    // float view and the float residual that gives its doubles back): 31.
+    // (The workbench's own bytes are asserted in its Qt test.)
+    constexpr std::size_t kPoints = 200'000;
+    const fs::path path = tempDir() / "survey.ply";
+    {
+        std::ofstream out(path, std::ios::binary);
+        out << "ply\nformat binary_little_endian 1.0\nelement vertex " << kPoints
+            << "\nproperty double x\nproperty double y\nproperty double z\nproperty uchar red\nproperty uchar green\n"
+               "property uchar blue\nproperty float intensity\nproperty float classification\nproperty double gps_time\n"
+               "end_header\n";
+        for (std::size_t i = 0; i < kPoints; ++i) {
+            const double xyz[3] = {512000.0 + 0.001 * static_cast<double>(i % 1000), 5423000.0 + 0.003 * static_cast<double>(i / 1000),
+                                   112.5 + 1e-4 * static_cast<double>(i % 77)};
+            const unsigned char rgb[3] = {static_cast<unsigned char>(i), static_cast<unsigned char>(i >> 8), 7};
+            const float intensity = static_cast<float>(i % 4096), classification = static_cast<float>(i % 7);
+            const double time = 3.2e8 + 1.25e-6 * static_cast<double>(i);
+            out.write(reinterpret_cast<const char*>(xyz), sizeof xyz);
+            out.write(reinterpret_cast<const char*>(rgb), sizeof rgb);
+            out.write(reinterpret_cast<const char*>(&intensity), sizeof intensity);
+            out.write(reinterpret_cast<const char*>(&classification), sizeof classification);
+            out.write(reinterpret_cast<const char*>(&time), sizeof time);
+        }
+    }
+    const PointCloud cloud = io::readPointCloud(plyRegistry(), path);
+    ASSERT_EQ(cloud.size(), kPoints);
+    for (std::size_t i : {std::size_t(0), std::size_t(12345), kPoints - 1})
+        EXPECT_EQ(cloud.field("gps_time")->value(i), 3.2e8 + 1.25e-6 * static_cast<double>(i)) << i; // a double stays a double
+    EXPECT_LE(cloud.heldBytes(), 31 * kPoints) << static_cast<double>(cloud.heldBytes()) / kPoints << " bytes a point";
 }
 
 TEST_P(PlyEncodingTest, MeshRoundTripIsExact)

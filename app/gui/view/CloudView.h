@@ -143,6 +143,13 @@ public:
         bool refining = false;        //!< slices remain and are scheduled
     };
     const Refinement& refinement() const;
+    //! Points whose coordinates OpenGL holds for the shown clouds (the vertex
+    //! buffers of the chunks' mappers): a stride-th of the clouds while they
+    //! are refined in slices, every point once a frame drew them all.
+    std::size_t pointsGivenToOpenGl() const;
+    //! Bytes the view holds per shown cloud besides OpenGL: its RGBA colours
+    //! and the copies a decimated frame and a slice draw.
+    std::size_t heldBytes() const;
 
     //! Scissors: left clicks draw a polygon on the screen, a right click (or
     //! finishScissors) closes it and emits polygonDrawn; turning the mode off

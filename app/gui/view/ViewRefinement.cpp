@@ -9,6 +9,9 @@
 #include <QTimer>
 
 #include <vtkCellArray.h>
+#include <vtkOpenGLPolyDataMapper.h>
+#include <vtkOpenGLVertexBufferObject.h>
+#include <vtkOpenGLVertexBufferObjectGroup.h>
 #include <vtkPointData.h>
 #include <vtkPlaneCollection.h>
 
@@ -33,6 +36,33 @@ void CloudView::timedRender(std::size_t points)
         scene_->budget = std::clamp<std::size_t>(budget, 100'000, 4 * scene_->budget);
         updateStride();
     }
+}
+
+std::size_t CloudView::pointsGivenToOpenGl() const
+{
+    std::size_t points = 0;
+    for (const auto& [id, s] : scene_->shown)
+        for (const auto& c : s.chunks)
+            for (vtkPolyDataMapper* mapper : {c.fullMapper.Get(), c.decimatedMapper.Get(), c.sliceMapper.Get()}) {
+                auto* openGl = vtkOpenGLPolyDataMapper::SafeDownCast(mapper);
+                vtkOpenGLVertexBufferObject* vertices = openGl ? openGl->GetVBOs()->GetVBO("vertexMC") : nullptr;
+                if (s.isCloud && !c.raster && vertices)
+                    points += vertices->GetNumberOfTuples();
+            }
+    return points;
+}
+
+std::size_t CloudView::heldBytes() const
+{
+    std::size_t bytes = 0;
+    for (const auto& [id, s] : scene_->shown) {
+        bytes += s.rgba.capacity();
+        for (const auto& c : s.chunks)
+            for (vtkPolyData* copy : {c.decimated.Get(), c.slice.Get()})
+                if (copy)
+                    bytes += 1024 * copy->GetActualMemorySize(); // kibibytes
+    }
+    return bytes;
 }
 
 bool CloudView::refinesInSlices() const { return scene_->stride > 1 && !scene_->eyeDomeLighting; }

@@ -165,6 +165,11 @@ public:
     const std::string& crsWkt() const { return crs_; }
     void setCrsWkt(std::string wkt) { crs_ = std::move(wkt); }
 
+    //! Bytes its per-point arrays hold (capacities: positions and their
+    //! exact residuals, colours, normals, every field): what the cloud costs
+    //! in memory, the view's and the tools' own buffers apart.
+    std::size_t heldBytes() const;
+
     //! Bounding box of the global coordinates, ignoring non-finite positions.
     BoundingBox bounds() const;
 

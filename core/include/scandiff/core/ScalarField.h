@@ -49,6 +49,12 @@ public:
     void rename(std::string name) { name_ = std::move(name); }
 
     std::size_t size() const { return values_.size(); }
+    //! Bytes its per-value arrays hold (their capacities): the float view and
+    //! the exact form when kept.
+    std::size_t heldBytes() const
+    {
+        return values_.capacity() * sizeof(float) + residuals_.capacity() * sizeof(float) + doubles_.capacity() * sizeof(double);
+    }
     double offset() const { return offset_; }
     void setOffset(double offset) { offset_ = offset; }
 
