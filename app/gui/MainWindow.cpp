@@ -98,9 +98,15 @@ MainWindow::MainWindow(const PluginRegistry& registry, QWidget* parent)
     connect(&document_, &Document::aboutToReplaceData, view_, &CloudView::removeEntity);
     connect(&document_, &Document::dataReplaced, this, [this](EntityId id) { view_->addEntity(document_.item(id)); });
     connect(&document_, &Document::cleared, view_, &CloudView::clear);
-    connect(&document_, &Document::displayChanged, this, [this](EntityId id) {
+    // The colour bar reads the field's range (every value): once, when the
+    // event loop turns, for the several display changes a tool makes at once.
+    auto* legendSoon = new QTimer(this);
+    legendSoon->setSingleShot(true);
+    legendSoon->setInterval(0);
+    connect(legendSoon, &QTimer::timeout, this, &MainWindow::updateLegend);
+    connect(&document_, &Document::displayChanged, this, [this, legendSoon](EntityId id) {
         view_->refreshEntity(document_.item(id));
-        updateLegend();
+        legendSoon->start();
     });
     connect(&document_, &Document::removed, this, [this] { updateLegend(); });
     // Which clouds are in the frame changes with the camera: the bar follows

@@ -27,6 +27,10 @@ int main(int argc, char** argv)
                                "Load FILEs, print the view's timings (first picture, everything drawn slice by slice, longest "
                                "event-loop turn, render while moving, threshold update) and quit.");
     parser.addOption(measure);
+    QCommandLineOption measureC2c("measure-c2c",
+                                  "Load REFERENCE and COMPARED, run C2C from the workbench, print its time, the longest the "
+                                  "interface waited and the memory, and quit.");
+    parser.addOption(measureC2c);
     parser.addPositionalArgument("FILE", "Clouds or meshes to open", "[FILE...]");
     parser.process(app);
 
@@ -34,9 +38,13 @@ int main(int argc, char** argv)
     scandiff::gui::MainWindow window(registry);
     window.show();
     const QStringList files = parser.positionalArguments();
-    const bool quiet = parser.isSet(screenshot) || parser.isSet(measure); // no questions (global shift) in unattended runs
+    const bool quiet = parser.isSet(screenshot) || parser.isSet(measure) || parser.isSet(measureC2c); // no questions (global shift) in unattended runs
     QTimer::singleShot(0, &window, [&] {
         const int loaded = files.isEmpty() ? 0 : window.openFiles(files, quiet);
+        if (parser.isSet(measureC2c)) {
+            QApplication::exit(loaded == files.size() ? scandiff::gui::measureCloudToCloud(window) : 1);
+            return;
+        }
         if (parser.isSet(measure)) {
             QApplication::exit(loaded == files.size() ? scandiff::gui::measureView(window) : 1);
             return;

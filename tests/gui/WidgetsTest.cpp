@@ -331,6 +331,37 @@ private slots:
         QCOMPARE(s.counts, (std::vector<std::size_t>{3, 1, 0, 0, 0, 0, 0, 0, 0, 1}));
     }
 
+    void histogramOfManyValuesIsTheOneCountedByHand()
+    {
+        // Far more values than one share of the threads' split (65,536): the
+        // counts added over the shares are those of one pass, bin by bin.
+        constexpr std::size_t kCount = 1'000'003;
+        std::vector<float> values(kCount);
+        for (std::size_t i = 0; i < kCount; ++i)
+            values[i] = i % 997 == 0 ? kNaN : static_cast<float>(std::sin(0.001 * static_cast<double>(i)) * 40.0);
+        const int bins = 37;
+        const Histogram h = computeHistogram(values.data(), values.size(), 2.5, bins);
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        std::size_t finite = 0;
+        for (float v : values)
+            if (std::isfinite(v)) {
+                lo = std::min(lo, static_cast<double>(v) + 2.5);
+                hi = std::max(hi, static_cast<double>(v) + 2.5);
+                ++finite;
+            }
+        std::vector<std::size_t> counts(bins, 0);
+        const double toBin = bins / (hi - lo);
+        for (float v : values)
+            if (std::isfinite(v)) {
+                const double x = (static_cast<double>(v) + 2.5 - lo) * toBin;
+                ++counts[static_cast<std::size_t>(std::min(x, bins - 1.0))];
+            }
+        QCOMPARE(h.min, lo);
+        QCOMPARE(h.max, hi);
+        QCOMPARE(h.finiteCount, finite);
+        QCOMPARE(h.counts, counts);
+    }
+
     void histogramAppliesTheOffset()
     {
         const std::vector<float> values{0.f, 1.f, 0.5f};

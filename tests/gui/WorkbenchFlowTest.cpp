@@ -428,13 +428,15 @@ private slots:
         // The reference no longer competes with the distances' colours: one neutral grey.
         QVERIFY(window.document().item(reference).display.neutral);
         QVERIFY(window.document().item(reference).display.activeField.empty());
-        QCOMPARE(window.view()->legend().title, std::string("c2c_distance"));
+        // The panels and the colour bar follow once the event loop turns (one
+        // refresh for the several changes a run makes).
+        QTRY_COMPARE(window.view()->legend().title, std::string("c2c_distance"));
         // The colour bar follows what is shown: with the compared cloud hidden
         // and selected, there is no bar (the reference has no field on screen).
         window.document().setVisible(compared, false);
-        QVERIFY(!window.view()->legend().shown);
+        QTRY_VERIFY(!window.view()->legend().shown);
         window.document().setVisible(compared, true);
-        QCOMPARE(window.view()->legend().title, std::string("c2c_distance"));
+        QTRY_COMPARE(window.view()->legend().title, std::string("c2c_distance"));
         QVERIFY(window.tree()->fieldRow(compared, "c2c_distance"));
         // The same numbers as core called directly.
         const CloudToCloudResult direct =
@@ -729,7 +731,7 @@ private slots:
         // A translation is kept in the history, shown in the properties, and survives the session.
         QVERIFY(window.toolController("transform")->run(reference, {{"translate", "1,2,3"}}));
         window.tree()->selectEntity(reference);
-        QCOMPARE(window.properties()->value("Transformations"), QString("1"));
+        QTRY_COMPARE(window.properties()->value("Transformations"), QString("1"));
         QTemporaryDir dir;
         const QString session = dir.filePath("tools.scandiff");
         QVERIFY(window.sessions()->save(session));

@@ -4,6 +4,7 @@
 #include <scandiff/io/CoordinateSystem.h>
 
 #include <QHeaderView>
+#include <QTimer>
 
 #include <cmath>
 #include <limits>
@@ -51,7 +52,7 @@ PropertiesPanel::PropertiesPanel(const Document& document, QWidget* parent) : QT
     setRootIsDecorated(true);
     connect(&document_, &Document::fieldsChanged, this, [this](EntityId id) {
         if (id == entity_)
-            rebuild();
+            rebuildSoon();
     });
     connect(&document_, &Document::renamed, this, [this](EntityId id) {
         if (id == entity_ || id == pickedEntity_)
@@ -83,8 +84,20 @@ void PropertiesPanel::showPickedPoint(EntityId id, std::size_t index)
     rebuild();
 }
 
+void PropertiesPanel::rebuildSoon()
+{
+    if (rebuildPending_)
+        return;
+    rebuildPending_ = true;
+    QTimer::singleShot(2, this, [this] {
+        if (rebuildPending_)
+            rebuild();
+    });
+}
+
 void PropertiesPanel::rebuild()
 {
+    rebuildPending_ = false;
     clear();
     const auto add = [this](QTreeWidgetItem* parent, const QString& key, const QString& value) {
         auto* row = parent ? new QTreeWidgetItem(parent) : new QTreeWidgetItem(this);

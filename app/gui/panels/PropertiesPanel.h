@@ -23,6 +23,11 @@ public:
 
 private:
     void rebuild();
+    //! rebuild() once the event loop turns: a tool's results change a
+    //! cloud's fields several times in one go, and each rebuild reads every
+    //! point (its bounds, its fields' ranges): one rebuild, in a turn of its own.
+    void rebuildSoon();
+    bool rebuildPending_ = false;
     const Document& document_;
     EntityId entity_ = kNoEntity;
     EntityId pickedEntity_ = kNoEntity;

@@ -9,6 +9,7 @@
 #include <scandiff/core/FieldRange.h>
 
 #include <QCheckBox>
+#include <QTimer>
 #include <QComboBox>
 #include <QFormLayout>
 #include <QHBoxLayout>
@@ -128,7 +129,7 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
     });
     connect(&document_, &Document::fieldsChanged, this, [this](EntityId id) {
         if (id == entity_)
-            refresh();
+            refreshSoon();
     });
     connect(&document_, &Document::renamed, this, [this](EntityId id) {
         if (const Document::Item* item = document_.find(id); item && id == entity_)
@@ -136,7 +137,7 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
     });
     connect(&document_, &Document::displayChanged, this, [this](EntityId id) {
         if (id == entity_ && !updating_)
-            refresh();
+            refreshSoon();
     });
     connect(&document_, &Document::removed, this, [this](EntityId id) {
         if (id == entity_)
@@ -179,8 +180,20 @@ void ScalarFieldPanel::refreshScaleBox()
         scaleBox_->addItem(QString::fromStdString(s.name()));
 }
 
+void ScalarFieldPanel::refreshSoon()
+{
+    if (refreshPending_)
+        return;
+    refreshPending_ = true;
+    QTimer::singleShot(1, this, [this] {
+        if (refreshPending_)
+            refresh();
+    });
+}
+
 void ScalarFieldPanel::refresh()
 {
+    refreshPending_ = false;
     updating_ = true;
     const Document::Item* item = document_.find(entity_);
     fieldBox_->clear();

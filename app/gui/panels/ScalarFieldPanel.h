@@ -54,6 +54,12 @@ signals:
 
 private:
     void refresh();
+    //! refresh() once the event loop turns: a tool's results change a
+    //! cloud's fields and display several times in one go, and each refresh
+    //! reads every value (range, histogram, count inside): one refresh, in a
+    //! turn of its own.
+    void refreshSoon();
+    bool refreshPending_ = false;
     void refreshScaleBox();
     void onFieldChosen(int index);
     void onScaleChosen(int index);

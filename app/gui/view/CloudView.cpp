@@ -1279,8 +1279,18 @@ void CloudView::renderInteractively()
             setDecimated(s, true);
         scene_->moving = true;
     }
-    scene_->window->Render();
     settleTimer_->start();
+    // One frame for the changes of one turn of the event loop (a tool's
+    // results recolour the compared and the reference clouds one after the
+    // other), drawn in a turn of its own.
+    if (scene_->interactiveRenderPending)
+        return;
+    scene_->interactiveRenderPending = true;
+    QTimer::singleShot(1, this, [this] {
+        scene_->interactiveRenderPending = false;
+        if (scene_->moving)
+            scene_->window->Render();
+    });
 }
 
 bool CloudView::saveScreenshot(const QString& path)

@@ -98,6 +98,7 @@ struct CloudView::Scene
     bool moving = false;
     bool settling = false; //!< decimated after a colour change, until the settle timer fires
     bool renderPending = false;
+    bool interactiveRenderPending = false; //!< a decimated frame scheduled by renderInteractively
     Refinement refinement;
     bool pickMode = false;
     // Measurements: one polydata of paths and marks, and a label per measurement.

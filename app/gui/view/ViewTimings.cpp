@@ -2,6 +2,7 @@
 #include "view/ViewTimings.h"
 
 #include "MainWindow.h"
+#include "controllers/DistanceController.h"
 #include "panels/EntityTree.h"
 #include "panels/ScalarFieldPanel.h"
 #include "view/CloudView.h"
@@ -9,11 +10,13 @@
 
 #include <QApplication>
 #include <QElapsedTimer>
+#include <QTimer>
 
 #include <algorithm>
 #include <fstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <iomanip>
 #include <iostream>
@@ -119,6 +122,53 @@ int measureView(MainWindow& window)
     if (!fieldName.empty())
         std::cout << "threshold update ms " << threshold << " (field " << fieldName << ", as a slider drag: recolour, count, decimated render)\n";
     return 0;
+}
+
+int measureCloudToCloud(MainWindow& window)
+{
+    Document& document = window.document();
+    std::vector<EntityId> clouds;
+    for (EntityId id : document.ids())
+        if (document.item(id).cloud())
+            clouds.push_back(id);
+    if (clouds.size() < 2) {
+        std::cerr << "measure-c2c: two point clouds are needed (reference, compared)\n";
+        return 1;
+    }
+    CloudView& view = *window.view();
+    view.setStandardView(StandardView::Iso);
+    while (view.refinement().refining) // the opened clouds drawn first: the run alone is measured
+        QApplication::processEvents();
+    QElapsedTimer sinceBeat, clock;
+    double longest = 0;
+    QTimer beat;
+    beat.setInterval(10);
+    QObject::connect(&beat, &QTimer::timeout, [&] {
+        longest = std::max(longest, sinceBeat.nsecsElapsed() / 1e6);
+        sinceBeat.restart();
+    });
+    sinceBeat.start();
+    beat.start();
+    clock.start();
+    const bool done = window.distances()->runCloudToCloud(clouds[1], clouds[0], {});
+    const double runSeconds = clock.nsecsElapsed() / 1e9;
+    // The result drawn: the recoloured clouds refined slice by slice.
+    QElapsedTimer drawing;
+    drawing.start();
+    do
+        QApplication::processEvents(QEventLoop::AllEvents, 50);
+    while ((view.refinement().refining || drawing.elapsed() < 500) && drawing.elapsed() < 600000);
+    const double drawnSeconds = clock.nsecsElapsed() / 1e9;
+    beat.stop();
+    const auto [resident, peak] = residentMegabytes();
+    std::size_t points = 0;
+    for (EntityId id : clouds)
+        points += document.item(id).points().size();
+    std::cout << std::fixed << std::setprecision(2) << "points " << points << "\n"
+              << "c2c " << (done ? "done" : "failed") << " in s " << runSeconds << ", result drawn at s " << drawnSeconds << "\n"
+              << "longest event-loop wait ms " << longest << " (10 ms heartbeat included)\n"
+              << std::setprecision(1) << "resident MB " << resident << ", peak " << peak << "\n";
+    return done ? 0 : 1;
 }
 
 } // namespace scandiff::gui
