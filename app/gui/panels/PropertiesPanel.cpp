@@ -50,9 +50,12 @@ PropertiesPanel::PropertiesPanel(const Document& document, QWidget* parent) : QT
     setTextElideMode(Qt::ElideNone);
     setHorizontalScrollMode(QAbstractItemView::ScrollPerPixel);
     setRootIsDecorated(true);
+    rebuildSoon_->setSingleShot(true);
+    rebuildSoon_->setInterval(2); // after the scalar field panel's
+    connect(rebuildSoon_, &QTimer::timeout, this, &PropertiesPanel::rebuild);
     connect(&document_, &Document::fieldsChanged, this, [this](EntityId id) {
         if (id == entity_)
-            rebuildSoon();
+            rebuildSoon_->start();
     });
     connect(&document_, &Document::renamed, this, [this](EntityId id) {
         if (id == entity_ || id == pickedEntity_)
@@ -84,20 +87,9 @@ void PropertiesPanel::showPickedPoint(EntityId id, std::size_t index)
     rebuild();
 }
 
-void PropertiesPanel::rebuildSoon()
-{
-    if (rebuildPending_)
-        return;
-    rebuildPending_ = true;
-    QTimer::singleShot(2, this, [this] {
-        if (rebuildPending_)
-            rebuild();
-    });
-}
-
 void PropertiesPanel::rebuild()
 {
-    rebuildPending_ = false;
+    rebuildSoon_->stop();
     clear();
     const auto add = [this](QTreeWidgetItem* parent, const QString& key, const QString& value) {
         auto* row = parent ? new QTreeWidgetItem(parent) : new QTreeWidgetItem(this);

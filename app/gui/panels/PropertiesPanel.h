@@ -5,6 +5,7 @@
 
 #include "document/Document.h"
 
+#include <QTimer>
 #include <QTreeWidget>
 
 namespace scandiff::gui {
@@ -23,11 +24,11 @@ public:
 
 private:
     void rebuild();
-    //! rebuild() once the event loop turns: a tool's results change a
-    //! cloud's fields several times in one go, and each rebuild reads every
-    //! point (its bounds, its fields' ranges): one rebuild, in a turn of its own.
-    void rebuildSoon();
-    bool rebuildPending_ = false;
+    //! rebuild() once the event loop turns (started by the document's
+    //! signals): a tool's results change a cloud's fields several times in
+    //! one go, and each rebuild reads every point (its bounds, its fields'
+    //! ranges): one rebuild, in a turn of its own.
+    QTimer* rebuildSoon_ = new QTimer(this);
     const Document& document_;
     EntityId entity_ = kNoEntity;
     EntityId pickedEntity_ = kNoEntity;

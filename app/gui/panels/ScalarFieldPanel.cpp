@@ -127,9 +127,12 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
         if (const ScalarField* field = activeField())
             emit splitRequested(entity_, field->name(), range_->low(), range_->high());
     });
+    refreshSoon_->setSingleShot(true);
+    refreshSoon_->setInterval(1);
+    connect(refreshSoon_, &QTimer::timeout, this, &ScalarFieldPanel::refresh);
     connect(&document_, &Document::fieldsChanged, this, [this](EntityId id) {
         if (id == entity_)
-            refreshSoon();
+            refreshSoon_->start();
     });
     connect(&document_, &Document::renamed, this, [this](EntityId id) {
         if (const Document::Item* item = document_.find(id); item && id == entity_)
@@ -137,7 +140,7 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
     });
     connect(&document_, &Document::displayChanged, this, [this](EntityId id) {
         if (id == entity_ && !updating_)
-            refreshSoon();
+            refreshSoon_->start();
     });
     connect(&document_, &Document::removed, this, [this](EntityId id) {
         if (id == entity_)
@@ -180,20 +183,9 @@ void ScalarFieldPanel::refreshScaleBox()
         scaleBox_->addItem(QString::fromStdString(s.name()));
 }
 
-void ScalarFieldPanel::refreshSoon()
-{
-    if (refreshPending_)
-        return;
-    refreshPending_ = true;
-    QTimer::singleShot(1, this, [this] {
-        if (refreshPending_)
-            refresh();
-    });
-}
-
 void ScalarFieldPanel::refresh()
 {
-    refreshPending_ = false;
+    refreshSoon_->stop();
     updating_ = true;
     const Document::Item* item = document_.find(entity_);
     fieldBox_->clear();

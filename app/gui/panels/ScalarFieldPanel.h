@@ -10,6 +10,7 @@
 #include "colour/ColourScale.h"
 #include "document/Document.h"
 
+#include <QTimer>
 #include <QWidget>
 
 #include <functional>
@@ -54,12 +55,11 @@ signals:
 
 private:
     void refresh();
-    //! refresh() once the event loop turns: a tool's results change a
-    //! cloud's fields and display several times in one go, and each refresh
-    //! reads every value (range, histogram, count inside): one refresh, in a
-    //! turn of its own.
-    void refreshSoon();
-    bool refreshPending_ = false;
+    //! refresh() once the event loop turns (started by the document's
+    //! signals): a tool's results change a cloud's fields and display several
+    //! times in one go, and each refresh reads every value (range, histogram,
+    //! count inside): one refresh, in a turn of its own.
+    QTimer* refreshSoon_ = new QTimer(this);
     void refreshScaleBox();
     void onFieldChosen(int index);
     void onScaleChosen(int index);
