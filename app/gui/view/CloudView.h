@@ -143,6 +143,9 @@ public:
         bool refining = false;        //!< slices remain and are scheduled
     };
     const Refinement& refinement() const;
+    //! Whether a decimated frame asked for by a colour or threshold change
+    //! is still to be drawn (it is, when the event loop next turns).
+    bool frameScheduled() const;
     //! Points whose coordinates OpenGL holds for the shown clouds (the vertex
     //! buffers of the chunks' mappers): a stride-th of the clouds while they
     //! are refined in slices, every point once a frame drew them all.

@@ -38,6 +38,8 @@ void CloudView::timedRender(std::size_t points)
     }
 }
 
+bool CloudView::frameScheduled() const { return scene_->interactiveRenderPending; }
+
 std::size_t CloudView::pointsGivenToOpenGl() const
 {
     std::size_t points = 0;

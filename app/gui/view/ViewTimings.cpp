@@ -109,7 +109,11 @@ int measureView(MainWindow& window)
         window.tree()->selectEntity(cloud);
         RangeEditor* range = window.scalarPanel()->rangeEditor();
         int step = 0;
-        threshold = averageMilliseconds([&] { range->setRange(r.min + (r.max - r.min) * 0.05 * (++step % 10), r.max); });
+        threshold = averageMilliseconds([&] {
+            range->setRange(r.min + (r.max - r.min) * 0.05 * (++step % 10), r.max);
+            while (view.frameScheduled()) // the frame the change asked for, drawn when the event loop turns
+                QApplication::processEvents();
+        });
     }
     const auto [resident, peak] = residentMegabytes();
     std::cout << std::fixed << std::setprecision(1) << "points " << points << "\n"
@@ -137,6 +141,8 @@ int measureCloudToCloud(MainWindow& window)
     }
     CloudView& view = *window.view();
     view.setStandardView(StandardView::Iso);
+    QApplication::processEvents();
+    view.setMoving(false); // at rest: the slices start
     while (view.refinement().refining) // the opened clouds drawn first: the run alone is measured
         QApplication::processEvents();
     QElapsedTimer sinceBeat, clock;

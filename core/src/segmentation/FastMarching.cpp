@@ -367,7 +367,9 @@ std::vector<bool> backgroundRegions(const ScalarField& field, const CellGrid& gr
         return std::vector<bool>(regionPoints.size(), false);
     }
     const double median = medianInPlace(all);
-    const double sigma = robustSigma(all, median);
+    for (double& v : all) // the deviations in place: a field holds millions of values
+        v = std::abs(v - median);
+    const double sigma = kMadToSigma * medianInPlace(all);
     ceiling = median + 3.0 * sigma;
 
     std::vector<std::vector<double>> values(regionPoints.size());
