@@ -4,7 +4,6 @@
 #include <scandiff/io/CoordinateSystem.h>
 
 #include <QHeaderView>
-#include <QTimer>
 
 #include <cmath>
 #include <limits>

@@ -9,7 +9,6 @@
 #include <scandiff/core/FieldRange.h>
 
 #include <QCheckBox>
-#include <QTimer>
 #include <QComboBox>
 #include <QFormLayout>
 #include <QHBoxLayout>

@@ -5,9 +5,9 @@
 #include <vtkCellData.h>
 #include <vtkFloatArray.h>
 #include <vtkNew.h>
-#include <vtkPointData.h>
 #include <vtkOpenGLPolyDataMapper.h>
 #include <vtkOpenGLVertexBufferObject.h>
+#include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
@@ -33,9 +33,14 @@ vtkSmartPointer<vtkPoints> pointsOver(const float* xyz, std::size_t count)
     return points;
 }
 
+std::size_t everyStride(std::size_t count, std::size_t stride, std::size_t first)
+{
+    return first < count ? (count - first + stride - 1) / stride : 0;
+}
+
 vtkSmartPointer<vtkCellArray> vertexCells(std::size_t count, std::size_t stride, std::size_t first)
 {
-    const auto n = static_cast<vtkIdType>(first < count ? (count - first + stride - 1) / stride : 0);
+    const auto n = static_cast<vtkIdType>(everyStride(count, stride, first));
     vtkNew<vtkTypeInt32Array> offsets;
     vtkNew<vtkTypeInt32Array> connectivity;
     offsets->SetNumberOfValues(n + 1);
@@ -67,16 +72,11 @@ Array* ownArray(vtkDataSetAttributes& attributes, const char* name, int componen
     return array;
 }
 
-std::size_t selectedCount(std::size_t count, std::size_t stride, std::size_t first)
-{
-    return first < count ? (count - first + stride - 1) / stride : 0;
-}
-
 } // namespace
 
 void gatherPoints(vtkPolyData& out, const ChunkArrays& chunk, std::size_t stride, std::size_t first)
 {
-    const std::size_t m = selectedCount(chunk.count, stride, first);
+    const std::size_t m = everyStride(chunk.count, stride, first);
     if (!out.GetPoints() || !vtkFloatArray::SafeDownCast(out.GetPoints()->GetData())) {
         auto points = vtkSmartPointer<vtkPoints>::New();
         points->SetDataTypeToFloat();
@@ -105,7 +105,7 @@ void gatherPoints(vtkPolyData& out, const ChunkArrays& chunk, std::size_t stride
 
 void gatherColours(vtkPolyData& out, const ChunkArrays& chunk, std::size_t stride, std::size_t first)
 {
-    const std::size_t m = selectedCount(chunk.count, stride, first);
+    const std::size_t m = everyStride(chunk.count, stride, first);
     auto* colours = ownArray<vtkUnsignedCharArray>(*out.GetPointData(), "display colours", 4);
     colours->SetNumberOfTuples(static_cast<vtkIdType>(m));
     std::uint8_t* c = colours->GetPointer(0);

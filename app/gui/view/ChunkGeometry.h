@@ -21,6 +21,10 @@ namespace scandiff::gui {
 //! VTK points reading `count` xyz triples at `xyz` in place (no copy; VTK does not free them).
 vtkSmartPointer<vtkPoints> pointsOver(const float* xyz, std::size_t count);
 
+//! How many of `count` points every stride-th from `first` on takes: a
+//! slice's or a decimated frame's share of a chunk.
+std::size_t everyStride(std::size_t count, std::size_t stride, std::size_t first = 0);
+
 //! Vertex cells for every stride-th point from `first` on, as two flat 32-bit
 //! arrays (half the memory of VTK's default 64-bit ids; a cloud above 2^31
 //! points is refused by the view before this). The `stride` sets of firsts

@@ -402,7 +402,7 @@ void CloudView::refreshEntity(const Document::Item& item)
                         std::copy_n(&s.rgba[4 * (c.begin + i)], 4, corners + 16 * i + 4 * k);
             }
             c.colours->Modified();
-            if (c.decimated && c.decimatedStride > 0)
+            if (c.decimated)
                 gatherColours(*c.decimated, c.arrays(s), c.decimatedStride);
         }
     }

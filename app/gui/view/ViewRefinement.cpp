@@ -92,7 +92,7 @@ void CloudView::startRefinement()
             continue;
         for (const auto& c : s.chunks)
             if (c.actor->GetVisibility())
-                r.pointsDrawn += c.raster ? c.count : (c.count + r.slices - 1) / r.slices;
+                r.pointsDrawn += c.raster ? c.count : everyStride(c.count, r.slices);
     }
     r.largestSlice = r.pointsDrawn;
     timedRender(r.pointsDrawn);
@@ -134,7 +134,7 @@ void CloudView::drawNextSlice()
             }
             c.sliceMapper->SetClippingPlanes(c.fullMapper->GetClippingPlanes());
             gatherPoints(*c.slice, c.arrays(s), r.slices, slice);
-            points += slice < c.count ? (c.count - slice + r.slices - 1) / r.slices : 0;
+            points += everyStride(c.count, r.slices, slice);
             c.actor->SetMapper(c.sliceMapper);
         }
         if (s.labels)
