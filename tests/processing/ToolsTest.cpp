@@ -204,6 +204,7 @@ TEST_F(ProcessingTools, EveryLongToolStopsAtAnyPollAndLeavesItsInputAsItWas)
         {"field-gradient", {{"field", "height"}, {"radius", "0.2"}}},
         {"mesh", {}},
         {"primitives", {}},
+        {"ground", {}},
     };
     for (const auto& [name, text] : runs) {
         const ToolSpec& spec = tool(name);
@@ -227,4 +228,24 @@ TEST_F(ProcessingTools, EveryLongToolStopsAtAnyPollAndLeavesItsInputAsItWas)
         ASSERT_EQ(cloud.fields().size(), before.fields().size()) << name;
         ASSERT_EQ(cloud.field("height")->values(), before.field("height")->values()) << name;
     }
+}
+
+TEST_F(ProcessingTools, GroundWritesAsprsClassesAndKeepsExistingOnesUnlessAsked)
+{
+    PointCloud cloud;
+    cloud.name = "lot";
+    for (int i = 0; i < 40; ++i)
+        for (int j = 0; j < 40; ++j)
+            cloud.positions().emplace_back(0.5f * i, 0.5f * j, (i >= 10 && i < 20 && j >= 10 && j < 20) ? 6.0f : 0.0f);
+    cloud.resize(cloud.positions().size());
+    const ToolResult first = run("ground", cloud, {});
+    const ScalarField* classes = first.cloud().field("classification");
+    ASSERT_NE(classes, nullptr);
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        ASSERT_EQ(classes->value(i), cloud.positions()[i].z() > 1 ? 1.0 : 2.0) << "point " << i;
+    // A cloud that has classes already: refused, then replaced when asked.
+    PointCloud classed = first.cloud().clone();
+    classed.field("classification")->values().assign(classed.size(), 6.f);
+    EXPECT_EQ(test::errorCodeOf([&] { run("ground", classed, {}); }), ErrorCode::InvalidArgument);
+    EXPECT_EQ(run("ground", classed, {{"overwrite-classes", "true"}}).cloud().field("classification")->values(), classes->values());
 }

@@ -6,6 +6,7 @@
 #include <scandiff/core/CloudOctree.h>
 #include <scandiff/core/Error.h>
 #include <scandiff/core/RobustStatistics.h>
+#include <scandiff/core/processing/GroundFilter.h>
 #include <scandiff/core/processing/Subsampling.h>
 
 #include <Eigen/Dense>
@@ -14,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 
 namespace scandiff::plugins {
@@ -110,33 +112,16 @@ void correspond(const detail::ReferenceSurface& surface, const std::vector<Eigen
     c.usedCount = static_cast<std::size_t>(std::count(c.used.begin(), c.used.end(), 1));
 }
 
-//! The sampled moving points on surfaces that do not change (change-robust
-//! mode): where the moving cloud says so by its ASPRS classes (2 ground, 6
-//! building), those; otherwise the points whose 12 nearest neighbours lie on
-//! a plane within 3 times the 20th percentile of that spread over the sample.
-//! A grown tree, a bush, a car, a person is a scatter of points, not a
-//! surface: on airborne epochs of a park half the points are vegetation that
-//! grew between the epochs, no minority the threshold can leave out, and it
-//! pulled the later epoch down by half a metre onto the earlier canopy. The
-//! ground, roofs and walls are planar at the scale of a few spacings. Empty
-//! when too few are left to register on (then every point is used).
-std::vector<char> stableSurfaces(const PointCloud& moving, const std::vector<std::size_t>& sample, std::string& note)
+//! Each sampled point's local plane: the spread of its 12 nearest
+//! neighbours off their best plane (infinite with fewer than 5) and how
+//! upright that plane's normal is (|n_z|).
+struct LocalPlanes
 {
-    std::vector<char> keep(sample.size(), 0);
-    std::size_t kept = 0;
-    if (const ScalarField* classes = moving.field("classification")) {
-        for (std::size_t k = 0; k < sample.size(); ++k) {
-            const double c = classes->value(sample[k]);
-            keep[k] = c == 2 || c == 6;
-            kept += keep[k];
-        }
-        if (kept >= std::max<std::size_t>(100, sample.size() / 20)) {
-            note = "change-robust: the " + std::to_string(kept) + " sampled points classed ground (2) or building (6) registered";
-            return keep;
-        }
-        std::fill(keep.begin(), keep.end(), 0);
-        kept = 0;
-    }
+    std::vector<double> spread, uprightness;
+};
+
+LocalPlanes localPlanes(const PointCloud& moving, const std::vector<std::size_t>& sample)
+{
     constexpr std::size_t kNeighbours = 12;
     const octree::Octree tree = buildOctree(moving);
     std::vector<Eigen::Vector3f> queries(sample.size());
@@ -144,7 +129,7 @@ std::vector<char> stableSurfaces(const PointCloud& moving, const std::vector<std
         queries[k] = moving.positions()[sample[k]];
     std::vector<octree::Neighbour> found;
     tree.nearestBatch(queries.data(), queries.size(), kNeighbours, tree.levelNearestMeanPopulation(8.0), found);
-    std::vector<double> spread(sample.size(), kInfinity);
+    LocalPlanes planes{std::vector<double>(sample.size(), kInfinity), std::vector<double>(sample.size(), 0.0)};
     for (std::size_t k = 0; k < sample.size(); ++k) {
         Eigen::Vector3d mean = Eigen::Vector3d::Zero();
         std::size_t count = 0;
@@ -162,28 +147,99 @@ std::vector<char> stableSurfaces(const PointCloud& moving, const std::vector<std
                 const Eigen::Vector3d d = moving.positions()[found[k * kNeighbours + j].index].cast<double>() - mean;
                 covariance += d * d.transpose() / static_cast<double>(count);
             }
-        spread[k] = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance, Eigen::EigenvaluesOnly).eigenvalues()(0)));
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+        planes.spread[k] = std::sqrt(std::max(0.0, eigen.eigenvalues()(0)));
+        planes.uprightness[k] = std::abs(eigen.eigenvectors()(2, 0));
     }
+    return planes;
+}
+
+//! The sampled moving points on what does not change (change-robust mode),
+//! by `parts` (StableParts): the ASPRS classes ground (2) and building (6)
+//! when the cloud has them; otherwise the planar points (12 nearest
+//! neighbours within 3 times the 20th percentile of that spread over the
+//! sample of their plane) and, with Ground, of those only the ground and the
+//! steep ones (walls). A grown tree, a bush, a car, a person is a scatter of
+//! points, not a surface: on airborne epochs of a park half the points are
+//! vegetation that grew between the epochs, no minority the threshold can
+//! leave out, and it pulled the later epoch down by half a metre onto the
+//! earlier canopy. A raised roof is planar and still pulls (8.8 cm on the
+//! real samp11 pair): the ground under it does not move.
+struct StableSelection
+{
+    std::vector<char> first; //!< per sampled point; empty: too few left to register on (every point is used)
+    //! With Ground on a cloud without classes: the second phase's points,
+    //! the first's with their whole reference normal and every other planar
+    //! one with its horizontal part only. What grows (a tree, a raised roof)
+    //! grows upwards: it would pull the height (a roof raised by 0.3-1.5 m
+    //! pulled the real samp11 pair by 8.8 cm) while its edges stay where they
+    //! were, and they hold the horizontal position and the heading where the
+    //! ground is flat.
+    std::vector<char> second;
+    std::vector<char> secondSideways; //!< per sampled point: in the second phase, for the horizontal only
+};
+
+StableSelection stableSurfaces(const PointCloud& moving, const std::vector<std::size_t>& sample, StableParts parts, std::string& note)
+{
+    std::vector<char> keep(sample.size(), 0);
+    const std::size_t enough = std::max<std::size_t>(100, sample.size() / 20);
+    std::size_t kept = 0;
+    if (const ScalarField* classes = moving.field("classification")) {
+        for (std::size_t k = 0; k < sample.size(); ++k) {
+            const double c = classes->value(sample[k]);
+            keep[k] = c == 2 || c == 6;
+            kept += keep[k];
+        }
+        if (kept >= enough) {
+            note = "change-robust: the " + std::to_string(kept) + " sampled points classed ground (2) or building (6) registered";
+            return {keep, {}, {}};
+        }
+        std::fill(keep.begin(), keep.end(), 0);
+        kept = 0;
+    }
+    const LocalPlanes planes = localPlanes(moving, sample);
     std::vector<double> finite;
-    for (double v : spread)
+    for (double v : planes.spread)
         if (std::isfinite(v))
             finite.push_back(v);
     if (finite.size() < 20)
         return {};
-    const auto at = finite.begin() + static_cast<std::ptrdiff_t>(finite.size() / 5);
-    std::nth_element(finite.begin(), at, finite.end());
-    const double limit = 3.0 * std::max(*at, 1e-9);
+    const double limit = 3.0 * std::max(percentileOf(finite, 0.2), 1e-9);
     for (std::size_t k = 0; k < sample.size(); ++k) {
-        keep[k] = spread[k] <= limit;
+        keep[k] = planes.spread[k] <= limit;
         kept += keep[k];
     }
-    if (kept < std::max<std::size_t>(100, sample.size() / 20))
-        return {};
     std::ostringstream text;
+    if (parts == StableParts::Ground) {
+        // Ground (SMRF with its defaults) and walls (a plane within 30 deg of vertical).
+        const GroundFilterResult ground = filterGround(moving);
+        std::vector<char> groundOrWalls(sample.size(), 0), surfaces(sample.size(), 0), sideways(sample.size(), 0);
+        std::size_t onGround = 0, onWalls = 0;
+        for (std::size_t k = 0; k < sample.size(); ++k) {
+            const bool wall = keep[k] && planes.uprightness[k] < 0.5;
+            groundOrWalls[k] = ground.ground[sample[k]] || wall;
+            surfaces[k] = groundOrWalls[k] || keep[k];
+            sideways[k] = surfaces[k] && !groundOrWalls[k];
+            onGround += ground.ground[sample[k]];
+            onWalls += wall && !ground.ground[sample[k]];
+        }
+        if (onGround + onWalls >= enough) {
+            text << "change-robust: " << onGround << " of " << sample.size() << " sampled points on the ground (morphological filter) and "
+                 << onWalls << " on walls registered, then with them the " << kept << " on surfaces (12 neighbours within " << limit
+                 << " m of a plane), those off the ground for the horizontal and the heading only; the rest (vegetation, clutter) "
+                 << "left out";
+            note = text.str();
+            if (kept < enough)
+                return {groundOrWalls, {}, {}};
+            return {groundOrWalls, surfaces, sideways};
+        }
+    }
+    if (kept < enough)
+        return {};
     text << "change-robust: " << kept << " of " << sample.size() << " sampled points on surfaces (12 neighbours within "
          << limit << " m of a plane) registered; scattered points (vegetation, clutter) left out";
     note = text.str();
-    return keep;
+    return {keep, {}, {}};
 }
 
 } // namespace
@@ -236,28 +292,65 @@ struct IterationPoints
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     double length = 1.0; //!< the points' RMS distance to their centroid
     std::string note;    //!< what the change-robust selection kept
+    //! The points of a second phase, from where the first ends (StableSelection::second).
+    std::shared_ptr<const IterationPoints> secondPhase;
+    //! Per point (empty: none), those whose residual counts along the
+    //! horizontal part of the reference normal only (StableSelection::second).
+    std::vector<char> sidewaysOnly;
 };
+
+//! The sampled points (indices) in the reference's frame, an even share of
+//! them first (the coarse iterations'), their centroid and spread.
+//! `sideways`, when given, flags per sampled point those that hold the
+//! horizontal only (IterationPoints::sidewaysOnly).
+IterationPoints pointsOf(const PointCloud& moving, const Eigen::Vector3d& origin, const std::vector<std::size_t>& sample,
+                         const std::vector<char>& sideways = {});
+
+//! The sampled points the selection keeps (all when it is empty).
+std::vector<std::size_t> selected(const std::vector<std::size_t>& sample, const std::vector<char>& keep)
+{
+    if (keep.empty())
+        return sample;
+    std::vector<std::size_t> kept;
+    for (std::size_t k = 0; k < sample.size(); ++k)
+        if (keep[k])
+            kept.push_back(sample[k]);
+    return kept;
+}
 
 IterationPoints iterationPoints(const PointCloud& moving, const Eigen::Vector3d& origin, const IcpParams& params)
 {
-    IterationPoints points;
-    std::vector<std::size_t> sample = params.sampleCount > 0 ? randomSubsample(moving, params.sampleCount, params.seed)
-                                                             : randomSubsample(moving, moving.size(), 0);
-    if (params.changeRobust) {
-        const std::vector<char> stable = stableSurfaces(moving, sample, points.note);
-        if (!stable.empty()) {
-            std::size_t kept = 0;
-            for (std::size_t k = 0; k < sample.size(); ++k)
-                if (stable[k])
-                    sample[kept++] = sample[k];
-            sample.resize(kept);
-        }
+    const std::vector<std::size_t> sample = params.sampleCount > 0 ? randomSubsample(moving, params.sampleCount, params.seed)
+                                                                   : randomSubsample(moving, moving.size(), 0);
+    if (!params.changeRobust)
+        return pointsOf(moving, origin, sample);
+    std::string note;
+    const StableSelection stable = stableSurfaces(moving, sample, params.stableParts, note);
+    IterationPoints points = pointsOf(moving, origin, selected(sample, stable.first));
+    points.note = note;
+    if (!stable.second.empty()) {
+        std::vector<char> sideways;
+        for (std::size_t k = 0; k < sample.size(); ++k)
+            if (stable.second[k])
+                sideways.push_back(stable.secondSideways[k]);
+        points.secondPhase = std::make_shared<IterationPoints>(pointsOf(moving, origin, selected(sample, stable.second), sideways));
     }
+    return points;
+}
+
+IterationPoints pointsOf(const PointCloud& moving, const Eigen::Vector3d& origin, const std::vector<std::size_t>& sample,
+                         const std::vector<char>& sideways)
+{
+    IterationPoints points;
     std::vector<Eigen::Vector3d>& x0 = points.x0;
+    std::vector<char> flags;
     x0.reserve(sample.size());
-    for (std::size_t i : sample)
-        if (moving.positions()[i].allFinite())
-            x0.push_back(moving.globalPosition(i) - origin);
+    for (std::size_t k = 0; k < sample.size(); ++k)
+        if (moving.positions()[sample[k]].allFinite()) {
+            x0.push_back(moving.globalPosition(sample[k]) - origin);
+            if (!sideways.empty())
+                flags.push_back(sideways[k]);
+        }
     if (x0.size() < 6)
         throw Error(ErrorCode::InvalidData, "registration: the moving cloud has fewer than 6 points with finite coordinates");
     // Coarse to fine: the first iterations, while the clouds are still apart
@@ -266,16 +359,25 @@ IterationPoints iterationPoints(const PointCloud& moving, const Eigen::Vector3d&
     points.coarse = x0.size();
     if (x0.size() > 2 * kCoarsePoints) {
         const std::size_t stride = x0.size() / kCoarsePoints;
-        std::vector<Eigen::Vector3d> ordered;
-        ordered.reserve(x0.size());
+        std::vector<std::size_t> order;
+        order.reserve(x0.size());
         for (std::size_t i = 0; i < x0.size(); i += stride)
-            ordered.push_back(x0[i]);
-        points.coarse = ordered.size();
+            order.push_back(i);
+        points.coarse = order.size();
         for (std::size_t i = 0; i < x0.size(); ++i)
             if (i % stride != 0)
-                ordered.push_back(x0[i]);
+                order.push_back(i);
+        std::vector<Eigen::Vector3d> ordered(x0.size());
+        std::vector<char> orderedFlags(flags.size());
+        for (std::size_t k = 0; k < order.size(); ++k) {
+            ordered[k] = x0[order[k]];
+            if (!flags.empty())
+                orderedFlags[k] = flags[order[k]];
+        }
         x0 = std::move(ordered);
+        flags = std::move(orderedFlags);
     }
+    points.sidewaysOnly = std::move(flags);
     for (const auto& p : x0)
         points.centroid += p;
     points.centroid /= static_cast<double>(x0.size());
@@ -299,9 +401,11 @@ struct IterationRun
 
 //! The iterations from `motion`: match, select, weigh, solve, apply, until
 //! converged or at the limit; `held` directions (orthonormal columns in the
-//! solver's unknowns) are never moved along.
+//! solver's unknowns) are never moved along; the change-robust threshold
+//! starts at `startThreshold` (a second phase goes on from the first's).
 IterationRun runIterations(const detail::ReferenceSurface& surface, const IterationPoints& points, const IcpParams& params,
-                           Eigen::Isometry3d motion, const Eigen::MatrixXd* held, ProgressTicker& ticker)
+                           Eigen::Isometry3d motion, const Eigen::MatrixXd* held, ProgressTicker& ticker,
+                           double startThreshold = kInfinity)
 {
     const bool plane = params.method == IcpMethod::PointToPlane;
     const std::vector<Eigen::Vector3d>& x0 = points.x0;
@@ -309,7 +413,7 @@ IterationRun runIterations(const detail::ReferenceSurface& surface, const Iterat
     std::size_t active = points.coarse;
     IterationRun run;
     const Eigen::Vector3d centre = motion * points.centroid;
-    double threshold = kInfinity, previousRms = kInfinity, rmsTwoBefore = kInfinity;
+    double threshold = startThreshold, previousRms = kInfinity, rmsTwoBefore = kInfinity;
     bool kernelActive = false;
     double kernelScale = kInfinity, medianDistance = kInfinity;
     std::vector<Eigen::Vector3d> x(x0.size()), xs, ys, ns;
@@ -346,6 +450,11 @@ IterationRun runIterations(const detail::ReferenceSurface& surface, const Iterat
                 ns.push_back(c.closest.normals[i]);
                 usedResiduals.push_back(c.residual[i]);
                 usedDistances.push_back(c.distance[i]);
+                if (plane && !points.sidewaysOnly.empty() && points.sidewaysOnly[i]) {
+                    // Horizontal only: a roof's normal (up) says nothing, its edge's all it has.
+                    ns.back().z() = 0;
+                    usedResiduals.back() = ns.back().dot(x[i] - ys.back());
+                }
             }
         // Robust weights on the residuals over their robust scale, once the
         // plain iterations have converged: a scale taken from residuals that
@@ -527,6 +636,7 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
     // independent), and roof edges seen from the air pull both halves the
     // same way; a real shift over hills lowers the residuals by 2-17 %.
     const Eigen::MatrixXd held = weakDirections(run.normalMatrix);
+    bool holding = false; // whether the run holds the weak directions fixed
     if (held.cols() > 0 && held.cols() < run.normalMatrix.rows()) {
         const Eigen::Vector3d centre = start * points.centroid;
         const auto along = [&](const Eigen::Isometry3d& motion) {
@@ -572,11 +682,25 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
                  << "residuals by " << 100 * gain << " %";
         } else {
             run = fixed.trace.empty() ? runIterations(surface, points, params, start, &held, ticker) : std::move(fixed);
+            holding = true;
             note << held.cols() << " direction(s) the surfaces do not hold held fixed (see the degeneracy warning): a free run "
                  << "moved " << full.norm() << " m along them, which the halves of the sample do not agree on (" << apart
                  << " m apart) or which lowers the residuals by " << 100 * gain << " % only";
         }
         report.notes.push_back(note.str());
+    }
+    // The second phase (StableSelection::second), not after a first phase
+    // that had to hold weak directions (a flat site: what its surfaces say
+    // sideways was found not to be in the data).
+    const bool secondPhase = points.secondPhase && !holding;
+    const IterationPoints& used = secondPhase ? *points.secondPhase : points;
+    if (secondPhase) {
+        std::vector<RegistrationIteration> trace = std::move(run.trace);
+        run = runIterations(surface, used, params, run.motion, nullptr, ticker, run.threshold);
+        for (RegistrationIteration& step : run.trace)
+            step.iteration += trace.size();
+        trace.insert(trace.end(), run.trace.begin(), run.trace.end());
+        run.trace = std::move(trace);
     }
     report.trace = run.trace;
     report.iterations = run.trace.size();
@@ -584,7 +708,7 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
     const Eigen::Isometry3d& motion = run.motion;
     const Eigen::MatrixXd& normalMatrix = run.normalMatrix;
     const double threshold = run.threshold;
-    const Eigen::Vector3d& centroid = points.centroid;
+    const Eigen::Vector3d& centroid = used.centroid;
     const double cutoff = run.cutoff;
     report.matrix = toGlobal(motion, origin);
     report.centre = centroid + origin;
@@ -595,9 +719,9 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
     const double finalThreshold = std::min(threshold, cutoff);
     std::vector<double> magnitudes;
     if (!params.residualOfEveryPoint) {
-        std::vector<Eigen::Vector3d> x(points.x0.size());
+        std::vector<Eigen::Vector3d> x(used.x0.size());
         for (std::size_t i = 0; i < x.size(); ++i)
-            x[i] = motion * points.x0[i];
+            x[i] = motion * used.x0[i];
         Correspondences last;
         correspond(surface, x, final, finalThreshold, last, params.maxDistance.value_or(kInfinity));
         for (std::size_t i = 0; i < x.size(); ++i)

@@ -173,6 +173,21 @@ ToolResult registerAndReport(const ToolInputs& inputs, IcpParams icp, const Glob
     return refineAndReport(inputs, icp, &coarse.report, "global alignment: ", refine, progress);
 }
 
+//! With --exclude-changes, what the ICP registers on (StableParts).
+ParameterSpec stableParameter()
+{
+    return ParameterSpec::choice("stable", "Stable parts",
+                                 "With Exclude changes, on a cloud without classes: surfaces (every planar part: ground, walls, "
+                                 "roofs) or ground (the ground a morphological filter finds and the walls; the other planar "
+                                 "parts for the horizontal only: for epochs whose roofs or objects may have been raised)",
+                                 {"surfaces", "ground"}, "surfaces");
+}
+
+StableParts stablePartsFrom(const ParameterValues& values)
+{
+    return values.text("stable") == "ground" ? StableParts::Ground : StableParts::Surfaces;
+}
+
 std::vector<ParameterSpec> icpParameters()
 {
     const IcpParams defaults;
@@ -187,6 +202,7 @@ std::vector<ParameterSpec> icpParameters()
         ParameterSpec::choice("kernel", "Kernel", "The robust kernel", {"cauchy", "huber", "geman-mcclure"}, "cauchy"),
         ParameterSpec::boolean("exclude-changes", "Exclude changes",
                                "Leave out correspondences beyond a threshold that shrinks with the residuals (changed areas)", false),
+        stableParameter(),
         ParameterSpec::integer("sample", "Sampled points", "Moving points used per iteration, at random (0: all)",
                                static_cast<std::int64_t>(defaults.sampleCount), 0, 1000000000, "points"),
         ParameterSpec::integer("iterations", "Maximum iterations", "Iterations at most", static_cast<std::int64_t>(defaults.maxIterations),
@@ -204,6 +220,7 @@ IcpParams icpFrom(const ParameterValues& values)
     params.overlap = values.real("overlap");
     params.kernel = values.boolean("robust") ? parseRobustKernel(values.text("kernel")) : RobustKernel::None;
     params.changeRobust = values.boolean("exclude-changes");
+    params.stableParts = stablePartsFrom(values);
     params.sampleCount = static_cast<std::size_t>(values.integer("sample"));
     params.maxIterations = static_cast<std::size_t>(values.integer("iterations"));
     params.seed = static_cast<std::uint64_t>(values.integer("seed"));
@@ -273,12 +290,14 @@ void addGlobalTool(ToolRegistry& registry)
     tool.parameters.push_back(ParameterSpec::boolean("refine", "Refine with ICP", "Finish with point-to-plane ICP (robust kernel)", true));
     tool.parameters.push_back(ParameterSpec::boolean(
         "exclude-changes", "Exclude changes", "In the ICP, leave out what changed between the epochs (thesis 000 §1.4)", false));
+    tool.parameters.push_back(stableParameter());
     tool.parameters.push_back(seedParameter());
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
         IcpParams icp;
         icp.constraint = dofFrom(values);
         icp.kernel = RobustKernel::Cauchy;
         icp.changeRobust = values.boolean("exclude-changes");
+        icp.stableParts = stablePartsFrom(values);
         icp.seed = static_cast<std::uint64_t>(values.integer("seed"));
         const GlobalAlignmentParams global = globalFrom(values);
         return registerAndReport(inputs, icp, &global, values.boolean("refine"), progress);

@@ -13,6 +13,7 @@ void registerProcessingTools(ToolRegistry& registry)
     detail::registerFieldTools(registry);
     detail::registerSurfaceTools(registry);
     detail::registerDistanceTools(registry);
+    detail::registerGroundTools(registry);
 }
 
 } // namespace scandiff

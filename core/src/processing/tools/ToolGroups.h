@@ -16,6 +16,7 @@ void registerFieldTools(ToolRegistry& registry);
 void registerSurfaceTools(ToolRegistry& registry);
 void registerDistanceTools(ToolRegistry& registry); // M3C2, then the raster tools
 void registerRasterTools(ToolRegistry& registry);
+void registerGroundTools(ToolRegistry& registry);
 
 //! The declaration of a tool taking one cloud, with its first output.
 inline ToolSpec oneCloudTool(std::string name, std::string title, std::string category, std::string description,
