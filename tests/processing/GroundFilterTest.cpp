@@ -229,9 +229,11 @@ TEST(GroundFilter, DegenerateCloudsHaveADocumentedAnswer)
         for (int k = 0; k <= 100; ++k)
             wall.emplace_back(0.2f * i, 0.0f, 0.1f * k);
     const GroundFilterResult facade = filterGround(cloudOf(wall));
-    for (std::size_t i = 0; i < wall.size(); ++i)
-        if (wall[i].z() > 1.0f)
+    for (std::size_t i = 0; i < wall.size(); ++i) {
+        if (wall[i].z() > 1.0f) {
             ASSERT_EQ(facade.ground[i], 0) << "point " << i << " at " << wall[i].z() << " m";
+        }
+    }
     // Non-finite points are never ground; a cloud with no finite point, an
     // empty cloud and parameters out of range are errors.
     lot.emplace_back(std::numeric_limits<float>::quiet_NaN(), 1.f, 1.f);

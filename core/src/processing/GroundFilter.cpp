@@ -247,7 +247,8 @@ GroundFilterResult filterGround(const PointCloud& cloud, const GroundFilterParam
     for (std::size_t c = 0; c < terrain.z.size(); ++c)
         if (object[c] || !hadPoints[c])
             terrain.z[c] = kEmpty;
-    result.objectCells = static_cast<std::size_t>(std::count_if(object.begin(), object.end(), [](char o) { return o != 0; }));
+    for (std::size_t c = 0; c < object.size(); ++c)
+        result.objectCells += object[c] && hadPoints[c];
     if (std::all_of(terrain.z.begin(), terrain.z.end(), [](double z) { return std::isnan(z); }))
         terrain.z = lowest.z; // every cell an object (a lone roof): the lowest points are all the terrain there is
     fillEmptyCells(terrain, 20);

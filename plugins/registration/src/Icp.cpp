@@ -204,7 +204,9 @@ StableSelection stableSurfaces(const PointCloud& moving, const std::vector<std::
             finite.push_back(v);
     if (finite.size() < 20)
         return {};
-    const double limit = 3.0 * std::max(percentileOf(finite, 0.2), 1e-9);
+    const auto at = finite.begin() + static_cast<std::ptrdiff_t>(finite.size() / 5); // the 20th percentile
+    std::nth_element(finite.begin(), at, finite.end());
+    const double limit = 3.0 * std::max(*at, 1e-9);
     for (std::size_t k = 0; k < sample.size(); ++k) {
         keep[k] = planes.spread[k] <= limit;
         kept += keep[k];
@@ -451,7 +453,7 @@ IterationRun runIterations(const detail::ReferenceSurface& surface, const Iterat
                 usedResiduals.push_back(c.residual[i]);
                 usedDistances.push_back(c.distance[i]);
                 if (plane && !points.sidewaysOnly.empty() && points.sidewaysOnly[i]) {
-                    // Horizontal only: a roof's normal (up) says nothing, its edge's all it has.
+                    // Horizontal only: a roof's upward normal then weighs nothing, an edge's sideways one holds.
                     ns.back().z() = 0;
                     usedResiduals.back() = ns.back().dot(x[i] - ys.back());
                 }

@@ -47,8 +47,8 @@ void registerGroundTools(ToolRegistry& registry)
         out.addField(std::move(classes));
         ToolResult result;
         result.summary = describe(ground.groundCount, " of ", input.size(), " points ground (class 2), the others 1; ",
-                                  ground.objectCells, " of ", ground.terrain.columns * ground.terrain.rows, " cells of ",
-                                  params.cell, " m objects");
+                                  ground.objectCells, " cells of ", params.cell,
+                                  " m with points marked as objects");
         result.add("output", std::move(out));
         return result;
     };

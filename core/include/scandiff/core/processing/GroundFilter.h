@@ -52,7 +52,7 @@ struct GroundFilterResult
 {
     std::vector<std::uint8_t> ground; //!< per point: 1 ground, 0 not (0 for non-finite points)
     std::size_t groundCount = 0;
-    std::size_t objectCells = 0;      //!< grid cells the opening marked as objects
+    std::size_t objectCells = 0;      //!< grid cells with points the opening marked as objects
     TerrainGrid terrain;
 };
 
