@@ -216,7 +216,6 @@ GroundFilterResult filterGround(const PointCloud& cloud, const GroundFilterParam
     lowest.columns = static_cast<std::size_t>(columnsWide);
     lowest.rows = static_cast<std::size_t>(rowsWide);
     lowest.z.assign(lowest.columns * lowest.rows, kEmpty);
-    std::vector<std::size_t> cellOf(positions.size(), SIZE_MAX);
     {
         ProgressTicker ticker(progress, "Ground: lowest points", positions.size());
         for (std::size_t i = 0; i < positions.size(); ++i) {
@@ -226,7 +225,6 @@ GroundFilterResult filterGround(const PointCloud& cloud, const GroundFilterParam
             const auto col = std::min(lowest.columns - 1, static_cast<std::size_t>((q.x() - minX) / params.cell));
             const auto row = std::min(lowest.rows - 1, static_cast<std::size_t>((q.y() - minY) / params.cell));
             const std::size_t c = lowest.at(col, row);
-            cellOf[i] = c;
             if (std::isnan(lowest.z[c]) || q.z() < lowest.z[c])
                 lowest.z[c] = q.z();
             ticker.step();
@@ -244,11 +242,11 @@ GroundFilterResult filterGround(const PointCloud& cloud, const GroundFilterParam
 
     GroundFilterResult result;
     HeightGrid terrain = lowest;
-    for (std::size_t c = 0; c < terrain.z.size(); ++c)
+    for (std::size_t c = 0; c < terrain.z.size(); ++c) {
         if (object[c] || !hadPoints[c])
             terrain.z[c] = kEmpty;
-    for (std::size_t c = 0; c < object.size(); ++c)
         result.objectCells += object[c] && hadPoints[c];
+    }
     if (std::all_of(terrain.z.begin(), terrain.z.end(), [](double z) { return std::isnan(z); }))
         terrain.z = lowest.z; // every cell an object (a lone roof): the lowest points are all the terrain there is
     fillEmptyCells(terrain, 20);
@@ -265,9 +263,9 @@ GroundFilterResult filterGround(const PointCloud& cloud, const GroundFilterParam
     ProgressTicker ticker(progress, "Ground: points", positions.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i < range.end(); ++i) {
-            if (cellOf[i] == SIZE_MAX)
-                continue;
             const auto& q = positions[i];
+            if (!q.allFinite())
+                continue;
             const double allowed = params.threshold + params.scalar * result.terrain.slopeAt(q.x(), q.y());
             result.ground[i] = std::abs(q.z() - result.terrain.heightAt(q.x(), q.y())) <= allowed;
         }

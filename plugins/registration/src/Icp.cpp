@@ -176,7 +176,6 @@ struct StableSelection
     //! were, and they hold the horizontal position and the heading where the
     //! ground is flat.
     std::vector<char> second;
-    std::vector<char> secondSideways; //!< per sampled point: in the second phase, for the horizontal only
 };
 
 StableSelection stableSurfaces(const PointCloud& moving, const std::vector<std::size_t>& sample, StableParts parts, std::string& note)
@@ -192,7 +191,7 @@ StableSelection stableSurfaces(const PointCloud& moving, const std::vector<std::
         }
         if (kept >= enough) {
             note = "change-robust: the " + std::to_string(kept) + " sampled points classed ground (2) or building (6) registered";
-            return {keep, {}, {}};
+            return {keep, {}};
         }
         std::fill(keep.begin(), keep.end(), 0);
         kept = 0;
@@ -215,25 +214,24 @@ StableSelection stableSurfaces(const PointCloud& moving, const std::vector<std::
     if (parts == StableParts::Ground) {
         // Ground (SMRF with its defaults) and walls (a plane within 30 deg of vertical).
         const GroundFilterResult ground = filterGround(moving);
-        std::vector<char> groundOrWalls(sample.size(), 0), surfaces(sample.size(), 0), sideways(sample.size(), 0);
+        std::vector<char> groundOrWalls(sample.size(), 0), surfaces(sample.size(), 0);
         std::size_t onGround = 0, onWalls = 0;
         for (std::size_t k = 0; k < sample.size(); ++k) {
             const bool wall = keep[k] && planes.uprightness[k] < 0.5;
             groundOrWalls[k] = ground.ground[sample[k]] || wall;
             surfaces[k] = groundOrWalls[k] || keep[k];
-            sideways[k] = surfaces[k] && !groundOrWalls[k];
             onGround += ground.ground[sample[k]];
             onWalls += wall && !ground.ground[sample[k]];
         }
         if (onGround + onWalls >= enough) {
             text << "change-robust: " << onGround << " of " << sample.size() << " sampled points on the ground (morphological filter) and "
-                 << onWalls << " on walls registered, then with them the " << kept << " on surfaces (12 neighbours within " << limit
-                 << " m of a plane), those off the ground for the horizontal and the heading only; the rest (vegetation, clutter) "
-                 << "left out";
+                 << onWalls << " on walls registered";
+            if (kept >= enough)
+                text << ", then with them the " << kept << " on surfaces (12 neighbours within " << limit
+                     << " m of a plane), those off the ground for the horizontal and the heading only";
+            text << "; the rest (vegetation, clutter) left out";
             note = text.str();
-            if (kept < enough)
-                return {groundOrWalls, {}, {}};
-            return {groundOrWalls, surfaces, sideways};
+            return {groundOrWalls, kept >= enough ? surfaces : std::vector<char>()};
         }
     }
     if (kept < enough)
@@ -241,7 +239,7 @@ StableSelection stableSurfaces(const PointCloud& moving, const std::vector<std::
     text << "change-robust: " << kept << " of " << sample.size() << " sampled points on surfaces (12 neighbours within "
          << limit << " m of a plane) registered; scattered points (vegetation, clutter) left out";
     note = text.str();
-    return {keep, {}, {}};
+    return {keep, {}};
 }
 
 } // namespace
@@ -334,7 +332,7 @@ IterationPoints iterationPoints(const PointCloud& moving, const Eigen::Vector3d&
         std::vector<char> sideways;
         for (std::size_t k = 0; k < sample.size(); ++k)
             if (stable.second[k])
-                sideways.push_back(stable.secondSideways[k]);
+                sideways.push_back(!stable.first[k]); // not ground nor wall: for the horizontal only
         points.secondPhase = std::make_shared<IterationPoints>(pointsOf(moving, origin, selected(sample, stable.second), sideways));
     }
     return points;
