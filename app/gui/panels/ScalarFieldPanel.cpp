@@ -6,11 +6,16 @@
 #include "widgets/HistogramWidget.h"
 #include "widgets/RangeEditor.h"
 
+#include <scandiff/core/Error.h>
 #include <scandiff/core/FieldRange.h>
+#include <scandiff/core/processing/FieldOperations.h>
+#include <scandiff/io/ResultFiles.h>
 
 #include <QCheckBox>
 #include <QComboBox>
+#include <QFileDialog>
 #include <QFormLayout>
+#include <QMessageBox>
 #include <QHBoxLayout>
 #include <QLabel>
 #include <QPushButton>
@@ -80,8 +85,13 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
     auto* logScale = new QCheckBox(tr("Log counts"), this);
     logScale->setObjectName("logCounts");
     logScale->setToolTip(tr("Histogram heights on a logarithmic scale: the few changed points next to the many unchanged ones"));
+    auto* exportCsv = new QPushButton(tr("CSV..."), this);
+    exportCsv->setObjectName("exportHistogram");
+    exportCsv->setToolTip(tr("Save the histogram's bins as a CSV table (bin_min, bin_max, count)"));
+    connect(exportCsv, &QPushButton::clicked, this, &ScalarFieldPanel::exportHistogramWithDialog);
     countsRow->addWidget(inside_, 1);
     countsRow->addWidget(logScale);
+    countsRow->addWidget(exportCsv);
     layout->addLayout(countsRow);
     connect(logScale, &QCheckBox::toggled, histogram_, &HistogramWidget::setLogarithmic);
     auto* buttons = new QHBoxLayout;
@@ -359,5 +369,35 @@ void ScalarFieldPanel::updateInsideCount()
 }
 
 QString ScalarFieldPanel::insideText() const { return inside_->text(); }
+
+bool ScalarFieldPanel::exportHistogram(const QString& path, QString* error)
+{
+    const ScalarField* field = activeField();
+    try {
+        if (!field)
+            throw Error(ErrorCode::InvalidArgument, "the selected entity shows no scalar field");
+        io::writeTable(fieldHistogram(*field, kHistogramBins), path.toStdString());
+        return true;
+    } catch (const std::exception& e) {
+        if (error)
+            *error = QString::fromStdString(e.what());
+        return false;
+    }
+}
+
+void ScalarFieldPanel::exportHistogramWithDialog()
+{
+    const ScalarField* field = activeField();
+    if (!field)
+        return;
+    const QString path = QFileDialog::getSaveFileName(this, tr("Export the histogram"),
+                                                      QString::fromStdString(field->name()) + "-histogram.csv",
+                                                      tr("CSV tables (*.csv)"));
+    if (path.isEmpty())
+        return;
+    QString error;
+    if (!exportHistogram(path, &error))
+        QMessageBox::warning(this, tr("Export the histogram"), error);
+}
 
 } // namespace scandiff::gui

@@ -49,6 +49,12 @@ public:
     HistogramWidget* histogram() const { return histogram_; }
     QPushButton* splitButton() const { return split_; }
     QString insideText() const;
+    //! The histogram as drawn (its bins over the field's range) to a CSV file
+    //! bin_min,bin_max,count, the table `scandiff-cli field-histogram` writes.
+    //! False, with the reason in `error`, when there is no field or the write fails.
+    bool exportHistogram(const QString& path, QString* error = nullptr);
+    //! Asks for a file, then exportHistogram.
+    void exportHistogramWithDialog();
 
 signals:
     void splitRequested(EntityId id, const std::string& field, double low, double high);

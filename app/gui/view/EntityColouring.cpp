@@ -191,7 +191,7 @@ ColourLegend colourEntity(const PointCloud& points, const DisplayState& display,
     FieldColouring how;
     how.colourMin = zmin <= zmax ? zmin : 0.0;
     how.colourMax = zmin < zmax ? zmax : how.colourMin + 1.0;
-    const ColourScale scale = *ColourScale::preset("Blue-Green-Yellow-Red");
+    const ColourScale scale = ColourScale::defaultScale();
     colourise(heights.data(), n, 0.0, scale, how, rgba);
     legend = {true, "height", scale, how.colourMin + points.origin().z(), how.colourMax + points.origin().z(), {}};
     return legend;

@@ -20,7 +20,7 @@ struct ColourLegend
 {
     bool shown = false;
     std::string title;
-    ColourScale scale = *ColourScale::preset("Blue-Green-Yellow-Red");
+    ColourScale scale = ColourScale::defaultScale();
     double min = 0, max = 1;
     //! For a label field: each value present (ascending) and its colour; the
     //! legend is then a list of swatches, not a ramp.

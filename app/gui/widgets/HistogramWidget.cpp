@@ -18,7 +18,7 @@ constexpr int kMarkerGrab = 4; // pixels either side of a marker line that grab 
 } // namespace
 
 HistogramWidget::HistogramWidget(QWidget* parent)
-    : QWidget(parent), scale_(ColourScale::presets().front())
+    : QWidget(parent), scale_(ColourScale::defaultScale())
 {
     setMouseTracking(true); // for the cursor over the markers
     setSizePolicy(QSizePolicy::Expanding, QSizePolicy::Preferred);
@@ -103,7 +103,34 @@ double HistogramWidget::axisMax() const
 QRect HistogramWidget::plotRect() const
 {
     const int labelHeight = fontMetrics().height() + 4;
-    return rect().adjusted(6, 6, -6, -labelHeight - 3);
+    // Room for the widest count label (the tallest bar's), and half a line
+    // above the plot so the top label is not cut.
+    std::size_t most = 0;
+    for (std::size_t c : histogram_.counts)
+        most = std::max(most, c);
+    const int countWidth = fontMetrics().horizontalAdvance(QString::number(static_cast<qulonglong>(most)));
+    return rect().adjusted(countWidth + 10, fontMetrics().height() / 2 + 2, -6, -labelHeight - 3);
+}
+
+std::vector<std::pair<std::size_t, int>> HistogramWidget::countTicks() const
+{
+    if (histogram_.finiteCount == 0 || histogram_.counts.empty())
+        return {};
+    const std::size_t most = *std::max_element(histogram_.counts.begin(), histogram_.counts.end());
+    const QRect plot = plotRect();
+    // The top of a bar of that fraction of the tallest (as paintEvent draws it).
+    const auto yOf = [&](double fraction) { return plot.bottom() + 1 - std::max(1, static_cast<int>(std::lround(fraction * plot.height()))); };
+    const double middle = logarithmic_ ? std::expm1(std::log1p(static_cast<double>(most)) / 2) : most / 2.0;
+    std::vector<std::pair<std::size_t, int>> ticks{{0, plot.bottom()}};
+    const auto middleCount = static_cast<std::size_t>(std::llround(middle));
+    if (middleCount > 0 && middleCount < most) { // a tick of its own, at the height a bar of that count has
+        const double top = logarithmic_ ? std::log1p(static_cast<double>(most)) : static_cast<double>(most);
+        const double c = static_cast<double>(middleCount);
+        ticks.push_back({middleCount, yOf((logarithmic_ ? std::log1p(c) : c) / top)});
+    }
+    if (most > 0)
+        ticks.push_back({most, yOf(1.0)});
+    return ticks;
 }
 
 int HistogramWidget::xOfValue(double value) const
@@ -237,8 +264,15 @@ void HistogramWidget::paintEvent(QPaintEvent*)
         painter.setBrush(Qt::NoBrush);
     }
 
-    // Axis labels at min, middle and max, under the plot.
+    // The count axis on the left: ticks and their counts, right-aligned.
     painter.setPen(palette().color(QPalette::WindowText));
+    for (const auto& [count, y] : countTicks()) {
+        painter.drawLine(plot.left() - 4, y, plot.left() - 1, y);
+        const QRect label(0, y - fontMetrics().height() / 2, plot.left() - 6, fontMetrics().height());
+        painter.drawText(label, Qt::AlignRight | Qt::AlignVCenter, QString::number(static_cast<qulonglong>(count)));
+    }
+
+    // Axis labels at min, middle and max, under the plot.
     const QRect labels(plot.left(), plot.bottom() + 3, plot.width(), fontMetrics().height() + 2);
     const double amin = axisMin();
     const double amax = axisMax();

@@ -2,8 +2,9 @@
 #pragma once
 //! Draws a scalar field's histogram: one bar per bin, coloured as colourise
 //! would colour the bin's centre, the colour range's ends dashed, a marked
-//! range (e.g. the visible threshold) with the outside shaded, and the value
-//! axis labelled at min, middle and max. The markers can be dragged with the
+//! range (e.g. the visible threshold) with the outside shaded, the value
+//! axis labelled at min, middle and max and the count axis at 0, its middle
+//! and the tallest bar's count. The markers can be dragged with the
 //! mouse; hovering a bar shows its count.
 
 #include "colour/ColourScale.h"
@@ -51,7 +52,13 @@ public:
     double axisMin() const;
     double axisMax() const;
     //! The plot area (bars) in widget coordinates, and the x of a value in it.
+    //! Its left margin holds the count axis's labels.
     QRect plotRect() const;
+    //! The count axis as drawn: (count, y of its tick) from 0 at the plot's
+    //! bottom to the tallest bar's count at its top; the middle tick is the
+    //! count of a bar half as tall (on the log scale, e^(log(1 + top) / 2) - 1).
+    //! Empty when there are no values.
+    std::vector<std::pair<std::size_t, int>> countTicks() const;
     int xOfValue(double value) const;
 
     QSize sizeHint() const override;

@@ -29,9 +29,13 @@ public:
     //! and last positions are not exactly 0 and 1.
     ColourScale(std::string name, std::vector<ColourStop> stops, bool symmetric = false);
 
-    //! "Blue-Green-Yellow-Red" (the first one, CloudCompare's default look),
-    //! "Grey", "Diverging Blue-White-Red" (symmetric) and "Viridis".
+    //! The named scales of the workbench and the field-to-colours tool:
+    //! perceptually uniform ones first (Viridis, Cividis, Magma, Inferno,
+    //! Plasma), the diverging ones (symmetric), then CloudCompare's classics.
     static const std::vector<ColourScale>& presets();
+    //! The scale a field is first shown with: "Blue-Green-Yellow-Red", the
+    //! look CloudCompare users know (the list puts the perceptual ones first).
+    static const ColourScale& defaultScale();
     static std::optional<ColourScale> preset(const std::string& name);
 
     const std::string& name() const { return name_; }

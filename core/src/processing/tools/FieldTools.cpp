@@ -169,7 +169,7 @@ void addToColoursTool(ToolRegistry& registry)
                                  updatedCloud("Cloud with the colours"));
     tool.parameters = {
         fieldParameter("The field to colour by"),
-        ParameterSpec::choice("scale", "Colour scale", "The scale", scales, scales.front()),
+        ParameterSpec::choice("scale", "Colour scale", "The scale", scales, ColourScale::defaultScale().name()),
         ParameterSpec::real("min", "Minimum", "Value of the scale's first colour (default: the field's minimum)", 0, -1e300, 1e300)
             .asOptional(),
         ParameterSpec::real("max", "Maximum", "Value of the scale's last colour (default: the field's maximum)", 1, -1e300, 1e300)
