@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "MainWindow.h"
 
+#include "HelpDialogs.h"
+
 #include <algorithm>
 
 #include "controllers/DistanceController.h"
@@ -26,7 +28,11 @@
 #include <QColorDialog>
 #include <QActionGroup>
 #include <QApplication>
+#include <QDesktopServices>
+#include <QDir>
 #include <QDockWidget>
+#include <QFileInfo>
+#include <QUrl>
 #include <QFileDialog>
 #include <QDragEnterEvent>
 #include <QDropEvent>
@@ -210,6 +216,26 @@ void MainWindow::buildDocks()
 
 void MainWindow::buildMenus()
 {
+    buildFileMenu();
+    QMenu* edit = buildEditMenu();
+    buildViewMenu();
+    QMenu* tools = menuBar()->addMenu(tr("&Tools"));
+    QMenu* distances = tools->addMenu(tr("&Distances"));
+    distances->addAction(tr("&Cloud/cloud distance (C2C)..."), this,
+                         [this] { distances_->runInteractively(DistanceKind::CloudToCloud, tree_->currentEntity()); });
+    distances->addAction(tr("Cloud/&mesh distance (C2M)..."), this,
+                         [this] { distances_->runInteractively(DistanceKind::CloudToMesh, tree_->currentEntity()); });
+    tools->addAction(tr("S&egment the changes..."), this, [this] { segmentation_->runInteractively(tree_->currentEntity()); });
+    // The panel's own button: one place decides what a split takes.
+    tools->addAction(tr("&Split at thresholds"), scalarPanel_->splitButton(), &QPushButton::click);
+    buildToolsMenu(edit, tools);
+
+    buildHelpMenu();
+    buildTreeMenu();
+}
+
+void MainWindow::buildFileMenu()
+{
     QMenu* file = menuBar()->addMenu(tr("&File"));
     file->addAction(tr("&Open..."), files_, &FileController::openWithDialog)->setShortcut(QKeySequence::Open);
     QMenu* recent = file->addMenu(tr("Open &recent"));
@@ -220,12 +246,23 @@ void MainWindow::buildMenus()
     regionExportActions_.push_back(
         file->addAction(tr("Export re&gions (PLY, DXF, CSV)..."), this, [this] { segmentation_->exportRegionsWithDialog(tree_->currentEntity()); }));
     file->addSeparator();
+    QAction* closeSelected = file->addAction(tr("&Close selected"), this, &MainWindow::closeSelected);
+    closeSelected->setObjectName("closeSelectedAction");
+    closeSelected->setShortcut(QKeySequence::Close);
+    QAction* closeAll = file->addAction(tr("Close a&ll"), this, [this] { closeEverything(); });
+    closeAll->setObjectName("closeAllAction");
+    closeAll->setShortcut(QKeySequence(tr("Ctrl+Shift+W")));
+    file->addSeparator();
     file->addAction(tr("Open &session..."), sessions_, &SessionController::restoreWithDialog);
     file->addAction(tr("&Save session..."), sessions_, &SessionController::saveWithDialog)->setShortcut(QKeySequence::Save);
     file->addSeparator();
     // Through close(), so unsaved work is asked about whichever way one quits.
     file->addAction(tr("&Quit"), this, &QWidget::close)->setShortcut(QKeySequence::Quit);
 
+}
+
+QMenu* MainWindow::buildEditMenu()
+{
     QMenu* edit = menuBar()->addMenu(tr("&Edit"));
     // Undo and redo histories: deletions, tools' changes and outputs, fields, splits, the scissors.
     QAction* undo = edit->addAction(tr("Undo"), &document_, &Document::undo);
@@ -263,46 +300,48 @@ void MainWindow::buildMenus()
     extract->setEnabled(false);
     connect(view_, &CloudView::clippingBoxChanged, extract, &QAction::setEnabled);
     edit->addSeparator();
-    edit->addAction(tr("&Delete selected"), this, [this] {
-        const std::vector<EntityId> ids = tree_->selectedEntities(false);
-        const Document::UndoGroup group(document_, ids.size() == 1 && document_.find(ids.front())
-                                                       ? tr("delete '%1'").arg(document_.item(ids.front()).name)
-                                                       : tr("delete of %1 entities").arg(ids.size()));
-        for (EntityId id : ids)
-            document_.remove(id);
-    })->setShortcut(QKeySequence::Delete);
-    edit->addAction(tr("&Rename..."), this, [this] {
-        const EntityId id = tree_->currentEntity();
-        if (!document_.contains(id))
-            return;
-        bool ok = false;
-        const QString name = QInputDialog::getText(this, tr("Rename"), tr("Name"), QLineEdit::Normal, document_.item(id).name, &ok);
-        if (ok && !name.isEmpty())
-            document_.rename(id, name);
-    })->setShortcut(QKeySequence(Qt::Key_F2));
+    deleteAction_ = edit->addAction(tr("&Delete selected"), this, [this] { removeSelected(tr("delete")); });
+    deleteAction_->setShortcut(QKeySequence::Delete);
+    renameAction_ = edit->addAction(tr("&Rename..."), this, &MainWindow::renameCurrent);
+    renameAction_->setShortcut(QKeySequence(Qt::Key_F2));
+    return edit;
 
+}
+
+void MainWindow::buildViewMenu()
+{
     QMenu* viewMenu = menuBar()->addMenu(tr("&View"));
     QToolBar* viewBar = addToolBar(tr("View"));
     viewBar->setObjectName("viewToolBar");
-    const std::pair<QString, StandardView> views[] = {{tr("Top"), StandardView::Top},       {tr("Front"), StandardView::Front},
-                                                      {tr("Left"), StandardView::Left},     {tr("Right"), StandardView::Right},
-                                                      {tr("Back"), StandardView::Back},     {tr("Bottom"), StandardView::Bottom},
-                                                      {tr("Iso"), StandardView::Iso}};
+    // Keys laid out as the views are on a numeric keypad: 8 from above, 2
+    // from below, 4 and 6 from the sides, 5 from the front, 0 from the back.
+    struct Standard
+    {
+        QString label;
+        StandardView which;
+        Qt::Key key;
+    };
+    const Standard views[] = {{tr("Top"), StandardView::Top, Qt::Key_8},       {tr("Front"), StandardView::Front, Qt::Key_5},
+                              {tr("Left"), StandardView::Left, Qt::Key_4},     {tr("Right"), StandardView::Right, Qt::Key_6},
+                              {tr("Back"), StandardView::Back, Qt::Key_0},     {tr("Bottom"), StandardView::Bottom, Qt::Key_2},
+                              {tr("Iso"), StandardView::Iso, Qt::Key_7}};
     QMenu* standard = viewMenu->addMenu(tr("&Standard views"));
-    for (const auto& [label, which] : views) {
-        const StandardView v = which;
-        QAction* a = standard->addAction(label, this, [this, v] { view_->setStandardView(v); });
+    for (const Standard& view : views) {
+        const StandardView v = view.which;
+        QAction* a = standard->addAction(view.label, this, [this, v] { view_->setStandardView(v); });
+        a->setShortcut(QKeySequence(view.key));
+        a->setToolTip(tr("%1 view (%2)").arg(view.label, QKeySequence(view.key).toString()));
         viewBar->addAction(a);
     }
     viewBar->addSeparator();
     QAction* zoomAll = viewMenu->addAction(tr("Zoom to &all"), view_, &CloudView::resetCamera);
     zoomAll->setShortcut(QKeySequence(tr("Ctrl+0")));
     viewBar->addAction(zoomAll);
-    QAction* zoomSelection = viewMenu->addAction(tr("Zoom to &selection"), this, [this] {
+    zoomSelection_ = viewMenu->addAction(tr("Zoom to &selection"), this, [this] {
         if (document_.contains(tree_->currentEntity()))
             view_->zoomToEntity(tree_->currentEntity());
     });
-    viewBar->addAction(zoomSelection);
+    viewBar->addAction(zoomSelection_);
     QAction* ortho = viewMenu->addAction(tr("&Orthographic projection"));
     ortho->setCheckable(true);
     connect(ortho, &QAction::toggled, view_, &CloudView::setParallelProjection);
@@ -420,30 +459,48 @@ void MainWindow::buildMenus()
     for (QDockWidget* d : findChildren<QDockWidget*>())
         viewMenu->addAction(d->toggleViewAction());
 
-    QMenu* tools = menuBar()->addMenu(tr("&Tools"));
-    QMenu* distances = tools->addMenu(tr("&Distances"));
-    distances->addAction(tr("&Cloud/cloud distance (C2C)..."), this,
-                         [this] { distances_->runInteractively(DistanceKind::CloudToCloud, tree_->currentEntity()); });
-    distances->addAction(tr("Cloud/&mesh distance (C2M)..."), this,
-                         [this] { distances_->runInteractively(DistanceKind::CloudToMesh, tree_->currentEntity()); });
-    tools->addAction(tr("S&egment the changes..."), this, [this] { segmentation_->runInteractively(tree_->currentEntity()); });
-    // The panel's own button: one place decides what a split takes.
-    tools->addAction(tr("&Split at thresholds"), scalarPanel_->splitButton(), &QPushButton::click);
-    buildToolsMenu(edit, tools);
+}
 
-    // The tree's own menu: what applies to the entity under the mouse.
+void MainWindow::buildTreeMenu()
+{
+    // The tree's own menu: what applies to the entities under the mouse, as
+    // CloudCompare's tree offers it.
     tree_->setContextMenuPolicy(Qt::ActionsContextMenu);
-    tree_->addAction(zoomSelection);
-    QAction* exportOne = new QAction(tr("Export..."), tree_);
-    connect(exportOne, &QAction::triggered, this, [this] { files_->exportWithDialog(tree_->selectedEntities()); });
-    tree_->addAction(exportOne);
-    QAction* exportRegions = new QAction(tr("Export regions (PLY, DXF, CSV)..."), tree_);
-    connect(exportRegions, &QAction::triggered, this, [this] { segmentation_->exportRegionsWithDialog(tree_->currentEntity()); });
-    tree_->addAction(exportRegions);
+    const auto treeAction = [this](const QString& text, const char* name, auto slot) {
+        auto* action = new QAction(text, tree_);
+        action->setObjectName(name);
+        connect(action, &QAction::triggered, this, slot);
+        tree_->addAction(action);
+        return action;
+    };
+    treeAction(tr("Show / hide"), "treeShowHide", [this] { toggleSelectedVisibility(); });
+    treeAction(tr("Colour..."), "treeColour", [this] {
+        const QColor chosen = QColorDialog::getColor(QColor(255, 200, 0), this, tr("One colour for the selected clouds"));
+        if (chosen.isValid())
+            colourSelected(chosen);
+    });
+    treeAction(tr("Properties"), "treeProperties", [this] {
+        if (auto* dock = findChild<QDockWidget*>("Properties")) {
+            dock->show();
+            dock->raise();
+        }
+    });
+    tree_->addAction(renameAction_);
+    treeAction(tr("Clone"), "treeClone", [this] { cloneSelected(); });
+    treeAction(tr("Merge..."), "treeMerge", [this] {
+        if (ToolController* merge = toolController("merge"))
+            merge->runInteractively(toolSelection());
+    });
+    auto* separator = new QAction(tree_);
+    separator->setSeparator(true);
+    tree_->addAction(separator);
+    tree_->addAction(zoomSelection_);
+    treeAction(tr("Export..."), "treeExport", [this] { files_->exportWithDialog(tree_->selectedEntities()); });
+    QAction* exportRegions =
+        treeAction(tr("Export regions (PLY, DXF, CSV)..."), "treeExportRegions", [this] { segmentation_->exportRegionsWithDialog(tree_->currentEntity()); });
     regionExportActions_.push_back(exportRegions);
     updateRegionExport();
-    QAction* pointSize = new QAction(tr("Point size..."), tree_);
-    connect(pointSize, &QAction::triggered, this, [this] {
+    treeAction(tr("Point size..."), "treePointSize", [this] {
         const std::vector<EntityId> ids = tree_->selectedEntities(false);
         if (ids.empty())
             return;
@@ -454,18 +511,108 @@ void MainWindow::buildMenus()
             for (EntityId id : ids)
                 document_.setPointSize(id, static_cast<float>(size));
     });
-    tree_->addAction(pointSize);
-    QAction* remove = new QAction(tr("Delete"), tree_);
-    connect(remove, &QAction::triggered, this, [this] {
-        const std::vector<EntityId> ids = tree_->selectedEntities(false);
-        // One Ctrl+Z brings back everything this deletion took.
-        const Document::UndoGroup group(document_, ids.size() == 1 && document_.find(ids.front())
-                                                       ? tr("delete '%1'").arg(document_.item(ids.front()).name)
-                                                       : tr("delete of %1 entities").arg(ids.size()));
-        for (EntityId id : ids)
-            document_.remove(id);
-    });
-    tree_->addAction(remove);
+    treeAction(tr("Delete"), "treeDelete", [this] { removeSelected(tr("delete")); });
+}
+
+void MainWindow::buildHelpMenu()
+{
+    QMenu* help = menuBar()->addMenu(tr("&Help"));
+    const QString docs = documentationFolder();
+    // The guide's pages, opened by the desktop's viewer for Markdown (or its browser).
+    const std::pair<QString, QString> pages[] = {{tr("&User guide (the workbench step by step)"), "workbench.md"},
+                                                 {tr("&Command line and formats (README)"), "../README.md"},
+                                                 {tr("&Distances"), "distances.md"},
+                                                 {tr("&M3C2 and the DEM of difference"), "m3c2.md"},
+                                                 {tr("&Segmentation"), "segmentation.md"},
+                                                 {tr("&Registration"), "registration.md"},
+                                                 {tr("&Primitives"), "primitives.md"},
+                                                 {tr("C&ontours"), "contours.md"},
+                                                 {tr("Processing &tools"), "processing.md"},
+                                                 {tr("Cl&assification"), "classification.md"},
+                                                 {tr("&Benchmarks"), "benchmarks.md"}};
+    for (const auto& [label, page] : pages) {
+        const QString path = QDir::cleanPath(docs + "/" + page);
+        if (docs.isEmpty() || !QFileInfo::exists(path))
+            continue;
+        QAction* a = help->addAction(label, this, [path] { QDesktopServices::openUrl(QUrl::fromLocalFile(path)); });
+        a->setStatusTip(path);
+    }
+    if (!help->actions().isEmpty())
+        help->actions().front()->setShortcut(QKeySequence::HelpContents); // F1: the user guide
+    help->addSeparator();
+    QAction* keys = help->addAction(tr("&Keyboard shortcuts"), this, [this] { showShortcuts(this, *menuBar()); });
+    keys->setObjectName("shortcutsAction");
+    help->addAction(tr("&About scandiff"), this, [this] { showAbout(this); });
+}
+
+void MainWindow::removeSelected(const QString& verb)
+{
+    const std::vector<EntityId> ids = tree_->selectedEntities(false);
+    if (ids.empty())
+        return;
+    // One Ctrl+Z brings back everything this took.
+    const Document::UndoGroup group(document_, ids.size() == 1 && document_.find(ids.front())
+                                                   ? tr("%1 '%2'").arg(verb, document_.item(ids.front()).name)
+                                                   : tr("%1 of %2 entities").arg(verb).arg(ids.size()));
+    for (EntityId id : ids)
+        document_.remove(id);
+}
+
+void MainWindow::closeSelected() { removeSelected(tr("close")); }
+
+bool MainWindow::closeEverything()
+{
+    if (document_.size() == 0 || !mayDiscardUnsavedWork())
+        return false;
+    document_.clear();
+    statusBar()->showMessage(tr("Everything closed (File > Open recent brings the files back)"));
+    return true;
+}
+
+void MainWindow::renameCurrent()
+{
+    const EntityId id = tree_->currentEntity();
+    if (!document_.contains(id))
+        return;
+    bool ok = false;
+    const QString name = QInputDialog::getText(this, tr("Rename"), tr("Name"), QLineEdit::Normal, document_.item(id).name, &ok);
+    if (ok && !name.isEmpty())
+        document_.rename(id, name);
+}
+
+void MainWindow::toggleSelectedVisibility()
+{
+    const std::vector<EntityId> ids = tree_->selectedEntities(false);
+    // Any shown: hide them all; all hidden: show them.
+    const bool anyShown = std::any_of(ids.begin(), ids.end(), [this](EntityId id) { return document_.item(id).display.visible; });
+    for (EntityId id : ids)
+        document_.setVisible(id, !anyShown);
+}
+
+int MainWindow::colourSelected(const QColor& colour)
+{
+    ToolController* setColour = toolController("set-colour");
+    int coloured = 0;
+    const Document::UndoGroup group(document_, tr("colour"));
+    for (EntityId id : tree_->selectedEntities(false)) {
+        if (!setColour || !document_.item(id).cloud())
+            continue;
+        if (setColour->run(id, {{"colour", colour.name().toStdString()}})) {
+            document_.setActiveField(id, {}); // the colour just given is what the user wants to see
+            ++coloured;
+        }
+    }
+    return coloured;
+}
+
+int MainWindow::cloneSelected()
+{
+    ToolController* clone = toolController("clone");
+    int cloned = 0;
+    for (EntityId id : tree_->selectedEntities(false))
+        if (clone && document_.item(id).cloud() && clone->run(id, {}))
+            ++cloned;
+    return cloned;
 }
 
 void MainWindow::buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu)

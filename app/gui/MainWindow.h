@@ -8,6 +8,7 @@
 
 #include <scandiff/plugins/PluginRegistry.h>
 
+#include <QColor>
 #include <QMainWindow>
 #include <QStringList>
 
@@ -67,6 +68,21 @@ public:
     //! discarded), false to stay (Cancel, or the save did not happen).
     bool mayDiscardUnsavedWork();
 
+    // What the File menu and the tree's menu do with the tree's selection
+    // (public for tests; the menus call them).
+    //! File > Close selected: the selected entities leave the document (one undo step).
+    void closeSelected();
+    //! File > Close all: everything, after the unsaved-work question; false
+    //! when nothing was open or the user stayed. Not undoable (the files stay).
+    bool closeEverything();
+    //! Hides the selected entities if any is shown, else shows them.
+    void toggleSelectedVisibility();
+    //! Gives each selected cloud one colour (the set-colour tool) and shows
+    //! its colours; returns how many were coloured.
+    int colourSelected(const QColor& colour);
+    //! A copy of each selected cloud (the clone tool); returns how many.
+    int cloneSelected();
+
 protected:
     void closeEvent(QCloseEvent* event) override;
     void dragEnterEvent(QDragEnterEvent* event) override;
@@ -75,6 +91,14 @@ protected:
 private:
     void buildDocks();
     void buildMenus();
+    void buildFileMenu();
+    QMenu* buildEditMenu();
+    void buildViewMenu();
+    void buildHelpMenu();
+    void buildTreeMenu();
+    //! Removes the tree's selected entities as one undo step named by `verb`.
+    void removeSelected(const QString& verb);
+    void renameCurrent();
     void buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu);
     //! The tree's current entity, then the other selected ones: what a tool proposes as its inputs.
     std::vector<EntityId> toolSelection() const;
@@ -90,6 +114,9 @@ private:
     const PluginRegistry& registry_;
     Document document_;
     std::vector<QAction*> regionExportActions_;
+    QAction* deleteAction_ = nullptr;
+    QAction* renameAction_ = nullptr;
+    QAction* zoomSelection_ = nullptr;
     CloudView* view_;
     CloudView* secondView_ = nullptr;
     EntityTree* tree_ = nullptr;

@@ -316,6 +316,24 @@ private slots:
         QVERIFY(!QFile::exists(folder.filePath("none.csv")));
     }
 
+    void aRenameIsUndoneAndRedone()
+    {
+        gui::Document document;
+        const EntityId id = document.add("scan", fourPoints());
+        document.forgetUndo();
+        QSignalSpy renamed(&document, &gui::Document::renamed);
+        document.rename(id, "scan 2019");
+        document.rename(id, "scan 2019"); // the same name: nothing to undo
+        QCOMPARE(document.undoText(), QString("Undo rename to 'scan 2019'"));
+        document.undo();
+        QCOMPARE(document.item(id).name, QString("scan"));
+        QVERIFY(!document.canUndo());
+        QCOMPARE(document.redoText(), QString("Redo rename to 'scan 2019'"));
+        document.redo();
+        QCOMPARE(document.item(id).name, QString("scan 2019"));
+        QCOMPARE(renamed.count(), 3);
+    }
+
     void undoRestoresADeletionAChangeAndAField()
     {
         gui::Document document;

@@ -38,7 +38,7 @@ protected:
 
 TEST_F(ProcessingTools, EveryToolIsDeclaredWithHelpAndValidDefaults)
 {
-    for (const char* name : {"normals", "orient-normals", "features", "subsample", "clone", "merge", "transform", "crop", "field",
+    for (const char* name : {"normals", "orient-normals", "features", "subsample", "clone", "merge", "set-colour", "transform", "crop", "field",
                              "field-gradient", "field-smooth", "field-rename", "field-delete", "field-to-colours",
                              "colours-to-field", "field-histogram", "primitive-distance", "unroll", "sample-mesh", "mesh"}) {
         const ToolSpec& spec = tool(name);
@@ -51,6 +51,25 @@ TEST_F(ProcessingTools, EveryToolIsDeclaredWithHelpAndValidDefaults)
             EXPECT_NO_THROW(p.validate(p.defaultValue)) << name << " --" << p.name;
         }
     }
+}
+
+TEST_F(ProcessingTools, SetColourGivesEveryPointOneColourAndRefusesWhatIsNoColour)
+{
+    PointCloud cloud = test::sphereCloud(500, 1.0);
+    cloud.addField("d");
+    for (const auto& [text, expected] : std::vector<std::pair<std::string, Rgb8>>{
+             {"#ff8000", Rgb8{255, 128, 0}}, {"12, 34, 56", Rgb8{12, 34, 56}}, {"0;0;255", Rgb8{0, 0, 255}}}) {
+        const ToolResult result = run("set-colour", cloud, {{"colour", text}});
+        const PointCloud& out = result.cloud();
+        ASSERT_TRUE(out.hasColors()) << text;
+        EXPECT_EQ(out.positions(), cloud.positions());
+        EXPECT_NE(out.field("d"), nullptr); // the rest kept
+        for (const Rgb8& c : out.colors())
+            ASSERT_EQ(c, expected) << text;
+    }
+    EXPECT_TRUE(tool("set-colour").outputs.front().updatesInput);
+    for (const char* bad : {"256,0,0", "#12345", "#gg0000", "1,2", "1.5,2,3", "-1,0,0", "red"})
+        EXPECT_EQ(test::errorCodeOf([&] { run("set-colour", cloud, {{"colour", bad}}); }), ErrorCode::InvalidArgument) << bad;
 }
 
 TEST_F(ProcessingTools, NormalsUpdateTheirInputAndKeepItsPoints)

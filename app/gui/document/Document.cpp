@@ -324,10 +324,17 @@ FieldDisplay Document::fieldDisplay(EntityId id, const std::string& fieldName) c
 
 void Document::rename(EntityId id, const QString& name)
 {
-    if (Item* item = findMutable(id)) {
-        item->name = name;
-        emit renamed(id);
-    }
+    Item* item = findMutable(id);
+    if (!item || item->name == name)
+        return;
+    UndoStep step;
+    step.kind = UndoKind::Rename;
+    step.name = name;
+    step.id = id;
+    step.previousName = item->name;
+    item->name = name;
+    remember(std::move(step));
+    emit renamed(id);
 }
 
 std::vector<EntityId> Document::unsavedIds() const
@@ -417,6 +424,7 @@ QString Document::describe(const UndoAction& action)
     case UndoKind::Replacement: return tr("the change of '%1'").arg(step.name);
     case UndoKind::Field: return tr("field %1 of '%2'").arg(QString::fromStdString(step.fieldName), step.name);
     case UndoKind::Visibility: return tr("showing '%1'").arg(step.name);
+    case UndoKind::Rename: return tr("rename to '%1'").arg(step.name);
     case UndoKind::None: break;
     }
     return QString();
@@ -538,6 +546,16 @@ Document::UndoStep Document::revertStep(UndoStep& step)
             inverse.id = step.id;
             inverse.previousVisible = item->display.visible;
             setDisplayMember(step.id, &DisplayState::visible, step.previousVisible);
+        }
+        break;
+    case UndoKind::Rename:
+        if (Item* item = findMutable(step.id)) {
+            inverse.kind = UndoKind::Rename;
+            inverse.id = step.id;
+            inverse.name = item->name; // redo renames to it again
+            inverse.previousName = item->name;
+            item->name = step.previousName;
+            emit renamed(step.id);
         }
         break;
     case UndoKind::None: break;

@@ -147,7 +147,7 @@ public:
 
     //! An undo history, and its redo, of what changes data: a removal (with
     //! the entity's descendants), a replacement of an entity's data (a tool
-    //! that moved or edited it), a field added or recomputed; inside an
+    //! that moved or edited it), a field added or recomputed, a rename; inside an
     //! UndoGroup also the entities added (a tool's outputs, a split's or the
     //! scissors' parts) and the visibility changed (the parent they hide). Up
     //! to kUndoLevels actions; a new action empties the redo history; clear()
@@ -206,18 +206,19 @@ private:
     //! Sets one member of an entity's display state; signals only a real change.
     template <class Value> void setDisplayMember(EntityId id, Value DisplayState::*member, const Value& value);
     void removeWithoutUndo(EntityId id, std::vector<std::unique_ptr<Item>>& taken);
-    enum class UndoKind { None, Removal, Addition, Replacement, Field, Visibility };
+    enum class UndoKind { None, Removal, Addition, Replacement, Field, Visibility, Rename };
     struct UndoStep
     {
         UndoKind kind = UndoKind::None;
         QString name;                                //!< the entity's, for the menu
         std::vector<std::unique_ptr<Item>> removed;  //!< Removal: the entity and its descendants, children first
-        EntityId id = kNoEntity;                     //!< Addition, Replacement, Field, Visibility
+        EntityId id = kNoEntity;                     //!< Addition, Replacement, Field, Visibility, Rename
         std::optional<io::Entity> previousData;      //!< Replacement
         DisplayState previousDisplay;                //!< Replacement, Field
         std::string fieldName;                       //!< Field
         std::optional<ScalarField> previousField;    //!< Field: the one it replaced, if any
         bool previousVisible = true;                 //!< Visibility
+        QString previousName;                        //!< Rename
     };
     //! One user action: its steps in the order made, and its menu text.
     struct UndoAction

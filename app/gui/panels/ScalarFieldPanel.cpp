@@ -85,13 +85,13 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
     auto* logScale = new QCheckBox(tr("Log counts"), this);
     logScale->setObjectName("logCounts");
     logScale->setToolTip(tr("Histogram heights on a logarithmic scale: the few changed points next to the many unchanged ones"));
-    auto* exportCsv = new QPushButton(tr("CSV..."), this);
-    exportCsv->setObjectName("exportHistogram");
-    exportCsv->setToolTip(tr("Save the histogram's bins as a CSV table (bin_min, bin_max, count)"));
-    connect(exportCsv, &QPushButton::clicked, this, &ScalarFieldPanel::exportHistogramWithDialog);
+    exportHistogram_ = new QPushButton(tr("CSV..."), this);
+    exportHistogram_->setObjectName("exportHistogram");
+    exportHistogram_->setToolTip(tr("Save the histogram's bins as a CSV table (bin_min, bin_max, count)"));
+    connect(exportHistogram_, &QPushButton::clicked, this, &ScalarFieldPanel::exportHistogramWithDialog);
     countsRow->addWidget(inside_, 1);
     countsRow->addWidget(logScale);
-    countsRow->addWidget(exportCsv);
+    countsRow->addWidget(exportHistogram_);
     layout->addLayout(countsRow);
     connect(logScale, &QCheckBox::toggled, histogram_, &HistogramWidget::setLogarithmic);
     auto* buttons = new QHBoxLayout;
@@ -212,7 +212,7 @@ void ScalarFieldPanel::refresh()
     }
     const bool enabled = field != nullptr;
     for (QWidget* w : std::initializer_list<QWidget*>{scaleBox_, editScale_, outsideBox_, colours_, symmetric_, automaticColours_, range_,
-                                                      histogram_, resetRange_, split_})
+                                                      histogram_, exportHistogram_, resetRange_, split_})
         w->setEnabled(enabled);
     fieldBox_->setEnabled(item != nullptr);
     if (field) {
@@ -247,7 +247,9 @@ void ScalarFieldPanel::refresh()
             references.emplace_back(value, QString::fromStdString(label) + " " + QString::number(value, 'g', 6));
         histogram_->setReferenceLines(std::move(references));
     } else {
-        // Nothing of the previous entity's field stays on show.
+        // Nothing of the previous entity's field stays on show; the height is
+        // drawn in the default scale.
+        scaleBox_->setCurrentText(QString::fromStdString(ColourScale::defaultScale().name()));
         for (RangeEditor* editor : {range_, colours_}) {
             editor->setBounds(0.0, 1.0);
             editor->setRange(0.0, 1.0);

@@ -93,6 +93,7 @@ private:
     QLabel* inside_;
     QPushButton* resetRange_;
     QPushButton* split_;
+    QPushButton* exportHistogram_;
     bool updating_ = false;
 };
 

@@ -103,6 +103,52 @@ void addCloneTool(ToolRegistry& registry)
     registry.add(std::move(tool));
 }
 
+// "R,G,B" (each 0-255) or "#rrggbb".
+Rgb8 parseColour(const std::string& text)
+{
+    const auto invalid = [&] {
+        return Error(ErrorCode::InvalidArgument, "set-colour: '" + text + "' is not a colour (R,G,B with each 0-255, or #rrggbb)");
+    };
+    int channels[3] = {0, 0, 0};
+    if (!text.empty() && text.front() == '#') {
+        if (text.size() != 7 || text.find_first_not_of("0123456789abcdefABCDEF", 1) != std::string::npos)
+            throw invalid();
+        for (int c = 0; c < 3; ++c)
+            channels[c] = std::stoi(text.substr(1 + 2 * c, 2), nullptr, 16);
+    } else {
+        const std::vector<double> values = parseNumberWords(text, "set-colour");
+        if (values.size() != 3)
+            throw invalid();
+        for (int c = 0; c < 3; ++c) {
+            if (!(values[c] >= 0 && values[c] <= 255) || values[c] != std::floor(values[c]))
+                throw invalid();
+            channels[c] = static_cast<int>(values[c]);
+        }
+    }
+    return Rgb8{static_cast<std::uint8_t>(channels[0]), static_cast<std::uint8_t>(channels[1]), static_cast<std::uint8_t>(channels[2])};
+}
+
+// CloudCompare's Edit > Colors > Set unique: one colour for every point,
+// e.g. to tell two epochs apart at a glance.
+void addSetColourTool(ToolRegistry& registry)
+{
+    ToolSpec tool = oneCloudTool("set-colour", "Set one colour", "Edit",
+                                 "Gives every point of the cloud one colour (replacing its colours, if any).",
+                                 updatedCloud("Coloured cloud"));
+    tool.parameters = {ParameterSpec::text("colour", "Colour", "R,G,B (each 0-255) or #rrggbb", "255,200,0")};
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver*) {
+        const Rgb8 colour = parseColour(values.text("colour"));
+        PointCloud out = inputs.cloud().clone();
+        std::vector<Rgb8>& colours = out.enableColors();
+        std::fill(colours.begin(), colours.end(), colour);
+        ToolResult result;
+        result.summary = describe("coloured ", out.size(), " points ", int(colour.r), ",", int(colour.g), ",", int(colour.b));
+        result.add("output", std::move(out));
+        return result;
+    };
+    registry.add(std::move(tool));
+}
+
 void addMergeTool(ToolRegistry& registry)
 {
     ToolSpec tool = oneCloudTool("merge", "Merge clouds", "Edit",
@@ -355,6 +401,7 @@ void registerEditTools(ToolRegistry& registry)
 {
     addCloneTool(registry);
     addMergeTool(registry);
+    addSetColourTool(registry);
     addTransformTool(registry);
     addUndoTransformTool(registry);
     addCropTool(registry);

@@ -1,0 +1,204 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Qt Test under Xvfb: the everyday conveniences a CloudCompare user reaches
+// for, driven through the workbench's own menus and keys: the Help menu, the
+// shortcuts (none shared by two actions), the standard views' keys, Close and
+// Close all, the tree's context menu (show/hide, colour, clone, rename...).
+#include "HelpDialogs.h"
+#include "MainWindow.h"
+#include "panels/EntityTree.h"
+#include "view/CloudView.h"
+
+#include <scandiff/plugins/PluginRegistry.h>
+
+#include <QAction>
+#include <QFileInfo>
+#include <QMenu>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QPushButton>
+#include <QStandardPaths>
+#include <QtTest>
+
+#include <map>
+
+using namespace scandiff;
+using gui::EntityId;
+
+namespace {
+
+struct Workbench
+{
+    PluginRegistry registry = makePluginRegistry();
+    gui::MainWindow window{registry};
+    bool shown()
+    {
+        window.show();
+        return QTest::qWaitForWindowExposed(&window);
+    }
+};
+
+const QString kReference = SCANDIFF_SAMPLE_DATA_DIR "/demo/site-2019.ply";
+const QString kCompared = SCANDIFF_SAMPLE_DATA_DIR "/demo/site-2024.ply";
+
+QAction* treeAction(gui::MainWindow& window, const char* name)
+{
+    for (QAction* action : window.tree()->actions())
+        if (action->objectName() == name)
+            return action;
+    return nullptr;
+}
+
+} // namespace
+
+class WorkbenchMenusTest : public QObject
+{
+    Q_OBJECT
+
+private slots:
+    void initTestCase()
+    {
+        QStandardPaths::setTestModeEnabled(true);
+        QCoreApplication::setOrganizationName("scandiff-tests");
+        qRegisterMetaType<gui::EntityId>("EntityId");
+    }
+
+    // Help > the guide's pages (files that exist), the shortcuts, About; the
+    // shortcut list read from the menus; no key given to two actions (Qt then
+    // runs neither: an "ambiguous shortcut").
+    void theHelpMenuAndTheShortcutsAreCompleteAndUnambiguous()
+    {
+        Workbench w;
+        QVERIFY(w.shown());
+        QMenu* help = nullptr;
+        for (QAction* a : w.window.menuBar()->actions())
+            if (a->text().remove('&') == "Help")
+                help = a->menu();
+        QVERIFY(help);
+        QStringList texts;
+        for (QAction* a : help->actions())
+            texts << a->text().remove('&');
+        QVERIFY2(texts.contains("User guide (the workbench step by step)"), qPrintable(texts.join('|')));
+        QVERIFY(texts.contains("Keyboard shortcuts") && texts.contains("About scandiff"));
+        const QString docs = gui::documentationFolder();
+        QVERIFY(QFileInfo::exists(docs + "/workbench.md"));
+        for (QAction* a : help->actions())
+            if (!a->statusTip().isEmpty())
+                QVERIFY2(QFileInfo::exists(a->statusTip()), qPrintable(a->statusTip()));
+
+        std::map<QString, QString> byAction;
+        for (const auto& [action, keys] : gui::shortcutList(*w.window.menuBar()))
+            byAction[action] = keys;
+        QCOMPARE(byAction["View > Standard views > Top"], QString("8"));
+        QCOMPARE(byAction["View > Standard views > Front"], QString("5"));
+        QCOMPARE(byAction["File > Close all"], QString("Ctrl+Shift+W"));
+        QCOMPARE(byAction["File > Close selected"], QKeySequence(QKeySequence::Close).toString(QKeySequence::NativeText));
+        QVERIFY(byAction.count("Edit > Redo") == 1 && byAction.count("Help > User guide (the workbench step by step)") == 1);
+
+        std::map<QString, QStringList> actionsOfKey;
+        std::function<void(QMenu*)> walk = [&](QMenu* menu) {
+            for (QAction* a : menu->actions()) {
+                if (a->menu())
+                    walk(a->menu());
+                for (const QKeySequence& key : a->shortcuts())
+                    actionsOfKey[key.toString()] << a->text();
+            }
+        };
+        for (QAction* a : w.window.menuBar()->actions())
+            if (a->menu())
+                walk(a->menu());
+        for (const auto& [key, actions] : actionsOfKey)
+            QVERIFY2(actions.size() == 1, qPrintable(key + ": " + actions.join(", ")));
+
+        QVERIFY(QMetaObject::invokeMethod(help->actions().last(), "trigger", Qt::QueuedConnection)); // About: a modal box
+        QTimer::singleShot(300, [] {
+            if (QWidget* box = QApplication::activeModalWidget())
+                box->close();
+        });
+        QTest::qWait(600);
+    }
+
+    // The keys of the standard views turn the camera as the menu does.
+    void theStandardViewsAnswerTheirKeys()
+    {
+        Workbench w;
+        QVERIFY(w.shown());
+        QCOMPARE(w.window.openFiles({kReference}, true), 1);
+        w.window.view()->setStandardView(gui::StandardView::Iso);
+        w.window.activateWindow();
+        QVERIFY(QTest::qWaitForWindowActive(&w.window));
+        w.window.view()->setFocus();
+        QTest::keyClick(w.window.view(), Qt::Key_8);
+        QTest::qWait(50);
+        gui::CameraState top = w.window.view()->camera();
+        Eigen::Vector3d direction = Eigen::Vector3d(top.focalPoint.data()) - Eigen::Vector3d(top.position.data());
+        QVERIFY2(direction.normalized().z() < -0.999, "8 looks down");
+        QTest::keyClick(w.window.view(), Qt::Key_5);
+        QTest::qWait(50);
+        const gui::CameraState front = w.window.view()->camera();
+        direction = Eigen::Vector3d(front.focalPoint.data()) - Eigen::Vector3d(front.position.data());
+        QVERIFY2(std::abs(direction.normalized().z()) < 1e-6 && direction.normalized().y() > 0.999999,
+                 qPrintable(QString("5 looks level, along +y: %1 %2 %3").arg(direction.x()).arg(direction.y()).arg(direction.z())));
+    }
+
+    // The tree's menu: every entry there; show/hide, one colour (undone by
+    // Ctrl+Z), a clone, Close selected (undone) and Close all.
+    void theTreeMenuActsOnTheSelection()
+    {
+        Workbench w;
+        QVERIFY(w.shown());
+        QCOMPARE(w.window.openFiles({kReference, kCompared}, true), 2);
+        gui::Document& document = w.window.document();
+        const std::vector<EntityId> ids = document.ids();
+        QCOMPARE(ids.size(), std::size_t(2));
+        for (const char* name : {"treeShowHide", "treeColour", "treeProperties", "treeClone", "treeMerge", "treeExport",
+                                 "treeExportRegions", "treePointSize", "treeDelete"})
+            QVERIFY2(treeAction(w.window, name), name);
+        QStringList texts;
+        for (QAction* a : w.window.tree()->actions())
+            texts << a->text().remove('&');
+        QVERIFY(texts.contains("Rename...") && texts.contains("Zoom to selection"));
+
+        const EntityId first = ids.front();
+        w.window.tree()->selectEntity(first);
+        treeAction(w.window, "treeShowHide")->trigger();
+        QVERIFY(!document.item(first).display.visible);
+        QVERIFY(document.item(ids.back()).display.visible);
+        treeAction(w.window, "treeShowHide")->trigger();
+        QVERIFY(document.item(first).display.visible);
+
+        const std::vector<Rgb8> before = document.item(first).points().colors();
+        QCOMPARE(w.window.colourSelected(QColor(10, 200, 30)), 1);
+        const PointCloud& coloured = document.item(first).points();
+        QVERIFY(coloured.hasColors());
+        for (const Rgb8& c : coloured.colors())
+            QVERIFY(c == (Rgb8{10, 200, 30}));
+        QVERIFY(document.item(first).display.activeField.empty());
+        document.undo();
+        QVERIFY(document.item(first).points().colors() == before);
+
+        QCOMPARE(w.window.cloneSelected(), 1);
+        QCOMPARE(document.size(), std::size_t(3));
+        const EntityId copy = document.ids().back();
+        QCOMPARE(document.item(copy).points().size(), document.item(first).points().size());
+        QVERIFY(document.item(copy).points().positions() == document.item(first).points().positions());
+
+        w.window.tree()->selectEntity(copy);
+        w.window.closeSelected();
+        QCOMPARE(document.size(), std::size_t(2));
+        QVERIFY(document.undoText().contains("close"));
+        document.undo();
+        QCOMPARE(document.size(), std::size_t(3));
+
+        // Close all: the clone holds unsaved work, so the question comes: Discard.
+        QTimer::singleShot(300, [] {
+            if (auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget()))
+                box->button(QMessageBox::Discard)->click();
+        });
+        QVERIFY(w.window.closeEverything());
+        QCOMPARE(document.size(), std::size_t(0));
+        QVERIFY(!w.window.closeEverything()); // nothing left to close
+    }
+};
+
+QTEST_MAIN(WorkbenchMenusTest)
+#include "WorkbenchMenusTest.moc"
