@@ -364,7 +364,12 @@ void MainWindow::buildViewMenu()
     // Deferred: the cut changes the document, which must not happen inside VTK's mouse event.
     connect(view_, &CloudView::polygonDrawn, this, [this](const std::vector<Eigen::Vector2d>& polygon, const Eigen::Matrix4d& projection) {
         QTimer::singleShot(0, this, [this, polygon, projection] {
-            splits_->cutWithPolygon(polygon, projection, [this](EntityId id, std::size_t i) { return view_->isPointShown(id, i); });
+            const std::optional<SplitController::Keep> keep = askWhatTheScissorsKeep();
+            if (!keep) {
+                statusBar()->showMessage(tr("Scissors: nothing cut; draw another polygon, or T to stop"));
+                return;
+            }
+            splits_->cutWithPolygon(polygon, projection, [this](EntityId id, std::size_t i) { return view_->isPointShown(id, i); }, *keep);
         });
     });
     viewBar->addAction(scissors);
@@ -543,6 +548,29 @@ void MainWindow::buildHelpMenu()
     QAction* keys = help->addAction(tr("&Keyboard shortcuts"), this, [this] { showShortcuts(this, *menuBar()); });
     keys->setObjectName("shortcutsAction");
     help->addAction(tr("&About scandiff"), this, [this] { showAbout(this); });
+}
+
+std::optional<SplitController::Keep> MainWindow::askWhatTheScissorsKeep()
+{
+    QMessageBox box(QMessageBox::Question, tr("Segment by polygon"), tr("What becomes a cloud of its own?"), QMessageBox::NoButton, this);
+    box.setObjectName("scissors-question");
+    box.setInformativeText(tr("The cloud cut stays in the tree, hidden; Undo takes the cut back."));
+    QPushButton* inside = box.addButton(tr("Keep &inside"), QMessageBox::AcceptRole);
+    inside->setObjectName("keepInside");
+    QPushButton* outside = box.addButton(tr("Keep &outside"), QMessageBox::AcceptRole);
+    outside->setObjectName("keepOutside");
+    QPushButton* both = box.addButton(tr("&Both parts"), QMessageBox::AcceptRole);
+    both->setObjectName("keepBoth");
+    box.addButton(QMessageBox::Cancel);
+    box.setDefaultButton(inside);
+    box.exec();
+    if (box.clickedButton() == inside)
+        return SplitController::Keep::Inside;
+    if (box.clickedButton() == outside)
+        return SplitController::Keep::Outside;
+    if (box.clickedButton() == both)
+        return SplitController::Keep::Both;
+    return std::nullopt;
 }
 
 void MainWindow::removeSelected(const QString& verb)

@@ -4,6 +4,7 @@
 //! signals; files, distances, splits, sessions and plugin tools each have
 //! their own controller (controllers/), panels show the document (panels/).
 
+#include "controllers/SplitController.h"
 #include "document/Document.h"
 
 #include <scandiff/plugins/PluginRegistry.h>
@@ -13,6 +14,7 @@
 #include <QStringList>
 
 #include <map>
+#include <optional>
 #include <vector>
 
 namespace scandiff::gui {
@@ -27,7 +29,6 @@ class PropertiesPanel;
 class ScalarFieldPanel;
 class SegmentationController;
 class SessionController;
-class SplitController;
 class ToolController;
 
 class MainWindow : public QMainWindow
@@ -99,6 +100,8 @@ private:
     //! Removes the tree's selected entities as one undo step named by `verb`.
     void removeSelected(const QString& verb);
     void renameCurrent();
+    //! The scissors' confirm step: which part to keep, or nothing (Cancel).
+    std::optional<SplitController::Keep> askWhatTheScissorsKeep();
     void buildToolsMenu(QMenu* editMenu, QMenu* toolsMenu);
     //! The tree's current entity, then the other selected ones: what a tool proposes as its inputs.
     std::vector<EntityId> toolSelection() const;

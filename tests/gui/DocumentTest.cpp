@@ -334,6 +334,55 @@ private slots:
         QCOMPARE(renamed.count(), 3);
     }
 
+    // The scissors keep what the user chose: both parts, the inside or the
+    // outside alone (shown), each holding exactly the points a brute force
+    // puts there (points hidden by the view never inside); undone, the cut goes.
+    void theScissorsKeepTheChosenPartAndNothingIsLost()
+    {
+        // A 20 x 20 grid at UTM-like coordinates, seen from above: screen x, y
+        // = global x, y minus the corner (w = 1).
+        PointCloud grid;
+        grid.setOrigin(Eigen::Vector3d(512000, 5403000, 100));
+        grid.resize(400);
+        for (std::size_t i = 0; i < 400; ++i)
+            grid.positions()[i] = Eigen::Vector3f(float(i % 20), float(i / 20), 0);
+        Eigen::Matrix4d toScreen = Eigen::Matrix4d::Identity();
+        toScreen(0, 3) = -512000;
+        toScreen(1, 3) = -5403000;
+        const std::vector<Eigen::Vector2d> triangle{{-0.5, -0.5}, {12.7, -0.5}, {-0.5, 12.7}};
+        const auto insideByHand = [](std::size_t i) { return i % 20 + i / 20 <= 12; }; // under the hypotenuse x + y = 12.2
+        const auto hidden = [](std::size_t i) { return i % 7 == 0; }; // e.g. beyond a threshold
+        using Keep = gui::SplitController::Keep;
+        for (Keep keep : {Keep::Both, Keep::Inside, Keep::Outside}) {
+            gui::Document document;
+            gui::SplitController splits(document);
+            const EntityId id = document.add("grid", grid.clone());
+            QCOMPARE(splits.cutWithPolygon(triangle, toScreen, [&](EntityId, std::size_t i) { return !hidden(i); }, keep), 1);
+            const std::vector<EntityId> parts = document.children(id);
+            QCOMPARE(parts.size(), std::size_t(keep == Keep::Both ? 2 : 1));
+            QVERIFY(!document.item(id).display.visible);
+            std::size_t expectedInside = 0;
+            for (std::size_t i = 0; i < 400; ++i)
+                expectedInside += insideByHand(i) && !hidden(i);
+            const std::size_t expected = keep == Keep::Outside ? 400 - expectedInside : expectedInside;
+            const gui::Document::Item& kept = document.item(parts.front());
+            QCOMPARE(kept.points().size(), expected);
+            QVERIFY(kept.display.visible);
+            // Every kept point is one of the grid's, on the side chosen.
+            for (const Eigen::Vector3f& p : kept.points().positions()) {
+                const auto i = static_cast<std::size_t>(std::lround(p.y()) * 20 + std::lround(p.x()));
+                QCOMPARE(insideByHand(i) && !hidden(i), keep != Keep::Outside);
+            }
+            if (keep == Keep::Both) {
+                QCOMPARE(document.item(parts.back()).points().size(), 400 - expectedInside);
+                QVERIFY(!document.item(parts.back()).display.visible);
+            }
+            document.undo();
+            QVERIFY(document.children(id).empty());
+            QVERIFY(document.item(id).display.visible);
+        }
+    }
+
     void undoRestoresADeletionAChangeAndAField()
     {
         gui::Document document;

@@ -1179,14 +1179,41 @@ private slots:
         // A triangle drawn in the middle of the view.
         auto* action = window.findChild<QAction*>("scissorsAction");
         QVERIFY(action);
-        action->setChecked(true);
-        QVERIFY(window.view()->scissorsMode());
         const double w = window.view()->width(), h = window.view()->height();
         const std::vector<Eigen::Vector2d> triangle{{0.3 * w, 0.3 * h}, {0.8 * w, 0.4 * h}, {0.4 * w, 0.8 * h}};
-        for (const Eigen::Vector2d& v : triangle)
-            window.view()->addScissorsVertex(v.x(), v.y());
-        const Eigen::Matrix4d projection = window.view()->globalToWidgetPixels();
-        window.view()->finishScissors();
+        // The confirm step asks what to keep: answered by `button` once it shows.
+        const auto answerTheQuestion = [](const char* button) {
+            auto* poll = new QTimer;
+            poll->setInterval(20);
+            QObject::connect(poll, &QTimer::timeout, poll, [poll, button] {
+                auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget());
+                if (!box || box->objectName() != "scissors-question")
+                    return;
+                QAbstractButton* answer = box->findChild<QAbstractButton*>(button);
+                if (!answer) // the standard Cancel has no name of ours
+                    answer = box->button(QMessageBox::Cancel);
+                answer->click();
+                poll->deleteLater();
+            });
+            poll->start();
+        };
+        const auto drawTriangle = [&] {
+            action->setChecked(true);
+            for (const Eigen::Vector2d& v : triangle)
+                window.view()->addScissorsVertex(v.x(), v.y());
+            const Eigen::Matrix4d drawnWith = window.view()->globalToWidgetPixels();
+            window.view()->finishScissors();
+            return drawnWith;
+        };
+        // Cancelled: nothing cut.
+        answerTheQuestion("cancel");
+        drawTriangle();
+        QTest::qWait(300);
+        QCOMPARE(window.document().ids().size(), std::size_t(1));
+        QVERIFY(window.document().item(id).display.visible);
+        // Both parts kept.
+        answerTheQuestion("keepBoth");
+        const Eigen::Matrix4d projection = drawTriangle();
         QVERIFY(!window.view()->scissorsMode() && !action->isChecked());
         // Brute force: project each point, keep those shown and inside the triangle.
         auto insideTriangle = [&](const Eigen::Vector2d& p) {

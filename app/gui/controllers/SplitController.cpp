@@ -66,23 +66,26 @@ std::pair<EntityId, EntityId> SplitController::split(EntityId id, const std::str
 }
 
 int SplitController::cutWithPolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Matrix4d& globalToPixels,
-                                    const std::function<bool(EntityId, std::size_t)>& shown)
+                                    const std::function<bool(EntityId, std::size_t)>& shown, Keep keep)
 {
-    return cutVisibleClouds(tr("segment by polygon"), tr("inside polygon"), tr("outside polygon"), [&](EntityId id, const PointCloud& cloud) {
-        std::vector<std::size_t> inside = pointsInScreenPolygon(cloud, globalToPixels, polygon);
-        inside.erase(std::remove_if(inside.begin(), inside.end(), [&](std::size_t i) { return !shown(id, i); }), inside.end());
-        return inside;
-    });
+    return cutVisibleClouds(
+        tr("segment by polygon"), tr("inside polygon"), tr("outside polygon"),
+        [&](EntityId id, const PointCloud& cloud) {
+            std::vector<std::size_t> inside = pointsInScreenPolygon(cloud, globalToPixels, polygon);
+            inside.erase(std::remove_if(inside.begin(), inside.end(), [&](std::size_t i) { return !shown(id, i); }), inside.end());
+            return inside;
+        },
+        keep);
 }
 
 int SplitController::extractInBox(const CropBox& box)
 {
     return cutVisibleClouds(tr("extract in the clipping box"), tr("in box"), tr("outside box"),
-                            [&](EntityId, const PointCloud& cloud) { return pointsInBox(cloud, box); });
+                            [&](EntityId, const PointCloud& cloud) { return pointsInBox(cloud, box); }, Keep::Both);
 }
 
 int SplitController::cutVisibleClouds(const QString& what, const QString& insideName, const QString& outsideName,
-                                      const std::function<std::vector<std::size_t>(EntityId, const PointCloud&)>& select)
+                                      const std::function<std::vector<std::size_t>(EntityId, const PointCloud&)>& select, Keep keep)
 {
     int cut = 0;
     EntityId lastInside = kNoEntity;
@@ -98,12 +101,14 @@ int SplitController::cutVisibleClouds(const QString& what, const QString& inside
             emit failed(QString::fromStdString(e.what()));
             return cut;
         }
-        if (inside.empty())
-            continue;
         const std::vector<std::size_t> outside = complementOf(inside, item->cloud()->size());
+        // Nothing to cut off: the part kept would be the whole cloud, or nothing.
+        if (inside.empty() || (keep == Keep::Outside && outside.empty()))
+            continue;
         const QString name = item->name;
         const DisplayState display = item->display;
-        PointCloud insidePart = item->cloud()->subset(inside), outsidePart = item->cloud()->subset(outside);
+        PointCloud insidePart = keep != Keep::Outside ? item->cloud()->subset(inside) : PointCloud();
+        PointCloud outsidePart = keep != Keep::Inside ? item->cloud()->subset(outside) : PointCloud();
         // The parts look as their cloud did: active field, scales, thresholds.
         auto dress = [this, &display](EntityId part) {
             for (const auto& [field, fieldDisplay] : display.fields)
@@ -112,12 +117,17 @@ int SplitController::cutVisibleClouds(const QString& what, const QString& inside
             document_.setOutsideMode(part, display.outside);
             document_.setNeutral(part, display.neutral);
         };
-        lastInside = document_.add(QString("%1 (%2)").arg(name, insideName), std::move(insidePart), id);
-        dress(lastInside);
-        if (!outside.empty()) {
+        if (keep != Keep::Outside) {
+            lastInside = document_.add(QString("%1 (%2)").arg(name, insideName), std::move(insidePart), id);
+            dress(lastInside);
+        }
+        if (keep != Keep::Inside && !outside.empty()) {
             const EntityId rest = document_.add(QString("%1 (%2)").arg(name, outsideName), std::move(outsidePart), id);
             dress(rest);
-            document_.setVisible(rest, false);
+            if (keep == Keep::Both)
+                document_.setVisible(rest, false);
+            else
+                lastInside = rest; // the part kept is what the tree selects
         }
         document_.setVisible(id, false);
         emit finished(tr("%1 %2: %3 points inside, %4 outside").arg(what, name).arg(inside.size()).arg(outside.size()));
