@@ -5,13 +5,17 @@
 // Close all, the tree's context menu (show/hide, colour, clone, rename...).
 #include "HelpDialogs.h"
 #include "MainWindow.h"
+#include "controllers/SessionController.h"
 #include "panels/EntityTree.h"
+#include "tools/MeasurePanel.h"
 #include "view/CloudView.h"
 
 #include <scandiff/plugins/PluginRegistry.h>
 
 #include <QAction>
 #include <QFileInfo>
+#include <QListWidget>
+#include <QTemporaryDir>
 #include <QMenu>
 #include <QMenuBar>
 #include <QMessageBox>
@@ -115,6 +119,45 @@ private slots:
                 box->close();
         });
         QTest::qWait(600);
+    }
+
+    // A measurement of one point is a label: its coordinates to the
+    // millimetre and the value of the field shown where it was picked; kept
+    // in the list, the view and the session.
+    void aPointLabelStaysWithItsCoordinatesAndValue()
+    {
+        Workbench w;
+        QVERIFY(w.shown());
+        QCOMPARE(w.window.openFiles({kCompared}, true), 1);
+        gui::Document& document = w.window.document();
+        const EntityId id = document.ids().front();
+        ScalarField d("d", document.item(id).points().size());
+        for (std::size_t i = 0; i < d.size(); ++i)
+            d.setValue(i, 0.001 * double(i));
+        document.addField(id, std::move(d));
+        QCOMPARE(document.item(id).display.activeField, std::string("d"));
+        w.window.measure()->setMeasuring(true);
+        w.window.measure()->addPick(id, 1234);
+        w.window.measure()->startNew();
+        w.window.measure()->setMeasuring(false);
+        const Eigen::Vector3d p = document.item(id).points().globalPosition(1234);
+        const QString expected = QString("X %1, Y %2, Z %3; site-2024: d = 1.234")
+                                     .arg(p.x(), 0, 'f', 3)
+                                     .arg(p.y(), 0, 'f', 3)
+                                     .arg(p.z(), 0, 'f', 3);
+        auto* kept = w.window.measure()->findChild<QListWidget*>("kept");
+        QVERIFY(kept);
+        QCOMPARE(kept->count(), 1);
+        QCOMPARE(kept->item(0)->text(), "M1: " + expected);
+        QCOMPARE(w.window.view()->annotationCount(), std::size_t(1));
+        QTemporaryDir folder;
+        const QString session = folder.filePath("label.scandiff");
+        QVERIFY(w.window.sessions()->save(session));
+        document.clear();
+        QVERIFY(w.window.sessions()->restore(session));
+        QCOMPARE(kept->count(), 1);
+        QCOMPARE(kept->item(0)->text(), "M1: " + expected);
+        QCOMPARE(w.window.view()->annotationCount(), std::size_t(1));
     }
 
     // The keys of the standard views turn the camera as the menu does.

@@ -160,21 +160,23 @@ bool SessionController::save(const QString& qpath)
     json scales = json::array();
     for (const ColourScale& s : scalarPanel_.customScales())
         scales.push_back(s.toText());
-    json measurements = json::array();
+    json measurements = json::array(), measurementNotes = json::array();
     if (measure_)
-        for (const auto& points : measure_->measurements())
-            if (!points.empty()) {
+        for (std::size_t k = 0; k < measure_->measurements().size(); ++k)
+            if (const auto& points = measure_->measurements()[k]; !points.empty()) {
                 json list = json::array();
                 for (const Eigen::Vector3d& p : points)
                     list.push_back({p.x(), p.y(), p.z()});
                 measurements.push_back(list);
+                measurementNotes.push_back(measure_->notes()[k].toStdString());
             }
     const json session = {{"scandiffSession", kSessionVersion},
                           {"entities", entities},
                           {"customScales", scales},
                           {"camera", cameraJson(view_.camera())},
                           {"pointSize", view_.pointSize()},
-                          {"measurements", measurements}};
+                          {"measurements", measurements},
+                          {"measurementNotes", measurementNotes}};
 
     const TaskResult result = runTask(parentWindow_, tr("Saving session"), [&](ProgressObserver& progress) {
         // A previous save stays whole until the new one is: its data folder is
@@ -236,6 +238,7 @@ bool SessionController::restore(const QString& qpath)
     std::optional<CameraState> camera;
     float pointSize = 2.0f;
     std::vector<std::vector<Eigen::Vector3d>> measurements;
+    std::vector<QString> notes;
     const TaskResult result = runTask(parentWindow_, tr("Opening session"), [&](ProgressObserver& progress) {
         std::ifstream in(path);
         if (!in)
@@ -305,6 +308,8 @@ bool SessionController::restore(const QString& qpath)
                     points.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
                 measurements.push_back(std::move(points));
             }
+            for (const json& note : session.value("measurementNotes", json::array()))
+                notes.push_back(QString::fromStdString(note.get<std::string>()));
         } catch (const json::exception& e) {
             throw Error(ErrorCode::InvalidData, path.string() + " is not a valid scandiff session: " + e.what());
         }
@@ -338,7 +343,7 @@ bool SessionController::restore(const QString& qpath)
     view_.setPointSize(pointSize);
     // The measurements first: the camera's near and far planes take them in.
     if (measure_)
-        measure_->setMeasurements(std::move(measurements));
+        measure_->setMeasurements(std::move(measurements), std::move(notes));
     if (camera)
         view_.setCamera(*camera);
     document_.markAllSaved(); // derived entities are in the session's data folder

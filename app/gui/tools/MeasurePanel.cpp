@@ -64,6 +64,12 @@ void MeasurePanel::addPick(EntityId id, std::size_t index)
     const Document::Item* item = document_.find(id);
     if (!measuring_ || !item || index >= item->points().size())
         return;
+    // A point label says what the point holds of the field shown.
+    if (measurements_.back().empty()) {
+        const ScalarField* field = item->display.activeField.empty() ? nullptr : item->points().field(item->display.activeField);
+        notes_.back() = field ? tr("%1: %2 = %3").arg(item->name, QString::fromStdString(field->name())).arg(field->value(index), 0, 'g', 6)
+                              : QString();
+    }
     addPoint(item->points().globalPosition(index));
 }
 
@@ -75,38 +81,52 @@ void MeasurePanel::addPoint(const Eigen::Vector3d& global)
 
 void MeasurePanel::startNew()
 {
-    if (!measurements_.back().empty())
+    if (!measurements_.back().empty()) {
         measurements_.emplace_back();
+        notes_.emplace_back();
+    }
     refresh();
 }
 
 void MeasurePanel::undoLastPoint()
 {
-    if (!measurements_.back().empty())
+    if (!measurements_.back().empty()) {
         measurements_.back().pop_back();
-    else if (measurements_.size() > 1) // back into the previous measurement
+        if (measurements_.back().empty())
+            notes_.back().clear();
+    } else if (measurements_.size() > 1) { // back into the previous measurement
         measurements_.pop_back();
+        notes_.pop_back();
+    }
     refresh();
 }
 
 void MeasurePanel::deleteAll()
 {
     measurements_.assign(1, {});
+    notes_.assign(1, QString());
     refresh();
 }
 
-void MeasurePanel::setMeasurements(std::vector<std::vector<Eigen::Vector3d>> measurements)
+void MeasurePanel::setMeasurements(std::vector<std::vector<Eigen::Vector3d>> measurements, std::vector<QString> notes)
 {
     measurements_ = std::move(measurements);
+    notes_ = std::move(notes);
     if (measurements_.empty() || !measurements_.back().empty())
         measurements_.emplace_back();
+    notes_.resize(measurements_.size());
     refresh();
 }
 
-QString MeasurePanel::summary(const PointMeasurement& m)
+QString MeasurePanel::summary(const PointMeasurement& m, const std::vector<Eigen::Vector3d>& points, const QString& note)
 {
+    if (m.pointCount == 1) {
+        const Eigen::Vector3d& p = points.front();
+        const QString where = tr("X %1, Y %2, Z %3").arg(p.x(), 0, 'f', 3).arg(p.y(), 0, 'f', 3).arg(p.z(), 0, 'f', 3);
+        return note.isEmpty() ? where : where + "; " + note;
+    }
     if (m.pointCount < 2)
-        return m.pointCount == 1 ? tr("1 point") : QString();
+        return QString();
     if (m.pointCount == 2)
         return metres(m.pathLength);
     if (m.pointCount == 3)
@@ -141,7 +161,7 @@ void MeasurePanel::refresh()
         if (points.empty())
             continue;
         const PointMeasurement m = measurePoints(points);
-        const QString label = summary(m);
+        const QString label = summary(m, points, notes_[k]);
         if (k + 1 < measurements_.size())
             kept_->addItem(tr("M%1: %2").arg(k + 1).arg(label));
         annotations.push_back({points, points.size() > 3, QString("M%1: %2").arg(k + 1).arg(label).toStdString()});
