@@ -383,6 +383,45 @@ private slots:
         }
     }
 
+    // A field shown over the cloud's photo: each point's field colour times
+    // 0.35 + 0.65 x the luminance of its own colour; hidden points stay hidden;
+    // offered only on a cloud with colours; kept by the document.
+    void aFieldIsShadedByTheCloudsOwnColoursWhenAsked()
+    {
+        PointCloud cloud = fourPoints();
+        cloud.enableColors() = {Rgb8{255, 255, 255}, Rgb8{0, 0, 0}, Rgb8{200, 100, 50}, Rgb8{10, 20, 30}};
+        gui::DisplayState display;
+        display.activeField = "d";
+        display.fields["d"].high = 1.5; // hides the point of value 2
+        std::vector<std::uint8_t> plain(16), blended(16);
+        gui::colourEntity(cloud, display, plain.data());
+        display.blendColours = true;
+        gui::colourEntity(cloud, display, blended.data());
+        for (std::size_t i = 0; i < 4; ++i) {
+            const Rgb8 own = cloud.colors()[i];
+            const double shade = 0.35 + 0.65 * (0.2126 * own.r + 0.7152 * own.g + 0.0722 * own.b) / 255.0;
+            QCOMPARE(blended[4 * i + 3], plain[4 * i + 3]);
+            for (int k = 0; k < 3; ++k) {
+                const auto expected = plain[4 * i + 3] == 0 ? plain[4 * i + k] : static_cast<std::uint8_t>(std::lround(plain[4 * i + k] * shade));
+                QCOMPARE(blended[4 * i + k], expected);
+            }
+        }
+        QCOMPARE(plain[4 * 2 + 3], std::uint8_t(0)); // value 2: hidden either way
+        QCOMPARE(blended[0], plain[0]);                // white keeps the field's colour
+
+        gui::Document document;
+        gui::ScalarFieldPanel panel(document);
+        const EntityId coloured = document.add("photo", std::move(cloud));
+        document.setActiveField(coloured, "d");
+        panel.showEntity(coloured);
+        QVERIFY(panel.blendColoursBox()->isEnabled());
+        panel.blendColoursBox()->setChecked(true);
+        QVERIFY(document.item(coloured).display.blendColours);
+        const EntityId bare = document.add("bare", fourPoints());
+        panel.showEntity(bare);
+        QVERIFY(!panel.blendColoursBox()->isEnabled() && !panel.blendColoursBox()->isChecked());
+    }
+
     void undoRestoresADeletionAChangeAndAField()
     {
         gui::Document document;

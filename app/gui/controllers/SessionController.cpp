@@ -150,6 +150,7 @@ bool SessionController::save(const QString& qpath)
                             {"visible", item.display.visible},
                             {"activeField", item.display.activeField},
                             {"neutral", item.display.neutral},
+                            {"blendColours", item.display.blendColours},
                             {"pointSize", item.display.pointSize},
                             {"outside", item.display.outside == FieldColouring::Outside::Grey ? "grey" : "hide"},
                             {"fields", fields},
@@ -225,6 +226,7 @@ bool SessionController::restore(const QString& qpath)
         bool visible = true;
         std::string activeField;
         bool neutral = false;
+        bool blendColours = false;
         float pointSize = 0;
         FieldColouring::Outside outside = FieldColouring::Outside::Hide;
         std::map<std::string, FieldDisplay> fields;
@@ -258,6 +260,7 @@ bool SessionController::restore(const QString& qpath)
                 entry.visible = e.value("visible", true);
                 entry.activeField = e.value("activeField", std::string());
                 entry.neutral = e.value("neutral", false);
+                entry.blendColours = e.value("blendColours", false);
                 entry.pointSize = e.value("pointSize", 0.0f);
                 entry.outside = e.value("outside", std::string("hide")) == "grey" ? FieldColouring::Outside::Grey
                                                                                   : FieldColouring::Outside::Hide;
@@ -336,6 +339,7 @@ bool SessionController::restore(const QString& qpath)
             document_.setFieldDisplay(id, name, display);
         document_.setActiveField(id, e.activeField);
         document_.setNeutral(id, e.neutral);
+        document_.setBlendColours(id, e.blendColours);
         document_.setPointSize(id, e.pointSize);
         document_.setOutsideMode(id, e.outside);
         document_.setVisible(id, e.visible);

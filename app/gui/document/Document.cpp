@@ -308,6 +308,11 @@ void Document::setNeutral(EntityId id, bool neutral)
     setDisplayMember(id, &DisplayState::neutral, neutral);
 }
 
+void Document::setBlendColours(EntityId id, bool blend)
+{
+    setDisplayMember(id, &DisplayState::blendColours, blend);
+}
+
 void Document::setPointSize(EntityId id, float pixels)
 {
     setDisplayMember(id, &DisplayState::pointSize, pixels);

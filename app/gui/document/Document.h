@@ -54,6 +54,9 @@ struct DisplayState
     bool neutral = false;
     //! The entity's own point size in pixels; 0: the view's.
     float pointSize = 0;
+    //! An active field's colours shaded by the cloud's own (its photo's
+    //! lightness), so the field reads over the texture; no effect without colours.
+    bool blendColours = false;
     FieldColouring::Outside outside = FieldColouring::Outside::Hide;
     std::map<std::string, FieldDisplay> fields; //!< by field name; absent = defaults
 };
@@ -140,6 +143,7 @@ public:
     void setFieldDisplay(EntityId id, const std::string& fieldName, const FieldDisplay& display);
     void setOutsideMode(EntityId id, FieldColouring::Outside mode);
     void setNeutral(EntityId id, bool neutral);
+    void setBlendColours(EntityId id, bool blend);
     void setPointSize(EntityId id, float pixels);
     //! The display of a field (defaults when never set).
     FieldDisplay fieldDisplay(EntityId id, const std::string& fieldName) const;

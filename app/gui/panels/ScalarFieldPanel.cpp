@@ -56,6 +56,11 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
     outsideBox_->addItem(tr("Hidden"));
     outsideBox_->addItem(tr("Greyed"));
     form->addRow(tr("Outside the range"), outsideBox_);
+    blendColours_ = new QCheckBox(tr("Shaded by the cloud's colours"), this);
+    blendColours_->setObjectName("blendColours");
+    blendColours_->setToolTip(tr("The field's colours darkened where the cloud's own colours (its photo) are dark: "
+                                 "the field over the texture"));
+    form->addRow(QString(), blendColours_);
     layout->addLayout(form);
     // The colour range: what the scale spans, apart from what is shown.
     colours_ = new RangeEditor(this);
@@ -112,6 +117,10 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
     });
     connect(range_, &RangeEditor::rangeChanged, this, &ScalarFieldPanel::onRangeEdited);
     connect(colours_, &RangeEditor::rangeChanged, this, &ScalarFieldPanel::onColourRangeEdited);
+    connect(blendColours_, &QCheckBox::toggled, this, [this](bool on) {
+        if (!updating_)
+            document_.setBlendColours(entity_, on);
+    });
     connect(symmetric_, &QCheckBox::toggled, this, [this](bool on) {
         if (!updating_)
             editDisplay([on](FieldDisplay& d) { d.symmetric = on; });
@@ -215,6 +224,9 @@ void ScalarFieldPanel::refresh()
                                                       histogram_, exportHistogram_, resetRange_, split_})
         w->setEnabled(enabled);
     fieldBox_->setEnabled(item != nullptr);
+    // Only where it does something: a field shown on a cloud with colours.
+    blendColours_->setEnabled(enabled && item->points().hasColors());
+    blendColours_->setChecked(item && item->display.blendColours);
     if (field) {
         const FieldDisplay display = document_.fieldDisplay(entity_, field->name());
         scaleBox_->setCurrentText(QString::fromStdString(display.scale.name()));

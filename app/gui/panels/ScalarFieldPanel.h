@@ -45,6 +45,7 @@ public:
     RangeEditor* rangeEditor() const { return range_; }
     RangeEditor* colourRangeEditor() const { return colours_; }
     QCheckBox* symmetricBox() const { return symmetric_; }
+    QCheckBox* blendColoursBox() const { return blendColours_; }
     QPushButton* automaticColoursButton() const { return automaticColours_; }
     HistogramWidget* histogram() const { return histogram_; }
     QPushButton* splitButton() const { return split_; }
@@ -94,6 +95,7 @@ private:
     QPushButton* resetRange_;
     QPushButton* split_;
     QPushButton* exportHistogram_;
+    QCheckBox* blendColours_;
     bool updating_ = false;
 };
 

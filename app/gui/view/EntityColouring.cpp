@@ -138,6 +138,22 @@ ColourLegend legendOf(const PointCloud& points, const DisplayState& display)
     return legend;
 }
 
+void blendWithOwnColours(const PointCloud& points, std::uint8_t* rgba)
+{
+    if (!points.hasColors())
+        return;
+    const std::vector<Rgb8>& own = points.colors();
+    for (std::size_t i = 0; i < own.size(); ++i) {
+        std::uint8_t* c = rgba + 4 * i;
+        if (c[3] == 0)
+            continue;
+        const double lightness = (0.2126 * own[i].r + 0.7152 * own[i].g + 0.0722 * own[i].b) / 255.0;
+        const double shade = 0.35 + 0.65 * lightness;
+        for (int k = 0; k < 3; ++k)
+            c[k] = static_cast<std::uint8_t>(std::lround(c[k] * shade));
+    }
+}
+
 ColourLegend colourEntity(const PointCloud& points, const DisplayState& display, std::uint8_t* rgba)
 {
     const std::size_t n = points.size();
@@ -148,6 +164,8 @@ ColourLegend colourEntity(const PointCloud& points, const DisplayState& display,
         const FieldDisplay fieldDisplay = it == display.fields.end() ? FieldDisplay{} : it->second;
         if (isCategoricalField(*field)) {
             colourLabels(*field, fieldDisplay, display.outside, rgba);
+            if (display.blendColours)
+                blendWithOwnColours(points, rgba);
             return legendOf(points, display);
         }
         FieldColouring how;
@@ -156,6 +174,8 @@ ColourLegend colourEntity(const PointCloud& points, const DisplayState& display,
         how.visibleMax = fieldDisplay.high;
         how.outside = display.outside;
         colourise(field->values().data(), n, field->offset(), fieldDisplay.scale, how, rgba);
+        if (display.blendColours)
+            blendWithOwnColours(points, rgba);
         legend = {true, field->name(), fieldDisplay.scale, how.colourMin, how.colourMax, {}};
         return legend;
     }
