@@ -16,6 +16,7 @@
 #include "panels/PropertiesPanel.h"
 #include "panels/ScalarFieldPanel.h"
 #include "tools/MeasurePanel.h"
+#include "tools/MoveDialog.h"
 #include "tools/TableDialog.h"
 #include "view/CloudView.h"
 #include "view/EntityColouring.h"
@@ -304,6 +305,10 @@ QMenu* MainWindow::buildEditMenu()
     deleteAction_->setShortcut(QKeySequence::Delete);
     renameAction_ = edit->addAction(tr("&Rename..."), this, &MainWindow::renameCurrent);
     renameAction_->setShortcut(QKeySequence(Qt::Key_F2));
+    QAction* move = edit->addAction(tr("&Move / rotate..."), this, [this] { moveSelectedInteractively(); });
+    move->setObjectName("moveAction");
+    move->setShortcut(QKeySequence(tr("Ctrl+T")));
+    move->setStatusTip(tr("Move and turn the selected entities with the mouse or by typed values, then apply"));
     return edit;
 
 }
@@ -631,6 +636,44 @@ int MainWindow::colourSelected(const QColor& colour)
         }
     }
     return coloured;
+}
+
+MoveDialog* MainWindow::moveSelectedInteractively()
+{
+    std::vector<EntityId> ids;
+    for (EntityId id : tree_->selectedEntities(false))
+        if (document_.item(id).hasData())
+            ids.push_back(id);
+    if (ids.empty()) {
+        statusBar()->showMessage(tr("Move / rotate: select the clouds or meshes to move first"));
+        return nullptr;
+    }
+    auto* dialog = new MoveDialog(*view_, ids, this);
+    dialog->setAttribute(Qt::WA_DeleteOnClose);
+    connect(dialog, &MoveDialog::applyRequested, this, [this, ids](const Eigen::Matrix4d& global) { applyMotion(ids, global); });
+    dialog->show();
+    // Beside what it moves, not over it: the view's top right corner.
+    dialog->move(view_->mapToGlobal(QPoint(std::max(0, view_->width() - dialog->width() - 12), 12)));
+    return dialog;
+}
+
+int MainWindow::applyMotion(const std::vector<EntityId>& ids, const Eigen::Matrix4d& global)
+{
+    // Through the transform tool: in double, kept in each cloud's history,
+    // logged as the command line that repeats it, undone as one step.
+    ToolController* transform = toolController("transform");
+    if (!transform)
+        return 0;
+    QString matrix;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+            matrix += QString::number(global(r, c), 'g', 17) + (r == 3 && c == 3 ? "" : " ");
+    const Document::UndoGroup group(document_, tr("move"));
+    int moved = 0;
+    for (EntityId id : ids)
+        if (document_.contains(id) && transform->run(id, {{"matrix", matrix.toStdString()}}))
+            ++moved;
+    return moved;
 }
 
 int MainWindow::cloneSelected()

@@ -10,6 +10,8 @@
 #include <scandiff/plugins/PluginRegistry.h>
 
 #include <QColor>
+
+#include <Eigen/Core>
 #include <QMainWindow>
 #include <QStringList>
 
@@ -25,6 +27,7 @@ class DistanceController;
 class EntityTree;
 class FileController;
 class MeasurePanel;
+class MoveDialog;
 class PropertiesPanel;
 class ScalarFieldPanel;
 class SegmentationController;
@@ -83,6 +86,12 @@ public:
     int colourSelected(const QColor& colour);
     //! A copy of each selected cloud (the clone tool); returns how many.
     int cloneSelected();
+    //! Edit > Move / rotate: the dialog for the selected entities (null when
+    //! none is selected); it deletes itself when closed.
+    MoveDialog* moveSelectedInteractively();
+    //! Moves the entities by a global matrix with the transform tool (one undo
+    //! step); returns how many moved.
+    int applyMotion(const std::vector<EntityId>& ids, const Eigen::Matrix4d& global);
 
 protected:
     void closeEvent(QCloseEvent* event) override;

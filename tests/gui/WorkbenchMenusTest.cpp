@@ -8,8 +8,10 @@
 #include "controllers/SessionController.h"
 #include "panels/EntityTree.h"
 #include "tools/MeasurePanel.h"
+#include "tools/MoveDialog.h"
 #include "view/CloudView.h"
 
+#include <scandiff/core/processing/CloudEditing.h>
 #include <scandiff/plugins/PluginRegistry.h>
 
 #include <QAction>
@@ -158,6 +160,80 @@ private slots:
         QCOMPARE(kept->count(), 1);
         QCOMPARE(kept->item(0)->text(), "M1: " + expected);
         QCOMPARE(w.window.view()->annotationCount(), std::size_t(1));
+    }
+
+    // Move / rotate: a drag on the box moves the entities' drawing and the
+    // typed boxes follow; typed values move the drawing; Cancel leaves the
+    // data as it was; Apply moves every point by the matrix (brute force),
+    // as one undo step.
+    void moveAndRotateByMouseAndByValuesThenApplyOrCancel()
+    {
+        Workbench w;
+        QVERIFY(w.shown());
+        QCOMPARE(w.window.openFiles({kCompared}, true), 1);
+        gui::Document& document = w.window.document();
+        const EntityId id = document.ids().front();
+        w.window.tree()->selectEntity(id);
+        w.window.view()->setStandardView(gui::StandardView::Top);
+        QApplication::processEvents();
+        std::vector<Eigen::Vector3d> before;
+        for (std::size_t i = 0; i < document.item(id).points().size(); i += 97)
+            before.push_back(document.item(id).points().globalPosition(i));
+
+        // Cancelled: nothing moves.
+        gui::MoveDialog* dialog = w.window.moveSelectedInteractively();
+        QVERIFY(dialog && w.window.view()->movingEntities());
+        RigidMotion typed;
+        typed.offset = Eigen::Vector3d(1.5, -2.0, 0.25);
+        typed.heading = 30;
+        dialog->setMotion(typed);
+        const Eigen::Vector3d centre = w.window.view()->movingCentre();
+        QVERIFY((w.window.view()->movedBy() - rigidMotionMatrix(typed, centre)).norm() < 1e-12);
+        dialog->reject();
+        QApplication::processEvents();
+        QVERIFY(!w.window.view()->movingEntities());
+        QVERIFY(w.window.view()->movedBy().isIdentity(0.0));
+        QCOMPARE(document.item(id).points().globalPosition(0), before.front());
+
+        // A middle-button drag inside the box, seen from above: a move in the
+        // ground plane, no turn, and the boxes show it.
+        dialog = w.window.moveSelectedInteractively();
+        QVERIFY(dialog);
+        dialog->move(w.window.geometry().right() - 10, 0); // out of the view's way
+        const Eigen::Vector4d c = w.window.view()->globalToWidgetPixels() * w.window.view()->movingCentre().homogeneous();
+        const QPoint from(int(c.x() / c.w()), int(c.y() / c.w()));
+        QWidget* surface = w.window.view()->childAt(from);
+        QVERIFY(surface);
+        const QPoint at = surface->mapFrom(w.window.view(), from);
+        QTest::mousePress(surface, Qt::MiddleButton, {}, at);
+        for (int step = 1; step <= 8; ++step) {
+            QMouseEvent drag(QEvent::MouseMove, at + QPoint(5 * step, 0), Qt::NoButton, Qt::MiddleButton, Qt::NoModifier);
+            QApplication::sendEvent(surface, &drag);
+        }
+        QTest::mouseRelease(surface, Qt::MiddleButton, {}, at + QPoint(40, 0));
+        const Eigen::Matrix4d dragged = w.window.view()->movedBy();
+        const Eigen::Vector3d draggedBy = dragged.topRightCorner<3, 1>();
+        QVERIFY2(draggedBy.norm() > 0.1, "the drag moved the box");
+        const Eigen::Matrix3d draggedTurn = dragged.topLeftCorner<3, 3>();
+        QVERIFY((draggedTurn - Eigen::Matrix3d::Identity()).norm() < 1e-9);
+        QVERIFY(std::abs(dragged(2, 3)) < 1e-6); // seen from above: no height change
+        const RigidMotion shown = dialog->motion();
+        QVERIFY(std::abs(shown.offset.x() - dragged(0, 3)) < 1e-4 && std::abs(shown.offset.y() - dragged(1, 3)) < 1e-4);
+
+        // Typed, then applied.
+        dialog->setMotion(typed);
+        const Eigen::Matrix4d m = rigidMotionMatrix(typed, w.window.view()->movingCentre());
+        dialog->findChild<QPushButton*>("apply")->click();
+        QApplication::processEvents();
+        QVERIFY(!w.window.view()->movingEntities());
+        const PointCloud& moved = document.item(id).points();
+        for (std::size_t k = 0; k < before.size(); ++k) {
+            const Eigen::Vector3d expected = (m * before[k].homogeneous()).head<3>();
+            QVERIFY2((moved.globalPosition(97 * k) - expected).norm() < 1e-3, qPrintable(QString::number(k)));
+        }
+        QVERIFY(document.undoText().contains("move"));
+        document.undo();
+        QCOMPARE(document.item(id).points().globalPosition(0), before.front());
     }
 
     // The keys of the standard views turn the camera as the menu does.

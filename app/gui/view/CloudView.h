@@ -173,6 +173,20 @@ public:
     bool clippingBoxOn() const;
     void setClippingBox(const CropBox& box);
     CropBox clippingBox() const;
+    //! Move / rotate (CloudCompare's Translate/Rotate): a box with handles
+    //! around `ids` (drag inside it to move them, on a face to turn them about
+    //! its centre); they are drawn moved as it goes, their data untouched
+    //! until the caller applies the motion. movedBy() is the motion so far, in
+    //! global coordinates (global' = M global); movingCentre() the centre of
+    //! their bounds when it started (global).
+    void startMovingEntities(const std::vector<EntityId>& ids);
+    //! Moves the box and the drawing to a typed motion.
+    void setMovedBy(const Eigen::Matrix4d& global);
+    Eigen::Matrix4d movedBy() const;
+    Eigen::Vector3d movingCentre() const;
+    bool movingEntities() const;
+    //! The entities drawn where their data is again; the box goes.
+    void stopMovingEntities();
     //! Whether a point of a shown cloud is drawn (not hidden by its thresholds).
     bool isPointShown(EntityId id, std::size_t index) const;
 
@@ -206,6 +220,8 @@ signals:
     void projectionChanged(bool parallel);
     //! The camera moved (a drag, a zoom, a standard view, a restored session).
     void cameraChanged();
+    //! The move box was dragged: the motion so far (global coordinates).
+    void movedByChanged(const Eigen::Matrix4d& global);
 
 private:
     class PickCommand;
@@ -215,6 +231,8 @@ private:
     void updateScaleBar();
     //! Clips every chunk's mappers to the box's six faces (or none).
     void applyClipping();
+    //! The entities being moved drawn by the move box's transform.
+    void applyMovingPreview();
     void setDecimated(Shown& shown, bool moving);
     //! The near and far planes around what is shown and the measurements.
     void resetClippingRange();

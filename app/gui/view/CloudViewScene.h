@@ -117,6 +117,13 @@ struct CloudView::Scene
     vtkNew<vtkPolyData> scaleBarLine;
     vtkNew<vtkActor2D> scaleBarActor;
     vtkNew<vtkTextActor> scaleBarText;
+    // Move / rotate: the box around the entities being moved, their ids, the
+    // centre of their bounds (global) and the motion so far (global).
+    vtkNew<vtkBoxWidget2> moveWidget;
+    vtkNew<vtkBoxRepresentation> moveBox;
+    std::vector<EntityId> movingIds;
+    Eigen::Vector3d movingCentre = Eigen::Vector3d::Zero();
+    Eigen::Matrix4d movedBy = Eigen::Matrix4d::Identity();
     // Scissors: the polygon being drawn, in widget pixels, and its outline on screen.
     bool scissorsMode = false;
     std::vector<Eigen::Vector2d> scissors;

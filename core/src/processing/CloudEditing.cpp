@@ -262,22 +262,52 @@ CropBox parseOrientedBox(const std::string& text)
     box.centre = Eigen::Vector3d(v[0], v[1], v[2]);
     box.size = Eigen::Vector3d(v[3], v[4], v[5]);
     const double heading = v.size() > 6 ? v[6] : 0, pitch = v.size() > 7 ? v[7] : 0, roll = v.size() > 8 ? v[8] : 0;
-    // Heading about Z, then pitch about Y, then roll about X, as sensor poses.
-    box.rotation = (Eigen::AngleAxisd(heading * 3.14159265358979323846 / 180, Eigen::Vector3d::UnitZ()) *
-                    Eigen::AngleAxisd(pitch * 3.14159265358979323846 / 180, Eigen::Vector3d::UnitY()) *
-                    Eigen::AngleAxisd(roll * 3.14159265358979323846 / 180, Eigen::Vector3d::UnitX()))
-                       .toRotationMatrix();
+    box.rotation = rotationFromHeadingPitchRoll(heading, pitch, roll);
     return box;
+}
+
+Eigen::Matrix3d rotationFromHeadingPitchRoll(double heading, double pitch, double roll)
+{
+    // Heading about Z, then pitch about Y, then roll about X, as sensor poses.
+    constexpr double kRadians = 3.14159265358979323846 / 180;
+    return (Eigen::AngleAxisd(heading * kRadians, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch * kRadians, Eigen::Vector3d::UnitY()) *
+            Eigen::AngleAxisd(roll * kRadians, Eigen::Vector3d::UnitX()))
+        .toRotationMatrix();
+}
+
+Eigen::Vector3d headingPitchRollOf(const Eigen::Matrix3d& r)
+{
+    // The inverse of Rz(heading) Ry(pitch) Rx(roll).
+    const double degrees = 180.0 / 3.14159265358979323846;
+    return {std::atan2(r(1, 0), r(0, 0)) * degrees, std::asin(std::clamp(-r(2, 0), -1.0, 1.0)) * degrees,
+            std::atan2(r(2, 1), r(2, 2)) * degrees};
+}
+
+Eigen::Matrix4d rigidMotionMatrix(const RigidMotion& motion, const Eigen::Vector3d& centre)
+{
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    const Eigen::Matrix3d r = rotationFromHeadingPitchRoll(motion.heading, motion.pitch, motion.roll);
+    m.topLeftCorner<3, 3>() = r;
+    m.topRightCorner<3, 1>() = centre + motion.offset - r * centre;
+    return m;
+}
+
+RigidMotion rigidMotionOf(const Eigen::Matrix4d& matrix, const Eigen::Vector3d& centre)
+{
+    const Eigen::Matrix3d r = matrix.topLeftCorner<3, 3>();
+    const Eigen::Vector3d angles = headingPitchRollOf(r);
+    RigidMotion motion;
+    motion.heading = angles.x();
+    motion.pitch = angles.y();
+    motion.roll = angles.z();
+    motion.offset = matrix.topRightCorner<3, 1>() - centre + r * centre;
+    return motion;
 }
 
 std::string orientedBoxText(const CropBox& box)
 {
-    // The inverse of Rz(heading) Ry(pitch) Rx(roll).
-    const Eigen::Matrix3d& r = box.rotation;
-    const double degrees = 180.0 / 3.14159265358979323846;
-    const double heading = std::atan2(r(1, 0), r(0, 0)) * degrees;
-    const double pitch = std::asin(std::clamp(-r(2, 0), -1.0, 1.0)) * degrees;
-    const double roll = std::atan2(r(2, 1), r(2, 2)) * degrees;
+    const Eigen::Vector3d angles = headingPitchRollOf(box.rotation);
+    const double heading = angles.x(), pitch = angles.y(), roll = angles.z();
     char text[256];
     std::snprintf(text, sizeof text, "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.6g,%.6g,%.6g", box.centre.x(), box.centre.y(), box.centre.z(),
                   box.size.x(), box.size.y(), box.size.z(), heading, pitch, roll);

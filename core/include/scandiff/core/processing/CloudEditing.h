@@ -50,6 +50,23 @@ Eigen::Matrix4d rotationAbout(const Eigen::Vector3d& axis, double degrees, const
 Eigen::Matrix4d scaleAbout(double factor, const Eigen::Vector3d& centre);
 Eigen::Matrix4d translation(const Eigen::Vector3d& offset);
 
+//! Rz(heading) Ry(pitch) Rx(roll), angles in degrees: how oriented boxes,
+//! sensor poses and typed motions turn; and back (pitch in [-90, 90]).
+Eigen::Matrix3d rotationFromHeadingPitchRoll(double heading, double pitch, double roll);
+Eigen::Vector3d headingPitchRollOf(const Eigen::Matrix3d& rotation);
+
+//! A rigid motion as a user types it or drags it: turned about a centre by
+//! heading, pitch and roll (degrees), then moved by `offset` (metres).
+struct RigidMotion
+{
+    Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+    double heading = 0, pitch = 0, roll = 0;
+};
+//! The matrix of x' = R (x - centre) + centre + offset, R as above.
+Eigen::Matrix4d rigidMotionMatrix(const RigidMotion& motion, const Eigen::Vector3d& centre);
+//! The motion a rigid matrix makes about `centre` (its rotation part must be a rotation).
+RigidMotion rigidMotionOf(const Eigen::Matrix4d& matrix, const Eigen::Vector3d& centre);
+
 //! A box in global coordinates: centre, full side lengths along its own axes,
 //! and the rotation from its axes to the world's (identity: axis-aligned).
 struct CropBox
