@@ -31,14 +31,18 @@ void ProgressTicker::checkCancel() const
 
 void ProgressTicker::publish(std::uint64_t done)
 {
-    // Only the thread that moves the threshold reports, so the observer sees
-    // increasing fractions and at most one call per stride.
+    // The thresholds are the stride's multiples, and each one crossed is
+    // claimed by exactly one thread, which reports and polls for it: a run
+    // polls as many times as thresholds lie below its total, however the
+    // threads batched their steps. (Moving the threshold to done + stride
+    // made the count depend on that batching, so a Cancel set at the last
+    // poll of one run was never reached by the next.)
     std::uint64_t expected = nextReport_.load(std::memory_order_relaxed);
     while (done >= expected) {
-        if (nextReport_.compare_exchange_weak(expected, done + stride_, std::memory_order_relaxed)) {
-            observer_->report(std::min(1.0, static_cast<double>(done) / static_cast<double>(total_)));
+        if (nextReport_.compare_exchange_weak(expected, expected + stride_, std::memory_order_relaxed)) {
+            observer_->report(std::min(1.0, static_cast<double>(expected) / static_cast<double>(total_)));
             checkCancel();
-            return;
+            expected += stride_;
         }
     }
 }

@@ -78,12 +78,13 @@ void fitNormals(const octree::Octree& reference, const std::vector<Eigen::Vector
     for (double scale : params.normalScales) {
         for (std::size_t begin = 0; begin < n; begin += kQueriesPerBatch) {
             const std::size_t count = std::min(kQueriesPerBatch, n - begin);
+            detail::SparseSteps steps(ticker);
             reference.withinRadiusBatch(
                 cores.data() + begin, count, static_cast<float>(scale / 2),
                 [&](std::uint32_t q, const octree::Neighbour* list, std::size_t size) {
                     // Per query: Cancel is heard inside a batch, even when a
                     // large scale makes each query long.
-                    detail::stepSparingly(ticker);
+                    steps.step();
                     std::vector<std::uint32_t>& indices = scratch.local();
                     indices.resize(size);
                     for (std::size_t k = 0; k < size; ++k)
@@ -107,6 +108,7 @@ void fitNormals(const octree::Octree& reference, const std::vector<Eigen::Vector
                         scales[i] = scale;
                     }
                 });
+            steps.flush();
             ticker.checkCancel();
         }
     }
@@ -197,9 +199,10 @@ std::vector<CylinderStats> cylinderStats(const octree::Octree& epoch, const std:
             cylinder.radius = params.projectionScale / 2;
             cylinder.halfLength = params.maxDepth;
         }
+        detail::SparseSteps steps(ticker);
         epoch.withinCylinderBatch(cylinders.data(), count,
                                   [&](std::uint32_t q, const std::uint32_t* indices, const double* along, std::size_t size) {
-                                      detail::stepSparingly(ticker);
+                                      steps.step();
                                       // In the order of the points' indices (see fitNormals).
                                       std::vector<std::pair<std::uint32_t, double>>& byIndex = pairs.local();
                                       byIndex.resize(size);
@@ -212,6 +215,7 @@ std::vector<CylinderStats> cylinderStats(const octree::Octree& epoch, const std:
                                           t[k] = byIndex[k].second;
                                       stats[begin + q] = summarise(t, params);
                                   });
+        steps.flush();
         ticker.checkCancel();
     }
     return stats;
