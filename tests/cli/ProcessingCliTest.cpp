@@ -299,6 +299,18 @@ TEST(ProcessingCli, OutputPlacesAreCheckedOrCreatedBeforeTheInputsAreRead)
     r = test::runCliInProcess(registry, {"segment", input, "--field", "intensity", "--range", "90", "99", "--out-dir", (dir / "s" / "t").string()});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_TRUE(std::filesystem::exists(dir / "s" / "t" / "regions.csv"));
+    // The four that used to refuse a missing folder only after computing:
+    // the folder is made before the input is even read.
+    for (const std::vector<std::string>& command : std::vector<std::vector<std::string>>{
+             {"primitives", missingInput}, {"contours", missingInput}, {"stones", missingInput}, {"register-stations", missingInput, missingInput}}) {
+        const auto folder = dir / ("made-by-" + command.front()) / "x";
+        std::vector<std::string> args = command;
+        args.insert(args.end(), {"--out-dir", folder.string()});
+        r = test::runCliInProcess(registry, args);
+        EXPECT_NE(r.status, 0) << command.front();
+        EXPECT_NE(r.err.find("missing.ply"), std::string::npos) << command.front() << ": " << r.err;
+        EXPECT_TRUE(std::filesystem::is_directory(folder)) << command.front();
+    }
     // A file where the folder should be: refused, the file untouched.
     r = test::runCliInProcess(registry, {"sections", input, "--axis", "x", "--thickness", "0.2", "--step", "4", "--out-dir", input});
     EXPECT_NE(r.status, 0);
