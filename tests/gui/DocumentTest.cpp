@@ -316,6 +316,26 @@ private slots:
         QVERIFY(!QFile::exists(folder.filePath("none.csv")));
     }
 
+    // The panel keeps the width of its dock whatever the names it lists (the
+    // 18 scales, long field names): it once grew past the window's edge.
+    void thePanelStaysNarrowWithLongNames()
+    {
+        gui::Document document;
+        gui::ScalarFieldPanel panel(document);
+        panel.showEntity(document.add("x", fourPoints()));
+        const int usual = panel.minimumSizeHint().width();
+        PointCloud cloud = fourPoints();
+        cloud.addField("m3c2_distance_uncertainty_at_the_projection_scale");
+        panel.showEntity(document.add("a cloud with a rather long name for a scan of 2019", std::move(cloud)));
+        QCOMPARE(panel.minimumSizeHint().width(), usual);
+        // Nor the scales' names: the box is narrower than one sized to the longest.
+        QComboBox sizedToNames;
+        for (int i = 0; i < panel.scaleBox()->count(); ++i)
+            sizedToNames.addItem(panel.scaleBox()->itemText(i));
+        QVERIFY(panel.scaleBox()->minimumSizeHint().width() < sizedToNames.minimumSizeHint().width());
+        QCOMPARE(panel.scaleBox()->count(), int(ColourScale::presets().size()));
+    }
+
     void aRenameIsUndoneAndRedone()
     {
         gui::Document document;

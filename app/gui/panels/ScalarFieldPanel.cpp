@@ -12,6 +12,7 @@
 #include <scandiff/io/ResultFiles.h>
 
 #include <QCheckBox>
+#include <QAbstractItemView>
 #include <QComboBox>
 #include <QFileDialog>
 #include <QFormLayout>
@@ -42,10 +43,16 @@ ScalarFieldPanel::ScalarFieldPanel(Document& document, QWidget* parent) : QWidge
     auto* form = new QFormLayout;
     fieldBox_ = new QComboBox(this);
     fieldBox_->setObjectName("fieldBox");
+    fieldBox_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon); // long field names: see the scale's
+    fieldBox_->setMinimumContentsLength(22);
     form->addRow(tr("Active field"), fieldBox_);
     auto* scaleRow = new QHBoxLayout;
     scaleBox_ = new QComboBox(this);
     scaleBox_->setObjectName("scaleBox");
+    // As wide as a usual name, not the longest: the panel keeps its width
+    // (the list that opens shows every name whole).
+    scaleBox_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
+    scaleBox_->setMinimumContentsLength(22);
     editScale_ = new QPushButton(tr("Edit..."), this);
     editScale_->setToolTip(tr("Edit the colour scale's stops and save it as a new scale"));
     scaleRow->addWidget(scaleBox_, 1);
@@ -199,6 +206,7 @@ void ScalarFieldPanel::refreshScaleBox()
         scaleBox_->addItem(QString::fromStdString(s.name()));
     for (const ColourScale& s : customScales_)
         scaleBox_->addItem(QString::fromStdString(s.name()));
+    scaleBox_->view()->setMinimumWidth(scaleBox_->view()->sizeHintForColumn(0) + 24);
 }
 
 void ScalarFieldPanel::refresh()
