@@ -467,12 +467,9 @@ struct KeyedPoint
 };
 #pragma pack(pop)
 
-} // namespace
 
-CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference, const CloudToMeshParams& params,
-                              ProgressObserver* progress)
+void checkInputs(const PointCloud& compared, const Mesh& reference, const CloudToMeshParams& params)
 {
-    // --- Parameters and inputs.
     if (params.octreeLevel < 0 || params.octreeLevel > kMaxLevel)
         throw Error(ErrorCode::InvalidArgument, "cloud-to-mesh: octreeLevel must be 0 (automatic) or 1.." +
                                                     std::to_string(kMaxLevel) + ", got " +
@@ -494,29 +491,28 @@ CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference,
     if (reference.triangles.size() > std::numeric_limits<std::uint32_t>::max())
         throw Error(ErrorCode::Unsupported, "cloud-to-mesh: the reference mesh '" + reference.name +
                                                 "' has more than 4,294,967,295 triangles");
+}
 
-    const std::size_t pointCount = compared.size();
+//! What the level choice needs of the triangles: their total area and
+//! perimeters, how many are degenerate, and the box they span.
+struct TriangleTotals
+{
+    double area = 0.0, perimeter = 0.0, nonDegeneratePerimeter = 0.0;
+    std::size_t degenerate = 0;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(kInfinity), hi = Eigen::Vector3d::Constant(-kInfinity);
+};
+
+//! Each triangle's vertices and box, and their totals. A vertex with a
+//! non-finite coordinate is an error naming the first such triangle.
+std::vector<TriangleVertices> triangleTable(const Mesh& reference, TriangleTotals& totals, ProgressTicker& ticker)
+{
     const std::size_t triangleCount = reference.triangles.size();
-    const auto& positions = compared.positions();
     const auto& vertices = reference.vertices.positions();
-    // Everything happens in the mesh's local frame, in double.
-    const Eigen::Vector3d offset = compared.origin() - reference.vertices.origin();
-    const auto meshFrame = [&](std::size_t i) -> Eigen::Vector3d { return offset + positions[i].cast<double>(); };
-
-    ProgressTicker indexTicker(progress, "Indexing the mesh triangles", 2 * triangleCount);
-
-    // --- Triangles: vertices, boxes, sizes, validity.
     std::vector<TriangleVertices> triangles(triangleCount);
     std::atomic<std::size_t> firstBadTriangle{std::numeric_limits<std::size_t>::max()};
-    struct TriangleTotals
-    {
-        double area = 0.0, perimeter = 0.0, nonDegeneratePerimeter = 0.0;
-        std::size_t degenerate = 0;
-        Eigen::Vector3d lo = Eigen::Vector3d::Constant(kInfinity), hi = Eigen::Vector3d::Constant(-kInfinity);
-    };
     tbb::enumerable_thread_specific<TriangleTotals> triangleTotals;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangleCount, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-        TriangleTotals& totals = triangleTotals.local();
+        TriangleTotals& local = triangleTotals.local();
         for (std::size_t t = r.begin(); t != r.end(); ++t) {
             TriangleVertices& tv = triangles[t];
             bool finite = true;
@@ -534,22 +530,21 @@ CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference,
             tv.hi = tv.v[0].cwiseMax(tv.v[1]).cwiseMax(tv.v[2]);
             const Eigen::Vector3d a = tv.v[0].cast<double>(), b = tv.v[1].cast<double>(), c = tv.v[2].cast<double>();
             const double perimeter = (b - a).norm() + (c - b).norm() + (a - c).norm();
-            totals.perimeter += perimeter;
-            totals.area += 0.5 * (b - a).cross(c - a).norm();
+            local.perimeter += perimeter;
+            local.area += 0.5 * (b - a).cross(c - a).norm();
             if (geometry::isDegenerateTriangle(a, b, c))
-                ++totals.degenerate;
+                ++local.degenerate;
             else
-                totals.nonDegeneratePerimeter += perimeter;
-            totals.lo = totals.lo.cwiseMin(tv.lo.cast<double>());
-            totals.hi = totals.hi.cwiseMax(tv.hi.cast<double>());
+                local.nonDegeneratePerimeter += perimeter;
+            local.lo = local.lo.cwiseMin(tv.lo.cast<double>());
+            local.hi = local.hi.cwiseMax(tv.hi.cast<double>());
         }
-        indexTicker.step(r.size());
+        ticker.step(r.size());
     });
     if (firstBadTriangle.load() != std::numeric_limits<std::size_t>::max())
         throw Error(ErrorCode::InvalidData, "cloud-to-mesh: triangle " + std::to_string(firstBadTriangle.load()) +
                                                 " of the reference mesh '" + reference.name +
                                                 "' has a vertex with a non-finite coordinate");
-    TriangleTotals totals;
     for (const TriangleTotals& t : triangleTotals) {
         totals.area += t.area;
         totals.perimeter += t.perimeter;
@@ -558,15 +553,31 @@ CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference,
         totals.lo = totals.lo.cwiseMin(t.lo);
         totals.hi = totals.hi.cwiseMax(t.hi);
     }
+    return triangles;
+}
 
-    // --- The cube: the mesh and the finite compared points.
+//! The compared points in the mesh's local frame, in double (their origins
+//! may differ).
+struct InMeshFrame
+{
+    const std::vector<Eigen::Vector3f>& positions;
+    Eigen::Vector3d offset;
+    Eigen::Vector3d operator()(std::size_t i) const { return offset + positions[i].cast<double>(); }
+};
+
+//! The grid's cube: the mesh's box and the finite compared points'. Counts
+//! the points without a finite coordinate (warned about: they get NaN).
+Grid enclosingGrid(const PointCloud& compared, const Mesh& reference, const InMeshFrame& meshFrame, const TriangleTotals& totals,
+                   std::size_t& nonFinite)
+{
     struct PointBox
     {
         Eigen::Vector3d lo = Eigen::Vector3d::Constant(kInfinity), hi = Eigen::Vector3d::Constant(-kInfinity);
         std::size_t nonFinite = 0;
     };
+    const auto& positions = compared.positions();
     tbb::enumerable_thread_specific<PointBox> pointBoxes;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pointCount, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, compared.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
         PointBox& box = pointBoxes.local();
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             if (!positions[i].allFinite()) {
@@ -579,7 +590,7 @@ CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference,
         }
     });
     Eigen::Vector3d lo = totals.lo, hi = totals.hi;
-    std::size_t nonFinite = 0;
+    nonFinite = 0;
     for (const PointBox& b : pointBoxes) {
         lo = lo.cwiseMin(b.lo);
         hi = hi.cwiseMax(b.hi);
@@ -588,7 +599,6 @@ CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference,
     if (nonFinite > 0)
         logWarning("cloud-to-mesh: " + std::to_string(nonFinite) + " point(s) of '" + compared.name +
                    "' with a non-finite coordinate get no distance (NaN)");
-
     Grid grid;
     grid.min = lo;
     const double extent = (hi - lo).maxCoeff();
@@ -597,8 +607,15 @@ CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference,
         throw Error(ErrorCode::InvalidData, "cloud-to-mesh: the cloud '" + compared.name + "' and the mesh '" +
                                                 reference.name + "' span too large a volume");
     grid.absoluteSlack = kAbsoluteSlack * grid.size;
+    return grid;
+}
 
-    // --- The level.
+//! The level of the triangle index (thesis §2.2.2): cells about twice the
+//! mean edge of the usable triangles, or the one asked for; lowered while the
+//! triangles would be indexed in too many cells (a warning when the asked
+//! level was lowered).
+void chooseLevel(Grid& grid, const CloudToMeshParams& params, const TriangleTotals& totals, std::size_t triangleCount)
+{
     int level = params.octreeLevel;
     if (level == 0) {
         const std::size_t usable = triangleCount - totals.degenerate;
@@ -621,88 +638,223 @@ CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference,
     grid.level = level;
     grid.cell = grid.cellSize(level);
     grid.n = std::int64_t(1) << level;
+}
 
-    // --- Triangle references, sorted by (cell, triangle).
+//! Every triangle referenced in each cell it crosses (exact triangle-box
+//! overlap), the references sorted by (cell, triangle), each cell's box
+//! tightened to its triangles'.
+TriangleIndex indexTriangles(const std::vector<TriangleVertices>& triangles, const Grid& grid, ProgressTicker& ticker)
+{
     TriangleIndex index;
-    {
-        tbb::enumerable_thread_specific<std::vector<Reference>> localReferences;
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangleCount, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-            std::vector<Reference>& out = localReferences.local();
-            Rasterizer rasterizer(grid, out);
-            for (std::size_t t = r.begin(); t != r.end(); ++t)
-                rasterizer.run(triangles[t], static_cast<std::uint32_t>(t));
-            indexTicker.step(r.size());
-        });
-        std::size_t total = 0;
-        for (const auto& v : localReferences)
-            total += v.size();
-        std::vector<Reference> references;
-        references.reserve(total);
-        for (auto& v : localReferences) {
-            references.insert(references.end(), v.begin(), v.end());
-            std::vector<Reference>().swap(v);
-        }
-        tbb::parallel_sort(references.begin(), references.end());
-        index.triangles.resize(references.size());
-        for (std::size_t i = 0; i < references.size(); ++i) {
-            // By value: push_back takes a reference, and a reference to a
-            // member of the packed struct would be misaligned.
-            const MortonCode code = references[i].code;
-            if (i == 0 || code != references[i - 1].code) {
-                index.cellCodes.push_back(code);
-                index.cellFirst.push_back(i);
-            }
-            index.triangles[i] = references[i].triangle;
-        }
-        index.cellFirst.push_back(references.size());
-        const std::size_t cellCount = index.cellCodes.size();
-        index.tightLo.resize(cellCount);
-        index.tightHi.resize(cellCount);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cellCount, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
-                for (std::size_t k = index.cellFirst[i]; k < index.cellFirst[i + 1]; ++k) {
-                    lo = lo.cwiseMin(triangles[index.triangles[k]].lo);
-                    hi = hi.cwiseMax(triangles[index.triangles[k]].hi);
-                }
-                const CellCoordinates c = decodeCell(index.cellCodes[i]);
-                const Eigen::Vector3d cellLo =
-                    grid.min + Eigen::Vector3d(static_cast<double>(c.x), static_cast<double>(c.y), static_cast<double>(c.z)) * grid.cell;
-                index.tightLo[i] = cellLo.cwiseMax(lo.cast<double>());
-                index.tightHi[i] = (cellLo.array() + grid.cell).matrix().cwiseMin(hi.cast<double>());
-            }
-        });
+    tbb::enumerable_thread_specific<std::vector<Reference>> localReferences;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<Reference>& out = localReferences.local();
+        Rasterizer rasterizer(grid, out);
+        for (std::size_t t = r.begin(); t != r.end(); ++t)
+            rasterizer.run(triangles[t], static_cast<std::uint32_t>(t));
+        ticker.step(r.size());
+    });
+    std::size_t total = 0;
+    for (const auto& v : localReferences)
+        total += v.size();
+    std::vector<Reference> references;
+    references.reserve(total);
+    for (auto& v : localReferences) {
+        references.insert(references.end(), v.begin(), v.end());
+        std::vector<Reference>().swap(v);
     }
+    tbb::parallel_sort(references.begin(), references.end());
+    index.triangles.resize(references.size());
+    for (std::size_t i = 0; i < references.size(); ++i) {
+        // By value: push_back takes a reference, and a reference to a
+        // member of the packed struct would be misaligned.
+        const MortonCode code = references[i].code;
+        if (i == 0 || code != references[i - 1].code) {
+            index.cellCodes.push_back(code);
+            index.cellFirst.push_back(i);
+        }
+        index.triangles[i] = references[i].triangle;
+    }
+    index.cellFirst.push_back(references.size());
+    const std::size_t cellCount = index.cellCodes.size();
+    index.tightLo.resize(cellCount);
+    index.tightHi.resize(cellCount);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cellCount, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
+            for (std::size_t k = index.cellFirst[i]; k < index.cellFirst[i + 1]; ++k) {
+                lo = lo.cwiseMin(triangles[index.triangles[k]].lo);
+                hi = hi.cwiseMax(triangles[index.triangles[k]].hi);
+            }
+            const CellCoordinates c = decodeCell(index.cellCodes[i]);
+            const Eigen::Vector3d cellLo =
+                grid.min + Eigen::Vector3d(static_cast<double>(c.x), static_cast<double>(c.y), static_cast<double>(c.z)) * grid.cell;
+            index.tightLo[i] = cellLo.cwiseMax(lo.cast<double>());
+            index.tightHi[i] = (cellLo.array() + grid.cell).matrix().cwiseMin(hi.cast<double>());
+        }
+    });
+    return index;
+}
 
-    // --- Compared points grouped by cell, in Morton order.
+//! The finite compared points grouped by cell, in Morton order: `order`, and
+//! where each cell's group starts in it (one past the end last).
+struct CellGroups
+{
     std::vector<KeyedPoint> order;
-    order.reserve(pointCount - nonFinite);
-    for (std::size_t i = 0; i < pointCount; ++i) {
-        if (!positions[i].allFinite())
+    std::vector<std::size_t> start;
+};
+
+CellGroups groupPointsByCell(const PointCloud& compared, const InMeshFrame& meshFrame, const Grid& grid, std::size_t nonFinite)
+{
+    CellGroups groups;
+    groups.order.reserve(compared.size() - nonFinite);
+    for (std::size_t i = 0; i < compared.size(); ++i) {
+        if (!compared.positions()[i].allFinite())
             continue;
         const auto c = grid.cellOf(meshFrame(i));
-        order.push_back({encodeCell(static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]),
-                                    static_cast<std::uint32_t>(c[2])),
-                         static_cast<std::uint32_t>(i)});
+        groups.order.push_back({encodeCell(static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]),
+                                           static_cast<std::uint32_t>(c[2])),
+                                static_cast<std::uint32_t>(i)});
     }
-    tbb::parallel_sort(order.begin(), order.end(), [](const KeyedPoint& a, const KeyedPoint& b) {
+    tbb::parallel_sort(groups.order.begin(), groups.order.end(), [](const KeyedPoint& a, const KeyedPoint& b) {
         return a.code < b.code || (a.code == b.code && a.index < b.index);
     });
-    std::vector<std::size_t> groupStart;
-    for (std::size_t i = 0; i < order.size(); ++i)
-        if (i == 0 || order[i].code != order[i - 1].code)
-            groupStart.push_back(i);
-    groupStart.push_back(order.size());
+    for (std::size_t i = 0; i < groups.order.size(); ++i)
+        if (i == 0 || groups.order[i].code != groups.order[i - 1].code)
+            groups.start.push_back(i);
+    groups.start.push_back(groups.order.size());
+    return groups;
+}
 
-    // --- Distances.
+//! The search for the points of one cell (thesis §2.2.2): the triangles of
+//! the rings j = 0, 1, 2 of cells around it, gathered once and offered to
+//! every point still searching, until the stopping rule (eq. 4.1) settles
+//! it; the points left then share one descent of the index.
+class CellSearch
+{
+public:
+    CellSearch(const Grid& grid, const TriangleIndex& index, const std::vector<TriangleVertices>& triangles, const SearchSettings& settings,
+               const InMeshFrame& meshFrame)
+        : grid_(grid), index_(index), triangles_(triangles), settings_(settings), meshFrame_(meshFrame)
+    {
+    }
+
+    //! The points order[first, last), all in one cell, searched; their states in scratch.points.
+    void run(const std::vector<KeyedPoint>& order, std::size_t first, std::size_t last, Scratch& scratch) const
+    {
+        const CellCoordinates cell = decodeCell(order[first].code);
+        const Eigen::Vector3d cellLo =
+            grid_.min + Eigen::Vector3d(static_cast<double>(cell.x), static_cast<double>(cell.y), static_cast<double>(cell.z)) * grid_.cell;
+        auto& points = scratch.points;
+        points.clear();
+        for (std::size_t i = first; i < last; ++i) {
+            PointState s;
+            s.index = order[i].index;
+            s.q = meshFrame_(s.index);
+            s.inner = kInfinity;
+            for (int a = 0; a < 3; ++a)
+                s.inner = std::min({s.inner, s.q[a] - cellLo[a], cellLo[a] + grid_.cell - s.q[a]});
+            s.bound2 = settings_.maxBound2;
+            points.push_back(s);
+        }
+        const std::uint32_t epoch = scratch.nextEpoch(triangles_.size());
+        std::size_t searching = points.size();
+        for (int j = 0; j <= kMaxRing && searching > 0; ++j) {
+            gatherRing(cell, j, epoch, scratch);
+            const std::int64_t cx = cell.x, cy = cell.y, cz = cell.z; // signed: the ring may pass the grid's edges
+            const bool coversGrid = cx - j <= 0 && cy - j <= 0 && cz - j <= 0 && cx + j >= grid_.n - 1 && cy + j >= grid_.n - 1 &&
+                                    cz + j >= grid_.n - 1;
+            const double ringRadius = static_cast<double>(j) * grid_.cell;
+            for (PointState& s : points) {
+                if (!s.searching)
+                    continue;
+                for (const Candidate& c : scratch.candidates)
+                    consider(s, c, settings_);
+                // Stopping rule (eq. 4.1): every triangle not yet offered lies
+                // outside the rings 0..j, farther than their inscribed sphere.
+                const double inscribed = ringRadius + s.inner;
+                if (coversGrid || (inscribed > 0.0 && s.bound2 < inscribed * inscribed)) {
+                    s.searching = false;
+                    --searching;
+                }
+            }
+        }
+        // Points the rings did not settle: one shared descent.
+        descend(points, scratch, index_, grid_, triangles_, settings_);
+    }
+
+private:
+    //! The triangles of the cells at Chebyshev distance j of `cell` (its shell),
+    //! each once per cell searched (stamped with the cell's epoch), into scratch.candidates.
+    void gatherRing(const CellCoordinates& cell, int j, std::uint32_t epoch, Scratch& scratch) const
+    {
+        auto& candidates = scratch.candidates;
+        candidates.clear();
+        const auto gather = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+            const auto [b, e] =
+                index_.find(encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(z)));
+            for (std::size_t r = b; r < e; ++r) {
+                const std::uint32_t t = index_.triangles[r];
+                if (scratch.stamp[t] != epoch) {
+                    scratch.stamp[t] = epoch;
+                    candidates.push_back(makeCandidate(triangles_, t));
+                }
+            }
+        };
+        const std::int64_t cx = cell.x, cy = cell.y, cz = cell.z;
+        const std::int64_t x0 = std::max<std::int64_t>(cx - j, 0), x1 = std::min<std::int64_t>(cx + j, grid_.n - 1);
+        const std::int64_t y0 = std::max<std::int64_t>(cy - j, 0), y1 = std::min<std::int64_t>(cy + j, grid_.n - 1);
+        const std::int64_t z0 = std::max<std::int64_t>(cz - j, 0), z1 = std::min<std::int64_t>(cz + j, grid_.n - 1);
+        for (std::int64_t x = x0; x <= x1; ++x)
+            for (std::int64_t y = y0; y <= y1; ++y) {
+                if (std::abs(x - cx) == j || std::abs(y - cy) == j) {
+                    for (std::int64_t z = z0; z <= z1; ++z)
+                        gather(x, y, z);
+                } else {
+                    if (cz - j >= 0)
+                        gather(x, y, cz - j);
+                    if (j > 0 && cz + j < grid_.n)
+                        gather(x, y, cz + j);
+                }
+            }
+    }
+
+    const Grid& grid_;
+    const TriangleIndex& index_;
+    const std::vector<TriangleVertices>& triangles_;
+    const SearchSettings& settings_;
+    const InMeshFrame& meshFrame_;
+};
+
+} // namespace
+
+CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference, const CloudToMeshParams& params,
+                              ProgressObserver* progress)
+{
+    checkInputs(compared, reference, params);
+    const std::size_t triangleCount = reference.triangles.size();
+    // Everything happens in the mesh's local frame, in double.
+    const InMeshFrame meshFrame{compared.positions(), compared.origin() - reference.vertices.origin()};
+
+    // The index of the triangles: a grid over the cube of the mesh and the
+    // points, its level from the triangles' size, each triangle in the cells
+    // it crosses.
+    ProgressTicker indexTicker(progress, "Indexing the mesh triangles", 2 * triangleCount);
+    TriangleTotals totals;
+    const std::vector<TriangleVertices> triangles = triangleTable(reference, totals, indexTicker);
+    std::size_t nonFinite = 0;
+    Grid grid = enclosingGrid(compared, reference, meshFrame, totals, nonFinite);
+    chooseLevel(grid, params, totals, triangleCount);
+    const TriangleIndex index = indexTriangles(triangles, grid, indexTicker);
+
+    // The points cell by cell, each cell's searched together.
+    const CellGroups groups = groupPointsByCell(compared, meshFrame, grid, nonFinite);
     CloudToMeshResult result;
-    result.distance = ScalarField("c2m_distance", pointCount);
-    result.level = level;
+    result.distance = ScalarField("c2m_distance", compared.size());
+    result.level = grid.level;
     result.degenerateTriangles = totals.degenerate;
-    std::vector<float>& values = result.distance.values();
     if (params.closestTriangles)
-        result.closestTriangle.assign(pointCount, kNoClosestTriangle);
-
+        result.closestTriangle.assign(compared.size(), kNoClosestTriangle);
     SearchSettings settings;
     settings.signedDistances = params.signedDistances;
     settings.absoluteSlack = grid.absoluteSlack;
@@ -711,95 +863,24 @@ CloudToMeshResult cloudToMesh(const PointCloud& compared, const Mesh& reference,
         settings.maxBound2 = bound * bound;
     }
     const double beyond = params.clampBeyondMax ? *params.maxDistance : kNaN;
-
-    ProgressTicker distanceTicker(progress, "Computing cloud-to-mesh distances", order.size());
+    const CellSearch search(grid, index, triangles, settings, meshFrame);
+    std::vector<float>& values = result.distance.values();
+    ProgressTicker distanceTicker(progress, "Computing cloud-to-mesh distances", groups.order.size());
     tbb::enumerable_thread_specific<Scratch> scratches;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groupStart.size() - 1, 4), [&](const tbb::blocked_range<std::size_t>& range) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups.start.size() - 1, 4), [&](const tbb::blocked_range<std::size_t>& range) {
         Scratch& scratch = scratches.local();
         for (std::size_t g = range.begin(); g != range.end(); ++g) {
-            const std::size_t first = groupStart[g], last = groupStart[g + 1];
-            const CellCoordinates cell = decodeCell(order[first].code);
-            const std::int64_t cx = cell.x, cy = cell.y, cz = cell.z;
-            const Eigen::Vector3d cellLo =
-                grid.min + Eigen::Vector3d(static_cast<double>(cx), static_cast<double>(cy), static_cast<double>(cz)) * grid.cell;
-
-            auto& points = scratch.points;
-            points.clear();
-            for (std::size_t i = first; i < last; ++i) {
-                PointState s;
-                s.index = order[i].index;
-                s.q = meshFrame(s.index);
-                s.inner = kInfinity;
-                for (int a = 0; a < 3; ++a)
-                    s.inner = std::min({s.inner, s.q[a] - cellLo[a], cellLo[a] + grid.cell - s.q[a]});
-                s.bound2 = settings.maxBound2;
-                points.push_back(s);
-            }
-
-            // Rings j = 0, 1, 2 around the cell; their triangles are gathered
-            // once and offered to every point of the cell still searching.
-            const std::uint32_t epoch = scratch.nextEpoch(triangleCount);
-            std::size_t searching = points.size();
-            for (int j = 0; j <= kMaxRing && searching > 0; ++j) {
-                auto& candidates = scratch.candidates;
-                candidates.clear();
-                const auto gather = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-                    const auto [b, e] = index.find(
-                        encodeCell(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(z)));
-                    for (std::size_t r = b; r < e; ++r) {
-                        const std::uint32_t t = index.triangles[r];
-                        if (scratch.stamp[t] != epoch) {
-                            scratch.stamp[t] = epoch;
-                            candidates.push_back(makeCandidate(triangles, t));
-                        }
-                    }
-                };
-                const std::int64_t x0 = std::max<std::int64_t>(cx - j, 0), x1 = std::min<std::int64_t>(cx + j, grid.n - 1);
-                const std::int64_t y0 = std::max<std::int64_t>(cy - j, 0), y1 = std::min<std::int64_t>(cy + j, grid.n - 1);
-                const std::int64_t z0 = std::max<std::int64_t>(cz - j, 0), z1 = std::min<std::int64_t>(cz + j, grid.n - 1);
-                for (std::int64_t x = x0; x <= x1; ++x)
-                    for (std::int64_t y = y0; y <= y1; ++y) {
-                        if (std::abs(x - cx) == j || std::abs(y - cy) == j) {
-                            for (std::int64_t z = z0; z <= z1; ++z)
-                                gather(x, y, z);
-                        } else {
-                            if (cz - j >= 0)
-                                gather(x, y, cz - j);
-                            if (j > 0 && cz + j < grid.n)
-                                gather(x, y, cz + j);
-                        }
-                    }
-                const bool coversGrid = cx - j <= 0 && cy - j <= 0 && cz - j <= 0 && cx + j >= grid.n - 1 &&
-                                        cy + j >= grid.n - 1 && cz + j >= grid.n - 1;
-                const double ringRadius = static_cast<double>(j) * grid.cell;
-                for (PointState& s : points) {
-                    if (!s.searching)
-                        continue;
-                    for (const Candidate& c : candidates)
-                        consider(s, c, settings);
-                    // Stopping rule (eq. 4.1): every triangle not yet offered lies
-                    // outside the rings 0..j, farther than their inscribed sphere.
-                    const double inscribed = ringRadius + s.inner;
-                    if (coversGrid || (inscribed > 0.0 && s.bound2 < inscribed * inscribed)) {
-                        s.searching = false;
-                        --searching;
-                    }
-                }
-            }
-
-            // Points the rings did not settle: one shared descent.
-            descend(points, scratch, index, grid, triangles, settings);
-            for (const PointState& s : points) {
+            search.run(groups.order, groups.start[g], groups.start[g + 1], scratch);
+            for (const PointState& s : scratch.points) {
                 const double d = std::sqrt(s.best2);
                 const bool outside = !(s.best2 < kInfinity) || (params.maxDistance && d > *params.maxDistance);
                 values[s.index] = static_cast<float>(outside ? beyond : s.side * d);
                 if (params.closestTriangles && !outside)
                     result.closestTriangle[s.index] = s.triangle;
             }
-            distanceTicker.step(last - first);
+            distanceTicker.step(groups.start[g + 1] - groups.start[g]);
         }
     });
-
     result.statistics = computeStatistics(result.distance);
     return result;
 }
