@@ -422,7 +422,17 @@ void MainWindow::buildViewMenu()
         sizeGroup->addAction(a);
         connect(view_, &CloudView::pointSizeChanged, a, [a, size](float now) { a->setChecked(int(now) == size); });
     }
-    // Display options, remembered from one start to the next.
+    buildDisplayOptions(viewMenu);
+    viewMenu->addSeparator();
+    for (QDockWidget* d : findChildren<QDockWidget*>())
+        viewMenu->addAction(d->toggleViewAction());
+
+}
+
+//! View > Eye-Dome Lighting, scale bar, background, and how a reference looks
+//! after a comparison: remembered from one start to the next.
+void MainWindow::buildDisplayOptions(QMenu* viewMenu)
+{
     QAction* edl = viewMenu->addAction(tr("&Eye-Dome Lighting"));
     edl->setObjectName("edlAction");
     edl->setCheckable(true);
@@ -465,10 +475,6 @@ void MainWindow::buildViewMenu()
         a->setChecked(DistanceController::referenceAfterComparison() == choice);
         afterGroup->addAction(a);
     }
-    viewMenu->addSeparator();
-    for (QDockWidget* d : findChildren<QDockWidget*>())
-        viewMenu->addAction(d->toggleViewAction());
-
 }
 
 void MainWindow::buildTreeMenu()

@@ -104,6 +104,7 @@ private:
     void buildFileMenu();
     QMenu* buildEditMenu();
     void buildViewMenu();
+    void buildDisplayOptions(QMenu* viewMenu);
     void buildHelpMenu();
     void buildTreeMenu();
     //! Removes the tree's selected entities as one undo step named by `verb`.

@@ -213,75 +213,26 @@ void CloudView::addEntity(const Document::Item& item)
     if (item.isGroup())
         return; // its scans are entities of their own
     if (item.isDrawing()) {
-        // Lines over the clouds, in the scene's frame (the first vertex sets
-        // it when the drawing comes first), coloured by layer, unlit.
-        const Drawing& drawing = *item.drawing;
-        const auto first = std::find_if(drawing.polylines.begin(), drawing.polylines.end(),
-                                        [](const DrawingPolyline& p) { return p.points.size() >= 2; });
-        if (first == drawing.polylines.end())
+        addDrawing(item);
+    } else {
+        if (!addData(item))
             return;
-        if (!scene_->sceneOrigin)
-            scene_->sceneOrigin = first->points.front();
-        Shown& s = scene_->shown[item.id];
-        s.isCloud = false;
-        Shown::Chunk c;
-        c.full = drawingLines(drawing, *scene_->sceneOrigin);
-        c.fullMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-        c.fullMapper->SetInputData(c.full);
-        c.fullMapper->SetScalarModeToUseCellData();
-        c.fullMapper->SetColorModeToDirectScalars();
-        c.fullMapper->ScalarVisibilityOn();
-        // Lines lie on the scanned surface: drawn a little towards the eye so
-        // the points do not cover them.
-        c.fullMapper->SetResolveCoincidentTopologyToPolygonOffset();
-        c.fullMapper->SetRelativeCoincidentTopologyLineOffsetParameters(0.0, -2000.0);
-        c.actor = vtkSmartPointer<vtkActor>::New();
-        c.actor->SetMapper(c.fullMapper);
-        c.actor->GetProperty()->SetLineWidth(2.5f);
-        c.actor->GetProperty()->LightingOff();
-        c.actor->PickableOff(); // picks answer with a cloud's point, never a drawing's vertex
-        scene_->renderer->AddActor(c.actor);
-        s.chunks.push_back(c);
-        if (!drawing.texts.empty()) {
-            vtkNew<vtkPoints> anchors;
-            vtkNew<vtkStringArray> texts;
-            texts->SetName("text");
-            for (const DrawingText& text : drawing.texts) {
-                const Eigen::Vector3d local = text.position - *scene_->sceneOrigin; // in double, then small
-                anchors->InsertNextPoint(local.x(), local.y(), local.z());
-                texts->InsertNextValue(text.text);
-            }
-            vtkNew<vtkPolyData> labelled;
-            labelled->SetPoints(anchors);
-            labelled->GetPointData()->AddArray(texts);
-            vtkNew<vtkPointSetToLabelHierarchy> hierarchy;
-            hierarchy->SetInputData(labelled);
-            hierarchy->SetLabelArrayName("text");
-            hierarchy->GetTextProperty()->SetFontSize(12);
-            hierarchy->GetTextProperty()->SetColor(1.0, 1.0, 0.6);
-            hierarchy->GetTextProperty()->SetJustificationToCentered();
-            vtkNew<vtkLabelPlacementMapper> placement;
-            placement->SetInputConnection(hierarchy->GetOutputPort());
-            placement->SetShapeToRoundedRect();
-            placement->SetBackgroundColor(0.1, 0.1, 0.1);
-            placement->SetBackgroundOpacity(0.6);
-            s.labels = vtkSmartPointer<vtkActor2D>::New();
-            s.labels->SetMapper(placement);
-            s.labels->PickableOff();
-            scene_->renderer->AddActor(s.labels);
-        }
-        refreshEntity(item);
-        if (scene_->clipping)
-            applyClipping();
-        return;
     }
+    refreshEntity(item);
+    if (scene_->clipping)
+        applyClipping();
+}
+
+//! A cloud's or a mesh's actors; false when there is nothing to show.
+bool CloudView::addData(const Document::Item& item)
+{
     const PointCloud& points = item.points();
     if (points.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
         logWarning(item.name.toStdString() + ": more than 2^31 points cannot be shown (the data stays usable by the tools)");
-        return;
+        return false;
     }
     if (points.empty())
-        return;
+        return false;
     if (!scene_->sceneOrigin) {
         scene_->sceneOrigin = points.origin();
         if (!annotations_.empty())
@@ -297,79 +248,147 @@ void CloudView::addEntity(const Document::Item& item)
     // VTK composes the actor's and the camera's matrices in double before the
     // one float matrix the GPU gets, so a local cloud beside UTM ones keeps
     // its millimetres (adding the offset to the floats made it stripes).
-    const float* xyz = points.positions().front().data();
     const Eigen::Vector3d offset = points.origin() - *scene_->sceneOrigin;
     static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "positions are packed xyz triples");
+    if (!s.isCloud)
+        addMeshPiece(s, *item.mesh(), offset);
+    else
+        addCloudChunks(s, points, offset);
+    updateStride();
+    setDecimated(s, scene_->moving || refinesInSlices());
+    return true;
+}
 
-    if (!s.isCloud) { // a mesh: one piece, its triangles index every vertex
-        Shown::Chunk c;
-        c.count = points.size();
-        c.full = vtkSmartPointer<vtkPolyData>::New();
-        c.full->SetPoints(pointsOver(xyz, c.count));
-        const Mesh& mesh = *item.mesh();
-        vtkNew<vtkCellArray> polys;
-        polys->AllocateExact(static_cast<vtkIdType>(mesh.triangles.size()), static_cast<vtkIdType>(3 * mesh.triangles.size()));
-        for (const auto& t : mesh.triangles) {
-            const vtkIdType ids[3] = {t[0], t[1], t[2]};
-            polys->InsertNextCell(3, ids);
+void CloudView::addDrawing(const Document::Item& item)
+{
+    // Lines over the clouds, in the scene's frame (the first vertex sets
+    // it when the drawing comes first), coloured by layer, unlit.
+    const Drawing& drawing = *item.drawing;
+    const auto first = std::find_if(drawing.polylines.begin(), drawing.polylines.end(),
+                                    [](const DrawingPolyline& p) { return p.points.size() >= 2; });
+    if (first == drawing.polylines.end())
+        return;
+    if (!scene_->sceneOrigin)
+        scene_->sceneOrigin = first->points.front();
+    Shown& s = scene_->shown[item.id];
+    s.isCloud = false;
+    Shown::Chunk c;
+    c.full = drawingLines(drawing, *scene_->sceneOrigin);
+    c.fullMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+    c.fullMapper->SetInputData(c.full);
+    c.fullMapper->SetScalarModeToUseCellData();
+    c.fullMapper->SetColorModeToDirectScalars();
+    c.fullMapper->ScalarVisibilityOn();
+    // Lines lie on the scanned surface: drawn a little towards the eye so
+    // the points do not cover them.
+    c.fullMapper->SetResolveCoincidentTopologyToPolygonOffset();
+    c.fullMapper->SetRelativeCoincidentTopologyLineOffsetParameters(0.0, -2000.0);
+    c.actor = vtkSmartPointer<vtkActor>::New();
+    c.actor->SetMapper(c.fullMapper);
+    c.actor->GetProperty()->SetLineWidth(2.5f);
+    c.actor->GetProperty()->LightingOff();
+    c.actor->PickableOff(); // picks answer with a cloud's point, never a drawing's vertex
+    scene_->renderer->AddActor(c.actor);
+    s.chunks.push_back(c);
+    if (!drawing.texts.empty()) {
+        vtkNew<vtkPoints> anchors;
+        vtkNew<vtkStringArray> texts;
+        texts->SetName("text");
+        for (const DrawingText& text : drawing.texts) {
+            const Eigen::Vector3d local = text.position - *scene_->sceneOrigin; // in double, then small
+            anchors->InsertNextPoint(local.x(), local.y(), local.z());
+            texts->InsertNextValue(text.text);
         }
-        c.full->SetPolys(polys);
-        c.fullMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-        c.fullMapper->SetInputData(c.full);
-        c.fullMapper->ScalarVisibilityOff();
+        vtkNew<vtkPolyData> labelled;
+        labelled->SetPoints(anchors);
+        labelled->GetPointData()->AddArray(texts);
+        vtkNew<vtkPointSetToLabelHierarchy> hierarchy;
+        hierarchy->SetInputData(labelled);
+        hierarchy->SetLabelArrayName("text");
+        hierarchy->GetTextProperty()->SetFontSize(12);
+        hierarchy->GetTextProperty()->SetColor(1.0, 1.0, 0.6);
+        hierarchy->GetTextProperty()->SetJustificationToCentered();
+        vtkNew<vtkLabelPlacementMapper> placement;
+        placement->SetInputConnection(hierarchy->GetOutputPort());
+        placement->SetShapeToRoundedRect();
+        placement->SetBackgroundColor(0.1, 0.1, 0.1);
+        placement->SetBackgroundOpacity(0.6);
+        s.labels = vtkSmartPointer<vtkActor2D>::New();
+        s.labels->SetMapper(placement);
+        s.labels->PickableOff();
+        scene_->renderer->AddActor(s.labels);
+    }
+}
+
+//! A mesh: one piece, its triangles index every vertex.
+void CloudView::addMeshPiece(Shown& s, const Mesh& mesh, const Eigen::Vector3d& offset)
+{
+    Shown::Chunk c;
+    c.count = mesh.vertices.size();
+    c.full = vtkSmartPointer<vtkPolyData>::New();
+    c.full->SetPoints(pointsOver(mesh.vertices.positions().front().data(), c.count));
+    vtkNew<vtkCellArray> polys;
+    polys->AllocateExact(static_cast<vtkIdType>(mesh.triangles.size()), static_cast<vtkIdType>(3 * mesh.triangles.size()));
+    for (const auto& t : mesh.triangles) {
+        const vtkIdType ids[3] = {t[0], t[1], t[2]};
+        polys->InsertNextCell(3, ids);
+    }
+    c.full->SetPolys(polys);
+    c.fullMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+    c.fullMapper->SetInputData(c.full);
+    c.fullMapper->ScalarVisibilityOff();
+    c.actor = vtkSmartPointer<vtkActor>::New();
+    c.actor->SetPosition(offset.x(), offset.y(), offset.z());
+    c.actor->SetMapper(c.fullMapper);
+    c.actor->GetProperty()->SetColor(0.85, 0.85, 0.8);
+    scene_->renderer->AddActor(c.actor);
+    s.chunks.push_back(c);
+}
+
+//! A cloud's chunks, each drawing a range of its points (a grid's as cells).
+void CloudView::addCloudChunks(Shown& s, const PointCloud& points, const Eigen::Vector3d& offset)
+{
+    const float* xyz = points.positions().front().data();
+    s.rgba.assign(4 * points.size(), 255);
+    // A grid (DEM of difference, raster) is drawn as its cells, an image on the ground.
+    const std::optional<double> rasterCell = gridCellSize(points);
+    for (std::size_t begin = 0; begin < points.size(); begin += kChunkPoints) {
+        Shown::Chunk c;
+        c.begin = begin;
+        c.count = std::min(kChunkPoints, points.size() - begin);
+        c.full = vtkSmartPointer<vtkPolyData>::New();
+        c.colours = vtkSmartPointer<vtkUnsignedCharArray>::New();
+        c.colours->SetNumberOfComponents(4);
+        c.colours->SetName("display colours");
+        c.raster = rasterCell.has_value();
+        if (c.raster) {
+            makeRasterGeometry(*c.full, points, begin, c.count, *rasterCell);
+            c.colours->SetNumberOfTuples(static_cast<vtkIdType>(4 * c.count));
+        } else {
+            c.full->SetPoints(pointsOver(xyz + 3 * begin, c.count)); // its vertices when drawn in full (setDecimated)
+            c.colours->SetArray(s.rgba.data() + 4 * begin, static_cast<vtkIdType>(4 * c.count), /*save*/ 1);
+        }
+        c.full->GetPointData()->SetScalars(c.colours);
+        if (points.hasNormals() && !c.raster) {
+            // Shading by the normals, as CloudCompare lights clouds that have them:
+            // the shape reads at once. A view on the cloud's normals, no copy.
+            c.normals = vtkSmartPointer<vtkFloatArray>::New();
+            c.normals->SetNumberOfComponents(3);
+            c.normals->SetArray(const_cast<float*>(points.normals()[begin].data()), static_cast<vtkIdType>(3 * c.count), 1);
+            c.full->GetPointData()->SetNormals(c.normals);
+        }
+        c.fullMapper = chunkMapper(c.full);
         c.actor = vtkSmartPointer<vtkActor>::New();
         c.actor->SetPosition(offset.x(), offset.y(), offset.z());
         c.actor->SetMapper(c.fullMapper);
-        c.actor->GetProperty()->SetColor(0.85, 0.85, 0.8);
+        c.actor->GetProperty()->SetPointSize(scene_->pointSize);
+        if (c.raster)
+            c.actor->GetProperty()->LightingOff(); // the colours of the scale, unshaded
+        c.actor->ForceOpaqueOn();
+        c.actor->GetShaderProperty()->AddFragmentShaderReplacement("//VTK::Light::Impl", true, kDiscardHidden, false);
         scene_->renderer->AddActor(c.actor);
         s.chunks.push_back(c);
-    } else {
-        s.rgba.assign(4 * points.size(), 255);
-        // A grid (DEM of difference, raster) is drawn as its cells, an image on the ground.
-        const std::optional<double> rasterCell = gridCellSize(points);
-        for (std::size_t begin = 0; begin < points.size(); begin += kChunkPoints) {
-            Shown::Chunk c;
-            c.begin = begin;
-            c.count = std::min(kChunkPoints, points.size() - begin);
-            c.full = vtkSmartPointer<vtkPolyData>::New();
-            c.colours = vtkSmartPointer<vtkUnsignedCharArray>::New();
-            c.colours->SetNumberOfComponents(4);
-            c.colours->SetName("display colours");
-            c.raster = rasterCell.has_value();
-            if (c.raster) {
-                makeRasterGeometry(*c.full, points, begin, c.count, *rasterCell);
-                c.colours->SetNumberOfTuples(static_cast<vtkIdType>(4 * c.count));
-            } else {
-                c.full->SetPoints(pointsOver(xyz + 3 * begin, c.count)); // its vertices when drawn in full (setDecimated)
-                c.colours->SetArray(s.rgba.data() + 4 * begin, static_cast<vtkIdType>(4 * c.count), /*save*/ 1);
-            }
-            c.full->GetPointData()->SetScalars(c.colours);
-            if (points.hasNormals() && !c.raster) {
-                // Shading by the normals, as CloudCompare lights clouds that have them:
-                // the shape reads at once. A view on the cloud's normals, no copy.
-                c.normals = vtkSmartPointer<vtkFloatArray>::New();
-                c.normals->SetNumberOfComponents(3);
-                c.normals->SetArray(const_cast<float*>(points.normals()[begin].data()), static_cast<vtkIdType>(3 * c.count), 1);
-                c.full->GetPointData()->SetNormals(c.normals);
-            }
-            c.fullMapper = chunkMapper(c.full);
-            c.actor = vtkSmartPointer<vtkActor>::New();
-            c.actor->SetPosition(offset.x(), offset.y(), offset.z());
-            c.actor->SetMapper(c.fullMapper);
-            c.actor->GetProperty()->SetPointSize(scene_->pointSize);
-            if (c.raster)
-                c.actor->GetProperty()->LightingOff(); // the colours of the scale, unshaded
-            c.actor->ForceOpaqueOn();
-            c.actor->GetShaderProperty()->AddFragmentShaderReplacement("//VTK::Light::Impl", true, kDiscardHidden, false);
-            scene_->renderer->AddActor(c.actor);
-            s.chunks.push_back(c);
-        }
     }
-    updateStride();
-    setDecimated(s, scene_->moving || refinesInSlices());
-    refreshEntity(item);
-    if (scene_->clipping)
-        applyClipping();
 }
 
 void CloudView::refreshEntity(const Document::Item& item)
@@ -632,121 +651,6 @@ void CloudView::resetClippingRange()
         scene_->renderer->ResetCameraClippingRange(bounds);
     else
         scene_->renderer->ResetCameraClippingRange();
-}
-
-void CloudView::setClippingBox(bool on)
-{
-    if (on == scene_->clipping)
-        return;
-    scene_->clipping = on;
-    if (on) {
-        if (!scene_->clipWidget->GetInteractor()) { // first use (GetRepresentation would make a default one)
-            scene_->clipBox->SetPlaceFactor(1.0);
-            scene_->clipBox->HandlesOn();
-            scene_->clipWidget->SetInteractor(widget_->interactor());
-            scene_->clipWidget->SetDefaultRenderer(scene_->renderer);
-            scene_->clipWidget->SetRepresentation(scene_->clipBox);
-            auto moved = vtkSmartPointer<vtkCallbackCommand>::New();
-            moved->SetClientData(this);
-            moved->SetCallback([](vtkObject*, unsigned long, void* self, void*) { static_cast<CloudView*>(self)->applyClipping(); });
-            scene_->clipWidget->AddObserver(vtkCommand::InteractionEvent, moved);
-            // Dragging the box is a move like the camera's: decimated while it
-            // lasts, refined at rest (the widget's own frames draw what is set).
-            auto dragged = vtkSmartPointer<vtkCallbackCommand>::New();
-            dragged->SetClientData(this);
-            dragged->SetCallback([](vtkObject*, unsigned long event, void* self, void*) {
-                static_cast<CloudView*>(self)->setMoving(event == vtkCommand::StartInteractionEvent);
-            });
-            scene_->clipWidget->AddObserver(vtkCommand::StartInteractionEvent, dragged);
-            scene_->clipWidget->AddObserver(vtkCommand::EndInteractionEvent, dragged);
-        }
-        // Around what is shown.
-        double bounds[6];
-        scene_->renderer->ComputeVisiblePropBounds(bounds);
-        if (bounds[0] <= bounds[1])
-            scene_->clipBox->PlaceWidget(bounds);
-        scene_->clipWidget->On();
-    } else {
-        scene_->clipWidget->Off();
-    }
-    applyClipping();
-    emit clippingBoxChanged(on);
-}
-
-bool CloudView::clippingBoxOn() const { return scene_->clipping; }
-
-void CloudView::setClippingBox(const CropBox& box)
-{
-    // The representation is placed axis-aligned, then turned and moved by its transform.
-    const Eigen::Vector3d origin = scene_->sceneOrigin.value_or(Eigen::Vector3d::Zero());
-    const Eigen::Vector3d half = box.size / 2;
-    double bounds[6] = {-half.x(), half.x(), -half.y(), half.y(), -half.z(), half.z()};
-    scene_->clipBox->PlaceWidget(bounds);
-    vtkNew<vtkTransform> transform;
-    vtkNew<vtkMatrix4x4> matrix;
-    for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c)
-            matrix->SetElement(r, c, box.rotation(r, c));
-        matrix->SetElement(r, 3, box.centre[r] - origin[r]);
-    }
-    transform->SetMatrix(matrix);
-    scene_->clipBox->SetTransform(transform);
-    applyClipping();
-}
-
-CropBox CloudView::clippingBox() const
-{
-    // The box's corners in the scene: an axis-aligned box turned and moved, so
-    // its centre and edges give back the centre, the sizes and the rotation.
-    vtkPolyData* outline = vtkPolyData::New();
-    scene_->clipBox->GetPolyData(outline); // 8 corners first, then face centres and the middle
-    auto corner = [&](int i) {
-        double p[3];
-        outline->GetPoint(i, p);
-        return Eigen::Vector3d(p[0], p[1], p[2]);
-    };
-    // vtkBoxRepresentation numbers its corners as a hexahedron: 0-1 along x, 0-3 along y, 0-4 along z.
-    const Eigen::Vector3d c0 = corner(0), ex = corner(1) - c0, ey = corner(3) - c0, ez = corner(4) - c0;
-    outline->Delete();
-    CropBox box;
-    box.size = {ex.norm(), ey.norm(), ez.norm()};
-    box.centre = c0 + (ex + ey + ez) / 2 + scene_->sceneOrigin.value_or(Eigen::Vector3d::Zero());
-    for (int a = 0; a < 3; ++a) {
-        const Eigen::Vector3d edge = a == 0 ? ex : a == 1 ? ey : ez;
-        box.rotation.col(a) = edge.norm() > 0 ? Eigen::Vector3d(edge.normalized()) : Eigen::Vector3d::Unit(a);
-    }
-    return box;
-}
-
-void CloudView::applyClipping()
-{
-    vtkNew<vtkPlanes> planes;
-    if (scene_->clipping)
-        scene_->clipBox->GetPlanes(planes);
-    for (auto& [id, s] : scene_->shown)
-        for (auto& c : s.chunks)
-            for (vtkPolyDataMapper* mapper : {c.fullMapper.Get(), c.decimatedMapper.Get()}) {
-                if (!mapper)
-                    continue;
-                // The planes are in the scene's frame; a chunk's points sit at its actor's offset.
-                mapper->RemoveAllClippingPlanes();
-                if (!scene_->clipping)
-                    continue;
-                double offset[3];
-                c.actor->GetPosition(offset);
-                for (int k = 0; k < planes->GetNumberOfPlanes(); ++k) {
-                    vtkPlane* plane = planes->GetPlane(k);
-                    double origin[3], normal[3];
-                    plane->GetOrigin(origin);
-                    plane->GetNormal(normal);
-                    vtkNew<vtkPlane> local;
-                    local->SetOrigin(origin[0] - offset[0], origin[1] - offset[1], origin[2] - offset[2]);
-                    // The box's faces face outwards; a mapper keeps the side a plane faces.
-                    local->SetNormal(-normal[0], -normal[1], -normal[2]);
-                    mapper->AddClippingPlane(local);
-                }
-            }
-    render();
 }
 
 void CloudView::setShownHere(EntityId id, bool shown)
@@ -1071,156 +975,6 @@ void CloudView::setDecimated(Shown& s, bool moving)
         }
         c.actor->SetMapper(decimate ? c.decimatedMapper.Get() : c.fullMapper.Get());
     }
-}
-
-void CloudView::setScissorsMode(bool on)
-{
-    if (scene_->scissorsMode == on)
-        return;
-    scene_->scissorsMode = on;
-    scene_->scissors.clear();
-    addScissorsVertex(std::numeric_limits<double>::quiet_NaN(), 0); // redraws the (empty) outline
-    if (on)
-        setPickMode(false);
-    widget_->setCursor(on ? Qt::CrossCursor : Qt::ArrowCursor);
-    emit scissorsModeChanged(on);
-}
-
-bool CloudView::scissorsMode() const { return scene_->scissorsMode; }
-
-void CloudView::addScissorsVertex(double x, double y)
-{
-    if (std::isfinite(x))
-        scene_->scissors.emplace_back(x, y);
-    // The outline in VTK's display pixels (device pixels from the bottom-left),
-    // closed back to the first vertex so the user sees what will be cut.
-    const double ratio = widget_->devicePixelRatioF();
-    const int height = scene_->window->GetSize()[1];
-    vtkNew<vtkPoints> points;
-    vtkNew<vtkCellArray> lines;
-    std::vector<vtkIdType> ids;
-    for (const Eigen::Vector2d& v : scene_->scissors)
-        ids.push_back(points->InsertNextPoint(v.x() * ratio, height - 1 - v.y() * ratio, 0));
-    if (ids.size() > 2)
-        ids.push_back(ids.front());
-    if (ids.size() > 1)
-        lines->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
-    scene_->scissorsOutline->SetPoints(points);
-    scene_->scissorsOutline->SetLines(lines);
-    scene_->scissorsOutline->Modified();
-    renderSoon();
-}
-
-void CloudView::finishScissors()
-{
-    if (!scene_->scissorsMode)
-        return;
-    const std::vector<Eigen::Vector2d> polygon = scene_->scissors;
-    setScissorsMode(false);
-    if (polygon.size() >= 3)
-        emit polygonDrawn(polygon, globalToWidgetPixels());
-}
-
-Eigen::Matrix4d CloudView::globalToWidgetPixels() const
-{
-    vtkCamera* camera = scene_->renderer->GetActiveCamera();
-    const double width = std::max(1, widget_->width()), height = std::max(1, widget_->height());
-    vtkMatrix4x4* clip = camera->GetCompositeProjectionTransformMatrix(width / height, -1, 1);
-    Eigen::Matrix4d sceneToClip;
-    for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c)
-            sceneToClip(r, c) = clip->GetElement(r, c);
-    // Clip coordinates to pixels, still homogeneous: x from -1..1 to 0..width,
-    // y from 1..-1 (up) to 0..height (down).
-    Eigen::Matrix4d toPixels = Eigen::Matrix4d::Identity();
-    toPixels(0, 0) = width / 2, toPixels(0, 3) = width / 2;
-    toPixels(1, 1) = -height / 2, toPixels(1, 3) = height / 2;
-    Eigen::Matrix4d fromGlobal = Eigen::Matrix4d::Identity();
-    fromGlobal.block<3, 1>(0, 3) = -scene_->sceneOrigin.value_or(Eigen::Vector3d::Zero());
-    return toPixels * sceneToClip * fromGlobal;
-}
-
-bool CloudView::isPointShown(EntityId id, std::size_t index) const
-{
-    const auto it = scene_->shown.find(id);
-    if (it == scene_->shown.end() || !it->second.isCloud || index >= it->second.pointCount)
-        return false;
-    return it->second.rgba[4 * index + 3] != 0;
-}
-
-void CloudView::setPickMode(bool on)
-{
-    if (on)
-        setScissorsMode(false); // one use of the left click at a time
-    if (scene_->pickMode == on)
-        return;
-    scene_->pickMode = on;
-    widget_->setCursor(on ? Qt::CrossCursor : Qt::ArrowCursor);
-    emit pickModeChanged(on);
-}
-
-bool CloudView::pickMode() const { return scene_->pickMode; }
-
-bool CloudView::pickAt(int x, int y)
-{
-    // VTK counts pixels from the bottom-left, in device pixels.
-    const double ratio = widget_->devicePixelRatioF();
-    const int height = scene_->window->GetSize()[1];
-    return pickAtDevicePixel(static_cast<int>(x * ratio), static_cast<int>(height - 1 - y * ratio));
-}
-
-bool CloudView::pickAtDevicePixel(int x, int y)
-{
-    // Points by the point picker; a grid's cells (drawn as quads, whose
-    // vertices are corners shared by four cells) by the cell picker, when the
-    // point picker finds nothing else.
-    const Shown* pickedEntity = nullptr;
-    EntityId pickedId = kNoEntity;
-    std::size_t index = 0;
-    auto chunkOf = [&](vtkActor* actor, bool& raster, std::size_t& begin) {
-        for (const auto& [id, s] : scene_->shown)
-            for (const auto& c : s.chunks)
-                if (c.actor.Get() == actor) {
-                    pickedEntity = &s;
-                    pickedId = id;
-                    raster = c.raster;
-                    begin = c.begin;
-                    return true;
-                }
-        return false;
-    };
-    bool raster = false;
-    std::size_t begin = 0;
-    // Among every point of a chunk, not the few its decimated copy draws:
-    // the picker reads the points of the actor's mapper.
-    std::vector<std::pair<vtkActor*, vtkMapper*>> drawing;
-    for (auto& [id, s] : scene_->shown)
-        for (auto& c : s.chunks)
-            if (s.isCloud && !c.raster && c.actor->GetMapper() != c.fullMapper.Get()) {
-                if (!c.pickMapper) {
-                    c.pickMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-                    c.pickMapper->SetInputData(pickingGeometry(c.full->GetPoints()));
-                }
-                drawing.emplace_back(c.actor.Get(), c.actor->GetMapper());
-                c.actor->SetMapper(c.pickMapper);
-            }
-    const bool pointHit = scene_->picker->Pick(x, y, 0.0, scene_->renderer) && scene_->picker->GetPointId() >= 0 &&
-                          chunkOf(scene_->picker->GetActor(), raster, begin) && !raster;
-    for (auto& [actor, mapper] : drawing)
-        actor->SetMapper(mapper);
-    if (pointHit) {
-        index = begin + static_cast<std::size_t>(scene_->picker->GetPointId());
-    } else {
-        if (!scene_->cellPicker->Pick(x, y, 0.0, scene_->renderer) || scene_->cellPicker->GetCellId() < 0 ||
-            !chunkOf(scene_->cellPicker->GetActor(), raster, begin) || !raster)
-            return false;
-        index = begin + static_cast<std::size_t>(scene_->cellPicker->GetCellId());
-    }
-    // The picker sees every point; one hidden by the thresholds is not an answer.
-    if (pickedEntity->isCloud && pickedEntity->rgba[4 * index + 3] == 0)
-        return false;
-    emit pointPicked(pickedId, index);
-    return true;
 }
 
 void CloudView::render()

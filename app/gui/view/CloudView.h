@@ -227,6 +227,13 @@ private:
     class PickCommand;
     struct Shown;
     static constexpr std::size_t kChunkPoints = 1u << 18;
+    //! addEntity's kinds: a drawing's lines and texts; a cloud's or a mesh's
+    //! actors (false when it has nothing to show), as one mesh piece or as
+    //! chunks of a cloud's points.
+    void addDrawing(const Document::Item& item);
+    bool addData(const Document::Item& item);
+    void addMeshPiece(Shown& shown, const Mesh& mesh, const Eigen::Vector3d& offset);
+    void addCloudChunks(Shown& shown, const PointCloud& points, const Eigen::Vector3d& offset);
     void updateStride();
     void updateScaleBar();
     //! Clips every chunk's mappers to the box's six faces (or none).
