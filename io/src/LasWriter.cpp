@@ -149,22 +149,20 @@ std::string variableLengthRecord(const char* userId, std::uint16_t recordId, con
     return record;
 }
 
-} // namespace
-
-void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions& options, bool compressed)
+//! How the cloud's attributes go into the records: the standard ones into
+//! their slots of the point format, everything else as extra bytes.
+struct RecordPlan
 {
-    const std::size_t n = cloud.size();
-    const auto& positions = cloud.positions();
-
-    std::size_t finiteCount = 0;
-    for (const auto& p : positions)
-        finiteCount += p.allFinite() ? 1 : 0;
-    if (finiteCount != n)
-        logWarning(path.string() + ": " + std::to_string(n - finiteCount) +
-                   " points with non-finite coordinates were not written");
-
-    // Standard attributes into their slots, everything else as extra bytes.
     std::array<SlotSource, static_cast<std::size_t>(Slot::Count)> slots{};
+    int format = 6;
+    std::size_t baseSize = 0, recordLength = 0;
+    std::vector<ExtraOutput> extras;
+    const SlotSource& slot(Slot s) const { return slots[static_cast<std::size_t>(s)]; }
+};
+
+RecordPlan planRecords(const PointCloud& cloud, const fs::path& path)
+{
+    RecordPlan plan;
     std::vector<const ScalarField*> others;
     for (const ScalarField& f : cloud.fields()) {
         const auto it =
@@ -173,34 +171,33 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
             others.push_back(&f);
             continue;
         }
-        slots[static_cast<std::size_t>(it - kSlotNames.begin())] = SlotSource{&f};
+        plan.slots[static_cast<std::size_t>(it - kSlotNames.begin())] = SlotSource{&f};
     }
-    const SlotSource& nirSlot = slots[static_cast<std::size_t>(Slot::Nir)];
+    const SlotSource& nirSlot = plan.slot(Slot::Nir);
     // Format 8 adds near infrared to the colours of format 7; without colours a
     // "nir" field goes to the extra bytes rather than forcing black colours.
-    const int format = cloud.hasColors() ? (nirSlot.field ? 8 : 7) : 6;
-    if (format != 8 && nirSlot.field) {
+    plan.format = cloud.hasColors() ? (nirSlot.field ? 8 : 7) : 6;
+    if (plan.format != 8 && nirSlot.field) {
         others.push_back(cloud.field("nir"));
-        slots[static_cast<std::size_t>(Slot::Nir)] = SlotSource{};
+        plan.slots[static_cast<std::size_t>(Slot::Nir)] = SlotSource{};
     }
-    const std::size_t baseSize = kBaseRecordSize[static_cast<std::size_t>(format)];
+    plan.baseSize = kBaseRecordSize[static_cast<std::size_t>(plan.format)];
 
     // Extra bytes: float (type 9) keeps a field exactly; a field with an offset
     // (times, large values) or kept in double needs double (type 10).
-    std::vector<ExtraOutput> extras;
-    std::size_t recordLength = baseSize;
+    plan.recordLength = plan.baseSize;
     for (const ScalarField* f : others) {
         ExtraOutput e;
         e.field = f;
         e.asDouble = f->offset() != 0.0 || f->isDouble();
-        e.recordOffset = recordLength;
+        e.recordOffset = plan.recordLength;
         // The descriptor's name is char[32]: longer names are cut to 32 bytes,
         // and a cut name that repeats an earlier one ends with "~2", "~3"...
         e.lasName = f->name().substr(0, 32);
         if (e.lasName.empty())
             e.lasName = "field";
         auto taken = [&](const std::string& name) {
-            return std::any_of(extras.begin(), extras.end(), [&](const ExtraOutput& x) { return x.lasName == name; });
+            return std::any_of(plan.extras.begin(), plan.extras.end(), [&](const ExtraOutput& x) { return x.lasName == name; });
         };
         for (int k = 2; taken(e.lasName); ++k) {
             const std::string suffix = "~" + std::to_string(k);
@@ -209,66 +206,50 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
         if (e.lasName != f->name())
             logWarning(path.string() + ": scalar field '" + f->name() + "' is stored as '" + e.lasName +
                        "' (LAS extra dimension names are limited to 32 characters)");
-        recordLength += e.asDouble ? 8 : 4;
-        extras.push_back(std::move(e));
+        plan.recordLength += e.asDouble ? 8 : 4;
+        plan.extras.push_back(std::move(e));
     }
     // Both the point record length and the VLR payload (192 bytes per extra
     // dimension) are 16-bit numbers.
-    if (recordLength > std::numeric_limits<std::uint16_t>::max() ||
-        extras.size() * kExtraBytesDescriptorSize > std::numeric_limits<std::uint16_t>::max())
+    if (plan.recordLength > std::numeric_limits<std::uint16_t>::max() ||
+        plan.extras.size() * kExtraBytesDescriptorSize > std::numeric_limits<std::uint16_t>::max())
         throw Error(ErrorCode::InvalidArgument, path.string() + ": too many scalar fields for LAS (" +
-                                                    std::to_string(extras.size()) +
+                                                    std::to_string(plan.extras.size()) +
                                                     " extra dimensions; at most 341 fit in the Extra Bytes record)");
+    return plan;
+}
 
-    // Extra Bytes VLR.
-    std::string vlr;
-    std::uint32_t vlrCount = 0;
-    if (!extras.empty()) {
-        std::string descriptors(kExtraBytesDescriptorSize * extras.size(), '\0');
-        for (std::size_t d = 0; d < extras.size(); ++d) {
-            char* p = &descriptors[kExtraBytesDescriptorSize * d];
-            p[eb::dataType] = static_cast<char>(extras[d].asDouble ? eb::typeDouble : eb::typeFloat);
-            // NaN means "no value" in scandiff; declaring it as no_data tells other
-            // readers so (stored as a double, the upcast of float and double).
-            p[eb::options] = static_cast<char>(eb::optNoData);
-            store<double>(p + eb::noData, std::numeric_limits<double>::quiet_NaN());
-            std::memcpy(p + eb::name, extras[d].lasName.data(), extras[d].lasName.size());
-            const char description[] = "scandiff scalar field";
-            std::memcpy(p + eb::description, description, sizeof description - 1);
-        }
-        vlr += variableLengthRecord("LASF_Spec", 4, "Extra Bytes Record", descriptors, false);
-        ++vlrCount;
+//! The Extra Bytes VLR describing the extra dimensions.
+std::string extraBytesRecord(const std::vector<ExtraOutput>& extras)
+{
+    std::string descriptors(kExtraBytesDescriptorSize * extras.size(), '\0');
+    for (std::size_t d = 0; d < extras.size(); ++d) {
+        char* p = &descriptors[kExtraBytesDescriptorSize * d];
+        p[eb::dataType] = static_cast<char>(extras[d].asDouble ? eb::typeDouble : eb::typeFloat);
+        // NaN means "no value" in scandiff; declaring it as no_data tells other
+        // readers so (stored as a double, the upcast of float and double).
+        p[eb::options] = static_cast<char>(eb::optNoData);
+        store<double>(p + eb::noData, std::numeric_limits<double>::quiet_NaN());
+        std::memcpy(p + eb::name, extras[d].lasName.data(), extras[d].lasName.size());
+        const char description[] = "scandiff scalar field";
+        std::memcpy(p + eb::description, description, sizeof description - 1);
     }
+    return variableLengthRecord("LASF_Spec", 4, "Extra Bytes Record", descriptors, false);
+}
 
-    // The coordinate reference system as an OGC WKT record, NUL-terminated;
-    // one too long for a VLR's 16-bit length goes into an EVLR after the points.
-    std::string crsRecord;
-    if (!cloud.crsWkt().empty()) {
-        const std::string wkt = cloud.crsWkt() + '\0';
-        if (wkt.size() > std::numeric_limits<std::uint16_t>::max()) {
-            crsRecord = variableLengthRecord("LASF_Projection", 2112, "OGC coordinate system WKT", wkt, true);
-        } else {
-            vlr += variableLengthRecord("LASF_Projection", 2112, "OGC coordinate system WKT", wkt, false);
-            ++vlrCount;
-        }
-    }
+//! The file's scale and offset: chosen for the cloud's extent, or the grid
+//! it was read on (the same integers back) when its points still fit it.
+struct Quantization
+{
+    Eigen::Vector3d offset, scale;
+};
 
-    // LAZ: the LASzip record describing the compressed records.
-    std::optional<LazLayout> lazLayout;
-    if (compressed) {
-        lazLayout = lazLayoutForFormat(format, recordLength - baseSize);
-        vlr += variableLengthRecord(kLaszipUserId, kLaszipRecordId, "by scandiff, LASzip compatible",
-                                    lazRecordPayload(*lazLayout), false);
-        ++vlrCount;
-    }
-
+Quantization chooseGrid(const PointCloud& cloud, const fs::path& path)
+{
+    Quantization q;
     const BoundingBox bounds = cloud.bounds();
-    Eigen::Vector3d lasOffset, lasScale;
     for (int a = 0; a < 3; ++a)
-        chooseQuantization(path, cloud.origin()[a], bounds.min[a], bounds.max[a], bounds.empty, lasOffset[a],
-                           lasScale[a]);
-    // Points read from a LAS file go back on its grid (the same scale and
-    // offset, so the same integers) when they still fit it.
+        chooseQuantization(path, cloud.origin()[a], bounds.min[a], bounds.max[a], bounds.empty, q.offset[a], q.scale[a]);
     if (const auto& grid = cloud.sourceGrid(); grid && !bounds.empty) {
         bool fits = true;
         for (int a = 0; a < 3; ++a) {
@@ -276,108 +257,128 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
             fits = fits && grid->scale[a] > 0 && reach / grid->scale[a] <= 2147483000.0;
         }
         if (fits) {
-            lasOffset = grid->offset;
-            lasScale = grid->scale;
+            q.offset = grid->offset;
+            q.scale = grid->scale;
         }
     }
-    const Eigen::Vector3d inverseScale = lasScale.cwiseInverse();
-    const Eigen::Vector3d shift = cloud.origin() - lasOffset;
+    return q;
+}
 
-    AtomicFile output(path);
-    std::ofstream& stream = output.stream();
-    const std::uint64_t offsetToPoints = kHeaderSize14 + vlr.size();
-    // The header is written again at the end, with the extents and return counts.
-    std::array<char, kHeaderSize14> header{};
-    stream.write(header.data(), header.size());
-    stream.write(vlr.data(), static_cast<std::streamsize>(vlr.size()));
-
+//! What the header sums up of the records written.
+struct RecordTotals
+{
     std::array<std::uint64_t, 15> pointsByReturn{};
-    constexpr std::int32_t kInt32Max = std::numeric_limits<std::int32_t>::max();
-    constexpr std::int32_t kInt32Min = std::numeric_limits<std::int32_t>::lowest();
-    std::array<std::int32_t, 3> rawMin{kInt32Max, kInt32Max, kInt32Max};
-    std::array<std::int32_t, 3> rawMax{kInt32Min, kInt32Min, kInt32Min};
+    std::array<std::int32_t, 3> rawMin{std::numeric_limits<std::int32_t>::max(), std::numeric_limits<std::int32_t>::max(),
+                                       std::numeric_limits<std::int32_t>::max()};
+    std::array<std::int32_t, 3> rawMax{std::numeric_limits<std::int32_t>::lowest(), std::numeric_limits<std::int32_t>::lowest(),
+                                       std::numeric_limits<std::int32_t>::lowest()};
     double gpsMax = -std::numeric_limits<double>::infinity();
-    auto slot = [&](Slot s) -> const SlotSource& { return slots[static_cast<std::size_t>(s)]; };
+};
 
-    ProgressTicker ticker(options.progress, "Writing " + path.filename().string(), n);
+//! One point's record at p (zeroed); returns its return number.
+unsigned fillRecord(char* p, const PointCloud& cloud, std::size_t i, const RecordPlan& plan, const Eigen::Vector3d& shift,
+                    const Eigen::Vector3d& inverseScale, RecordTotals& totals)
+{
+    // With the file's exact coordinates where a float misses its grid.
+    const Eigen::Vector3d local = cloud.exactLocalPosition(i);
+    for (int a = 0; a < 3; ++a) {
+        const std::int32_t raw = clampRound<std::int32_t>((shift[a] + local[a]) * inverseScale[a]);
+        store<std::int32_t>(p + 4 * a, raw);
+        totals.rawMin[a] = std::min(totals.rawMin[a], raw);
+        totals.rawMax[a] = std::max(totals.rawMax[a], raw);
+    }
+    store<std::uint16_t>(p + 12, clampRound<std::uint16_t>(plan.slot(Slot::Intensity).get(i, 0.0)));
+    // Return number and count default to 1: "1 of 1" is what a single-return
+    // scanner produces, and 0 is not a valid return number.
+    const unsigned returnNumber = clampBits(plan.slot(Slot::ReturnNumber).get(i, 1.0), 15);
+    const unsigned numberOfReturns = clampBits(plan.slot(Slot::NumberOfReturns).get(i, 1.0), 15);
+    p[14] = static_cast<char>(returnNumber | (numberOfReturns << 4));
+    p[15] = static_cast<char>(clampBits(plan.slot(Slot::ClassificationFlags).get(i, 0.0), 15) |
+                              (clampBits(plan.slot(Slot::ScannerChannel).get(i, 0.0), 3) << 4) |
+                              (clampBits(plan.slot(Slot::ScanDirectionFlag).get(i, 0.0), 1) << 6) |
+                              (clampBits(plan.slot(Slot::EdgeOfFlightLine).get(i, 0.0), 1) << 7));
+    p[16] = static_cast<char>(clampRound<std::uint8_t>(plan.slot(Slot::Classification).get(i, 0.0)));
+    p[17] = static_cast<char>(clampRound<std::uint8_t>(plan.slot(Slot::UserData).get(i, 0.0)));
+    // Scan angle in 0.006 degree units; LAS 1.4 R15 limits it to ±30000 (±180°).
+    const double angle = std::clamp(plan.slot(Slot::ScanAngle).get(i, 0.0) / 0.006, -30000.0, 30000.0);
+    store<std::int16_t>(p + 18, clampRound<std::int16_t>(angle));
+    store<std::uint16_t>(p + 20, clampRound<std::uint16_t>(plan.slot(Slot::PointSourceId).get(i, 0.0)));
+    const double gps = plan.slot(Slot::GpsTime).get(i, 0.0);
+    totals.gpsMax = std::max(totals.gpsMax, gps);
+    store<double>(p + 22, gps);
+    if (plan.format >= 7) {
+        // 8-bit to 16-bit: x257 maps 0..255 onto the full 0..65535 range.
+        const Rgb8& c = cloud.colors()[i];
+        store<std::uint16_t>(p + 30, static_cast<std::uint16_t>(c.r * 257));
+        store<std::uint16_t>(p + 32, static_cast<std::uint16_t>(c.g * 257));
+        store<std::uint16_t>(p + 34, static_cast<std::uint16_t>(c.b * 257));
+    }
+    if (plan.format == 8)
+        store<std::uint16_t>(p + 36, clampRound<std::uint16_t>(plan.slot(Slot::Nir).get(i, 0.0)));
+    for (const ExtraOutput& e : plan.extras) {
+        if (e.asDouble)
+            store<double>(p + e.recordOffset, e.field->value(i));
+        else
+            store<float>(p + e.recordOffset, e.field->values()[i]);
+    }
+    return returnNumber;
+}
+
+//! Every finite point's record, by chunks, plain or through the LAZ coder.
+RecordTotals writeRecords(std::ofstream& stream, const PointCloud& cloud, const RecordPlan& plan, const Quantization& grid,
+                          const std::optional<LazLayout>& lazLayout, ProgressTicker& ticker)
+{
+    RecordTotals totals;
+    const Eigen::Vector3d inverseScale = grid.scale.cwiseInverse();
+    const Eigen::Vector3d shift = cloud.origin() - grid.offset;
     std::optional<LazPointWriter> lazPoints;
     if (lazLayout)
-        lazPoints.emplace(stream, *lazLayout, recordLength);
-    std::vector<char> buffer(kChunkPoints * recordLength);
+        lazPoints.emplace(stream, *lazLayout, plan.recordLength);
+    std::vector<char> buffer(kChunkPoints * plan.recordLength);
+    const std::size_t n = cloud.size();
     for (std::size_t begin = 0; begin < n; begin += kChunkPoints) {
         const std::size_t end = std::min(n, begin + kChunkPoints);
         std::fill(buffer.begin(), buffer.end(), '\0');
         char* p = buffer.data();
         for (std::size_t i = begin; i < end; ++i) {
-            if (!positions[i].allFinite())
+            if (!cloud.positions()[i].allFinite())
                 continue;
-            // With the file's exact coordinates where a float misses its grid.
-            const Eigen::Vector3d local = cloud.exactLocalPosition(i);
-            for (int a = 0; a < 3; ++a) {
-                const std::int32_t raw = clampRound<std::int32_t>((shift[a] + local[a]) * inverseScale[a]);
-                store<std::int32_t>(p + 4 * a, raw);
-                rawMin[a] = std::min(rawMin[a], raw);
-                rawMax[a] = std::max(rawMax[a], raw);
-            }
-            store<std::uint16_t>(p + 12, clampRound<std::uint16_t>(slot(Slot::Intensity).get(i, 0.0)));
-            // Return number and count default to 1: "1 of 1" is what a single-return
-            // scanner produces, and 0 is not a valid return number.
-            const unsigned returnNumber = clampBits(slot(Slot::ReturnNumber).get(i, 1.0), 15);
-            const unsigned numberOfReturns = clampBits(slot(Slot::NumberOfReturns).get(i, 1.0), 15);
-            p[14] = static_cast<char>(returnNumber | (numberOfReturns << 4));
-            p[15] = static_cast<char>(clampBits(slot(Slot::ClassificationFlags).get(i, 0.0), 15) |
-                                      (clampBits(slot(Slot::ScannerChannel).get(i, 0.0), 3) << 4) |
-                                      (clampBits(slot(Slot::ScanDirectionFlag).get(i, 0.0), 1) << 6) |
-                                      (clampBits(slot(Slot::EdgeOfFlightLine).get(i, 0.0), 1) << 7));
-            p[16] = static_cast<char>(clampRound<std::uint8_t>(slot(Slot::Classification).get(i, 0.0)));
-            p[17] = static_cast<char>(clampRound<std::uint8_t>(slot(Slot::UserData).get(i, 0.0)));
-            // Scan angle in 0.006 degree units; LAS 1.4 R15 limits it to ±30000 (±180°).
-            const double angle = std::clamp(slot(Slot::ScanAngle).get(i, 0.0) / 0.006, -30000.0, 30000.0);
-            store<std::int16_t>(p + 18, clampRound<std::int16_t>(angle));
-            store<std::uint16_t>(p + 20, clampRound<std::uint16_t>(slot(Slot::PointSourceId).get(i, 0.0)));
-            const double gps = slot(Slot::GpsTime).get(i, 0.0);
-            gpsMax = std::max(gpsMax, gps);
-            store<double>(p + 22, gps);
-            if (format >= 7) {
-                // 8-bit to 16-bit: x257 maps 0..255 onto the full 0..65535 range.
-                const Rgb8& c = cloud.colors()[i];
-                store<std::uint16_t>(p + 30, static_cast<std::uint16_t>(c.r * 257));
-                store<std::uint16_t>(p + 32, static_cast<std::uint16_t>(c.g * 257));
-                store<std::uint16_t>(p + 34, static_cast<std::uint16_t>(c.b * 257));
-            }
-            if (format == 8)
-                store<std::uint16_t>(p + 36, clampRound<std::uint16_t>(slot(Slot::Nir).get(i, 0.0)));
-            for (const ExtraOutput& e : extras) {
-                if (e.asDouble)
-                    store<double>(p + e.recordOffset, e.field->value(i));
-                else
-                    store<float>(p + e.recordOffset, e.field->values()[i]);
-            }
+            const unsigned returnNumber = fillRecord(p, cloud, i, plan, shift, inverseScale, totals);
             if (returnNumber >= 1)
-                ++pointsByReturn[returnNumber - 1];
-            p += recordLength;
+                ++totals.pointsByReturn[returnNumber - 1];
+            p += plan.recordLength;
         }
         if (lazPoints)
-            lazPoints->add(buffer.data(), static_cast<std::size_t>(p - buffer.data()) / recordLength);
+            lazPoints->add(buffer.data(), static_cast<std::size_t>(p - buffer.data()) / plan.recordLength);
         else
             stream.write(buffer.data(), p - buffer.data());
         ticker.step(end - begin);
     }
     if (lazPoints)
         lazPoints->finish();
+    return totals;
+}
 
-    const auto evlrStart = static_cast<std::uint64_t>(stream.tellp());
-    stream.write(crsRecord.data(), static_cast<std::streamsize>(crsRecord.size()));
+//! The LAS 1.4 public header block, once the records are written.
+struct HeaderFacts
+{
+    int format = 6;
+    bool compressed = false;
+    std::size_t recordLength = 0;
+    std::uint64_t offsetToPoints = 0, finiteCount = 0, evlrStart = 0;
+    std::uint32_t vlrCount = 0;
+    bool hasEvlr = false;
+};
 
-    // Public header block, LAS 1.4.
-    char* h = header.data();
+void fillHeader(char* h, const HeaderFacts& facts, const Quantization& grid, const RecordTotals& totals)
+{
     std::memcpy(h, "LASF", 4);
     // Global encoding: bit 4 (WKT) is required for point formats 6-10 (LAS 1.4 R15,
     // "Coordinate Reference System Representation": GeoTIFF with them is an error).
     // Bit 0: the cloud does not record the GPS time type, but times beyond one week
     // (604800 s) cannot be GPS week time, so they are adjusted standard GPS time.
     std::uint16_t globalEncoding = 1u << 4;
-    if (gpsMax > 604800.0)
+    if (totals.gpsMax > 604800.0)
         globalEncoding |= 1u;
     store<std::uint16_t>(h + hdr::globalEncoding, globalEncoding);
     h[hdr::versionMajor] = 1;
@@ -393,28 +394,85 @@ void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions&
         store<std::uint16_t>(h + hdr::creationYear, static_cast<std::uint16_t>(utc.tm_year + 1900));
     }
     store<std::uint16_t>(h + hdr::headerSize, static_cast<std::uint16_t>(kHeaderSize14));
-    store<std::uint32_t>(h + hdr::offsetToPoints, static_cast<std::uint32_t>(offsetToPoints));
-    store<std::uint32_t>(h + hdr::vlrCount, vlrCount);
-    if (!crsRecord.empty()) {
-        store<std::uint64_t>(h + hdr::evlrStart, evlrStart);
+    store<std::uint32_t>(h + hdr::offsetToPoints, static_cast<std::uint32_t>(facts.offsetToPoints));
+    store<std::uint32_t>(h + hdr::vlrCount, facts.vlrCount);
+    if (facts.hasEvlr) {
+        store<std::uint64_t>(h + hdr::evlrStart, facts.evlrStart);
         store<std::uint32_t>(h + hdr::evlrCount, 1u);
     }
     // LASzip marks compressed records with bit 7 of the format.
-    h[hdr::pointFormat] = static_cast<char>(format | (compressed ? 0x80 : 0));
-    store<std::uint16_t>(h + hdr::recordLength, static_cast<std::uint16_t>(recordLength));
+    h[hdr::pointFormat] = static_cast<char>(facts.format | (facts.compressed ? 0x80 : 0));
+    store<std::uint16_t>(h + hdr::recordLength, static_cast<std::uint16_t>(facts.recordLength));
     // Legacy point counts stay 0: LAS 1.4 R15 requires it for point formats 6 and above.
     for (int a = 0; a < 3; ++a) {
-        store<double>(h + hdr::scale + 8 * a, lasScale[a]);
-        store<double>(h + hdr::offset + 8 * a, lasOffset[a]);
+        store<double>(h + hdr::scale + 8 * a, grid.scale[a]);
+        store<double>(h + hdr::offset + 8 * a, grid.offset[a]);
         // The extents of the stored (quantised) coordinates; zero without points.
-        const double lo = finiteCount ? rawMin[a] * lasScale[a] + lasOffset[a] : 0.0;
-        const double hi = finiteCount ? rawMax[a] * lasScale[a] + lasOffset[a] : 0.0;
+        const double lo = facts.finiteCount ? totals.rawMin[a] * grid.scale[a] + grid.offset[a] : 0.0;
+        const double hi = facts.finiteCount ? totals.rawMax[a] * grid.scale[a] + grid.offset[a] : 0.0;
         store<double>(h + hdr::bounds + 16 * a, hi);
         store<double>(h + hdr::bounds + 16 * a + 8, lo);
     }
-    store<std::uint64_t>(h + hdr::pointCount, finiteCount);
-    for (std::size_t r = 0; r < pointsByReturn.size(); ++r)
-        store<std::uint64_t>(h + hdr::pointsByReturn + 8 * r, pointsByReturn[r]);
+    store<std::uint64_t>(h + hdr::pointCount, facts.finiteCount);
+    for (std::size_t r = 0; r < totals.pointsByReturn.size(); ++r)
+        store<std::uint64_t>(h + hdr::pointsByReturn + 8 * r, totals.pointsByReturn[r]);
+}
+
+} // namespace
+
+void writeLas(const PointCloud& cloud, const fs::path& path, const WriteOptions& options, bool compressed)
+{
+    HeaderFacts facts;
+    facts.compressed = compressed;
+    for (const auto& p : cloud.positions())
+        facts.finiteCount += p.allFinite() ? 1 : 0;
+    if (facts.finiteCount != cloud.size())
+        logWarning(path.string() + ": " + std::to_string(cloud.size() - facts.finiteCount) +
+                   " points with non-finite coordinates were not written");
+    const RecordPlan plan = planRecords(cloud, path);
+    facts.format = plan.format;
+    facts.recordLength = plan.recordLength;
+
+    // The variable-length records: the extra dimensions, the coordinate
+    // reference system as an OGC WKT record, NUL-terminated (one too long for
+    // a VLR's 16-bit length goes into an EVLR after the points), and for LAZ
+    // the LASzip record describing the compressed records.
+    std::string vlr;
+    if (!plan.extras.empty()) {
+        vlr += extraBytesRecord(plan.extras);
+        ++facts.vlrCount;
+    }
+    std::string crsRecord;
+    if (!cloud.crsWkt().empty()) {
+        const std::string wkt = cloud.crsWkt() + '\0';
+        if (wkt.size() > std::numeric_limits<std::uint16_t>::max()) {
+            crsRecord = variableLengthRecord("LASF_Projection", 2112, "OGC coordinate system WKT", wkt, true);
+        } else {
+            vlr += variableLengthRecord("LASF_Projection", 2112, "OGC coordinate system WKT", wkt, false);
+            ++facts.vlrCount;
+        }
+    }
+    std::optional<LazLayout> lazLayout;
+    if (compressed) {
+        lazLayout = lazLayoutForFormat(plan.format, plan.recordLength - plan.baseSize);
+        vlr += variableLengthRecord(kLaszipUserId, kLaszipRecordId, "by scandiff, LASzip compatible", lazRecordPayload(*lazLayout), false);
+        ++facts.vlrCount;
+    }
+    const Quantization grid = chooseGrid(cloud, path);
+
+    AtomicFile output(path);
+    std::ofstream& stream = output.stream();
+    facts.offsetToPoints = kHeaderSize14 + vlr.size();
+    // The header is written again at the end, with the extents and return counts.
+    std::array<char, kHeaderSize14> header{};
+    stream.write(header.data(), header.size());
+    stream.write(vlr.data(), static_cast<std::streamsize>(vlr.size()));
+    ProgressTicker ticker(options.progress, "Writing " + path.filename().string(), cloud.size());
+    const RecordTotals totals = writeRecords(stream, cloud, plan, grid, lazLayout, ticker);
+    facts.evlrStart = static_cast<std::uint64_t>(stream.tellp());
+    facts.hasEvlr = !crsRecord.empty();
+    stream.write(crsRecord.data(), static_cast<std::streamsize>(crsRecord.size()));
+    fillHeader(header.data(), facts, grid, totals);
     stream.seekp(0);
     stream.write(header.data(), header.size());
     output.commit();
