@@ -653,16 +653,15 @@ void appendNumber(std::string& out, double value, bool single)
     out.append(buffer, result.ptr);
 }
 
-void writePcd(const PointCloud& cloud, const fs::path& path, const WriteOptions& options)
+//! The fields a cloud is written with, in order: x y z (doubles when the
+//! cloud has a global shift, so coordinates keep their millimetres), normals,
+//! the packed colour, then one per scalar field (double when it has an offset
+//! or is kept in double), under names unique in the file.
+std::vector<OutField> pcdFields(const PointCloud& cloud)
 {
-    if (options.encoding == Encoding::BinaryBigEndian)
-        throw Error(ErrorCode::Unsupported, path.string() + ": PCD has no big-endian encoding");
-    ProgressTicker ticker(options.progress, "Writing " + path.filename().string(), 2);
-    const std::size_t n = cloud.size();
-    const bool doubles = !cloud.origin().isZero();
     std::vector<OutField> fields;
     std::set<std::string> taken{"x", "y", "z", "normal_x", "normal_y", "normal_z", "rgb", "rgba", "_"};
-    const unsigned coordinateSize = doubles ? 8 : 4;
+    const unsigned coordinateSize = cloud.origin().isZero() ? 4 : 8;
     fields.push_back({"x", 'F', coordinateSize});
     fields.push_back({"y", 'F', coordinateSize});
     fields.push_back({"z", 'F', coordinateSize});
@@ -673,37 +672,47 @@ void writePcd(const PointCloud& cloud, const fs::path& path, const WriteOptions&
         fields.push_back({"rgb", 'F', 4}); // PCL's convention: the packed bytes declared as a float
     for (const ScalarField& f : cloud.fields())
         fields.push_back({uniqueName(f.name(), taken), 'F', f.offset() != 0.0 || f.isDouble() ? 8u : 4u});
-    std::size_t pointStep = 0;
-    for (const OutField& f : fields)
-        pointStep += f.size;
+    return fields;
+}
 
-    // The numbers of point i, in field order, as they are written.
-    auto valuesOf = [&](std::size_t i, std::vector<double>& values, std::uint32_t& packed) {
+//! The numbers of one point, in field order, as they are written; the colour
+//! as its packed bytes beside them (its place in `values` holds 0).
+class PcdPointValues
+{
+public:
+    explicit PcdPointValues(const PointCloud& cloud) : cloud_(cloud), doubles_(!cloud.origin().isZero()) {}
+    //! Where the packed colour goes among the fields (past the end without colours).
+    std::size_t colourIndex(std::size_t fieldCount) const
+    {
+        return cloud_.hasColors() ? (cloud_.hasNormals() ? 6 : 3) : fieldCount;
+    }
+    void of(std::size_t i)
+    {
         values.clear();
-        const Eigen::Vector3d p = cloud.globalPosition(i);
+        const Eigen::Vector3d p = cloud_.globalPosition(i);
         for (int a = 0; a < 3; ++a)
-            values.push_back(doubles ? p[a] : static_cast<double>(cloud.positions()[i][a]));
-        if (cloud.hasNormals())
+            values.push_back(doubles_ ? p[a] : static_cast<double>(cloud_.positions()[i][a]));
+        if (cloud_.hasNormals())
             for (int a = 0; a < 3; ++a)
-                values.push_back(cloud.normals()[i][a]);
-        if (cloud.hasColors()) {
-            const Rgb8 c = cloud.colors()[i];
+                values.push_back(cloud_.normals()[i][a]);
+        if (cloud_.hasColors()) {
+            const Rgb8 c = cloud_.colors()[i];
             packed = (std::uint32_t(c.r) << 16) | (std::uint32_t(c.g) << 8) | c.b;
-            values.push_back(0); // placeholder: the colour is written from `packed`
+            values.push_back(0);
         }
-        for (const ScalarField& f : cloud.fields())
+        for (const ScalarField& f : cloud_.fields())
             values.push_back(f.offset() != 0.0 || f.isDouble() ? f.value(i) : static_cast<double>(f.values()[i]));
-    };
-    auto putValue = [](unsigned char* at, double value, unsigned size) {
-        if (size == 8) {
-            std::memcpy(at, &value, 8);
-        } else {
-            const float v = static_cast<float>(value);
-            std::memcpy(at, &v, 4);
-        }
-    };
-    const std::size_t colourIndex = cloud.hasColors() ? (cloud.hasNormals() ? 6 : 3) : fields.size();
+    }
+    std::vector<double> values;
+    std::uint32_t packed = 0;
 
+private:
+    const PointCloud& cloud_;
+    bool doubles_;
+};
+
+std::string pcdHeader(const PointCloud& cloud, const std::vector<OutField>& fields, Encoding encoding)
+{
     std::string header = "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS";
     for (const OutField& f : fields)
         header += " " + f.name;
@@ -716,7 +725,7 @@ void writePcd(const PointCloud& cloud, const fs::path& path, const WriteOptions&
     header += "\nCOUNT";
     for (std::size_t k = 0; k < fields.size(); ++k)
         header += " 1";
-    header += "\nWIDTH " + std::to_string(n) + "\nHEIGHT 1\nVIEWPOINT";
+    header += "\nWIDTH " + std::to_string(cloud.size()) + "\nHEIGHT 1\nVIEWPOINT";
     double viewpoint[7] = {0, 0, 0, 1, 0, 0, 0};
     if (!cloud.sensors().empty()) {
         const SensorPose& pose = cloud.sensors().front();
@@ -732,74 +741,108 @@ void writePcd(const PointCloud& cloud, const fs::path& path, const WriteOptions&
         header += ' ';
         appendNumber(header, v, false);
     }
-    header += "\nPOINTS " + std::to_string(n) + "\nDATA " +
-              std::string(options.encoding == Encoding::Ascii ? "ascii" : options.encoding == Encoding::BinaryCompressed ? "binary_compressed" : "binary") + "\n";
+    header += "\nPOINTS " + std::to_string(cloud.size()) + "\nDATA " +
+              std::string(encoding == Encoding::Ascii ? "ascii" : encoding == Encoding::BinaryCompressed ? "binary_compressed" : "binary") + "\n";
+    return header;
+}
 
+//! DATA ascii: one line per point, floats with the digits that give them back.
+void writePcdAscii(std::ofstream& out, const PointCloud& cloud, const std::vector<OutField>& fields, ProgressTicker& ticker)
+{
+    PcdPointValues point(cloud);
+    const std::size_t colourIndex = point.colourIndex(fields.size());
+    std::string line;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        point.of(i);
+        line.clear();
+        for (std::size_t k = 0; k < point.values.size(); ++k) {
+            if (k > 0)
+                line += ' ';
+            if (k == colourIndex) {
+                float asFloat;
+                std::memcpy(&asFloat, &point.packed, 4);
+                appendNumber(line, asFloat, true);
+            } else {
+                appendNumber(line, point.values[k], fields[k].size == 4);
+            }
+        }
+        line += '\n';
+        out.write(line.data(), static_cast<std::streamsize>(line.size()));
+        if ((i & 0xffff) == 0)
+            ticker.checkCancel();
+    }
+}
+
+//! DATA binary (point after point, written by blocks of 65,536) or
+//! binary_compressed (field after field, the whole LZF-compressed).
+void writePcdBinary(std::ofstream& out, const PointCloud& cloud, const std::vector<OutField>& fields, bool compressed,
+                    const fs::path& path, ProgressTicker& ticker)
+{
+    const std::size_t n = cloud.size();
+    std::size_t pointStep = 0;
+    for (const OutField& f : fields)
+        pointStep += f.size;
+    PcdPointValues point(cloud);
+    const std::size_t colourIndex = point.colourIndex(fields.size());
+    const auto putValue = [](unsigned char* at, double value, unsigned size) {
+        if (size == 8) {
+            std::memcpy(at, &value, 8);
+        } else {
+            const float v = static_cast<float>(value);
+            std::memcpy(at, &v, 4);
+        }
+    };
+    std::vector<unsigned char> records(compressed ? n * pointStep : pointStep * std::min<std::size_t>(n, 65536));
+    std::vector<std::size_t> fieldOffset(fields.size());
+    for (std::size_t k = 1; k < fields.size(); ++k)
+        fieldOffset[k] = fieldOffset[k - 1] + fields[k - 1].size;
+    for (std::size_t i = 0; i < n; ++i) {
+        point.of(i);
+        const std::size_t slot = compressed ? i : i % 65536;
+        for (std::size_t k = 0; k < fields.size(); ++k) {
+            unsigned char* at = compressed ? records.data() + fieldOffset[k] * n + slot * fields[k].size
+                                           : records.data() + slot * pointStep + fieldOffset[k];
+            if (k == colourIndex)
+                std::memcpy(at, &point.packed, 4);
+            else
+                putValue(at, point.values[k], fields[k].size);
+        }
+        if (!compressed && (slot == 65535 || i + 1 == n)) {
+            out.write(reinterpret_cast<const char*>(records.data()), static_cast<std::streamsize>((slot + 1) * pointStep));
+            ticker.checkCancel();
+        }
+    }
+    if (!compressed)
+        return;
+    if (records.size() > std::numeric_limits<std::uint32_t>::max() / 2)
+        throw Error(ErrorCode::Unsupported, path.string() + ": binary_compressed PCD holds at most 2 GB of data; use binary");
+    // Room for incompressible data: LZF adds at most one byte per 32.
+    std::vector<unsigned char> packedData(records.size() + records.size() / 16 + 64);
+    const unsigned length = records.empty() ? 0
+                                            : lzf_compress(records.data(), static_cast<unsigned>(records.size()), packedData.data(),
+                                                           static_cast<unsigned>(packedData.size()));
+    if (!records.empty() && length == 0)
+        throw Error(ErrorCode::Io, path.string() + ": LZF compression failed");
+    const std::uint32_t blockSizes[2] = {length, static_cast<std::uint32_t>(records.size())};
+    out.write(reinterpret_cast<const char*>(blockSizes), 8);
+    out.write(reinterpret_cast<const char*>(packedData.data()), length);
+}
+
+void writePcd(const PointCloud& cloud, const fs::path& path, const WriteOptions& options)
+{
+    if (options.encoding == Encoding::BinaryBigEndian)
+        throw Error(ErrorCode::Unsupported, path.string() + ": PCD has no big-endian encoding");
+    ProgressTicker ticker(options.progress, "Writing " + path.filename().string(), 2);
+    const std::vector<OutField> fields = pcdFields(cloud);
     AtomicFile file(path);
     std::ofstream out(file.tempPath(), std::ios::binary);
     if (!out)
         throw Error(ErrorCode::Io, path.string() + ": cannot write");
-    out << header;
-    std::vector<double> values;
-    std::uint32_t packed = 0;
-    if (options.encoding == Encoding::Ascii) {
-        std::string line;
-        for (std::size_t i = 0; i < n; ++i) {
-            valuesOf(i, values, packed);
-            line.clear();
-            for (std::size_t k = 0; k < values.size(); ++k) {
-                if (k > 0)
-                    line += ' ';
-                if (k == colourIndex) {
-                    float asFloat;
-                    std::memcpy(&asFloat, &packed, 4);
-                    appendNumber(line, asFloat, true);
-                } else {
-                    appendNumber(line, values[k], fields[k].size == 4);
-                }
-            }
-            line += '\n';
-            out.write(line.data(), static_cast<std::streamsize>(line.size()));
-            if ((i & 0xffff) == 0)
-                ticker.checkCancel();
-        }
-    } else {
-        const bool fieldMajor = options.encoding == Encoding::BinaryCompressed;
-        std::vector<unsigned char> records(fieldMajor ? n * pointStep : pointStep * std::min<std::size_t>(n, 65536));
-        std::vector<std::size_t> fieldOffset(fields.size());
-        for (std::size_t k = 1; k < fields.size(); ++k)
-            fieldOffset[k] = fieldOffset[k - 1] + fields[k - 1].size;
-        for (std::size_t i = 0; i < n; ++i) {
-            valuesOf(i, values, packed);
-            const std::size_t slot = fieldMajor ? i : i % 65536;
-            for (std::size_t k = 0; k < fields.size(); ++k) {
-                unsigned char* at = fieldMajor ? records.data() + fieldOffset[k] * n + slot * fields[k].size
-                                               : records.data() + slot * pointStep + fieldOffset[k];
-                if (k == colourIndex)
-                    std::memcpy(at, &packed, 4);
-                else
-                    putValue(at, values[k], fields[k].size);
-            }
-            if (!fieldMajor && (slot == 65535 || i + 1 == n)) {
-                out.write(reinterpret_cast<const char*>(records.data()), static_cast<std::streamsize>((slot + 1) * pointStep));
-                ticker.checkCancel();
-            }
-        }
-        if (fieldMajor) {
-            if (records.size() > std::numeric_limits<std::uint32_t>::max() / 2)
-                throw Error(ErrorCode::Unsupported, path.string() + ": binary_compressed PCD holds at most 2 GB of data; use binary");
-            // Room for incompressible data: LZF adds at most one byte per 32.
-            std::vector<unsigned char> packedData(records.size() + records.size() / 16 + 64);
-            const unsigned compressed = records.empty() ? 0
-                                            : lzf_compress(records.data(), static_cast<unsigned>(records.size()), packedData.data(),
-                                                           static_cast<unsigned>(packedData.size()));
-            if (!records.empty() && compressed == 0)
-                throw Error(ErrorCode::Io, path.string() + ": LZF compression failed");
-            const std::uint32_t blockSizes[2] = {compressed, static_cast<std::uint32_t>(records.size())};
-            out.write(reinterpret_cast<const char*>(blockSizes), 8);
-            out.write(reinterpret_cast<const char*>(packedData.data()), compressed);
-        }
-    }
+    out << pcdHeader(cloud, fields, options.encoding);
+    if (options.encoding == Encoding::Ascii)
+        writePcdAscii(out, cloud, fields, ticker);
+    else
+        writePcdBinary(out, cloud, fields, options.encoding == Encoding::BinaryCompressed, path, ticker);
     ticker.step();
     out.close();
     if (!out)
