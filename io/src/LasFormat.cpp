@@ -962,6 +962,67 @@ bool floatsMissTheGrid(const LasHeader& h, const Eigen::Vector3d& origin)
 
 //! The whole file, or with `range` the records of that range (a LAZ file's
 //! chunks that hold them are decoded whole).
+//! Where the parse writes each attribute: the cloud's arrays, null for a
+//! field not made.
+PointOutputs pointOutputs(PointCloud& cloud, double gpsTimeOffset)
+{
+    auto values = [&](const char* name) {
+        ScalarField* f = cloud.field(name);
+        return f ? f->values().data() : nullptr;
+    };
+    PointOutputs out;
+    out.positions = cloud.positions().data();
+    if (!cloud.positionResiduals().empty())
+        out.positionResiduals = cloud.positionResiduals().data();
+    out.colors = cloud.hasColors() ? cloud.enableColors().data() : nullptr;
+    out.intensity = values("intensity");
+    out.returnNumber = values("return_number");
+    out.numberOfReturns = values("number_of_returns");
+    out.classification = values("classification");
+    out.classificationFlags = values("classification_flags");
+    out.scannerChannel = values("scanner_channel");
+    out.scanDirectionFlag = values("scan_direction_flag");
+    out.edgeOfFlightLine = values("edge_of_flight_line");
+    out.scanAngle = values("scan_angle");
+    out.userData = values("user_data");
+    out.pointSourceId = values("point_source_id");
+    out.gpsTime = values("gps_time");
+    if (ScalarField* time = cloud.field("gps_time"))
+        out.gpsTimeResidual = time->residuals().data();
+    out.gpsTimeOffset = gpsTimeOffset;
+    out.nir = values("nir");
+    return out;
+}
+
+//! A standard field made late (the scanner channel of a LAZ file) at its
+//! place among the others, as the LAS reader has it.
+void insertAmongStandardFields(PointCloud& cloud, ScalarField field, const std::vector<std::string>& standardNames)
+{
+    const auto rank = std::find(standardNames.begin(), standardNames.end(), field.name()) - standardNames.begin();
+    std::size_t position = 0;
+    while (position < cloud.fields().size()) {
+        const auto other = std::find(standardNames.begin(), standardNames.end(), cloud.fields()[position].name());
+        if (other == standardNames.end() || other - standardNames.begin() > rank)
+            break;
+        ++position;
+    }
+    cloud.addField(std::move(field), position);
+}
+
+//! A standard attribute that is 0 for every point (user_data, scanner_channel,
+//! flags... in most files) carries nothing: dropping it saves 4 bytes per point
+//! each, and writing LAS again puts 0 in its slot all the same. Extra Bytes
+//! are the user's own dimensions and always kept.
+void dropEmptyStandardFields(PointCloud& cloud, const std::vector<std::string>& extraNames)
+{
+    std::vector<std::string> empty;
+    for (const ScalarField& f : cloud.fields())
+        if (std::find(extraNames.begin(), extraNames.end(), f.name()) == extraNames.end() && f.isZeroEverywhere())
+            empty.push_back(f.name());
+    for (const std::string& name : empty)
+        cloud.removeField(name);
+}
+
 Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<RecordRange> range = std::nullopt)
 {
     MappedFile file(path);
@@ -1073,31 +1134,7 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
     }
 
     // Pointers are taken once every field exists: adding fields moves them.
-    auto values = [&](const char* name) {
-        ScalarField* f = cloud.field(name);
-        return f ? f->values().data() : nullptr;
-    };
-    PointOutputs out;
-    out.positions = cloud.positions().data();
-    if (!cloud.positionResiduals().empty())
-        out.positionResiduals = cloud.positionResiduals().data();
-    out.colors = cloud.hasColors() ? cloud.enableColors().data() : nullptr;
-    out.intensity = values("intensity");
-    out.returnNumber = values("return_number");
-    out.numberOfReturns = values("number_of_returns");
-    out.classification = values("classification");
-    out.classificationFlags = values("classification_flags");
-    out.scannerChannel = values("scanner_channel");
-    out.scanDirectionFlag = values("scan_direction_flag");
-    out.edgeOfFlightLine = values("edge_of_flight_line");
-    out.scanAngle = values("scan_angle");
-    out.userData = values("user_data");
-    out.pointSourceId = values("point_source_id");
-    out.gpsTime = values("gps_time");
-    if (ScalarField* time = cloud.field("gps_time"))
-        out.gpsTimeResidual = time->residuals().data();
-    out.gpsTimeOffset = gpsTimeOffset;
-    out.nir = values("nir");
+    const PointOutputs out = pointOutputs(cloud, gpsTimeOffset);
 
     const CoordinateTransform transform{h.scale, h.offset - cloud.origin()};
     if (h.compressed)
@@ -1107,33 +1144,11 @@ Entity readLas(const fs::path& path, const ReadOptions& options, std::optional<R
         parseRecordsInMemory(h, records, count, transform, out, extraFillers, cloud, ticker);
     for (ExtraFieldFiller& extra : extraFillers)
         extra.finish();
-    if (deferredChannel) {
-        // At its place among the standard fields, as the LAS reader has it.
-        const auto rank = std::find(standardNames.begin(), standardNames.end(), "scanner_channel") - standardNames.begin();
-        std::size_t position = 0;
-        while (position < cloud.fields().size()) {
-            const auto other = std::find(standardNames.begin(), standardNames.end(), cloud.fields()[position].name());
-            if (other == standardNames.end() || other - standardNames.begin() > rank)
-                break;
-            ++position;
-        }
-        cloud.addField(std::move(*deferredChannel), position);
-    }
-
-    // A standard attribute that is 0 for every point (user_data, scanner_channel,
-    // flags... in most files) carries nothing: dropping it saves 4 bytes per point
-    // each, and writing LAS again puts 0 in its slot all the same. Extra Bytes
-    // are the user's own dimensions and always kept.
-    // The ranges of one file keep them all, so that each has the same fields.
-    std::vector<std::string> emptyStandardFields;
-    for (const ScalarField& f : cloud.fields()) {
-        if (range || std::find(extraNames.begin(), extraNames.end(), f.name()) != extraNames.end())
-            continue;
-        if (f.isZeroEverywhere())
-            emptyStandardFields.push_back(f.name());
-    }
-    for (const std::string& name : emptyStandardFields)
-        cloud.removeField(name);
+    if (deferredChannel)
+        insertAmongStandardFields(cloud, std::move(*deferredChannel), standardNames);
+    // The ranges of one file keep every field, so that each has the same ones.
+    if (!range)
+        dropEmptyStandardFields(cloud, extraNames);
 
     const std::size_t dropped = cloud.removeNonFinitePoints();
     if (dropped > 0)
