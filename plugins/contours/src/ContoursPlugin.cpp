@@ -108,6 +108,200 @@ std::vector<Segment> segmentsOf(const PointCloud& cloud, const std::string& fiel
     return segments;
 }
 
+//! What the contours tool gives, built plane by plane: the drawing (a layer
+//! per plane), the table of rings, the JSON document, and each plane's
+//! outline polylines for the joining of neighbouring planes.
+class ContoursOutput
+{
+public:
+    ContoursOutput(const ParameterValues& values) : values_(values)
+    {
+        table_.columns = {"plane", "part", "ring", "vertices", "area", "perimeter", "threshold", "plane_rms"};
+    }
+
+    //! One segment: its plane, its outline parts (and holes) above the
+    //! smallest area, each ring as it is drawn (vectorised on request).
+    //! False when the segment has no plane (fewer than 3 points, or a line).
+    bool addSegment(const PointCloud& cloud, const Segment& segment, const OutlineParams& outline)
+    {
+        std::vector<Eigen::Vector3d> global;
+        global.reserve(segment.points.size());
+        for (std::size_t i : segment.points)
+            global.push_back(cloud.globalPosition(i));
+        PlaneFrame frame;
+        try {
+            frame = fitPlaneFrame(global);
+        } catch (const Error&) {
+            return false;
+        }
+        std::vector<Eigen::Vector2d> uv;
+        uv.reserve(global.size());
+        for (const Eigen::Vector3d& p : global)
+            uv.push_back(frame.toPlane(p));
+        const OutlineResult parts = extractOutlines(uv, outline);
+        const double spacing = parts.spacing;
+        largestSpacing_ = std::max(largestSpacing_, spacing);
+        outlined_.push_back(OutlinedPlane{frame, {}, {}});
+        const double minArea = values_.real("min-area") > 0 ? values_.real("min-area") : 50.0 * spacing * spacing;
+        VectoriseParams vector;
+        vector.tolerance = values_.real("tolerance") > 0 ? values_.real("tolerance") : std::max(1.5 * spacing, 1e-6);
+        vector.edgeOffset = values_.boolean("offset-edges") ? 0.5 * spacing : 0.0;
+
+        nlohmann::json polygons = nlohmann::json::array();
+        const std::string layer = segment.id < 0 ? std::string("OUTLINE") : layerName("PLANE", segment.id);
+        long partNumber = 0;
+        for (const OutlinePart& part : parts.parts) {
+            if (part.area < minArea)
+                continue;
+            std::vector<Ring2d> ringList{part.outer};
+            for (const Ring2d& hole : part.holes)
+                if (std::abs(signedArea(hole)) >= minArea)
+                    ringList.push_back(hole);
+            nlohmann::json polygon = {{"holes", nlohmann::json::array()}};
+            for (std::size_t r = 0; r < ringList.size(); ++r) {
+                nlohmann::json ringDoc = addRing(ringList[r], r == 0, frame, vector, layer);
+                table_.rows.push_back({static_cast<double>(segment.id), static_cast<double>(partNumber), std::string(r == 0 ? "outer" : "hole"),
+                                       ringDoc["vertex_count"].get<double>(), ringDoc["area"].get<double>(), ringDoc["perimeter"].get<double>(),
+                                       parts.threshold, frame.rms});
+                ringDoc.erase("vertex_count");
+                if (r == 0)
+                    polygon["outer"] = ringDoc;
+                else
+                    polygon["holes"].push_back(ringDoc);
+            }
+            polygons.push_back(polygon);
+            ++partNumber;
+        }
+        planes_.push_back({{"id", segment.id},
+                           {"layer", layer},
+                           {"normal", pointJson(frame.normal)},
+                           {"d", -frame.normal.dot(frame.origin)},
+                           {"points", segment.points.size()},
+                           {"plane_rms", frame.rms},
+                           {"method", values_.text("method")},
+                           {"threshold", parts.threshold},
+                           {"polygons", polygons}});
+        return true;
+    }
+
+    //! Vertices near the lines where neighbouring planes meet moved onto them
+    //! (thesis 001 §4.4), in the drawing and the document.
+    PlaneJoinResult joinPlanes()
+    {
+        PlaneJoinResult joined;
+        if (!values_.boolean("join-planes") || outlined_.size() < 2)
+            return joined;
+        PlaneJoinParams join;
+        join.tolerance = values_.real("join-tolerance") > 0 ? values_.real("join-tolerance") : std::max(3.0 * largestSpacing_, 1e-6);
+        joined = joinNeighbouringPlanes(drawing_, outlined_, join);
+        replaceMovedPoints(planes_, joined.moves);
+        return joined;
+    }
+
+    std::size_t rings() const { return rings_; }
+    std::size_t holes() const { return holes_; }
+    Drawing takeDrawing() { return std::move(drawing_); }
+    Table takeTable() { return std::move(table_); }
+    const nlohmann::json& planes() const { return planes_; }
+
+private:
+    //! One ring drawn (its corners and arcs as bulges when vectorised, CAD
+    //! draws true arcs) and described: its document entry, with its vertex
+    //! count beside it for the table.
+    nlohmann::json addRing(Ring2d ring, bool outer, const PlaneFrame& frame, const VectoriseParams& vector, const std::string& layer)
+    {
+        nlohmann::json pieces = nlohmann::json::array();
+        DrawingPolyline polyline{layer, {}, true};
+        const bool vectorise = values_.boolean("vectorise");
+        if (vectorise) {
+            const VectorRing vectorised = vectoriseRing(ring, vector);
+            ring = vectorised.vertices;
+            bool arcs = false;
+            for (const VectorPiece& piece : vectorised.pieces) {
+                polyline.points.push_back(frame.toWorld(piece.start));
+                polyline.bulges.push_back(piece.bulge);
+                arcs = arcs || piece.bulge != 0.0;
+            }
+            if (arcs)
+                polyline.normal = frame.normal;
+            else
+                polyline.bulges.clear();
+            for (const VectorPiece& piece : vectorised.pieces) {
+                nlohmann::json p = {{"type", pieceKindName(piece.kind)},
+                                    {"start", pointJson(frame.toWorld(piece.start))},
+                                    {"end", pointJson(frame.toWorld(piece.end))}};
+                if (piece.kind == PieceKind::Arc) {
+                    p["centre"] = pointJson(frame.toWorld(piece.centre));
+                    p["radius"] = piece.radius;
+                    p["sagitta"] = piece.sagitta;
+                    p["bulge"] = piece.bulge;
+                }
+                pieces.push_back(p);
+            }
+        }
+        const std::vector<Eigen::Vector3d> lifted = lift(frame, ring);
+        if (polyline.points.size() < 3) { // not vectorised, or a ring too small to split
+            polyline.points = lifted;
+            polyline.bulges.clear();
+        }
+        (outer ? outlined_.back().outer : outlined_.back().holes).push_back(drawing_.polylines.size());
+        drawing_.polylines.push_back(std::move(polyline));
+        const double area = std::abs(signedArea(ring)), perimeter = ringPerimeter(ring);
+        nlohmann::json ringDoc = {{"vertices", ringJson(lifted)}, {"area", area}, {"perimeter", perimeter}};
+        if (vectorise)
+            ringDoc["pieces"] = pieces;
+        ringDoc["vertex_count"] = static_cast<double>(ring.size());
+        ++rings_;
+        holes_ += outer ? 0 : 1;
+        return ringDoc;
+    }
+
+    const ParameterValues& values_;
+    Drawing drawing_;
+    Table table_;
+    nlohmann::json planes_ = nlohmann::json::array();
+    std::vector<OutlinedPlane> outlined_;
+    double largestSpacing_ = 0;
+    std::size_t rings_ = 0, holes_ = 0;
+};
+
+ToolResult runContours(const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress)
+{
+    const PointCloud& cloud = inputs.cloud();
+    OutlineParams outline;
+    outline.method = parseOutlineMethod(values.text("method"));
+    outline.threshold = outline.method == OutlineMethod::LongEdges ? thresholdFrom(values.text("edge-threshold")) : values.real("alpha");
+    std::string note;
+    const std::vector<Segment> segments = segmentsOf(cloud, values.text("segment-field"), note);
+    ProgressTicker ticker(progress, "Contours", segments.size());
+    ContoursOutput output(values);
+    std::size_t skipped = 0;
+    for (const Segment& segment : segments) {
+        ticker.checkCancel();
+        ticker.step();
+        if (!output.addSegment(cloud, segment, outline))
+            ++skipped; // fewer than 3 points, or a line
+    }
+    const PlaneJoinResult joined = output.joinPlanes();
+    ToolResult result;
+    const std::string document =
+        nlohmann::json({{"planes", output.planes()}, {"joined_vertices", joined.movedVertices}}).dump(1) + "\n";
+    result.add("contours", output.takeDrawing());
+    result.add("rings", output.takeTable());
+    result.add("document", TextDocument{".json", document});
+    std::ostringstream summary;
+    summary << segments.size() - skipped << " planes outlined: " << output.rings() - output.holes() << " outer rings, " << output.holes()
+            << " holes";
+    if (joined.joints > 0)
+        summary << "; " << joined.joints << " pairs of planes joined (" << joined.movedVertices << " vertices moved onto their common lines)";
+    if (skipped)
+        summary << "; " << skipped << " segments skipped (fewer than 3 points or on a line)";
+    if (!note.empty())
+        summary << "; " << note;
+    result.summary = summary.str();
+    return result;
+}
+
 ToolSpec contoursTool()
 {
     ToolSpec tool;
@@ -165,147 +359,7 @@ ToolSpec contoursTool()
     tool.outputs = {OutputSpec{"contours", "Contours", DataKind::Drawing},
                     OutputSpec{"rings", "Contour rings", DataKind::Table, false, false, "contours"},
                     OutputSpec{"document", "Contours (JSON)", DataKind::Document, false, false, "contours"}};
-    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
-        const PointCloud& cloud = inputs.cloud();
-        OutlineParams outline;
-        outline.method = parseOutlineMethod(values.text("method"));
-        outline.threshold = outline.method == OutlineMethod::LongEdges ? thresholdFrom(values.text("edge-threshold")) : values.real("alpha");
-        std::string note;
-        const std::vector<Segment> segments = segmentsOf(cloud, values.text("segment-field"), note);
-        ProgressTicker ticker(progress, "Contours", segments.size());
-
-        Drawing drawing;
-        Table table;
-        table.columns = {"plane", "part", "ring", "vertices", "area", "perimeter", "threshold", "plane_rms"};
-        nlohmann::json planes = nlohmann::json::array();
-        std::vector<OutlinedPlane> outlined; // for joining the planes
-        double largestSpacing = 0;
-        std::size_t rings = 0, holes = 0, skipped = 0;
-        for (const Segment& segment : segments) {
-            ticker.checkCancel();
-            ticker.step();
-            std::vector<Eigen::Vector3d> global;
-            global.reserve(segment.points.size());
-            for (std::size_t i : segment.points)
-                global.push_back(cloud.globalPosition(i));
-            PlaneFrame frame;
-            try {
-                frame = fitPlaneFrame(global);
-            } catch (const Error&) {
-                ++skipped; // fewer than 3 points, or a line
-                continue;
-            }
-            std::vector<Eigen::Vector2d> uv;
-            uv.reserve(global.size());
-            for (const Eigen::Vector3d& p : global)
-                uv.push_back(frame.toPlane(p));
-            OutlineResult parts = extractOutlines(uv, outline);
-            const double spacing = parts.spacing;
-            largestSpacing = std::max(largestSpacing, spacing);
-            outlined.push_back(OutlinedPlane{frame, {}, {}});
-            const double minArea = values.real("min-area") > 0 ? values.real("min-area") : 50.0 * spacing * spacing;
-            VectoriseParams vector;
-            vector.tolerance = values.real("tolerance") > 0 ? values.real("tolerance") : std::max(1.5 * spacing, 1e-6);
-            vector.edgeOffset = values.boolean("offset-edges") ? 0.5 * spacing : 0.0;
-            const bool vectorise = values.boolean("vectorise");
-
-            nlohmann::json polygons = nlohmann::json::array();
-            const std::string layer = segment.id < 0 ? std::string("OUTLINE") : layerName("PLANE", segment.id);
-            long partNumber = 0;
-            for (const OutlinePart& part : parts.parts) {
-                if (part.area < minArea)
-                    continue;
-                std::vector<Ring2d> ringList{part.outer};
-                for (const Ring2d& hole : part.holes)
-                    if (std::abs(signedArea(hole)) >= minArea)
-                        ringList.push_back(hole);
-                nlohmann::json polygon = {{"holes", nlohmann::json::array()}};
-                for (std::size_t r = 0; r < ringList.size(); ++r) {
-                    Ring2d ring = ringList[r];
-                    nlohmann::json pieces = nlohmann::json::array();
-                    DrawingPolyline polyline{layer, {}, true};
-                    if (vectorise) {
-                        const VectorRing vectorised = vectoriseRing(ring, vector);
-                        ring = vectorised.vertices;
-                        // The drawing holds the corners and each arc as a bulge (CAD draws true arcs).
-                        bool arcs = false;
-                        for (const VectorPiece& piece : vectorised.pieces) {
-                            polyline.points.push_back(frame.toWorld(piece.start));
-                            polyline.bulges.push_back(piece.bulge);
-                            arcs = arcs || piece.bulge != 0.0;
-                        }
-                        if (arcs)
-                            polyline.normal = frame.normal;
-                        else
-                            polyline.bulges.clear();
-                        for (const VectorPiece& piece : vectorised.pieces) {
-                            nlohmann::json p = {{"type", pieceKindName(piece.kind)},
-                                                {"start", pointJson(frame.toWorld(piece.start))},
-                                                {"end", pointJson(frame.toWorld(piece.end))}};
-                            if (piece.kind == PieceKind::Arc) {
-                                p["centre"] = pointJson(frame.toWorld(piece.centre));
-                                p["radius"] = piece.radius;
-                                p["sagitta"] = piece.sagitta;
-                                p["bulge"] = piece.bulge;
-                            }
-                            pieces.push_back(p);
-                        }
-                    }
-                    const std::vector<Eigen::Vector3d> lifted = lift(frame, ring);
-                    if (polyline.points.size() < 3) { // not vectorised, or a ring too small to split
-                        polyline.points = lifted;
-                        polyline.bulges.clear();
-                    }
-                    (r == 0 ? outlined.back().outer : outlined.back().holes).push_back(drawing.polylines.size());
-                    drawing.polylines.push_back(std::move(polyline));
-                    const double area = std::abs(signedArea(ring)), perimeter = ringPerimeter(ring);
-                    table.rows.push_back({static_cast<double>(segment.id), static_cast<double>(partNumber), std::string(r == 0 ? "outer" : "hole"),
-                                          static_cast<double>(ring.size()), area, perimeter, parts.threshold, frame.rms});
-                    nlohmann::json ringDoc = {{"vertices", ringJson(lifted)}, {"area", area}, {"perimeter", perimeter}};
-                    if (vectorise)
-                        ringDoc["pieces"] = pieces;
-                    if (r == 0)
-                        polygon["outer"] = ringDoc;
-                    else
-                        polygon["holes"].push_back(ringDoc);
-                    ++rings;
-                    holes += r > 0;
-                }
-                polygons.push_back(polygon);
-                ++partNumber;
-            }
-            planes.push_back({{"id", segment.id},
-                              {"layer", layer},
-                              {"normal", pointJson(frame.normal)},
-                              {"d", -frame.normal.dot(frame.origin)},
-                              {"points", segment.points.size()},
-                              {"plane_rms", frame.rms},
-                              {"method", values.text("method")},
-                              {"threshold", parts.threshold},
-                              {"polygons", polygons}});
-        }
-        PlaneJoinResult joined;
-        if (values.boolean("join-planes") && outlined.size() >= 2) {
-            PlaneJoinParams join;
-            join.tolerance = values.real("join-tolerance") > 0 ? values.real("join-tolerance") : std::max(3.0 * largestSpacing, 1e-6);
-            joined = joinNeighbouringPlanes(drawing, outlined, join);
-            replaceMovedPoints(planes, joined.moves);
-        }
-        ToolResult result;
-        result.add("contours", std::move(drawing));
-        result.add("rings", std::move(table));
-        result.add("document", TextDocument{".json", nlohmann::json({{"planes", planes}, {"joined_vertices", joined.movedVertices}}).dump(1) + "\n"});
-        std::ostringstream summary;
-        summary << segments.size() - skipped << " planes outlined: " << rings - holes << " outer rings, " << holes << " holes";
-        if (joined.joints > 0)
-            summary << "; " << joined.joints << " pairs of planes joined (" << joined.movedVertices << " vertices moved onto their common lines)";
-        if (skipped)
-            summary << "; " << skipped << " segments skipped (fewer than 3 points or on a line)";
-        if (!note.empty())
-            summary << "; " << note;
-        result.summary = summary.str();
-        return result;
-    };
+    tool.run = runContours;
     return tool;
 }
 
