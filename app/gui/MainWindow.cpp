@@ -654,7 +654,18 @@ MoveDialog* MainWindow::moveSelectedInteractively()
         statusBar()->showMessage(tr("Move / rotate: select the clouds or meshes to move first"));
         return nullptr;
     }
+    if (moveDialog_ && moveDialog_->isVisible()) { // one at a time: the view has one box
+        moveDialog_->raise();
+        moveDialog_->activateWindow();
+        return moveDialog_;
+    }
     auto* dialog = new MoveDialog(*view_, ids, this);
+    if (!view_->movingEntities()) { // none of them is drawn: nothing to turn about
+        delete dialog;
+        statusBar()->showMessage(tr("Move / rotate: the selected entities are not shown in the view"));
+        return nullptr;
+    }
+    moveDialog_ = dialog;
     dialog->setAttribute(Qt::WA_DeleteOnClose);
     connect(dialog, &MoveDialog::applyRequested, this, [this, ids](const Eigen::Matrix4d& global) { applyMotion(ids, global); });
     dialog->show();

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <QMainWindow>
+#include <QPointer>
 #include <QStringList>
 
 #include <map>
@@ -130,6 +131,7 @@ private:
     QAction* deleteAction_ = nullptr;
     QAction* renameAction_ = nullptr;
     QAction* zoomSelection_ = nullptr;
+    QPointer<MoveDialog> moveDialog_;
     CloudView* view_;
     CloudView* secondView_ = nullptr;
     EntityTree* tree_ = nullptr;

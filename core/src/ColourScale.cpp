@@ -137,9 +137,10 @@ const std::vector<ColourScale>& ColourScale::presets()
     // read in grey and to colour-blind eyes), then the diverging ones for
     // signed distances, then CloudCompare's classics. The matplotlib and
     // ColorBrewer scales are their published tables (matplotlib 3.6's
-    // _cm_listed.py and _cm.py, Brewer's ColorBrewer 2.0) sampled at 17 or 33
-    // even steps (11 for ColorBrewer's own 11 classes): linear between the
-    // samples is within 5 levels of 255 of the full 256-entry tables.
+    // _cm_listed.py and _cm.py, Brewer's ColorBrewer 2.0): matplotlib's
+    // sampled at 17 or 33 even steps (linear between the samples is within 5
+    // levels of 255 of the full 256-entry tables), ColorBrewer's as its own
+    // classes (11 for the diverging ones, 9 for Yellow-Brown).
     static const std::vector<ColourScale> all = [] {
         std::vector<ColourScale> list;
         list.emplace_back("Viridis", evenStops({

@@ -317,7 +317,7 @@ private slots:
     }
 
     // The panel keeps the width of its dock whatever the names it lists (the
-    // 18 scales, long field names): it once grew past the window's edge.
+    // 19 scales, long field names): it once grew past the window's edge.
     void thePanelStaysNarrowWithLongNames()
     {
         gui::Document document;

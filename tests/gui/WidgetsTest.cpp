@@ -125,7 +125,7 @@ private slots:
     void presetsAreTheDocumentedOnes()
     {
         const auto& presets = ColourScale::presets();
-        QVERIFY(presets.size() >= 15); // CloudCompare 2.11 ships 16
+        QCOMPARE(presets.size(), std::size_t(19)); // CloudCompare 2.11 ships 16
         std::set<std::string> names;
         for (const ColourScale& s : presets)
             names.insert(s.name());
@@ -142,6 +142,30 @@ private slots:
         QCOMPARE(bgyr.colourAt(0.0), (Rgb{0, 0, 255}));
         QCOMPARE(bgyr.colourAt(1.0 / 3.0), (Rgb{0, 255, 0}));
         QCOMPARE(bgyr.colourAt(2.0 / 3.0), (Rgb{255, 255, 0}));
+        QCOMPARE(bgyr.colourAt(1.0), (Rgb{255, 0, 0}));
+        // The diverging scale of signed distances: white at 0.
+        QCOMPARE(ColourScale::preset("Diverging Blue-White-Red")->colourAt(0.5), (Rgb{247, 247, 247}));
+    }
+
+    void colourAtInterpolatesBetweenStops()
+    {
+        const ColourScale s = evenScale();
+        QCOMPARE(s.colourAt(0.0), (Rgb{0, 0, 0}));
+        QCOMPARE(s.colourAt(0.5), (Rgb{100, 200, 50}));
+        QCOMPARE(s.colourAt(1.0), (Rgb{200, 0, 250}));
+        QCOMPARE(s.colourAt(0.25), (Rgb{50, 100, 25}));
+        QCOMPARE(s.colourAt(0.75), (Rgb{150, 100, 150}));
+        // Clamped, and NaN counts as the start.
+        QCOMPARE(s.colourAt(-3.0), (Rgb{0, 0, 0}));
+        QCOMPARE(s.colourAt(7.0), (Rgb{200, 0, 250}));
+        QCOMPARE(s.colourAt(std::nan("")), (Rgb{0, 0, 0}));
+        // Rounded to the nearest level: 127.5 -> 128, 63.75 -> 64.
+        QCOMPARE(greyScale().colourAt(0.5), (Rgb{128, 128, 128}));
+        QCOMPARE(greyScale().colourAt(0.25), (Rgb{64, 64, 64}));
+    }
+
+    void equalPositionsMakeAHardEdge()
+    {
         const ColourScale s("edge", {{0.0, 0, 0, 0}, {0.5, 255, 0, 0}, {0.5, 0, 0, 255}, {1.0, 0, 0, 255}});
         QCOMPARE(s.colourAt(0.5), (Rgb{0, 0, 255}));
         QCOMPARE(s.colourAt(0.25), (Rgb{128, 0, 0}));

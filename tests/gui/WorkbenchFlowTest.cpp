@@ -37,6 +37,7 @@
 #include <scandiff/plugins/PluginRegistry.h>
 
 #include <QAction>
+#include <memory>
 #include <QCheckBox>
 #include <QDockWidget>
 #include <QDropEvent>
@@ -1182,10 +1183,12 @@ private slots:
         const double w = window.view()->width(), h = window.view()->height();
         const std::vector<Eigen::Vector2d> triangle{{0.3 * w, 0.3 * h}, {0.8 * w, 0.4 * h}, {0.4 * w, 0.8 * h}};
         // The confirm step asks what to keep: answered by `button` once it shows.
+        // Returns a flag set once it has answered, so the test knows the question came.
         const auto answerTheQuestion = [](const char* button) {
+            auto answered = std::make_shared<bool>(false);
             auto* poll = new QTimer;
             poll->setInterval(20);
-            QObject::connect(poll, &QTimer::timeout, poll, [poll, button] {
+            QObject::connect(poll, &QTimer::timeout, poll, [poll, button, answered] {
                 auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget());
                 if (!box || box->objectName() != "scissors-question")
                     return;
@@ -1193,9 +1196,11 @@ private slots:
                 if (!answer) // the standard Cancel has no name of ours
                     answer = box->button(QMessageBox::Cancel);
                 answer->click();
+                *answered = true;
                 poll->deleteLater();
             });
             poll->start();
+            return answered;
         };
         const auto drawTriangle = [&] {
             action->setChecked(true);
@@ -1206,14 +1211,16 @@ private slots:
             return drawnWith;
         };
         // Cancelled: nothing cut.
-        answerTheQuestion("cancel");
+        const auto cancelled = answerTheQuestion("cancel");
         drawTriangle();
-        QTest::qWait(300);
+        QTRY_VERIFY(*cancelled);
+        QTest::qWait(100);
         QCOMPARE(window.document().ids().size(), std::size_t(1));
         QVERIFY(window.document().item(id).display.visible);
         // Both parts kept.
-        answerTheQuestion("keepBoth");
+        const auto bothKept = answerTheQuestion("keepBoth");
         const Eigen::Matrix4d projection = drawTriangle();
+        QTRY_VERIFY(*bothKept);
         QVERIFY(!window.view()->scissorsMode() && !action->isChecked());
         // Brute force: project each point, keep those shown and inside the triangle.
         auto insideTriangle = [&](const Eigen::Vector2d& p) {

@@ -219,6 +219,8 @@ private slots:
         QVERIFY(std::abs(dragged(2, 3)) < 1e-6); // seen from above: no height change
         const RigidMotion shown = dialog->motion();
         QVERIFY(std::abs(shown.offset.x() - dragged(0, 3)) < 1e-4 && std::abs(shown.offset.y() - dragged(1, 3)) < 1e-4);
+        QVERIFY(dialog->matrix() == dragged); // Apply would apply the drag itself, not its rounded values
+        QCOMPARE(w.window.moveSelectedInteractively(), dialog); // one dialog at a time
 
         // Typed, then applied.
         dialog->setMotion(typed);

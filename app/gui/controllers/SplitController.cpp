@@ -103,7 +103,7 @@ int SplitController::cutVisibleClouds(const QString& what, const QString& inside
         }
         const std::vector<std::size_t> outside = complementOf(inside, item->cloud()->size());
         // Nothing to cut off: the part kept would be the whole cloud, or nothing.
-        if (inside.empty() || (keep == Keep::Outside && outside.empty()))
+        if (inside.empty() || (keep != Keep::Both && outside.empty()))
             continue;
         const QString name = item->name;
         const DisplayState display = item->display;

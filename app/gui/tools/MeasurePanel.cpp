@@ -67,7 +67,8 @@ void MeasurePanel::addPick(EntityId id, std::size_t index)
     // A point label says what the point holds of the field shown.
     if (measurements_.back().empty()) {
         const ScalarField* field = item->display.activeField.empty() ? nullptr : item->points().field(item->display.activeField);
-        notes_.back() = field ? tr("%1: %2 = %3").arg(item->name, QString::fromStdString(field->name())).arg(field->value(index), 0, 'g', 6)
+        notes_.back() = field ? tr("%1: %2 = %3")
+                                    .arg(item->name, QString::fromStdString(field->name()), QString::number(field->value(index), 'g', 6))
                               : QString();
     }
     addPoint(item->points().globalPosition(index));

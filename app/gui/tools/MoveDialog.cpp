@@ -54,8 +54,6 @@ MoveDialog::MoveDialog(CloudView& view, const std::vector<EntityId>& ids, QWidge
     connect(&view_, &CloudView::movedByChanged, this, &MoveDialog::dragged);
 }
 
-MoveDialog::~MoveDialog() { view_.stopMovingEntities(); }
-
 RigidMotion MoveDialog::motion() const
 {
     RigidMotion m;
@@ -76,18 +74,21 @@ void MoveDialog::setMotion(const RigidMotion& motion)
     typed();
 }
 
-Eigen::Matrix4d MoveDialog::matrix() const { return rigidMotionMatrix(motion(), view_.movingCentre()); }
+Eigen::Matrix4d MoveDialog::matrix() const { return dragged_ ? *dragged_ : rigidMotionMatrix(motion(), view_.movingCentre()); }
 
 void MoveDialog::typed()
 {
-    if (!updating_)
-        view_.setMovedBy(matrix());
+    if (updating_)
+        return;
+    dragged_.reset();
+    view_.setMovedBy(matrix());
 }
 
 void MoveDialog::dragged(const Eigen::Matrix4d& global)
 {
-    // The boxes show the drag (rounded to their decimals); the view keeps the
-    // dragged matrix itself until something is typed.
+    // The boxes show the drag rounded to their decimals; Apply applies the
+    // drag itself, what the view shows, until something is typed.
+    dragged_ = global;
     const RigidMotion m = rigidMotionOf(global, view_.movingCentre());
     updating_ = true;
     const double values[6] = {m.offset.x(), m.offset.y(), m.offset.z(), m.heading, m.pitch, m.roll};

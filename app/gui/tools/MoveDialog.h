@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <optional>
 #include <vector>
 
 class QDoubleSpinBox;
@@ -29,13 +30,15 @@ class MoveDialog : public QDialog
 {
     Q_OBJECT
 public:
+    //! Starts moving `ids` in the view; check view.movingEntities() (none of
+    //! them shown: nothing to move). Closing the dialog, however, stops it.
     MoveDialog(CloudView& view, const std::vector<EntityId>& ids, QWidget* parent = nullptr);
-    ~MoveDialog() override;
 
     RigidMotion motion() const;
     //! As if typed: the boxes, the view's box and drawing follow.
     void setMotion(const RigidMotion& motion);
-    //! The motion as a matrix on global coordinates, about the selection's centre.
+    //! The motion as a matrix on global coordinates: the last drag's exactly,
+    //! else the typed values' about the selection's centre.
     Eigen::Matrix4d matrix() const;
 
 signals:
@@ -50,6 +53,8 @@ private:
     //! Offset X, Y, Z, then heading, pitch, roll.
     std::array<QDoubleSpinBox*, 6> boxes_{};
     bool updating_ = false;
+    //! The box's motion after a drag, until something is typed.
+    std::optional<Eigen::Matrix4d> dragged_;
 };
 
 } // namespace scandiff::gui

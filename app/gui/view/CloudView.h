@@ -173,7 +173,7 @@ public:
     bool clippingBoxOn() const;
     void setClippingBox(const CropBox& box);
     CropBox clippingBox() const;
-    //! Move / rotate (CloudCompare's Translate/Rotate): a box with handles
+    //! Move / rotate (CloudCompare's Translate/Rotate): a box
     //! around `ids` (drag inside it to move them, on a face to turn them about
     //! its centre); they are drawn moved as it goes, their data untouched
     //! until the caller applies the motion. movedBy() is the motion so far, in

@@ -69,8 +69,8 @@ std::pair<double, double> colourRange(const ScalarField& field, const FieldDispl
 ColourLegend legendOf(const PointCloud& points, const DisplayState& display);
 
 //! Shades each shown point's colour by the lightness of the cloud's own colour
-//! there: c x (0.35 + 0.65 L), L the colour's relative luminance (BT.709) in
-//! [0, 1]; a white point keeps the field's colour, a black one a third of it,
+//! there: c x (0.35 + 0.65 L), L the colour's luma (BT.709 weights on its
+//! sRGB values) in [0, 1]; a white point keeps the field's colour, a black one a third of it,
 //! so the texture reads and the field's hue stays. Hidden points (alpha 0) are
 //! left alone; a cloud without colours is left as it is.
 void blendWithOwnColours(const PointCloud& points, std::uint8_t* rgba);

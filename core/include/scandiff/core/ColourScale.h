@@ -31,7 +31,8 @@ public:
 
     //! The named scales of the workbench and the field-to-colours tool:
     //! perceptually uniform ones first (Viridis, Cividis, Magma, Inferno,
-    //! Plasma), the diverging ones (symmetric), then CloudCompare's classics.
+    //! Plasma), the diverging ones (symmetric), then the classic ones
+    //! (CloudCompare's default, Grey, Red-Yellow..., Turbo, Terrain, HSV).
     static const std::vector<ColourScale>& presets();
     //! The scale a field is first shown with: "Blue-Green-Yellow-Red", the
     //! look CloudCompare users know (the list puts the perceptual ones first).
