@@ -7,8 +7,8 @@
 //
 //   scandiff-laz-decode FILE.laz [THREADS=1] [RUNS=3]
 
-#include "internal/LasLayout.h"
-#include "internal/LazDecoder.h"
+#include "las/LasLayout.h"
+#include "laz/LazDecoder.h"
 
 #include <tbb/global_control.h>
 

@@ -4,8 +4,8 @@
 // damaged files refused with a clear error.
 
 #include "internal/Formats.h"
-#include "internal/LazDecoder.h"
-#include "internal/LazEncoder.h"
+#include "laz/LazDecoder.h"
+#include "laz/LazEncoder.h"
 #include "laz/ArithmeticCoder.h"
 
 #include <scandiff/core/Error.h>

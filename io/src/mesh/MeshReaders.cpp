@@ -11,7 +11,7 @@
 //! Every size is checked against the file before anything is allocated, and
 //! every loop is linear in the file.
 
-#include "internal/MeshReaders.h"
+#include "mesh/MeshReaders.h"
 
 #include "internal/MappedFile.h"
 #include "internal/TextUtil.h"

@@ -8,7 +8,7 @@
 //! (github.com/LASzip/LASzip: laszip.hpp, lasreadpoint.cpp); this file follows
 //! that description. The item coders are in laz/.
 
-#include "internal/LazDecoder.h"
+#include "laz/LazDecoder.h"
 #include "laz/ArithmeticCoder.h"
 #include "laz/Items.h"
 

@@ -4,7 +4,7 @@
 //! extra bytes) compressed as LASzip's layered chunks, which any LAZ 1.4
 //! reader decodes.
 
-#include "internal/LazDecoder.h"
+#include "laz/LazDecoder.h"
 
 #include <cstdint>
 #include <ostream>

@@ -11,8 +11,8 @@
 //! reference system, when it has one, is the GeoTIFF's.
 
 #include "internal/Formats.h"
-#include "internal/GdalDataset.h"
-#include "internal/GriddedCloud.h"
+#include "raster/GdalDataset.h"
+#include "raster/GriddedCloud.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>

@@ -4,7 +4,7 @@
 //! georeferenced coordinates, and each is a few lines.
 
 #include "internal/Formats.h"
-#include "internal/MeshReaders.h"
+#include "mesh/MeshReaders.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>

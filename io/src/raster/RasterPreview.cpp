@@ -13,8 +13,8 @@
 //! need, written here: io has no GUI toolkit, and GDAL draws no text.
 
 #include "internal/Formats.h"
-#include "internal/GdalDataset.h"
-#include "internal/GriddedCloud.h"
+#include "raster/GdalDataset.h"
+#include "raster/GriddedCloud.h"
 
 #include <scandiff/core/ColourScale.h>
 #include <scandiff/core/Error.h>

@@ -5,8 +5,8 @@
 //! Layout facts quoted below come from the ASPRS LAS 1.4 specification, R15
 //! ("LAS 1.4 R15").
 
-#include "internal/LasLayout.h"
-#include "internal/LazEncoder.h"
+#include "las/LasLayout.h"
+#include "laz/LazEncoder.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>

@@ -12,9 +12,9 @@
 
 #include <map>
 
-#include "internal/DxfObjectAxes.h"
+#include "dxf/DxfObjectAxes.h"
 #include "internal/Formats.h"
-#include "internal/MeshReaders.h"
+#include "mesh/MeshReaders.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/Log.h>

@@ -4,7 +4,7 @@
 //! layer, the layers), the chunk table after them, as LASzip's
 //! laswritepoint.cpp lays them out. The item encoders are in laz/.
 
-#include "internal/LazEncoder.h"
+#include "laz/LazEncoder.h"
 #include "laz/Items.h"
 
 #include <scandiff/core/Error.h>

@@ -7,8 +7,8 @@
 //! ("LAS 1.4 R15"), which also describes the older versions this reader accepts.
 
 #include "internal/Formats.h"
-#include "internal/LasLayout.h"
-#include "internal/LazDecoder.h"
+#include "las/LasLayout.h"
+#include "laz/LazDecoder.h"
 #include "internal/MappedFile.h"
 
 #include <scandiff/core/Error.h>

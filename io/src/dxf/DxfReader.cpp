@@ -11,9 +11,9 @@
 //! Block definitions are not expanded (INSERT references are counted and
 //! reported), nor are the newer MESH entity and binary DXF (refused clearly).
 
-#include "internal/DxfObjectAxes.h"
+#include "dxf/DxfObjectAxes.h"
 #include "internal/MappedFile.h"
-#include "internal/MeshReaders.h"
+#include "mesh/MeshReaders.h"
 #include "internal/TextUtil.h"
 
 #include <scandiff/io/DxfReader.h>
