@@ -228,6 +228,134 @@ Drawing planeOutlines(const PointCloud& cloud, const PrimitiveDetectionResult& d
 
 } // namespace scandiff::plugins
 
+namespace scandiff::plugins {
+namespace {
+
+PrimitiveDetectionParams detectionParamsFrom(const ParameterValues& values)
+{
+    PrimitiveDetectionParams params;
+    params.method = parsePrimitiveMethod(values.text("method"));
+    params.kinds = kindsFrom(values.text("shapes"));
+    if (values.has("epsilon"))
+        params.epsilon = values.real("epsilon");
+    if (values.has("cluster-epsilon"))
+        params.clusterEpsilon = values.real("cluster-epsilon");
+    params.normalDeviationDegrees = values.real("normal-deviation");
+    params.minPoints = static_cast<std::size_t>(values.integer("min-points"));
+    params.probability = values.real("probability");
+    params.seed = static_cast<std::uint64_t>(values.integer("seed"));
+    params.orientationToleranceDegrees = values.real("orientation-tolerance");
+    params.growOn = parseGrowOn(values.text("grow-on"));
+    params.smoothnessDegrees = values.real("smoothness");
+    if (values.has("curvature"))
+        params.curvature = values.real("curvature");
+    params.valueField = values.text("field");
+    if (values.has("tolerance"))
+        params.valueTolerance = values.real("tolerance");
+    if (values.has("radius"))
+        params.valueRadius = values.real("radius");
+    return params;
+}
+
+//! The input with primitive_id, primitive_type and primitive_distance.
+PointCloud labelledCloud(const PointCloud& input, const PrimitiveDetectionResult& detected)
+{
+    PointCloud labelled = input.clone();
+    // The three fields are added before any is held: adding a field may
+    // move the others (a reference kept across addField dangles).
+    for (const char* name : {"primitive_id", "primitive_type", "primitive_distance"})
+        labelled.addField(name);
+    std::vector<float>& id = labelled.field("primitive_id")->values();
+    std::vector<float>& type = labelled.field("primitive_type")->values();
+    std::vector<float>& distance = labelled.field("primitive_distance")->values();
+    for (std::size_t i = 0; i < input.size(); ++i) {
+        id[i] = static_cast<float>(detected.primitiveId[i]);
+        type[i] = detected.primitiveId[i] < 0
+                      ? -1.0f
+                      : static_cast<float>(detected.primitives[static_cast<std::size_t>(detected.primitiveId[i])].primitive.kind);
+        distance[i] = detected.distance[i];
+    }
+    return labelled;
+}
+
+//! Each shape's surface, coloured as its points are by primitive_id (one
+//! colour per shape): the shapes in parallel, in their order.
+std::vector<Mesh> shapeSurfaces(const PointCloud& input, const PrimitiveDetectionResult& detected, ProgressObserver* progress)
+{
+    ProgressTicker surfaces(progress, "Primitives: shape surfaces", detected.primitives.size());
+    std::vector<Mesh> meshes(detected.primitives.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, meshes.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            surfaces.checkCancel();
+            const DetectedPrimitive& shape = detected.primitives[k];
+            Mesh& mesh = meshes[k];
+            mesh = shapeSurface(shape.primitive, input, shape.inliers, shapeCellSize(input, shape.inliers));
+            mesh.name = std::string(primitiveKindName(shape.primitive.kind)) + "_surface";
+            mesh.vertices.addField(ScalarField("primitive_id", mesh.vertices.size()));
+            std::fill(mesh.vertices.field("primitive_id")->values().begin(), mesh.vertices.field("primitive_id")->values().end(),
+                      static_cast<float>(shape.id));
+            surfaces.step();
+        }
+    }, tbb::simple_partitioner());
+    return meshes;
+}
+
+//! "12 shapes (7 planes, 3 cylinders, 2 spheres), ... points assigned; epsilon ...".
+std::string primitivesSummary(const PrimitiveDetectionResult& detected, std::size_t pointCount)
+{
+    std::ostringstream summary;
+    std::map<std::string, int> counts;
+    std::size_t assigned = 0;
+    for (const DetectedPrimitive& shape : detected.primitives) {
+        ++counts[primitiveKindName(shape.primitive.kind)];
+        assigned += shape.inliers.size();
+    }
+    summary << detected.primitives.size() << " shapes (";
+    bool first = true;
+    for (const auto& [name, count] : counts) {
+        summary << (first ? "" : ", ") << count << " " << (count > 1 ? (name == "torus" ? "tori" : name + "s") : name);
+        first = false;
+    }
+    summary << "), " << assigned << " of " << pointCount << " points assigned; epsilon " << detected.epsilon
+            << " m, cluster epsilon " << detected.clusterEpsilon << " m";
+    for (const std::string& note : detected.notes)
+        summary << "; " << note;
+    return summary.str();
+}
+
+ToolResult runPrimitives(const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress)
+{
+    const PointCloud& input = inputs.cloud();
+    const PrimitiveDetectionResult detected = detectPrimitives(input, detectionParamsFrom(values), progress);
+    ToolResult result;
+    PointCloud labelled = labelledCloud(input, detected);
+    // Each shape's points with every field, the primitive ones included.
+    std::vector<PointCloud> parts;
+    for (const DetectedPrimitive& shape : detected.primitives) {
+        std::vector<std::size_t> indices(shape.inliers.begin(), shape.inliers.end());
+        parts.push_back(labelled.subset(indices));
+    }
+    result.add("primitives", std::move(labelled));
+    // The surfaces, then the outlines, not both at once: the largest plane's
+    // surface and outline side by side raised the peak by 40 MB a million points.
+    std::vector<Mesh> meshes = shapeSurfaces(input, detected, progress);
+    Drawing outlines = planeOutlines(input, detected, progress);
+    for (std::size_t k = 0; k < meshes.size(); ++k) {
+        const DetectedPrimitive& shape = detected.primitives[k];
+        parts[k].name = primitiveKindName(shape.primitive.kind); // the CLI adds the shape's id: plane_0.ply
+        result.add("shape", std::move(parts[k]), shapeProperties(shape));
+        result.add("surface", std::move(meshes[k]), shapeProperties(shape));
+    }
+    result.add("table", primitivesTable(detected));
+    result.add("outlines", std::move(outlines));
+    result.add("document", TextDocument{".json", primitivesJson(detected)});
+    result.summary = primitivesSummary(detected, input.size());
+    return result;
+}
+
+} // namespace
+} // namespace scandiff::plugins
+
 void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
 {
     using namespace scandiff;
@@ -323,102 +451,6 @@ void scandiff_register_plugin_primitives(scandiff::PluginRegistry& registry)
                     OutputSpec{"table", "Primitives", DataKind::Table, false, false, "primitives"},
                     OutputSpec{"outlines", "Plane outlines", DataKind::Drawing, false, false, "primitives"},
                     OutputSpec{"document", "Primitives (JSON)", DataKind::Document, false, false, "primitives"}};
-    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
-        const PointCloud& input = inputs.cloud();
-        PrimitiveDetectionParams params;
-        params.method = parsePrimitiveMethod(values.text("method"));
-        params.kinds = kindsFrom(values.text("shapes"));
-        if (values.has("epsilon"))
-            params.epsilon = values.real("epsilon");
-        if (values.has("cluster-epsilon"))
-            params.clusterEpsilon = values.real("cluster-epsilon");
-        params.normalDeviationDegrees = values.real("normal-deviation");
-        params.minPoints = static_cast<std::size_t>(values.integer("min-points"));
-        params.probability = values.real("probability");
-        params.seed = static_cast<std::uint64_t>(values.integer("seed"));
-        params.orientationToleranceDegrees = values.real("orientation-tolerance");
-        params.growOn = parseGrowOn(values.text("grow-on"));
-        params.smoothnessDegrees = values.real("smoothness");
-        if (values.has("curvature"))
-            params.curvature = values.real("curvature");
-        params.valueField = values.text("field");
-        if (values.has("tolerance"))
-            params.valueTolerance = values.real("tolerance");
-        if (values.has("radius"))
-            params.valueRadius = values.real("radius");
-        const PrimitiveDetectionResult detected = detectPrimitives(input, params, progress);
-
-        ToolResult result;
-        PointCloud labelled = input.clone();
-        // The three fields are added before any is held: adding a field may
-        // move the others (a reference kept across addField dangles).
-        for (const char* name : {"primitive_id", "primitive_type", "primitive_distance"})
-            labelled.addField(name);
-        std::vector<float>& id = labelled.field("primitive_id")->values();
-        std::vector<float>& type = labelled.field("primitive_type")->values();
-        std::vector<float>& distance = labelled.field("primitive_distance")->values();
-        for (std::size_t i = 0; i < input.size(); ++i) {
-            id[i] = static_cast<float>(detected.primitiveId[i]);
-            type[i] = detected.primitiveId[i] < 0
-                          ? -1.0f
-                          : static_cast<float>(detected.primitives[static_cast<std::size_t>(detected.primitiveId[i])].primitive.kind);
-            distance[i] = detected.distance[i];
-        }
-        // Each shape's points with every field, the primitive ones included.
-        std::vector<PointCloud> parts;
-        for (const DetectedPrimitive& shape : detected.primitives) {
-            std::vector<std::size_t> indices(shape.inliers.begin(), shape.inliers.end());
-            parts.push_back(labelled.subset(indices));
-        }
-        result.add("primitives", std::move(labelled));
-        // Each shape's surface, coloured as its points are by primitive_id (one
-        // colour per shape): the shapes in parallel, added in their order.
-        // (Not at the same time as the outlines: the largest plane's surface
-        // and outline side by side raised the peak by 40 MB a million points.)
-        ProgressTicker surfaces(progress, "Primitives: shape surfaces", detected.primitives.size());
-        std::vector<Mesh> meshes(detected.primitives.size());
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, meshes.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
-            for (std::size_t k = range.begin(); k != range.end(); ++k) {
-                surfaces.checkCancel();
-                const DetectedPrimitive& shape = detected.primitives[k];
-                Mesh& mesh = meshes[k];
-                mesh = shapeSurface(shape.primitive, input, shape.inliers, shapeCellSize(input, shape.inliers));
-                mesh.name = std::string(primitiveKindName(shape.primitive.kind)) + "_surface";
-                mesh.vertices.addField(ScalarField("primitive_id", mesh.vertices.size()));
-                std::fill(mesh.vertices.field("primitive_id")->values().begin(), mesh.vertices.field("primitive_id")->values().end(),
-                          static_cast<float>(shape.id));
-                surfaces.step();
-            }
-        }, tbb::simple_partitioner());
-        Drawing outlines = planeOutlines(input, detected, progress);
-        for (std::size_t k = 0; k < meshes.size(); ++k) {
-            const DetectedPrimitive& shape = detected.primitives[k];
-            parts[k].name = primitiveKindName(shape.primitive.kind); // the CLI adds the shape's id: plane_0.ply
-            result.add("shape", std::move(parts[k]), shapeProperties(shape));
-            result.add("surface", std::move(meshes[k]), shapeProperties(shape));
-        }
-        result.add("table", primitivesTable(detected));
-        result.add("outlines", std::move(outlines));
-        result.add("document", TextDocument{".json", primitivesJson(detected)});
-        std::ostringstream summary;
-        std::map<std::string, int> counts;
-        std::size_t assigned = 0;
-        for (const DetectedPrimitive& shape : detected.primitives) {
-            ++counts[primitiveKindName(shape.primitive.kind)];
-            assigned += shape.inliers.size();
-        }
-        summary << detected.primitives.size() << " shapes (";
-        bool first = true;
-        for (const auto& [name, count] : counts) {
-            summary << (first ? "" : ", ") << count << " " << (count > 1 ? (name == "torus" ? "tori" : name + "s") : name);
-            first = false;
-        }
-        summary << "), " << assigned << " of " << input.size() << " points assigned; epsilon " << detected.epsilon
-                << " m, cluster epsilon " << detected.clusterEpsilon << " m";
-        for (const std::string& note : detected.notes)
-            summary << "; " << note;
-        result.summary = summary.str();
-        return result;
-    };
+    tool.run = plugins::runPrimitives;
     registry.tools.add(std::move(tool));
 }
