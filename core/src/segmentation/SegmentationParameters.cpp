@@ -9,6 +9,7 @@
 #include <cmath>
 #include <iomanip>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 namespace scandiff {
@@ -149,14 +150,11 @@ const std::vector<ParameterSpec>& segmentationParameters()
     return parameters;
 }
 
-SegmentationRun runSegmentation(const PointCloud& cloud, const ParameterValues& values, ProgressObserver* progress)
+namespace {
+
+//! One classification method, or propagation alone.
+void checkMethods(const ParameterValues& values)
 {
-    const std::string fieldName = values.text("field");
-    const ScalarField* original = cloud.field(fieldName);
-    if (!original)
-        throw Error(ErrorCode::InvalidArgument, "segment: cloud '" + cloud.name + "' has no field '" + fieldName + "'");
-    if (cloud.empty())
-        throw Error(ErrorCode::InvalidData, "segment: cloud '" + cloud.name + "' is empty");
     int methods = 0;
     for (const char* m : {"range", "above", "kmeans", "stat-test"})
         methods += values.has(m);
@@ -166,13 +164,197 @@ SegmentationRun runSegmentation(const PointCloud& cloud, const ParameterValues& 
     if (!propagate && methods != 1)
         throw Error(ErrorCode::InvalidArgument, methods == 0 ? "segment: choose a method: range, above, kmeans, stat-test or propagate"
                                                              : "segment: choose only one of range, above, kmeans and stat-test");
+}
+
+//! Regions grown from seeds by fast marching (thesis 000 §3.3): its fields
+//! and summary, nothing classified first.
+void propagate(const PointCloud& source, const std::string& fieldName, const ParameterValues& values, SegmentationRun& run,
+               std::ostringstream& summary, ProgressObserver* progress)
+{
+    PropagationParams p;
+    if (!values.has("min-seed"))
+        throw Error(ErrorCode::InvalidArgument, "segment: propagate needs min-seed (the smallest value a region may start from)");
+    p.minSeedValue = values.real("min-seed");
+    p.alpha = values.real("alpha");
+    p.stopSpeed = values.real("stop-speed");
+    p.level = static_cast<int>(values.integer("level"));
+    p.minPoints = static_cast<std::size_t>(values.integer("min-points"));
+    p.keepBackground = values.boolean("keep-background");
+    p.gradient.radius = values.real("gradient-radius");
+    if (values.has("smoothing"))
+        p.gradient.smoothingSigma = values.real("smoothing");
+    PropagationResult r = propagationSegmentation(source, fieldName, p, progress);
+    run.regionCount = r.regionCount;
+    run.regionSizes = r.regionSizes;
+    run.level = r.level;
+    summary << "propagation (alpha " << p.alpha << ", stop speed " << p.stopSpeed << ", min seed " << p.minSeedValue << ", level "
+            << r.level << "): " << r.regionCount << " regions";
+    if (r.droppedRegions)
+        summary << " (" << r.droppedRegions << " smaller than " << p.minPoints << " points dropped)";
+    if (r.backgroundRegions)
+        summary << "; " << r.backgroundRegions << (r.backgroundRegions == 1 ? " region" : " regions") << " of "
+                << r.backgroundPoints << " points whose values are the field's noise (median below the seed value and "
+                << r.noiseCeiling << ", the field's median + 3 sigma): background, "
+                << (p.keepBackground ? "kept as asked" : "left out (keep-background keeps it)");
+    run.fields.push_back(std::move(r.regionId));
+    run.fields.push_back(std::move(r.arrivalTime));
+    run.fields.push_back(std::move(r.gradient));
+}
+
+//! The changed points by a range or a lower bound.
+ScalarField classifyByThresholds(const ScalarField& field, const ParameterValues& values, std::ostringstream& summary)
+{
+    double low = 0.0, high = kInf;
+    if (values.has("range")) {
+        const std::vector<double> range = parseNumberWords(values.text("range"), "range");
+        if (range.size() != 2)
+            throw Error(ErrorCode::InvalidArgument, "range: expected two values A B");
+        low = range[0];
+        high = range[1];
+        summary << "range [" << low << ", " << high << "]";
+    } else {
+        low = values.real("above");
+        summary << "above " << low;
+    }
+    return classifyByRange(field, low, high);
+}
+
+//! The changed points by K-means on the values (thesis 000 §3.2.2).
+ScalarField classifyByKMeans(const ScalarField& field, const ParameterValues& values, SegmentationRun& run, std::ostringstream& summary,
+                             ProgressObserver* progress)
+{
+    KMeansParams p;
+    p.classes = static_cast<int>(values.integer("kmeans"));
+    KMeansResult r = kMeans(field, p, progress);
+    run.centres = r.centres;
+    summary << "K-means (" << p.classes << " classes, centres";
+    for (double c : r.centres)
+        summary << ' ' << c;
+    summary << ", " << r.iterations << " iterations)";
+    run.fields.push_back(std::move(r.classes));
+    return std::move(r.changed);
+}
+
+//! The noise of the local test when given: its two parameters, or a fit on
+//! the values inside a box of points known unchanged. None: fitted on the field.
+std::optional<NoiseDistribution> noiseFrom(const ParameterValues& values, NoiseModel model, const PointCloud& source,
+                                           const ScalarField& field)
+{
+    if (values.has("noise")) {
+        const std::vector<double> n = numbers(values.text("noise"), "noise");
+        if (n.size() != 2 || !(n[1] > 0) || (model == NoiseModel::Weibull && !(n[0] > 0)))
+            throw Error(ErrorCode::InvalidArgument,
+                        "noise: expected MEAN,SIGMA (gaussian) or SHAPE,SCALE (weibull), the spread and shape positive");
+        NoiseDistribution d;
+        d.model = model;
+        if (model == NoiseModel::Gaussian) {
+            d.mean = n[0];
+            d.sigma = n[1];
+        } else {
+            d.shape = n[0];
+            d.scale = n[1];
+        }
+        return d;
+    }
+    if (!values.has("fit-box"))
+        return std::nullopt;
+    const std::vector<double> b = numbers(values.text("fit-box"), "fit-box");
+    if (b.size() != 6)
+        throw Error(ErrorCode::InvalidArgument, "fit-box: expected X0,Y0,Z0,X1,Y1,Z1");
+    const Eigen::Vector3d lo(std::min(b[0], b[3]), std::min(b[1], b[4]), std::min(b[2], b[5]));
+    const Eigen::Vector3d hi(std::max(b[0], b[3]), std::max(b[1], b[4]), std::max(b[2], b[5]));
+    std::vector<std::size_t> inside;
+    for (std::size_t i = 0; i < source.size(); ++i) {
+        const Eigen::Vector3d g = source.globalPosition(i);
+        if ((g.array() >= lo.array()).all() && (g.array() <= hi.array()).all() && field.hasValue(i))
+            inside.push_back(i);
+    }
+    if (inside.size() < 2)
+        throw Error(ErrorCode::InvalidArgument, "fit-box: fewer than 2 points with a value inside the box");
+    return fitNoise(field, model, &inside);
+}
+
+//! The changed points by the local chi-square test (thesis 000 §3.2.3).
+ScalarField classifyByChiSquare(const PointCloud& source, const std::string& fieldName, const ParameterValues& values,
+                                SegmentationRun& run, std::ostringstream& summary, ProgressObserver* progress)
+{
+    LocalChiSquareParams p;
+    p.model = parseNoiseModel(values.text("stat-test"));
+    p.neighbours = static_cast<int>(values.integer("neighbours"));
+    p.confidence = values.real("confidence");
+    p.calibration = parseNullCalibration(values.text("calibration"));
+    if (values.has("chi2-threshold"))
+        p.threshold = values.real("chi2-threshold");
+    p.noise = noiseFrom(values, p.model, source, *source.field(fieldName));
+    LocalChiSquareResult r = localChiSquareTest(source, fieldName, p, progress);
+    run.noise = r.noise;
+    run.threshold = r.threshold;
+    summary << "local chi-square test (" << noiseModelName(p.model) << ' ';
+    if (p.model == NoiseModel::Gaussian)
+        summary << "mean " << r.noise.mean << " sigma " << r.noise.sigma;
+    else
+        summary << "shape " << r.noise.shape << " scale " << r.noise.scale;
+    if (r.fitRejected > 0)
+        summary << ", fitted without " << r.fitRejected << " values beyond the noise";
+    summary << ", n " << p.neighbours << ", " << r.classes << " classes, cut " << r.threshold;
+    if (!p.threshold && p.calibration == NullCalibration::Spatial)
+        summary << " (spatial calibration on " << r.nullScalePoints << " quiet points: " << r.nullScale << " x the tabulated "
+                << r.quantileThreshold << ", their own quantile " << r.empiricalThreshold << ")";
+    summary << ")";
+    run.fields.push_back(std::move(r.chiSquare));
+    return std::move(r.changed);
+}
+
+//! The changed points grouped into regions: connected components of the
+//! octree's cells (thesis 000 §3.3), or all of them as one region.
+ScalarField regionsOf(const PointCloud& source, const std::vector<std::uint8_t>& selected, const ParameterValues& values,
+                      SegmentationRun& run, std::ostringstream& summary, ProgressObserver* progress)
+{
+    ScalarField regionId(fields::kRegionId, source.size());
+    if (values.boolean("components")) {
+        ConnectedComponentsParams p;
+        p.level = static_cast<int>(values.integer("level"));
+        p.connectivity = parseConnectivity(std::stoi(values.text("connectivity")));
+        p.minPoints = static_cast<std::size_t>(values.integer("min-points"));
+        ConnectedComponentsResult r = connectedComponents(source, selected, p, progress);
+        run.regionCount = r.regionCount;
+        run.regionSizes = r.regionSizes;
+        run.level = r.level;
+        summary << ", " << r.regionCount << " regions (level " << r.level << ", cell " << r.cellSize << " m, "
+                << static_cast<int>(p.connectivity) << "-connectivity";
+        if (r.droppedComponents)
+            summary << ", " << r.droppedComponents << " components smaller than " << p.minPoints << " points dropped";
+        summary << ")";
+        return std::move(r.regionId);
+    }
+    if (run.changedCount >= static_cast<std::size_t>(values.integer("min-points"))) {
+        for (std::size_t i = 0; i < selected.size(); ++i)
+            if (selected[i])
+                regionId.values()[i] = 1.0f;
+        run.regionCount = 1;
+        run.regionSizes = {run.changedCount};
+        summary << ", one region";
+    }
+    return regionId;
+}
+
+} // namespace
+
+SegmentationRun runSegmentation(const PointCloud& cloud, const ParameterValues& values, ProgressObserver* progress)
+{
+    const std::string fieldName = values.text("field");
+    const ScalarField* original = cloud.field(fieldName);
+    if (!original)
+        throw Error(ErrorCode::InvalidArgument, "segment: cloud '" + cloud.name + "' has no field '" + fieldName + "'");
+    if (cloud.empty())
+        throw Error(ErrorCode::InvalidData, "segment: cloud '" + cloud.name + "' is empty");
+    checkMethods(values);
 
     // The field segmented: the original, or its absolute values, under the
     // original name so the algorithms can find it on a working cloud.
-    const bool absolute = values.boolean("absolute");
     PointCloud working;
     const PointCloud* source = &cloud;
-    if (absolute) {
+    if (values.boolean("absolute")) {
         // Positions are needed for neighbourhoods; only the one field is copied.
         working.setOrigin(cloud.origin());
         working.positions() = cloud.positions();
@@ -185,151 +367,20 @@ SegmentationRun runSegmentation(const PointCloud& cloud, const ParameterValues& 
     SegmentationRun run;
     std::ostringstream summary;
     summary << std::setprecision(6);
-    if (propagate) {
-        PropagationParams p;
-        if (!values.has("min-seed"))
-            throw Error(ErrorCode::InvalidArgument, "segment: propagate needs min-seed (the smallest value a region may start from)");
-        p.minSeedValue = values.real("min-seed");
-        p.alpha = values.real("alpha");
-        p.stopSpeed = values.real("stop-speed");
-        p.level = static_cast<int>(values.integer("level"));
-        p.minPoints = static_cast<std::size_t>(values.integer("min-points"));
-        p.keepBackground = values.boolean("keep-background");
-        p.gradient.radius = values.real("gradient-radius");
-        if (values.has("smoothing"))
-            p.gradient.smoothingSigma = values.real("smoothing");
-        PropagationResult r = propagationSegmentation(*source, fieldName, p, progress);
-        run.regionCount = r.regionCount;
-        run.regionSizes = r.regionSizes;
-        run.level = r.level;
-        summary << "propagation (alpha " << p.alpha << ", stop speed " << p.stopSpeed << ", min seed " << p.minSeedValue << ", level "
-                << r.level << "): " << r.regionCount << " regions";
-        if (r.droppedRegions)
-            summary << " (" << r.droppedRegions << " smaller than " << p.minPoints << " points dropped)";
-        if (r.backgroundRegions)
-            summary << "; " << r.backgroundRegions << (r.backgroundRegions == 1 ? " region" : " regions") << " of "
-                    << r.backgroundPoints << " points whose values are the field's noise (median below the seed value and "
-                    << r.noiseCeiling << ", the field's median + 3 sigma): background, "
-                    << (p.keepBackground ? "kept as asked" : "left out (keep-background keeps it)");
-        run.fields.push_back(std::move(r.regionId));
-        run.fields.push_back(std::move(r.arrivalTime));
-        run.fields.push_back(std::move(r.gradient));
+    if (values.boolean("propagate")) {
+        propagate(*source, fieldName, values, run, summary, progress);
         run.summary = summary.str();
         return run;
     }
-
-    ScalarField changed;
-    if (values.has("range") || values.has("above")) {
-        double low = 0.0, high = kInf;
-        if (values.has("range")) {
-            const std::vector<double> range = parseNumberWords(values.text("range"), "range");
-            if (range.size() != 2)
-                throw Error(ErrorCode::InvalidArgument, "range: expected two values A B");
-            low = range[0];
-            high = range[1];
-            summary << "range [" << low << ", " << high << "]";
-        } else {
-            low = values.real("above");
-            summary << "above " << low;
-        }
-        changed = classifyByRange(field, low, high);
-    } else if (values.has("kmeans")) {
-        KMeansParams p;
-        p.classes = static_cast<int>(values.integer("kmeans"));
-        KMeansResult r = kMeans(field, p, progress);
-        run.centres = r.centres;
-        summary << "K-means (" << p.classes << " classes, centres";
-        for (double c : r.centres)
-            summary << ' ' << c;
-        summary << ", " << r.iterations << " iterations)";
-        changed = std::move(r.changed);
-        run.fields.push_back(std::move(r.classes));
-    } else {
-        LocalChiSquareParams p;
-        p.model = parseNoiseModel(values.text("stat-test"));
-        p.neighbours = static_cast<int>(values.integer("neighbours"));
-        p.confidence = values.real("confidence");
-        p.calibration = parseNullCalibration(values.text("calibration"));
-        if (values.has("chi2-threshold"))
-            p.threshold = values.real("chi2-threshold");
-        if (values.has("noise")) {
-            const std::vector<double> n = numbers(values.text("noise"), "noise");
-            if (n.size() != 2 || !(n[1] > 0) || (p.model == NoiseModel::Weibull && !(n[0] > 0)))
-                throw Error(ErrorCode::InvalidArgument,
-                            "noise: expected MEAN,SIGMA (gaussian) or SHAPE,SCALE (weibull), the spread and shape positive");
-            NoiseDistribution d;
-            d.model = p.model;
-            if (p.model == NoiseModel::Gaussian) {
-                d.mean = n[0];
-                d.sigma = n[1];
-            } else {
-                d.shape = n[0];
-                d.scale = n[1];
-            }
-            p.noise = d;
-        } else if (values.has("fit-box")) {
-            const std::vector<double> b = numbers(values.text("fit-box"), "fit-box");
-            if (b.size() != 6)
-                throw Error(ErrorCode::InvalidArgument, "fit-box: expected X0,Y0,Z0,X1,Y1,Z1");
-            const Eigen::Vector3d lo(std::min(b[0], b[3]), std::min(b[1], b[4]), std::min(b[2], b[5]));
-            const Eigen::Vector3d hi(std::max(b[0], b[3]), std::max(b[1], b[4]), std::max(b[2], b[5]));
-            std::vector<std::size_t> inside;
-            for (std::size_t i = 0; i < source->size(); ++i) {
-                const Eigen::Vector3d g = source->globalPosition(i);
-                if ((g.array() >= lo.array()).all() && (g.array() <= hi.array()).all() && field.hasValue(i))
-                    inside.push_back(i);
-            }
-            if (inside.size() < 2)
-                throw Error(ErrorCode::InvalidArgument, "fit-box: fewer than 2 points with a value inside the box");
-            p.noise = fitNoise(field, p.model, &inside);
-        }
-        LocalChiSquareResult r = localChiSquareTest(*source, fieldName, p, progress);
-        run.noise = r.noise;
-        run.threshold = r.threshold;
-        summary << "local chi-square test (" << noiseModelName(p.model) << ' ';
-        if (p.model == NoiseModel::Gaussian)
-            summary << "mean " << r.noise.mean << " sigma " << r.noise.sigma;
-        else
-            summary << "shape " << r.noise.shape << " scale " << r.noise.scale;
-        if (r.fitRejected > 0)
-            summary << ", fitted without " << r.fitRejected << " values beyond the noise";
-        summary << ", n " << p.neighbours << ", " << r.classes << " classes, cut " << r.threshold;
-        if (!p.threshold && p.calibration == NullCalibration::Spatial)
-            summary << " (spatial calibration on " << r.nullScalePoints << " quiet points: " << r.nullScale << " x the tabulated "
-                    << r.quantileThreshold << ", their own quantile " << r.empiricalThreshold << ")";
-        summary << ")";
-        changed = std::move(r.changed);
-        run.fields.push_back(std::move(r.chiSquare));
-    }
+    // Classify the points as changed or not, then group the changed ones.
+    ScalarField changed = values.has("range") || values.has("above") ? classifyByThresholds(field, values, summary)
+                          : values.has("kmeans")                     ? classifyByKMeans(field, values, run, summary, progress)
+                                                                     : classifyByChiSquare(*source, fieldName, values, run, summary, progress);
     const std::vector<std::uint8_t> selected = selectionFromLabels(changed);
     for (std::uint8_t s : selected)
         run.changedCount += s;
     summary << ": " << run.changedCount << " changed points";
-
-    ScalarField regionId(fields::kRegionId, cloud.size());
-    if (values.boolean("components")) {
-        ConnectedComponentsParams p;
-        p.level = static_cast<int>(values.integer("level"));
-        p.connectivity = parseConnectivity(std::stoi(values.text("connectivity")));
-        p.minPoints = static_cast<std::size_t>(values.integer("min-points"));
-        ConnectedComponentsResult r = connectedComponents(*source, selected, p, progress);
-        run.regionCount = r.regionCount;
-        run.regionSizes = r.regionSizes;
-        run.level = r.level;
-        summary << ", " << r.regionCount << " regions (level " << r.level << ", cell " << r.cellSize << " m, "
-                << static_cast<int>(p.connectivity) << "-connectivity";
-        if (r.droppedComponents)
-            summary << ", " << r.droppedComponents << " components smaller than " << p.minPoints << " points dropped";
-        summary << ")";
-        regionId = std::move(r.regionId);
-    } else if (run.changedCount >= static_cast<std::size_t>(values.integer("min-points"))) {
-        for (std::size_t i = 0; i < selected.size(); ++i)
-            if (selected[i])
-                regionId.values()[i] = 1.0f;
-        run.regionCount = 1;
-        run.regionSizes = {run.changedCount};
-        summary << ", one region";
-    }
+    ScalarField regionId = regionsOf(*source, selected, values, run, summary, progress);
     run.fields.push_back(std::move(changed));
     run.fields.push_back(std::move(regionId));
     run.summary = summary.str();
