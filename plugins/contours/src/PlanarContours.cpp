@@ -320,33 +320,30 @@ double ringPerimeter(const Ring2d& ring)
     return length;
 }
 
-OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const OutlineParams& params)
-{
-    if (!(params.threshold >= 0.0) || !(params.minPartArea >= 0.0) || !(params.minHoleArea >= 0.0))
-        throw Error(ErrorCode::InvalidArgument, "outlines: the threshold and the smallest areas must be >= 0");
-    for (const Eigen::Vector2d& p : points)
-        if (!p.allFinite())
-            throw Error(ErrorCode::InvalidData, "outlines: a point has a non-finite coordinate");
-    if (!params.labels.empty() && params.labels.size() != points.size())
-        throw Error(ErrorCode::InvalidArgument, "outlines: one label per point expected");
-    OutlineResult result;
-    result.partOfPoint.assign(points.size(), -1);
-    const std::vector<Triangle> triangles = delaunayTriangles(points);
-    result.triangles = triangles.size();
-    if (triangles.empty())
-        return result;
+namespace {
 
+//! Each triangle's gap measure (its longest edge or its circumradius; a
+//! triangle across labels never kept) and the cut above which it spans a gap.
+struct GapCut
+{
+    std::vector<double> measure;
+    double cut = 0;       //!< on the measures
+    double threshold = 0; //!< as reported: in metres
+};
+
+GapCut gapCut(const std::vector<Eigen::Vector2d>& points, const std::vector<Triangle>& triangles, const OutlineParams& params)
+{
+    GapCut g;
     auto mixed = [&](const Triangle& t) {
         if (params.labels.empty())
             return false;
         const std::int32_t a = params.labels[t[0]];
         return a < 0 || params.labels[t[1]] != a || params.labels[t[2]] != a;
     };
-    result.spacing = medianNearestDistance(points, triangles);
-    std::vector<double> measure(triangles.size());
+    g.measure.resize(triangles.size());
     for (std::size_t t = 0; t < triangles.size(); ++t)
-        measure[t] = mixed(triangles[t]) ? std::numeric_limits<double>::infinity()
-                     : params.method == OutlineMethod::LongEdges ? longestEdge(points, triangles[t]) : circumradius(points, triangles[t]);
+        g.measure[t] = mixed(triangles[t]) ? std::numeric_limits<double>::infinity()
+                       : params.method == OutlineMethod::LongEdges ? longestEdge(points, triangles[t]) : circumradius(points, triangles[t]);
     // The automatic long-edge criterion is relative: each triangle's longest
     // edge over the spacing where it lies (the mean of its corners'), its
     // knee floored at 2.5 (a regular grid's diagonal is 1.4 spacings, one
@@ -368,21 +365,33 @@ OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const 
             double local = 0;
             for (std::uint32_t v : triangles[t])
                 local += std::isfinite(spacing[v]) && spacing[v] > 0 ? spacing[v] : medianSpacing;
-            measure[t] /= local / 3.0;
+            g.measure[t] /= local / 3.0;
         }
     }
     // Floors: 2 x the median longest edge (a regular grid's diagonals are the
     // longest edges of its triangles), 1.5 x the median circumradius.
-    const double cut = params.threshold > 0 ? params.threshold
-                       : relative           ? std::max(2.5, kneeThreshold(measure, 1.0))
-                                            : kneeThreshold(measure, params.method == OutlineMethod::LongEdges ? 2.0 : 1.5);
-    result.threshold = relative ? cut * medianSpacing : cut;
-    std::vector<std::uint32_t> kept;
-    for (std::size_t t = 0; t < triangles.size(); ++t)
-        if (measure[t] <= cut)
-            kept.push_back(static_cast<std::uint32_t>(t));
-    result.keptTriangles = kept.size();
+    g.cut = params.threshold > 0 ? params.threshold
+            : relative           ? std::max(2.5, kneeThreshold(g.measure, 1.0))
+                                 : kneeThreshold(g.measure, params.method == OutlineMethod::LongEdges ? 2.0 : 1.5);
+    g.threshold = relative ? g.cut * medianSpacing : g.cut;
+    return g;
+}
 
+//! The kept triangles joined into parts across their shared edges: each
+//! part's area and boundary edges (the edges of one kept triangle only).
+struct TriangleParts
+{
+    explicit TriangleParts(std::size_t kept) : sets(kept), partOfRoot(kept, UINT32_MAX) {}
+    DisjointSets sets;
+    std::vector<std::uint32_t> partOfRoot; //!< a set's root -> its part
+    std::vector<double> area;
+    std::vector<std::vector<DirectedEdge>> boundary;
+    std::uint32_t partOf(std::uint32_t k) { return partOfRoot[sets.find(k)]; }
+};
+
+TriangleParts joinTriangles(const std::vector<Eigen::Vector2d>& points, const std::vector<Triangle>& triangles,
+                            const std::vector<std::uint32_t>& kept)
+{
     // Edges of the kept triangles, sorted: a pair of equal keys joins two
     // triangles into one part, a single key is a boundary edge.
     struct EdgeOfTriangle
@@ -401,7 +410,7 @@ OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const 
         }
     }
     std::sort(edges.begin(), edges.end(), [](const EdgeOfTriangle& a, const EdgeOfTriangle& b) { return a.key < b.key; });
-    DisjointSets sets(kept.size());
+    TriangleParts parts(kept.size());
     std::vector<std::uint32_t> boundary; // positions in `edges`
     for (std::size_t i = 0; i < edges.size();) {
         std::size_t j = i + 1;
@@ -411,72 +420,106 @@ OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const 
             boundary.push_back(static_cast<std::uint32_t>(i));
         else
             for (std::size_t k = i + 1; k < j; ++k)
-                sets.unite(edges[i].triangle, edges[k].triangle);
+                parts.sets.unite(edges[i].triangle, edges[k].triangle);
         i = j;
     }
-
-    // Parts: their area, triangles and boundary edges.
-    std::vector<std::uint32_t> partOfRoot(kept.size(), UINT32_MAX);
-    std::vector<double> area;
     for (std::uint32_t k = 0; k < kept.size(); ++k) {
-        const std::uint32_t root = sets.find(k);
-        if (partOfRoot[root] == UINT32_MAX) {
-            partOfRoot[root] = static_cast<std::uint32_t>(area.size());
-            area.push_back(0.0);
+        const std::uint32_t root = parts.sets.find(k);
+        if (parts.partOfRoot[root] == UINT32_MAX) {
+            parts.partOfRoot[root] = static_cast<std::uint32_t>(parts.area.size());
+            parts.area.push_back(0.0);
         }
-        area[partOfRoot[root]] += triangleArea(points, triangles[kept[k]]);
+        parts.area[parts.partOfRoot[root]] += triangleArea(points, triangles[kept[k]]);
     }
-    std::vector<std::vector<DirectedEdge>> boundaryOfPart(area.size());
+    parts.boundary.resize(parts.area.size());
     for (std::uint32_t i : boundary) {
         const EdgeOfTriangle& e = edges[i];
         const Triangle& t = triangles[kept[e.triangle]];
-        boundaryOfPart[partOfRoot[sets.find(e.triangle)]].push_back({t[e.corner], t[(e.corner + 1) % 3]});
+        parts.boundary[parts.partOf(e.triangle)].push_back({t[e.corner], t[(e.corner + 1) % 3]});
     }
-    edges.clear();
-    edges.shrink_to_fit();
+    return parts;
+}
+
+//! A part's rings chained from its boundary edges: the outer one (the largest
+//! counter-clockwise) and the holes (clockwise) above the smallest hole
+//! area. False when no ring runs counter-clockwise.
+bool ringsOfPart(std::vector<DirectedEdge> boundary, const std::vector<Eigen::Vector2d>& points, double minHoleArea, OutlinePart& out)
+{
+    const auto rings = chainRings(std::move(boundary), points);
+    std::size_t outerRing = rings.size();
+    double largest = 0.0;
+    for (std::size_t r = 0; r < rings.size(); ++r) {
+        const double a = signedArea(coordinates(rings[r], points));
+        if (a > largest) {
+            largest = a;
+            outerRing = r;
+        }
+    }
+    if (outerRing == rings.size())
+        return false;
+    out.outerIndices = rings[outerRing];
+    out.outer = coordinates(rings[outerRing], points);
+    for (std::size_t r = 0; r < rings.size(); ++r) {
+        if (r == outerRing)
+            continue;
+        Ring2d ring = coordinates(rings[r], points);
+        // A counter-clockwise ring besides the outer one can only come from
+        // a part touching itself around an island of another part: it is
+        // the outline of that island's surroundings, kept as a hole-free
+        // detail of the outer ring; holes are the clockwise rings.
+        if (signedArea(ring) < 0 && -signedArea(ring) >= minHoleArea) {
+            out.holes.push_back(std::move(ring));
+            out.holeIndices.push_back(rings[r]);
+        }
+    }
+    return true;
+}
+
+} // namespace
+
+OutlineResult extractOutlines(const std::vector<Eigen::Vector2d>& points, const OutlineParams& params)
+{
+    if (!(params.threshold >= 0.0) || !(params.minPartArea >= 0.0) || !(params.minHoleArea >= 0.0))
+        throw Error(ErrorCode::InvalidArgument, "outlines: the threshold and the smallest areas must be >= 0");
+    for (const Eigen::Vector2d& p : points)
+        if (!p.allFinite())
+            throw Error(ErrorCode::InvalidData, "outlines: a point has a non-finite coordinate");
+    if (!params.labels.empty() && params.labels.size() != points.size())
+        throw Error(ErrorCode::InvalidArgument, "outlines: one label per point expected");
+    OutlineResult result;
+    result.partOfPoint.assign(points.size(), -1);
+    // The Delaunay triangles, those spanning gaps dropped (thesis 001's long
+    // edges, or alpha shapes), the rest joined into parts with their rings.
+    const std::vector<Triangle> triangles = delaunayTriangles(points);
+    result.triangles = triangles.size();
+    if (triangles.empty())
+        return result;
+    result.spacing = medianNearestDistance(points, triangles);
+    const GapCut gaps = gapCut(points, triangles, params);
+    result.threshold = gaps.threshold;
+    std::vector<std::uint32_t> kept;
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+        if (gaps.measure[t] <= gaps.cut)
+            kept.push_back(static_cast<std::uint32_t>(t));
+    result.keptTriangles = kept.size();
+    TriangleParts parts = joinTriangles(points, triangles, kept);
 
     // Largest first; small parts dropped.
-    std::vector<std::uint32_t> order(area.size());
+    std::vector<std::uint32_t> order(parts.area.size());
     std::iota(order.begin(), order.end(), 0u);
-    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return area[a] > area[b]; });
-    std::vector<std::int32_t> finalIndex(area.size(), -1);
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return parts.area[a] > parts.area[b]; });
+    std::vector<std::int32_t> finalIndex(parts.area.size(), -1);
     for (std::uint32_t part : order) {
-        if (area[part] < params.minPartArea)
+        if (parts.area[part] < params.minPartArea)
             continue;
-        const auto rings = chainRings(std::move(boundaryOfPart[part]), points);
         OutlinePart out;
-        out.area = area[part];
-        std::size_t outerRing = rings.size();
-        double largest = 0.0;
-        for (std::size_t r = 0; r < rings.size(); ++r) {
-            const double a = signedArea(coordinates(rings[r], points));
-            if (a > largest) {
-                largest = a;
-                outerRing = r;
-            }
-        }
-        if (outerRing == rings.size())
+        out.area = parts.area[part];
+        if (!ringsOfPart(std::move(parts.boundary[part]), points, params.minHoleArea, out))
             continue;
-        out.outerIndices = rings[outerRing];
-        out.outer = coordinates(rings[outerRing], points);
-        for (std::size_t r = 0; r < rings.size(); ++r) {
-            if (r == outerRing)
-                continue;
-            Ring2d ring = coordinates(rings[r], points);
-            // A counter-clockwise ring besides the outer one can only come from
-            // a part touching itself around an island of another part: it is
-            // the outline of that island's surroundings, kept as a hole-free
-            // detail of the outer ring; holes are the clockwise rings.
-            if (signedArea(ring) < 0 && -signedArea(ring) >= params.minHoleArea) {
-                out.holes.push_back(std::move(ring));
-                out.holeIndices.push_back(rings[r]);
-            }
-        }
         finalIndex[part] = static_cast<std::int32_t>(result.parts.size());
         result.parts.push_back(std::move(out));
     }
-
-    assignPointsToParts(points, triangles, kept, [&](std::uint32_t k) { return finalIndex[partOfRoot[sets.find(k)]]; }, result);
+    assignPointsToParts(points, triangles, kept, [&](std::uint32_t k) { return finalIndex[parts.partOf(k)]; }, result);
     return result;
 }
 
