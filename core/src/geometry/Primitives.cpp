@@ -166,33 +166,186 @@ double signedDistance(const Primitive& s, const Eigen::Vector3d& p)
     return 0;
 }
 
-PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressObserver* progress)
+namespace {
+
+//! The points a fit uses: an even sample of at most kMaxFitPoints finite
+//! ones, relative to their centroid, in double from the global coordinates
+//! (the fit never sees a UTM magnitude).
+struct FitSample
 {
+    std::vector<std::size_t> used; //!< their indices in the cloud
+    std::vector<Eigen::Vector3d> points;
+    Eigen::Vector3d globalCentroid;
+};
+
+FitSample fitSample(const PointCloud& cloud, PrimitiveKind kind)
+{
+    FitSample sample;
     const std::size_t n = cloud.size();
-    if (n < 4)
-        cannotFit(kind, "cloud '" + cloud.name + "' has fewer than 4 points");
-    ProgressTicker ticker(progress, std::string("Fitting a ") + primitiveKindName(kind), 3);
-    // An even sample of large clouds, relative to its centroid (in double,
-    // from the global coordinates: the fit never sees a UTM magnitude).
     const std::size_t stride = (n + kMaxFitPoints - 1) / kMaxFitPoints;
-    std::vector<std::size_t> used;
     for (std::size_t i = 0; i < n; i += stride)
         if (cloud.positions()[i].allFinite())
-            used.push_back(i);
-    if (used.size() < 4)
+            sample.used.push_back(i);
+    if (sample.used.size() < 4)
         cannotFit(kind, "cloud '" + cloud.name + "' has fewer than 4 points with finite coordinates");
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (std::size_t i : used)
+    for (std::size_t i : sample.used)
         centroid += cloud.positions()[i].cast<double>();
-    centroid /= static_cast<double>(used.size());
-    std::vector<Eigen::Vector3d> points;
-    points.reserve(used.size());
-    for (std::size_t i : used)
-        points.push_back(cloud.positions()[i].cast<double>() - centroid);
-    const Eigen::Vector3d globalCentroid = cloud.origin() + centroid;
+    centroid /= static_cast<double>(sample.used.size());
+    sample.points.reserve(sample.used.size());
+    for (std::size_t i : sample.used)
+        sample.points.push_back(cloud.positions()[i].cast<double>() - centroid);
+    sample.globalCentroid = cloud.origin() + centroid;
+    return sample;
+}
 
-    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+//! The plane through the centroid across the least spread, on a fixed side
+//! so the same points always give the same plane.
+void fitPlaneTo(const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& pca, const Eigen::Vector3d& globalCentroid, Primitive& s)
+{
+    s.point = globalCentroid;
+    s.direction = pca.eigenvectors().col(0).normalized();
+    // A fixed side, so the same points always give the same plane: +Z
+    // first, then +Y, then +X.
+    const Eigen::Vector3d d = s.direction;
+    const double key = std::abs(d.z()) > 1e-9 ? d.z() : std::abs(d.y()) > 1e-9 ? d.y() : d.x();
+    if (key < 0)
+        s.direction = -s.direction;
+}
+
+//! The algebraic sphere, refined by least squares on the distances.
+void fitSphereTo(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& globalCentroid, Primitive& s)
+{
+    const PrimitiveKind kind = PrimitiveKind::Sphere;
+    const std::optional<Primitive> algebraic = algebraicSphere(points, globalCentroid);
+    if (!algebraic)
+        cannotFit(kind, "the points do not determine a sphere");
+    Eigen::VectorXd x(4);
+    x << algebraic->point - globalCentroid, algebraic->radius;
+    refine(points, x, [](const Eigen::VectorXd& x, const Eigen::Vector3d& p) { return (p - x.head<3>()).norm() - x[3]; }, kind);
+    s.point = globalCentroid + x.head<3>();
+    s.radius = std::abs(x[3]);
+}
+
+//! The axis from the normals, refined by least squares on the distances.
+void fitCylinderTo(const PointCloud& cloud, const FitSample& sample, ProgressObserver* progress, Primitive& s)
+{
+    const PrimitiveKind kind = PrimitiveKind::Cylinder;
+    const std::vector<Eigen::Vector3d>& points = sample.points;
+    const Eigen::Vector3d& globalCentroid = sample.globalCentroid;
+    // Every normal of a cylinder is orthogonal to its axis.
+    std::vector<Eigen::Vector3d> pairedPoints, normals;
+    withNormals(cloud, sample.used, points, progress, pairedPoints, normals);
+    if (normals.size() < 5)
+        cannotFit(kind, "too few points with a normal");
+    const std::optional<Primitive> start = cylinderFromNormals(points, normals, Eigen::Vector3d::Zero());
+    if (!start)
+        cannotFit(kind, "the points do not determine a circle across the axis");
+    const Eigen::Vector3d d0 = start->direction;
+    Eigen::Vector3d e1, e2;
+    orthonormalFrame(d0, e1, e2);
+    Eigen::VectorXd x(5);
+    x << start->point.dot(e1), start->point.dot(e2), 0, 0, start->radius;
+    const auto axisOf = [d0, e1, e2](const Eigen::VectorXd& x) { return (d0 + x[2] * e1 + x[3] * e2).normalized(); };
+    refine(points, x, [&](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
+        const Eigen::Vector3d d = axisOf(x), v = p - (x[0] * e1 + x[1] * e2);
+        return (v - v.dot(d) * d).norm() - x[4];
+    }, kind);
+    const Eigen::Vector3d d = axisOf(x), onAxis = x[0] * e1 + x[1] * e2;
+    s.direction = d;
+    s.point = globalCentroid + onAxis - onAxis.dot(d) * d; // the foot of the centroid
+    s.radius = std::abs(x[4]);
+}
+
+//! The apex and axis from the normals, refined by least squares.
+void fitConeTo(const PointCloud& cloud, const FitSample& sample, ProgressObserver* progress, Primitive& s)
+{
+    const PrimitiveKind kind = PrimitiveKind::Cone;
+    const std::vector<Eigen::Vector3d>& points = sample.points;
+    const Eigen::Vector3d& globalCentroid = sample.globalCentroid;
+    // A cone's normals make one angle with its axis (the axis is the
+    // direction along which they vary least), and each normal's plane
+    // through its point holds the apex.
+    std::vector<Eigen::Vector3d> pairedPoints, pairedNormals;
+    withNormals(cloud, sample.used, points, progress, pairedPoints, pairedNormals);
+    if (pairedNormals.size() < 6)
+        cannotFit(kind, "too few points with a normal");
+    // Normals are unoriented: each turned to the side of the first before they are compared.
+    std::vector<Eigen::Vector3d> aligned = pairedNormals;
+    for (auto& nrm : aligned)
+        if (nrm.dot(aligned.front()) < 0)
+            nrm = -nrm;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& nrm : aligned)
+        mean += nrm;
+    mean /= static_cast<double>(aligned.size());
+    Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+    for (const auto& nrm : aligned)
+        spread.noalias() += (nrm - mean) * (nrm - mean).transpose();
+    Eigen::Vector3d d0 = smallestAxis(spread);
+    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    for (std::size_t j = 0; j < pairedPoints.size(); ++j) {
+        a.noalias() += pairedNormals[j] * pairedNormals[j].transpose();
+        b += pairedNormals[j] * pairedNormals[j].dot(pairedPoints[j]);
+    }
+    const Eigen::Vector3d apex0 = a.ldlt().solve(b);
+    if (!apex0.allFinite())
+        cannotFit(kind, "the normals do not meet at an apex");
+    double along = 0;
     for (const auto& p : points)
+        along += (p - apex0).dot(d0);
+    if (along < 0)
+        d0 = -d0;
+    double angle = 0;
+    for (const auto& p : points) {
+        const Eigen::Vector3d v = p - apex0;
+        const double h = v.dot(d0);
+        angle += std::atan2((v - h * d0).norm(), h);
+    }
+    angle /= static_cast<double>(points.size());
+    Eigen::Vector3d e1, e2;
+    orthonormalFrame(d0, e1, e2);
+    Eigen::VectorXd x(6);
+    x << apex0, 0, 0, angle;
+    const auto axisOf = [d0, e1, e2](const Eigen::VectorXd& x) { return (d0 + x[3] * e1 + x[4] * e2).normalized(); };
+    refine(points, x, [&](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
+        const Eigen::Vector3d d = axisOf(x), v = p - x.head<3>();
+        const double h = v.dot(d), rho = (v - h * d).norm();
+        return rho * std::cos(x[5]) - h * std::sin(x[5]);
+    }, kind);
+    s.point = globalCentroid + x.head<3>();
+    s.direction = axisOf(x);
+    s.halfAngle = x[5];
+    if (!(s.halfAngle > 0 && s.halfAngle < kPi / 2))
+        cannotFit(kind, "the fitted half-angle is not between 0 and 90 degrees");
+}
+
+//! The root mean square of the signed distances of every finite point.
+double rmsDistance(const PointCloud& cloud, const Primitive& s)
+{
+    double sum = 0;
+    std::size_t finite = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const double d = signedDistance(s, cloud.globalPosition(i));
+        if (std::isfinite(d)) {
+            sum += d * d;
+            ++finite;
+        }
+    }
+    return std::sqrt(sum / static_cast<double>(finite));
+}
+
+} // namespace
+
+PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressObserver* progress)
+{
+    if (cloud.size() < 4)
+        cannotFit(kind, "cloud '" + cloud.name + "' has fewer than 4 points");
+    ProgressTicker ticker(progress, std::string("Fitting a ") + primitiveKindName(kind), 3);
+    const FitSample sample = fitSample(cloud, kind);
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (const auto& p : sample.points)
         covariance.noalias() += p * p.transpose();
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca(covariance);
     if (!(pca.eigenvalues()[1] > 1e-12 * pca.eigenvalues()[2]))
@@ -201,131 +354,19 @@ PrimitiveFit fitPrimitive(const PointCloud& cloud, PrimitiveKind kind, ProgressO
 
     Primitive s;
     s.kind = kind;
-    if (kind == PrimitiveKind::Torus)
-        throw Error(ErrorCode::Unsupported, "a torus is fitted from a detected one (primitive extraction), not from scratch");
     switch (kind) {
-    case PrimitiveKind::Plane: {
-        s.point = globalCentroid;
-        s.direction = pca.eigenvectors().col(0).normalized();
-        // A fixed side, so the same points always give the same plane: +Z
-        // first, then +Y, then +X.
-        const Eigen::Vector3d d = s.direction;
-        const double key = std::abs(d.z()) > 1e-9 ? d.z() : std::abs(d.y()) > 1e-9 ? d.y() : d.x();
-        if (key < 0)
-            s.direction = -s.direction;
-        break;
-    }
-    case PrimitiveKind::Sphere: {
-        const std::optional<Primitive> algebraic = algebraicSphere(points, globalCentroid);
-        if (!algebraic)
-            cannotFit(kind, "the points do not determine a sphere");
-        Eigen::VectorXd x(4);
-        x << algebraic->point - globalCentroid, algebraic->radius;
-        refine(points, x, [](const Eigen::VectorXd& x, const Eigen::Vector3d& p) { return (p - x.head<3>()).norm() - x[3]; }, kind);
-        s.point = globalCentroid + x.head<3>();
-        s.radius = std::abs(x[3]);
-        break;
-    }
-    case PrimitiveKind::Cylinder: {
-        // Every normal of a cylinder is orthogonal to its axis.
-        std::vector<Eigen::Vector3d> pairedPoints, normals;
-        withNormals(cloud, used, points, progress, pairedPoints, normals);
-        if (normals.size() < 5)
-            cannotFit(kind, "too few points with a normal");
-        const std::optional<Primitive> start = cylinderFromNormals(points, normals, Eigen::Vector3d::Zero());
-        if (!start)
-            cannotFit(kind, "the points do not determine a circle across the axis");
-        const Eigen::Vector3d d0 = start->direction;
-        Eigen::Vector3d e1, e2;
-        orthonormalFrame(d0, e1, e2);
-        Eigen::VectorXd x(5);
-        x << start->point.dot(e1), start->point.dot(e2), 0, 0, start->radius;
-        const auto axisOf = [d0, e1, e2](const Eigen::VectorXd& x) { return (d0 + x[2] * e1 + x[3] * e2).normalized(); };
-        refine(points, x, [&](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
-            const Eigen::Vector3d d = axisOf(x), v = p - (x[0] * e1 + x[1] * e2);
-            return (v - v.dot(d) * d).norm() - x[4];
-        }, kind);
-        const Eigen::Vector3d d = axisOf(x), onAxis = x[0] * e1 + x[1] * e2;
-        s.direction = d;
-        s.point = globalCentroid + onAxis - onAxis.dot(d) * d; // the foot of the centroid
-        s.radius = std::abs(x[4]);
-        break;
-    }
-    case PrimitiveKind::Cone: {
-        // A cone's normals make one angle with its axis (the axis is the
-        // direction along which they vary least), and each normal's plane
-        // through its point holds the apex.
-        std::vector<Eigen::Vector3d> pairedPoints, pairedNormals;
-        withNormals(cloud, used, points, progress, pairedPoints, pairedNormals);
-        if (pairedNormals.size() < 6)
-            cannotFit(kind, "too few points with a normal");
-        // Normals are unoriented: each turned to the side of the first before they are compared.
-        std::vector<Eigen::Vector3d> aligned = pairedNormals;
-        for (auto& nrm : aligned)
-            if (nrm.dot(aligned.front()) < 0)
-                nrm = -nrm;
-        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-        for (const auto& nrm : aligned)
-            mean += nrm;
-        mean /= static_cast<double>(aligned.size());
-        Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
-        for (const auto& nrm : aligned)
-            spread.noalias() += (nrm - mean) * (nrm - mean).transpose();
-        Eigen::Vector3d d0 = smallestAxis(spread);
-        Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
-        Eigen::Vector3d b = Eigen::Vector3d::Zero();
-        for (std::size_t j = 0; j < pairedPoints.size(); ++j) {
-            a.noalias() += pairedNormals[j] * pairedNormals[j].transpose();
-            b += pairedNormals[j] * pairedNormals[j].dot(pairedPoints[j]);
-        }
-        const Eigen::Vector3d apex0 = a.ldlt().solve(b);
-        if (!apex0.allFinite())
-            cannotFit(kind, "the normals do not meet at an apex");
-        double along = 0;
-        for (const auto& p : points)
-            along += (p - apex0).dot(d0);
-        if (along < 0)
-            d0 = -d0;
-        double angle = 0;
-        for (const auto& p : points) {
-            const Eigen::Vector3d v = p - apex0;
-            const double h = v.dot(d0);
-            angle += std::atan2((v - h * d0).norm(), h);
-        }
-        angle /= static_cast<double>(points.size());
-        Eigen::Vector3d e1, e2;
-        orthonormalFrame(d0, e1, e2);
-        Eigen::VectorXd x(6);
-        x << apex0, 0, 0, angle;
-        const auto axisOf = [d0, e1, e2](const Eigen::VectorXd& x) { return (d0 + x[3] * e1 + x[4] * e2).normalized(); };
-        refine(points, x, [&](const Eigen::VectorXd& x, const Eigen::Vector3d& p) {
-            const Eigen::Vector3d d = axisOf(x), v = p - x.head<3>();
-            const double h = v.dot(d), rho = (v - h * d).norm();
-            return rho * std::cos(x[5]) - h * std::sin(x[5]);
-        }, kind);
-        s.point = globalCentroid + x.head<3>();
-        s.direction = axisOf(x);
-        s.halfAngle = x[5];
-        if (!(s.halfAngle > 0 && s.halfAngle < kPi / 2))
-            cannotFit(kind, "the fitted half-angle is not between 0 and 90 degrees");
-        break;
-    }
-    case PrimitiveKind::Torus: break; // refused above
+    case PrimitiveKind::Plane: fitPlaneTo(pca, sample.globalCentroid, s); break;
+    case PrimitiveKind::Sphere: fitSphereTo(sample.points, sample.globalCentroid, s); break;
+    case PrimitiveKind::Cylinder: fitCylinderTo(cloud, sample, progress, s); break;
+    case PrimitiveKind::Cone: fitConeTo(cloud, sample, progress, s); break;
+    case PrimitiveKind::Torus:
+        throw Error(ErrorCode::Unsupported, "a torus is fitted from a detected one (primitive extraction), not from scratch");
     }
     ticker.step();
     PrimitiveFit fit;
     fit.primitive = s;
-    fit.points = used.size();
-    double sum = 0;
-    std::size_t finite = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        const double d = signedDistance(s, cloud.globalPosition(i));
-        if (std::isfinite(d)) {
-            sum += d * d;
-            ++finite;
-        }
-    }
-    fit.rms = std::sqrt(sum / static_cast<double>(finite));
+    fit.points = sample.used.size();
+    fit.rms = rmsDistance(cloud, s);
     ticker.step();
     return fit;
 }
