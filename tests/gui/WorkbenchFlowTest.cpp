@@ -4,6 +4,7 @@
 // declarations, set a threshold in the scalar-field panel, split, export, save
 // and restore the session. Answers are checked against core called directly
 // and against brute-force counts.
+#include "WorkbenchFixture.h"
 #include "MainWindow.h"
 #include "PrimitiveScene.h"
 #include "WallScenes.h"
@@ -71,20 +72,9 @@ using gui::EntityId;
 
 namespace {
 
-//! A workbench window, as each flow starts: the plugins, the window shown and exposed.
-struct Workbench
-{
-    PluginRegistry registry = makePluginRegistry();
-    gui::MainWindow window{registry};
-    bool shown()
-    {
-        window.show();
-        return QTest::qWaitForWindowExposed(&window);
-    }
-};
-
-const QString kReference = SCANDIFF_SAMPLE_DATA_DIR "/demo/site-2019.ply";
-const QString kCompared = SCANDIFF_SAMPLE_DATA_DIR "/demo/site-2024.ply";
+using test::Workbench;
+using test::kReference;
+using test::kCompared;
 
 std::size_t bruteForceInside(const ScalarField& f, double low, double high)
 {

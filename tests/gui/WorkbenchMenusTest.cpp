@@ -3,6 +3,7 @@
 // for, driven through the workbench's own menus and keys: the Help menu, the
 // shortcuts (none shared by two actions), the standard views' keys, Close and
 // Close all, the tree's context menu (show/hide, colour, clone, rename...).
+#include "WorkbenchFixture.h"
 #include "HelpDialogs.h"
 #include "MainWindow.h"
 #include "controllers/SessionController.h"
@@ -32,19 +33,9 @@ using gui::EntityId;
 
 namespace {
 
-struct Workbench
-{
-    PluginRegistry registry = makePluginRegistry();
-    gui::MainWindow window{registry};
-    bool shown()
-    {
-        window.show();
-        return QTest::qWaitForWindowExposed(&window);
-    }
-};
-
-const QString kReference = SCANDIFF_SAMPLE_DATA_DIR "/demo/site-2019.ply";
-const QString kCompared = SCANDIFF_SAMPLE_DATA_DIR "/demo/site-2024.ply";
+using test::Workbench;
+using test::kReference;
+using test::kCompared;
 
 QAction* treeAction(gui::MainWindow& window, const char* name)
 {
