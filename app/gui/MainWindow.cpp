@@ -647,7 +647,7 @@ int MainWindow::colourSelected(const QColor& colour)
 MoveDialog* MainWindow::moveSelectedInteractively()
 {
     std::vector<EntityId> ids;
-    for (EntityId id : tree_->selectedEntities(false))
+    for (EntityId id : tree_->selectedEntities(true)) // a field's row stands for its cloud
         if (document_.item(id).hasData())
             ids.push_back(id);
     if (ids.empty()) {

@@ -19,6 +19,7 @@
 #include <QFileInfo>
 #include <QListWidget>
 #include <QTemporaryDir>
+#include <QTreeWidgetItem>
 #include <QMenu>
 #include <QMenuBar>
 #include <QMessageBox>
@@ -170,6 +171,19 @@ private slots:
         std::vector<Eigen::Vector3d> before;
         for (std::size_t i = 0; i < document.item(id).points().size(); i += 97)
             before.push_back(document.item(id).points().globalPosition(i));
+
+        // A field's row selected stands for its cloud (as in the trial, a
+        // click on a field in the tree is the usual selection).
+        document.addField(id, ScalarField("d", document.item(id).points().size()));
+        w.window.tree()->clearSelection();
+        QTreeWidgetItem* fieldRow = w.window.tree()->fieldRow(id, "d");
+        QVERIFY(fieldRow);
+        fieldRow->setSelected(true);
+        gui::MoveDialog* byField = w.window.moveSelectedInteractively();
+        QVERIFY(byField && w.window.view()->movingEntities());
+        byField->reject();
+        QApplication::processEvents();
+        w.window.tree()->selectEntity(id);
 
         // Cancelled: nothing moves.
         gui::MoveDialog* dialog = w.window.moveSelectedInteractively();
