@@ -603,23 +603,12 @@ void summarise(const std::vector<double>& magnitudes, std::size_t considered, co
 
 namespace detail {
 
-IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface, const IcpParams& params, ProgressObserver* progress)
+//! Directions the surfaces hold weakly: solved when the data show the
+//! motion along them, else held fixed and the run redone so (see below).
+//! Returns whether the run now holds them; its note goes to the report.
+bool holdOrSolveWeakDirections(const ReferenceSurface& surface, const IterationPoints& points, const IcpParams& params,
+                               const Eigen::Isometry3d& start, IterationRun& run, ProgressTicker& ticker, RegistrationReport& report)
 {
-    checkParams(params);
-    if (moving.empty())
-        throw Error(ErrorCode::InvalidData, "registration: the moving cloud '" + moving.name + "' is empty");
-    const bool plane = params.method == IcpMethod::PointToPlane;
-    const Eigen::Vector3d origin = surface.frameOrigin();
-    const IterationPoints points = iterationPoints(moving, origin, params);
-    IcpResult result;
-    RegistrationReport& report = result.report;
-    report.method = std::string(plane ? "ICP point-to-plane" : "ICP point-to-point") + ", " + dofName(params.constraint.dof) + " DOF" +
-                    (params.changeRobust ? ", change-robust" : "");
-    if (!points.note.empty())
-        report.notes.push_back(points.note);
-    ProgressTicker ticker(progress, "Registration (ICP)", params.maxIterations);
-    const Eigen::Isometry3d start = toLocal(params.initial, origin);
-    IterationRun run = runIterations(surface, points, params, start, nullptr, ticker);
     // Directions the surfaces do not hold are held, unless the data show
     // them. The steps a free run takes along them follow noise and a few
     // edges (airborne epochs of a flat park slid by up to 1.5 m), or the
@@ -636,8 +625,10 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
     // independent), and roof edges seen from the air pull both halves the
     // same way; a real shift over hills lowers the residuals by 2-17 %.
     const Eigen::MatrixXd held = weakDirections(run.normalMatrix);
-    bool holding = false; // whether the run holds the weak directions fixed
-    if (held.cols() > 0 && held.cols() < run.normalMatrix.rows()) {
+    if (held.cols() == 0 || held.cols() >= run.normalMatrix.rows())
+        return false;
+    bool holding = false;
+    {
         const Eigen::Vector3d centre = start * points.centroid;
         const auto along = [&](const Eigen::Isometry3d& motion) {
             return Eigen::VectorXd(held.transpose() * twistAbout(motion * start.inverse(), centre, points.length, params.constraint));
@@ -689,6 +680,66 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
         }
         report.notes.push_back(note.str());
     }
+    return holding;
+}
+
+//! Every moving point, moved: its residual, and whether the last
+//! iteration's rules keep it; the magnitudes of those kept.
+std::vector<double> residualsOfEveryPoint(const PointCloud& moving, const ReferenceSurface& surface, const IcpParams& final,
+                                          const Eigen::Isometry3d& motion, const Eigen::Vector3d& origin, double finalThreshold,
+                                          IcpResult& result, ProgressObserver* progress)
+{
+    std::vector<double> magnitudes;
+    // In chunks, each a step of its own stage: on a
+    // large cloud this pass (closest points and the reference normals they
+    // need) takes longer than all the iterations, and Cancel must be heard.
+    const std::size_t n = moving.size();
+    result.residual = ScalarField(fields::kRegistrationResidual, n);
+    result.excluded = ScalarField(fields::kRegistrationExcluded, n);
+    constexpr std::size_t kChunk = 1 << 16;
+    ProgressTicker residualTicker(progress, "Registration: residual of every point", (n + kChunk - 1) / kChunk);
+    std::vector<Eigen::Vector3d> chunk;
+    Correspondences last;
+    for (std::size_t begin = 0; begin < n; begin += kChunk) {
+        const std::size_t end = std::min(n, begin + kChunk);
+        chunk.resize(end - begin);
+        for (std::size_t i = begin; i < end; ++i)
+            chunk[i - begin] = moving.positions()[i].allFinite()
+                                   ? Eigen::Vector3d(motion * (moving.globalPosition(i) - origin))
+                                   : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+        correspond(surface, chunk, final, finalThreshold, last, final.maxDistance.value_or(kInfinity));
+        for (std::size_t i = begin; i < end; ++i) {
+            const std::size_t k = i - begin;
+            if (std::isfinite(last.residual[k]))
+                result.residual.setValue(i, last.residual[k]);
+            result.excluded.setValue(i, last.used[k] ? 0.0 : 1.0);
+            if (last.used[k])
+                magnitudes.push_back(std::abs(last.residual[k]));
+        }
+        residualTicker.step();
+    }
+    return magnitudes;
+}
+
+IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface, const IcpParams& params, ProgressObserver* progress)
+{
+    checkParams(params);
+    if (moving.empty())
+        throw Error(ErrorCode::InvalidData, "registration: the moving cloud '" + moving.name + "' is empty");
+    const bool plane = params.method == IcpMethod::PointToPlane;
+    const Eigen::Vector3d origin = surface.frameOrigin();
+    const IterationPoints points = iterationPoints(moving, origin, params);
+    IcpResult result;
+    RegistrationReport& report = result.report;
+    report.method = std::string(plane ? "ICP point-to-plane" : "ICP point-to-point") + ", " + dofName(params.constraint.dof) + " DOF" +
+                    (params.changeRobust ? ", change-robust" : "");
+    if (!points.note.empty())
+        report.notes.push_back(points.note);
+    ProgressTicker ticker(progress, "Registration (ICP)", params.maxIterations);
+    const Eigen::Isometry3d start = toLocal(params.initial, origin);
+    IterationRun run = runIterations(surface, points, params, start, nullptr, ticker);
+    // Directions the surfaces do not hold (a flat site's horizontal).
+    const bool holding = holdOrSolveWeakDirections(surface, points, params, start, run, ticker, report);
     // The second phase (StableSelection::second), not after a first phase
     // that had to hold weak directions (a flat site: what its surfaces say
     // sideways was found not to be in the data).
@@ -730,36 +781,9 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
         summarise(magnitudes, x.size(), params, report);
         return result;
     }
-    // Every moving point, moved: its residual, and whether the last
-    // iteration's rules keep it. In chunks, each a step of its own stage: on a
-    // large cloud this pass (closest points and the reference normals they
-    // need) takes longer than all the iterations, and Cancel must be heard.
-    const std::size_t n = moving.size();
-    result.residual = ScalarField(fields::kRegistrationResidual, n);
-    result.excluded = ScalarField(fields::kRegistrationExcluded, n);
-    constexpr std::size_t kChunk = 1 << 16;
-    ProgressTicker residualTicker(progress, "Registration: residual of every point", (n + kChunk - 1) / kChunk);
-    std::vector<Eigen::Vector3d> chunk;
-    Correspondences last;
-    for (std::size_t begin = 0; begin < n; begin += kChunk) {
-        const std::size_t end = std::min(n, begin + kChunk);
-        chunk.resize(end - begin);
-        for (std::size_t i = begin; i < end; ++i)
-            chunk[i - begin] = moving.positions()[i].allFinite()
-                                   ? Eigen::Vector3d(motion * (moving.globalPosition(i) - origin))
-                                   : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-        correspond(surface, chunk, final, finalThreshold, last, params.maxDistance.value_or(kInfinity));
-        for (std::size_t i = begin; i < end; ++i) {
-            const std::size_t k = i - begin;
-            if (std::isfinite(last.residual[k]))
-                result.residual.setValue(i, last.residual[k]);
-            result.excluded.setValue(i, last.used[k] ? 0.0 : 1.0);
-            if (last.used[k])
-                magnitudes.push_back(std::abs(last.residual[k]));
-        }
-        residualTicker.step();
-    }
-    summarise(magnitudes, n, params, report);
+    const std::vector<double> everyMagnitude =
+        residualsOfEveryPoint(moving, surface, final, motion, origin, finalThreshold, result, progress);
+    summarise(everyMagnitude, moving.size(), params, report);
     return result;
 }
 
