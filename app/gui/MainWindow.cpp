@@ -23,6 +23,7 @@
 
 #include <scandiff/core/Error.h>
 #include <scandiff/io/DxfWriter.h>
+#include <scandiff/io/ResultFiles.h>
 
 #include <QAction>
 #include <QCloseEvent>
@@ -681,10 +682,8 @@ int MainWindow::applyMotion(const std::vector<EntityId>& ids, const Eigen::Matri
     ToolController* transform = toolController("transform");
     if (!transform)
         return 0;
-    QString matrix;
-    for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c)
-            matrix += QString::number(global(r, c), 'g', 17) + (r == 3 && c == 3 ? "" : " ");
+    // The matrix as the CLI writes it (every double given back exactly), on one line.
+    const QString matrix = QString::fromStdString(io::matrixText(global)).simplified();
     const Document::UndoGroup group(document_, tr("move"));
     int moved = 0;
     for (EntityId id : ids)

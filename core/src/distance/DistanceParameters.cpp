@@ -2,6 +2,7 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/TextLists.h>
 #include <scandiff/core/distance/DistanceParameters.h>
+#include <scandiff/core/processing/CloudEditing.h>
 #include <scandiff/core/processing/Normals.h>
 
 #include <cmath>
@@ -123,9 +124,7 @@ SensorPose parseSensorPose(const std::string& text, const std::string& step, con
     SensorPose pose;
     pose.position = {v[0], v[1], v[2]};
     if (v.size() == 6)
-        pose.orientation = Eigen::AngleAxisd(radians(v[3]), Eigen::Vector3d::UnitZ()) *
-                           Eigen::AngleAxisd(radians(v[4]), Eigen::Vector3d::UnitY()) *
-                           Eigen::AngleAxisd(radians(v[5]), Eigen::Vector3d::UnitX());
+        pose.orientation = orientationFromHeadingPitchRoll(v[3], v[4], v[5]);
     if (!step.empty()) {
         const std::vector<double> s = parseNumberList(step, "sensor-step");
         if (s.empty() || s.size() > 2 || s[0] <= 0 || s.back() <= 0)

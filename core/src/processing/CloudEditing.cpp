@@ -266,13 +266,17 @@ CropBox parseOrientedBox(const std::string& text)
     return box;
 }
 
+Eigen::Quaterniond orientationFromHeadingPitchRoll(double heading, double pitch, double roll)
+{
+    // Heading about Z, then pitch about Y, then roll about X.
+    constexpr double kPi = 3.14159265358979323846;
+    return Eigen::AngleAxisd(heading * kPi / 180, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch * kPi / 180, Eigen::Vector3d::UnitY()) *
+           Eigen::AngleAxisd(roll * kPi / 180, Eigen::Vector3d::UnitX());
+}
+
 Eigen::Matrix3d rotationFromHeadingPitchRoll(double heading, double pitch, double roll)
 {
-    // Heading about Z, then pitch about Y, then roll about X, as sensor poses.
-    constexpr double kRadians = 3.14159265358979323846 / 180;
-    return (Eigen::AngleAxisd(heading * kRadians, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch * kRadians, Eigen::Vector3d::UnitY()) *
-            Eigen::AngleAxisd(roll * kRadians, Eigen::Vector3d::UnitX()))
-        .toRotationMatrix();
+    return orientationFromHeadingPitchRoll(heading, pitch, roll).toRotationMatrix();
 }
 
 Eigen::Vector3d headingPitchRollOf(const Eigen::Matrix3d& r)

@@ -51,7 +51,9 @@ Eigen::Matrix4d scaleAbout(double factor, const Eigen::Vector3d& centre);
 Eigen::Matrix4d translation(const Eigen::Vector3d& offset);
 
 //! Rz(heading) Ry(pitch) Rx(roll), angles in degrees: how oriented boxes,
-//! sensor poses and typed motions turn; and back (pitch in [-90, 90]).
+//! sensor poses and typed motions turn (as a quaternion and as a matrix);
+//! and back (pitch in [-90, 90]).
+Eigen::Quaterniond orientationFromHeadingPitchRoll(double heading, double pitch, double roll);
 Eigen::Matrix3d rotationFromHeadingPitchRoll(double heading, double pitch, double roll);
 Eigen::Vector3d headingPitchRollOf(const Eigen::Matrix3d& rotation);
 
