@@ -2,6 +2,7 @@
 #include <scandiff/plugins/registration/Stations.h>
 
 #include "ReferenceSurface.h"
+#include "StationModel.h"
 
 #include <scandiff/core/Error.h>
 #include <scandiff/core/RobustStatistics.h>
@@ -44,79 +45,11 @@ constexpr double kMaxStationTilt = 10 * M_PI / 180;
 //! levels to a few thousandths) are searched for by turns about it.
 constexpr double kLevelledSearchTilt = M_PI / 180;
 
-//! One station: its cloud, the surface others are matched on, and its
-//! sampled points in station coordinates relative to the world origin.
-struct Station
-{
-    const PointCloud* cloud = nullptr;
-    std::unique_ptr<detail::ReferenceSurface> surface;
-    std::vector<Eigen::Vector3d> sample;
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero(); //!< of the sample, world-relative station coordinates
-    std::unique_ptr<DepthMap> view; //!< what the scanner saw, when the cloud holds its one sensor pose
-    std::optional<Eigen::Vector3d> scanner; //!< its centre, world-relative station coordinates, with the view
-    Eigen::Vector3d up = Eigen::Vector3d::UnitZ(); //!< the scanner's vertical in the station's coordinates
-};
-
-//! A pair's correspondences one way: points of `from` matched on `on`'s surface.
-struct Matched
-{
-    std::vector<Eigen::Vector3d> x, q, n; //!< world-relative, station 0's frame
-    std::vector<double> residual, distance;
-};
-
-//! The points of `from` (posed) matched on the surface of `on` (posed).
-void match(const Station& from, const Eigen::Isometry3d& fromPose, const Station& on, const Eigen::Isometry3d& onPose,
-           const Eigen::Vector3d& worldOrigin, std::size_t limit, Matched& m)
-{
-    const std::size_t count = std::min(limit, from.sample.size());
-    m.x.resize(count);
-    std::vector<Eigen::Vector3d> local(count);
-    const Eigen::Isometry3d toOn = onPose.inverse();
-    const Eigen::Vector3d toSurface = worldOrigin - on.surface->frameOrigin();
-    for (std::size_t i = 0; i < count; ++i) {
-        m.x[i] = fromPose * from.sample[i];
-        local[i] = toOn * m.x[i] + toSurface;
-    }
-    detail::ClosestPoints closest;
-    on.surface->closest(local, closest);
-    m.q.assign(count, Eigen::Vector3d::Zero());
-    m.n.assign(count, Eigen::Vector3d::Zero());
-    m.residual.assign(count, std::numeric_limits<double>::quiet_NaN());
-    m.distance.assign(count, kInfinity);
-    // A surface is seen from its front: a point a scanner saw lies on a
-    // surface that faces that scanner. The two faces of a thin wall (a
-    // partition, a door leaf), each seen from its own side, are not one
-    // surface; matched as one, they hold the stations on either side slid
-    // by the wall's thickness.
-    const bool sided = from.scanner && on.scanner;
-    Eigen::Vector3d fromScanner = Eigen::Vector3d::Zero(), onScanner = Eigen::Vector3d::Zero();
-    if (sided) {
-        fromScanner = toOn * (fromPose * *from.scanner) + toSurface;
-        onScanner = *on.scanner + toSurface;
-    }
-    for (std::size_t i = 0; i < count; ++i) {
-        if (!closest.found[i] || closest.normals[i] == Eigen::Vector3d::Zero())
-            continue;
-        if (sided) {
-            const Eigen::Vector3d& n = closest.normals[i];
-            const double facingOn = n.dot(onScanner - closest.points[i]), facingFrom = n.dot(fromScanner - local[i]);
-            if (facingOn * facingFrom < 0)
-                continue;
-        }
-        m.q[i] = onPose * (closest.points[i] - toSurface);
-        m.n[i] = onPose.linear() * closest.normals[i];
-        const Eigen::Vector3d d = m.x[i] - m.q[i];
-        m.distance[i] = d.norm();
-        m.residual[i] = m.n[i].dot(d);
-    }
-}
-
-//! The displacement a motion gives a point, and its angle.
-void motionSize(const Eigen::Matrix4d& m, const Eigen::Vector3d& at, double& degrees, double& metres)
-{
-    degrees = rotationDegrees(m.topLeftCorner<3, 3>());
-    metres = ((m * at.homogeneous()).head<3>() - at).norm();
-}
+using detail::match;
+using detail::Matched;
+using detail::motionSize;
+using detail::Station;
+using JointAdjustmentOutcome = detail::JointAdjustment;
 
 std::vector<Station> prepare(const std::vector<const PointCloud*>& clouds, const StationParams& params, Eigen::Vector3d& worldOrigin,
                              ProgressObserver* progress)
@@ -736,7 +669,9 @@ void leaveOutInconsistentPairs(std::vector<StationPair>& pairs, const std::vecto
 
 } // namespace
 
-StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const StationParams& params, ProgressObserver* progress)
+namespace {
+
+void checkStationParams(const std::vector<const PointCloud*>& clouds, const StationParams& params)
 {
     if (clouds.size() < 2)
         throw Error(ErrorCode::InvalidArgument, "stations: at least 2 stations");
@@ -744,31 +679,34 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
         params.sampleCount < 10 || params.maxIterations < 1)
         throw Error(ErrorCode::InvalidArgument,
                     "stations: the maximum distance is > 0, the minimum overlap in (0, 1], at least 10 points and 1 iteration");
-    Eigen::Vector3d worldOrigin;
-    std::vector<Station> stations = prepare(clouds, params, worldOrigin, progress);
-    const std::size_t count = stations.size();
-    StationResult result;
+}
 
-    // Every pair registered alone; those that disagree with their loops left out.
+//! The shape descriptors of every station for the global search (when the
+//! stations may start anywhere); returns the feature spacing the pairs use.
+double describeStations(const std::vector<Station>& stations, const StationParams& params,
+                        std::vector<std::shared_ptr<const AlignmentFeatures>>& features, ProgressObserver* progress)
+{
+    if (!params.anyStart)
+        return params.maxDistance / 2;
     double spacing = params.featureSpacing.value_or(0.0);
-    std::vector<std::shared_ptr<const AlignmentFeatures>> features(count);
-    if (params.anyStart) {
-        if (!params.featureSpacing) {
-            std::vector<double> spacings;
-            for (const Station& s : stations)
-                spacings.push_back(alignmentSpacing(*s.cloud, 10000));
-            spacing = medianOf(spacings);
-        }
-        ProgressTicker describeTicker(progress, "Stations: shape descriptors", count);
-        for (std::size_t k = 0; k < count; ++k) {
-            features[k] = describeForAlignment(*stations[k].cloud, spacing, nullptr);
-            describeTicker.step();
-        }
-    } else {
-        spacing = params.maxDistance / 2;
+    if (!params.featureSpacing) {
+        std::vector<double> spacings;
+        for (const Station& s : stations)
+            spacings.push_back(alignmentSpacing(*s.cloud, 10000));
+        spacing = medianOf(spacings);
     }
-    // Each scanner's view, for the free-space test: a point nearer than what
-    // it saw by a feature spacing (at least 5 cm) contradicts a pose.
+    ProgressTicker describeTicker(progress, "Stations: shape descriptors", stations.size());
+    for (std::size_t k = 0; k < stations.size(); ++k) {
+        features[k] = describeForAlignment(*stations[k].cloud, spacing, nullptr);
+        describeTicker.step();
+    }
+    return spacing;
+}
+
+//! Each scanner's view, for the free-space test: a point nearer than what
+//! it saw by a feature spacing (at least 5 cm) contradicts a pose.
+void giveStationsTheirViews(std::vector<Station>& stations, double spacing, const Eigen::Vector3d& worldOrigin)
+{
     VisibilityParams seeing;
     seeing.tolerance = std::max(0.05, spacing);
     for (Station& s : stations)
@@ -777,6 +715,17 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
             s.scanner = s.cloud->sensors().front().position - worldOrigin;
             s.up = s.cloud->sensors().front().orientation * Eigen::Vector3d::UnitZ();
         }
+}
+
+//! Every pair registered alone, placed together, and those that disagree
+//! with their loops left out: the used pairs go to result.pairs, the others
+//! are returned.
+std::vector<StationPair> chooseStationPairs(const std::vector<Station>& stations,
+                                            const std::vector<std::shared_ptr<const AlignmentFeatures>>& features, double spacing,
+                                            const StationParams& params, const Eigen::Vector3d& worldOrigin, StationResult& result,
+                                            ProgressObserver* progress)
+{
+    const std::size_t count = stations.size();
     std::vector<PairHypotheses> hypotheses;
     ProgressTicker pairTicker(progress, "Stations: pairwise registration", count * (count - 1) / 2);
     for (std::size_t a = 0; a < count; ++a)
@@ -796,171 +745,26 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
     std::vector<StationPair> leftOut;
     for (StationPair& p : allPairs)
         (p.used ? result.pairs : leftOut).push_back(std::move(p));
-    std::vector<std::ptrdiff_t> parentEdge;
-    std::vector<std::size_t> parent;
-    const std::vector<Eigen::Matrix4d> chain = chainPoses(count, result.pairs, parentEdge, parent);
-    result.loops = loopMisclosures(stations, result.pairs, chain, parentEdge, parent, worldOrigin);
+    return leftOut;
+}
 
-    // The joint adjustment, from the chained poses.
-    std::vector<Eigen::Isometry3d> pose(count);
-    for (std::size_t k = 0; k < count; ++k)
-        pose[k] = toLocal(chain[k], worldOrigin);
-    double spread = 0;
-    std::size_t points = 0;
-    for (const Station& s : stations)
-        for (const auto& p : s.sample) {
-            spread += p.squaredNorm();
-            ++points;
-        }
-    const double length = std::max(std::sqrt(spread / static_cast<double>(points)), 1e-9);
-    const int u = dofCount(params.constraint.dof);
-    const Eigen::Vector3d axis = params.constraint.axis.normalized();
-    const Eigen::Index unknowns = static_cast<Eigen::Index>(u * (count - 1));
+//! The adjusted poses in global coordinates, each used pair's residual and
+//! disagreement with its own registration, the left-out pairs with their
+//! reasons, and the residuals' statistics.
+void reportAdjustment(const std::vector<Station>& stations, const JointAdjustmentOutcome& adjusted, std::vector<StationPair> leftOut,
+                      const StationParams& params, const Eigen::Vector3d& worldOrigin, StationResult& result)
+{
     RegistrationReport& report = result.report;
-    report.method = "multi-station adjustment, " + std::to_string(count) + " stations, " + std::to_string(result.pairs.size()) +
-                    " pairs, " + dofName(params.constraint.dof) + " DOF";
-    double threshold = params.maxDistance, previousRms = kInfinity, rmsTwoBefore = kInfinity;
-    std::vector<double> finalResiduals;
-    std::vector<double> pairSquares(result.pairs.size()), pairCount(result.pairs.size());
-    // The unknowns of a station (none for station 0): its column block, and
-    // a full (rotation, translation) derivative reduced to them.
-    const auto block = [&](std::size_t station) -> Eigen::Index {
-        return station == 0 ? -1 : static_cast<Eigen::Index>(u * (station - 1));
-    };
-    const auto reduce = [&](const Eigen::Matrix<double, 6, 1>& full) -> Eigen::VectorXd {
-        Eigen::VectorXd v(u);
-        if (params.constraint.dof == Dof::Six)
-            v = full;
-        else if (params.constraint.dof == Dof::Four)
-            v << axis.dot(full.head<3>()), full.tail<3>();
-        else
-            v = full.tail<3>();
-        return v;
-    };
-    double graduatedScale = params.maxDistance / 3;
-    ProgressTicker ticker(progress, "Stations: joint adjustment", params.maxIterations);
-    Eigen::MatrixXd h;
-    for (std::size_t iteration = 1; iteration <= params.maxIterations; ++iteration) {
-        h = Eigen::MatrixXd::Zero(unknowns, unknowns);
-        Eigen::VectorXd g = Eigen::VectorXd::Zero(unknowns);
-        // Residuals of every pair, both ways, then their robust scale.
-        struct Row
-        {
-            std::size_t moving, on, pair;
-            Eigen::Vector3d x, q, n;
-            double r;
-        };
-        std::vector<Row> rows;
-        std::vector<double> distances;
-        for (std::size_t e = 0; e < result.pairs.size(); ++e)
-            for (int way = 0; way < 2; ++way) {
-                const std::size_t from = way ? result.pairs[e].a : result.pairs[e].b, on = way ? result.pairs[e].b : result.pairs[e].a;
-                Matched m;
-                match(stations[from], pose[from], stations[on], pose[on], worldOrigin, params.sampleCount, m);
-                for (std::size_t i = 0; i < m.x.size(); ++i)
-                    if (m.distance[i] <= params.maxDistance && std::abs(m.residual[i]) <= threshold) {
-                        rows.push_back({from, on, e, m.x[i], m.q[i], m.n[i], m.residual[i]});
-                        distances.push_back(m.distance[i]);
-                    }
-            }
-        if (rows.size() < static_cast<std::size_t>(unknowns) + 3)
-            throw Error(ErrorCode::InvalidData, "stations: only " + std::to_string(rows.size()) + " correspondences between the stations");
-        std::vector<double> magnitudes(rows.size());
-        for (std::size_t i = 0; i < rows.size(); ++i)
-            magnitudes[i] = std::abs(rows[i].r);
-        // Graduated: the weights start wide (a third of the maximum
-        // distance) and narrow by half each iteration to the residuals' own
-        // robust scale. Narrow from the start, a station slid along a hall
-        // by a pair that saw little across it stays slid: the few surfaces
-        // across the slide (an end wall, a column) are outliers to the many
-        // along it.
-        const double robustScale = std::max(kMadToSigma * medianOf(magnitudes), 1e-12 * length);
-        const double scale = std::max(robustScale, graduatedScale);
-        graduatedScale /= 2;
-        double sum2 = 0;
-        std::fill(pairSquares.begin(), pairSquares.end(), 0.0);
-        std::fill(pairCount.begin(), pairCount.end(), 0.0);
-        for (const Row& row : rows) {
-            // Cauchy weights (tuning 2.3849: 95 % efficiency on Gaussian noise).
-            const double v = row.r / scale / 2.3849, w = 1.0 / (1.0 + v * v);
-            sum2 += row.r * row.r;
-            pairSquares[row.pair] += row.r * row.r;
-            pairCount[row.pair] += 1;
-            // d r / d(station moved): rotation x × n, translation n; the
-            // surface's station: rotation n × (x - q) - q × n, translation -n.
-            const Eigen::Vector3d d = row.x - row.q;
-            Eigen::Matrix<double, 6, 1> jm, jo;
-            jm << row.x.cross(row.n) / length, row.n;
-            jo << (row.n.cross(d) - row.q.cross(row.n)) / length, -row.n;
-            // Only the two stations' blocks of the normal matrix change.
-            const Eigen::VectorXd a = reduce(jm), b = reduce(jo);
-            const Eigen::Index am = block(row.moving), ao = block(row.on);
-            if (am >= 0) {
-                h.block(am, am, u, u).noalias() += w * a * a.transpose();
-                g.segment(am, u).noalias() += w * row.r * a;
-            }
-            if (ao >= 0) {
-                h.block(ao, ao, u, u).noalias() += w * b * b.transpose();
-                g.segment(ao, u).noalias() += w * row.r * b;
-            }
-            if (am >= 0 && ao >= 0) {
-                h.block(am, ao, u, u).noalias() += w * a * b.transpose();
-                h.block(ao, am, u, u).noalias() += w * b * a.transpose();
-            }
-        }
-        const double rms = std::sqrt(sum2 / static_cast<double>(rows.size()));
-        const Eigen::LDLT<Eigen::MatrixXd> solver(h);
-        const Eigen::VectorXd delta = solver.solve(-g);
-        if (solver.info() != Eigen::Success || !delta.allFinite())
-            throw Error(ErrorCode::InvalidData, "stations: the overlaps do not determine every pose (degenerate geometry)");
-        double largestRotation = 0, largestTranslation = 0, largestMove = 0;
-        for (std::size_t k = 1; k < count; ++k) {
-            const Eigen::Index at = static_cast<Eigen::Index>(u * (k - 1));
-            Eigen::Vector3d omega = Eigen::Vector3d::Zero(), tau;
-            if (params.constraint.dof == Dof::Six) {
-                omega = delta.segment<3>(at) / length;
-                tau = delta.segment<3>(at + 3);
-            } else if (params.constraint.dof == Dof::Four) {
-                omega = axis * (delta[at] / length);
-                tau = delta.segment<3>(at + 1);
-            } else {
-                tau = delta.segment<3>(at);
-            }
-            Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-            if (omega.norm() > 0)
-                step.linear() = Eigen::AngleAxisd(omega.norm(), omega.normalized()).toRotationMatrix();
-            step.translation() = tau;
-            pose[k] = step * pose[k];
-            largestRotation = std::max(largestRotation, rotationDegrees(step.linear()));
-            largestTranslation = std::max(largestTranslation, tau.norm());
-            largestMove = std::max(largestMove, omega.norm() * 2 * length + tau.norm());
-        }
-        report.trace.push_back({iteration, rms, rows.size(), threshold, largestRotation, largestTranslation});
-        report.iterations = iteration;
-        finalResiduals = magnitudes;
-        // The threshold shrinks with the residuals, as in the change-robust
-        // ICP: 3 robust sigmas, never below the median match distance.
-        threshold = std::min(threshold, std::max(3 * scale, medianOf(distances)));
-        ticker.step();
-        const double tolerance = 1e-7 * std::max(rms, 1e-12);
-        const bool graduated = scale <= robustScale;
-        if (graduated && (largestMove < 1e-7 || std::abs(previousRms - rms) <= tolerance || std::abs(rmsTwoBefore - rms) <= tolerance)) {
-            report.converged = true;
-            break;
-        }
-        rmsTwoBefore = previousRms;
-        previousRms = rms;
-    }
-
-    result.poses.resize(count);
-    for (std::size_t k = 0; k < count; ++k)
-        result.poses[k] = toGlobal(pose[k], worldOrigin);
+    result.poses.resize(stations.size());
+    for (std::size_t k = 0; k < stations.size(); ++k)
+        result.poses[k] = toGlobal(adjusted.pose[k], worldOrigin);
     result.poses[0] = Eigen::Matrix4d::Identity();
     for (std::size_t e = 0; e < result.pairs.size(); ++e) {
         StationPair& p = result.pairs[e];
-        p.adjustedRms = pairCount[e] > 0 ? std::sqrt(pairSquares[e] / pairCount[e]) : std::numeric_limits<double>::quiet_NaN();
-        const Eigen::Matrix4d adjusted = result.poses[p.a].inverse() * result.poses[p.b];
-        motionSize(p.pairwise.matrix.inverse() * adjusted, stations[p.b].centre + worldOrigin, p.disagreementDegrees,
+        p.adjustedRms = adjusted.pairCount[e] > 0 ? std::sqrt(adjusted.pairSquares[e] / adjusted.pairCount[e])
+                                                  : std::numeric_limits<double>::quiet_NaN();
+        const Eigen::Matrix4d motion = result.poses[p.a].inverse() * result.poses[p.b];
+        motionSize(p.pairwise.matrix.inverse() * motion, stations[p.b].centre + worldOrigin, p.disagreementDegrees,
                    p.disagreementMetres);
         if (!p.pairwise.degeneracy.empty())
             report.notes.push_back("pair " + std::to_string(p.a) + "-" + std::to_string(p.b) + ": " + p.pairwise.degeneracy);
@@ -970,25 +774,44 @@ StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const
         p.adjustedRms = p.disagreementDegrees = p.disagreementMetres = std::numeric_limits<double>::quiet_NaN();
         result.pairs.push_back(std::move(p));
     }
+    const std::vector<double>& residuals = adjusted.finalResiduals;
     double sum2 = 0;
-    for (double r : finalResiduals)
+    for (double r : residuals)
         sum2 += r * r;
-    report.rms = std::sqrt(sum2 / static_cast<double>(std::max<std::size_t>(finalResiduals.size(), 1)));
-    report.median = percentileOf(finalResiduals, 0.5);
-    report.p90 = percentileOf(finalResiduals, 0.9);
-    report.p95 = percentileOf(finalResiduals, 0.95);
-    report.p99 = percentileOf(finalResiduals, 0.99);
+    report.rms = std::sqrt(sum2 / static_cast<double>(std::max<std::size_t>(residuals.size(), 1)));
+    report.median = percentileOf(residuals, 0.5);
+    report.p90 = percentileOf(residuals, 0.9);
+    report.p95 = percentileOf(residuals, 0.95);
+    report.p99 = percentileOf(residuals, 0.99);
     report.overlap = std::numeric_limits<double>::quiet_NaN();
-    // Each station's own block: the directions its overlaps do not hold, the
-    // other stations held fixed.
-    for (std::size_t k = 1; k < count; ++k) {
-        std::vector<double> eigenvalues;
-        const std::string weak = degeneracyWarning(h.block(block(k), block(k), u, u), u, axis, eigenvalues);
-        if (!weak.empty())
-            report.degeneracy += (report.degeneracy.empty() ? "" : "; ") + std::string("station ") + std::to_string(k) + ": " + weak;
-    }
     if (!report.converged)
         report.notes.push_back("not converged after " + std::to_string(params.maxIterations) + " iterations");
+}
+
+} // namespace
+
+StationResult adjustStations(const std::vector<const PointCloud*>& clouds, const StationParams& params, ProgressObserver* progress)
+{
+    checkStationParams(clouds, params);
+    Eigen::Vector3d worldOrigin;
+    std::vector<Station> stations = prepare(clouds, params, worldOrigin, progress);
+    const std::size_t count = stations.size();
+    StationResult result;
+
+    std::vector<std::shared_ptr<const AlignmentFeatures>> features(count);
+    const double spacing = describeStations(stations, params, features, progress);
+    giveStationsTheirViews(stations, spacing, worldOrigin);
+    std::vector<StationPair> leftOut = chooseStationPairs(stations, features, spacing, params, worldOrigin, result, progress);
+
+    // The joint adjustment, from the poses chained along a spanning tree of the used pairs.
+    std::vector<std::ptrdiff_t> parentEdge;
+    std::vector<std::size_t> parent;
+    const std::vector<Eigen::Matrix4d> chain = chainPoses(count, result.pairs, parentEdge, parent);
+    result.loops = loopMisclosures(stations, result.pairs, chain, parentEdge, parent, worldOrigin);
+    result.report.method = "multi-station adjustment, " + std::to_string(count) + " stations, " + std::to_string(result.pairs.size()) +
+                           " pairs, " + dofName(params.constraint.dof) + " DOF";
+    const JointAdjustmentOutcome adjusted = detail::adjustJointly(stations, result.pairs, chain, params, worldOrigin, result.report, progress);
+    reportAdjustment(stations, adjusted, std::move(leftOut), params, worldOrigin, result);
     return result;
 }
 
