@@ -45,6 +45,18 @@ struct QueryGroups
     MortonCode outside = 0;
 };
 
+//! What every query of one nearest-neighbour batch shares (NearestBatch.cpp).
+struct NearestBatchSetup
+{
+    std::size_t k = 1;
+    int level = 1;
+    bool bounded = false; //!< a finite maximum distance
+    float maxDistance = std::numeric_limits<float>::infinity();
+    float maxSquared = std::numeric_limits<float>::infinity();
+    std::int64_t cellsPerAxis = 2;
+    double cellSize = 1.0;
+};
+
 //! Finds the cells of the 3 x 3 x 3 block around one cell in a level's
 //! directory of non-empty cells (codes in increasing order, and where each
 //! cell's points start in sorted order, one more entry for the end). Morton

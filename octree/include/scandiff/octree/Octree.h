@@ -28,6 +28,8 @@ namespace scandiff::octree {
 namespace detail {
 struct QueryGroups;
 struct BatchScratch;
+struct KeyedIndex;
+struct NearestBatchSetup;
 } // namespace detail
 
 //! What a plane fit needs of a neighbourhood, without listing it: how many
@@ -298,6 +300,14 @@ private:
     //! Built on first use for a level and kept (thread-safe): callers that query
     //! in chunks must not rebuild it for every chunk.
     const CellDirectory& cellDirectory(int level) const;
+
+    //! nearestBatch's steps (NearestBatch.cpp): one query searched alone
+    //! (outside the cube, or not settled by its cell's block), and the
+    //! queries [first, last) of one cell answered from its 27-cell block.
+    void nearestAlone(const Eigen::Vector3f& q, const detail::NearestBatchSetup& setup, std::vector<Neighbour>& heap) const;
+    void nearestInCellGroup(const Eigen::Vector3f* queries, const detail::KeyedIndex* first, const detail::KeyedIndex* last,
+                            const detail::NearestBatchSetup& setup, const CellDirectory& directory, detail::BatchScratch& s,
+                            Neighbour* out) const;
     struct DirectoryCache
     {
         std::mutex mutex;
