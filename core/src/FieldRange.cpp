@@ -2,7 +2,11 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/FieldRange.h>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <cmath>
+#include <functional>
 
 namespace scandiff {
 
@@ -42,10 +46,15 @@ FieldRangeSplit splitByFieldRange(const PointCloud& cloud, const std::string& fi
 
 std::size_t countInRange(const ScalarField& field, double low, double high)
 {
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < field.size(); ++i)
-        n += inRange(field, i, low, high) ? 1 : 0;
-    return n;
+    // On every core: the workbench counts at each step of a threshold drag.
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, field.size(), 1 << 16), std::size_t(0),
+        [&](const tbb::blocked_range<std::size_t>& r, std::size_t n) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i)
+                n += inRange(field, i, low, high) ? 1 : 0;
+            return n;
+        },
+        std::plus<>());
 }
 
 } // namespace scandiff

@@ -403,6 +403,69 @@ private slots:
         }
     }
 
+    // The view colours a large cloud's points as its frames gather them:
+    // every stride-th point of a chunk from some first, in any order. Each
+    // part must get the very bytes a whole colouring gives, and leave the
+    // other points alone; for every kind of colouring, thresholds and NaN
+    // included, and a field shaded by the cloud's own colours.
+    void aColouringInPartsGivesEachPointTheColourOfTheWhole()
+    {
+        constexpr std::size_t kPoints = 100'003;
+        PointCloud cloud;
+        cloud.resize(kPoints);
+        std::mt19937 random(7);
+        std::uniform_real_distribution<float> uniform(-5, 5);
+        cloud.addField("c2c_distance");
+        cloud.addField("region_id");
+        ScalarField& distance = *cloud.field("c2c_distance");
+        ScalarField& region = *cloud.field("region_id");
+        std::vector<Rgb8>& colours = cloud.enableColors();
+        for (std::size_t i = 0; i < kPoints; ++i) {
+            cloud.positions()[i] = {uniform(random), uniform(random), uniform(random)};
+            distance.setValue(i, i % 97 == 0 ? std::numeric_limits<double>::quiet_NaN() : uniform(random));
+            region.setValue(i, static_cast<double>(i % 23));
+            colours[i] = Rgb8{static_cast<std::uint8_t>(i % 251), static_cast<std::uint8_t>(i % 13 * 19), 77};
+        }
+        // Chunks as the view cuts them, strides as its slices take them.
+        const std::size_t cuts[] = {0, 40'000, 65'536, kPoints};
+        const std::size_t strides[] = {1, 2, 13, 600};
+        for (int kind = 0; kind < 5; ++kind) {
+            gui::DisplayState display;
+            display.outside = kind == 1 ? gui::FieldColouring::Outside::Grey : gui::FieldColouring::Outside::Hide;
+            if (kind <= 1) {
+                display.activeField = "c2c_distance";
+                display.fields["c2c_distance"].low = -1.25;
+                display.fields["c2c_distance"].high = 3.5;
+                display.fields["c2c_distance"].scale = ColourScale::presets()[1];
+            } else if (kind == 2) {
+                display.activeField = "region_id";
+                display.fields["region_id"].high = 17;
+            } else if (kind == 3) {
+                display.activeField = "c2c_distance";
+                display.blendColours = true;
+            } else {
+                display.neutral = true;
+            }
+            std::vector<std::uint8_t> whole(4 * kPoints);
+            gui::colourEntity(cloud, display, whole.data());
+            const gui::EntityColourer colourer(cloud, display);
+            QCOMPARE(colourer.colouredInParts(), kind <= 3);
+            for (std::size_t stride : strides) {
+                std::vector<std::uint8_t> parts(4 * kPoints, 1);
+                const std::size_t first = std::min<std::size_t>(stride - 1, 5);
+                for (std::size_t c = 0; c + 1 < std::size(cuts); ++c)
+                    colourer.colour(parts.data(), cuts[c], cuts[c + 1], stride, first);
+                for (std::size_t c = 0; c + 1 < std::size(cuts); ++c)
+                    for (std::size_t i = cuts[c]; i < cuts[c + 1]; ++i) {
+                        const bool taken = i >= cuts[c] + first && (i - cuts[c] - first) % stride == 0;
+                        for (int k = 0; k < 4; ++k)
+                            if (parts[4 * i + k] != (taken ? whole[4 * i + k] : 1))
+                                QFAIL(qPrintable(QString("kind %1, stride %2, point %3").arg(kind).arg(stride).arg(i)));
+                    }
+            }
+        }
+    }
+
     // A field shown over the cloud's photo: each point's field colour times
     // 0.35 + 0.65 x the luminance of its own colour; hidden points stay hidden;
     // offered only on a cloud with colours; kept by the document.

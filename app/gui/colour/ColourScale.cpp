@@ -9,13 +9,25 @@
 
 namespace scandiff::gui {
 
+ColourTable colourTable(const ColourScale& scale)
+{
+    constexpr int lastEntry = kColourLutSize - 1;
+    ColourTable table;
+    for (int i = 0; i < kColourLutSize; ++i)
+        table[static_cast<std::size_t>(i)] = scale.colourAt(static_cast<double>(i) / lastEntry);
+    return table;
+}
+
 void colourise(const float* values, std::size_t count, double offset, const ColourScale& scale,
                const FieldColouring& how, std::uint8_t* rgba)
 {
+    colourise(values, count, offset, colourTable(scale), how, rgba);
+}
+
+void colourise(const float* values, std::size_t count, double offset, const ColourTable& lut,
+               const FieldColouring& how, std::uint8_t* rgba, std::size_t stride, std::size_t first)
+{
     constexpr int lastEntry = kColourLutSize - 1;
-    std::array<std::array<std::uint8_t, 3>, kColourLutSize> lut;
-    for (int i = 0; i < kColourLutSize; ++i)
-        lut[i] = scale.colourAt(static_cast<double>(i) / lastEntry);
 
     const double cmin = how.colourMin;
     const double cmax = how.colourMax;
@@ -25,8 +37,10 @@ void colourise(const float* values, std::size_t count, double offset, const Colo
     const double vmax = how.visibleMax;
     const bool hideOutside = how.outside == FieldColouring::Outside::Hide;
 
+    // Over the k-th values taken, k in [begin, end): value first + k * stride.
     auto colourRange = [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) {
+        for (std::size_t k = begin; k < end; ++k) {
+            const std::size_t i = first + k * stride;
             std::uint8_t* out = rgba + 4 * i;
             const double v = static_cast<double>(values[i]) + offset;
             const std::array<std::uint8_t, 3>* colour;
@@ -63,11 +77,12 @@ void colourise(const float* values, std::size_t count, double offset, const Colo
 
     // Below this the thread start-up costs more than the loop.
     constexpr std::size_t parallelThreshold = 1 << 16;
-    if (count < parallelThreshold) {
-        colourRange(0, count);
+    const std::size_t taken = first < count ? (count - first + stride - 1) / stride : 0;
+    if (taken < parallelThreshold) {
+        colourRange(0, taken);
         return;
     }
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1 << 14),
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, taken, 1 << 14),
                       [&](const tbb::blocked_range<std::size_t>& r) { colourRange(r.begin(), r.end()); });
 }
 

@@ -37,6 +37,11 @@ struct FieldColouring
 //! quarters, thirds and the middle of the colour range exactly on entries.
 inline constexpr int kColourLutSize = 3073;
 
+//! A scale's colours at kColourLutSize evenly spaced points of [0, 1]:
+//! built once per colouring, looked up per value.
+using ColourTable = std::array<std::array<std::uint8_t, 3>, kColourLutSize>;
+ColourTable colourTable(const ColourScale& scale);
+
 //! Colours `count` values into rgba[4*count]; a point's value is
 //! values[i] + offset, computed in double. Hidden points get (0,0,0,0).
 //! Values in the visible range are looked up in a table of kColourLutSize
@@ -46,5 +51,10 @@ inline constexpr int kColourLutSize = 3073;
 //! middle colour. Large inputs are split over TBB's threads.
 void colourise(const float* values, std::size_t count, double offset, const ColourScale& scale,
                const FieldColouring& how, std::uint8_t* rgba);
+//! The same with the scale's table built already, for every stride-th value
+//! from `first` only (i = first, first + stride, ... < count): the view
+//! colours the part of a large cloud a frame draws.
+void colourise(const float* values, std::size_t count, double offset, const ColourTable& table,
+               const FieldColouring& how, std::uint8_t* rgba, std::size_t stride = 1, std::size_t first = 0);
 
 } // namespace scandiff::gui

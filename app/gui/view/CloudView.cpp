@@ -412,7 +412,13 @@ void CloudView::refreshEntity(const Document::Item& item)
         updateStride();
     if (s.isCloud) {
         // Written in place: VTK re-uploads the colours only, never the points.
-        colourEntity(item.points(), item.display, s.rgba.data());
+        EntityColourer colourer(item.points(), item.display);
+        const bool rasters = std::any_of(s.chunks.begin(), s.chunks.end(), [](const Shown::Chunk& c) { return c.raster; });
+        s.pendingColours.reset();
+        if (colourer.colouredInParts() && refinesInSlices() && !rasters)
+            s.pendingColours.emplace(std::move(colourer)); // the decimated frame's points below, the slices' as they come
+        else
+            colourer.colourAll(s.rgba.data());
         for (auto& c : s.chunks) {
             if (c.raster) { // each cell's colour on its four corners
                 std::uint8_t* corners = c.colours->GetPointer(0);
@@ -421,8 +427,10 @@ void CloudView::refreshEntity(const Document::Item& item)
                         std::copy_n(&s.rgba[4 * (c.begin + i)], 4, corners + 16 * i + 4 * k);
             }
             c.colours->Modified();
-            if (c.decimated)
+            if (c.decimated) {
+                s.colourForGather(c, c.decimatedStride);
                 gatherColours(*c.decimated, c.arrays(s), c.decimatedStride);
+            }
         }
     }
     renderInteractively();
@@ -799,6 +807,8 @@ void CloudView::setDecimated(Shown& s, bool moving)
     if (!s.isCloud)
         return;
     const bool decimate = moving && scene_->stride > 1;
+    if (!decimate)
+        s.settleColours(); // every point drawn
     for (auto& c : s.chunks) {
         if (c.raster)
             continue; // one quad per cell: already light
@@ -814,6 +824,7 @@ void CloudView::setDecimated(Shown& s, bool moving)
                 c.decimated = vtkSmartPointer<vtkPolyData>::New();
                 c.decimatedMapper = chunkMapper(c.decimated);
             }
+            s.colourForGather(c, scene_->stride);
             gatherPoints(*c.decimated, c.arrays(s), scene_->stride);
             c.decimatedMapper->SetClippingPlanes(c.fullMapper->GetClippingPlanes()); // the clipping box holds for it too
             c.decimatedStride = scene_->stride;

@@ -153,6 +153,9 @@ public:
     //! Bytes the view holds per shown cloud besides OpenGL: its RGBA colours
     //! and the copies a decimated frame and a slice draw.
     std::size_t heldBytes() const;
+    //! Points whose colours wait for the slice that draws them (a display
+    //! change on a cloud refined in slices colours the decimated frame's only).
+    std::size_t pointsAwaitingColour() const;
 
     //! Scissors: left clicks draw a polygon on the screen, a right click (or
     //! finishScissors) closes it and emits polygonDrawn; turning the mode off

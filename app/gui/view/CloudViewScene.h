@@ -4,6 +4,7 @@
 //! entity, its chunks. Shared by CloudView.cpp and ViewRefinement.cpp.
 
 #include "view/ChunkGeometry.h"
+#include "view/EntityColouring.h"
 #include "view/CloudView.h"
 
 #include <vtkActor.h>
@@ -68,7 +69,27 @@ struct CloudView::Shown
     float ownPointSize = 0; //!< the entity's own point size; 0: the view's
     bool documentVisible = true; //!< its tick in the tree; the view may still hide it (setShownHere)
     std::vector<std::uint8_t> rgba; //!< 4 bytes per point, what the chunks' colour arrays show
+    //! A display change on a cloud refined in slices colours only the points
+    //! the next frame draws (a threshold drag on 60 M points then recolours a
+    //! few hundred thousand at each step); each slice colours its own before
+    //! it is gathered, and what reads every point settles the rest first.
+    std::optional<EntityColourer> pendingColours;
     std::vector<Chunk> chunks;
+
+    //! A chunk's every stride-th point from `first`, coloured if colours are pending.
+    void colourForGather(const Chunk& c, std::size_t stride, std::size_t first = 0)
+    {
+        if (pendingColours)
+            pendingColours->colour(rgba.data(), c.begin, c.begin + c.count, stride, first);
+    }
+    //! Every point's colour, for what reads them all (a full frame, picking, the scissors).
+    void settleColours()
+    {
+        if (pendingColours) {
+            pendingColours->colourAll(rgba.data());
+            pendingColours.reset();
+        }
+    }
     //! A drawing's texts (stone ids), placed so that they never overlap: as
     //! many as the view has room for, more as one zooms in.
     vtkSmartPointer<vtkActor2D> labels;

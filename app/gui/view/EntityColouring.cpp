@@ -91,12 +91,13 @@ std::vector<long> labelsPresent(const ScalarField& field, std::size_t limit)
     return {values.begin(), values.end()};
 }
 
-//! Colours a categorical field: each value its categoryColour, the thresholds as for any field.
-void colourLabels(const ScalarField& field, const FieldDisplay& display, FieldColouring::Outside outside, std::uint8_t* rgba)
+//! Colours a categorical field's points begin + first, then every stride-th
+//! before end: each value its categoryColour, the thresholds as for any field.
+void colourLabels(const ScalarField& field, const FieldDisplay& display, FieldColouring::Outside outside, bool label,
+                  std::uint8_t* rgba, std::size_t begin, std::size_t end, std::size_t stride, std::size_t first)
 {
     const FieldColouring how;
-    const bool label = isLabelField(field);
-    for (std::size_t i = 0; i < field.size(); ++i) {
+    for (std::size_t i = begin + first; i < end; i += stride) {
         std::uint8_t* c = rgba + 4 * i;
         if (!field.hasValue(i)) {
             c[0] = how.nanColour[0], c[1] = how.nanColour[1], c[2] = how.nanColour[2], c[3] = 255;
@@ -114,6 +115,28 @@ void colourLabels(const ScalarField& field, const FieldDisplay& display, FieldCo
         const auto colour = categoryColour(label, value);
         c[0] = colour[0], c[1] = colour[1], c[2] = colour[2], c[3] = 255;
     }
+}
+
+//! blendWithOwnColours over the same part.
+void blendPart(const PointCloud& points, std::uint8_t* rgba, std::size_t begin, std::size_t end, std::size_t stride, std::size_t first)
+{
+    if (!points.hasColors())
+        return;
+    const std::vector<Rgb8>& own = points.colors();
+    for (std::size_t i = begin + first; i < end; i += stride) {
+        std::uint8_t* c = rgba + 4 * i;
+        if (c[3] == 0)
+            continue;
+        const double lightness = (0.2126 * own[i].r + 0.7152 * own[i].g + 0.0722 * own[i].b) / 255.0;
+        const double shade = 0.35 + 0.65 * lightness;
+        for (int k = 0; k < 3; ++k)
+            c[k] = static_cast<std::uint8_t>(std::lround(c[k] * shade));
+    }
+}
+
+void setColour(std::uint8_t* c, std::uint8_t r, std::uint8_t g, std::uint8_t b)
+{
+    c[0] = r, c[1] = g, c[2] = b, c[3] = 255;
 }
 
 constexpr std::size_t kLegendCategories = 24;
@@ -140,81 +163,103 @@ ColourLegend legendOf(const PointCloud& points, const DisplayState& display)
 
 void blendWithOwnColours(const PointCloud& points, std::uint8_t* rgba)
 {
-    if (!points.hasColors())
+    blendPart(points, rgba, 0, points.size(), 1, 0);
+}
+
+EntityColourer::EntityColourer(const PointCloud& points, const DisplayState& display)
+    : points_(&points), outside_(display.outside), blend_(display.blendColours)
+{
+    const ScalarField* field = display.activeField.empty() ? nullptr : points.field(display.activeField);
+    if (field) {
+        fieldName_ = field->name();
+        const auto it = display.fields.find(field->name());
+        fieldDisplay_ = it == display.fields.end() ? FieldDisplay{} : it->second;
+        if (isCategoricalField(*field)) {
+            kind_ = Kind::Categories;
+            label_ = isLabelField(*field);
+            return;
+        }
+        kind_ = Kind::Ramp;
+        std::tie(how_.colourMin, how_.colourMax) = colourRange(*field, fieldDisplay_);
+        how_.visibleMin = fieldDisplay_.low;
+        how_.visibleMax = fieldDisplay_.high;
+        how_.outside = display.outside;
+        table_ = std::make_shared<const ColourTable>(colourTable(fieldDisplay_.scale));
         return;
-    const std::vector<Rgb8>& own = points.colors();
-    for (std::size_t i = 0; i < own.size(); ++i) {
-        std::uint8_t* c = rgba + 4 * i;
-        if (c[3] == 0)
-            continue;
-        const double lightness = (0.2126 * own[i].r + 0.7152 * own[i].g + 0.0722 * own[i].b) / 255.0;
-        const double shade = 0.35 + 0.65 * lightness;
-        for (int k = 0; k < 3; ++k)
-            c[k] = static_cast<std::uint8_t>(std::lround(c[k] * shade));
+    }
+    blend_ = false;
+    if (display.neutral) {
+        kind_ = Kind::Neutral;
+        return;
+    }
+    if (points.hasColors()) {
+        kind_ = Kind::OwnColours;
+        return;
+    }
+    // Height: what a user expects of a cloud with nothing else to show.
+    kind_ = Kind::Height;
+    float zmin = std::numeric_limits<float>::max(), zmax = -zmin;
+    for (const Eigen::Vector3f& p : points.positions())
+        if (std::isfinite(p.z())) {
+            zmin = std::min(zmin, p.z());
+            zmax = std::max(zmax, p.z());
+        }
+    how_.colourMin = zmin <= zmax ? zmin : 0.0;
+    how_.colourMax = zmin < zmax ? zmax : how_.colourMin + 1.0;
+    table_ = std::make_shared<const ColourTable>(colourTable(ColourScale::defaultScale()));
+}
+
+bool EntityColourer::colouredInParts() const { return kind_ == Kind::Ramp || kind_ == Kind::Categories; }
+
+ColourLegend EntityColourer::heightLegend() const
+{
+    if (kind_ != Kind::Height)
+        return {};
+    return {true, "height", ColourScale::defaultScale(), how_.colourMin + points_->origin().z(), how_.colourMax + points_->origin().z(), {}};
+}
+
+void EntityColourer::colour(std::uint8_t* rgba, std::size_t begin, std::size_t end, std::size_t stride, std::size_t first) const
+{
+    switch (kind_) {
+    case Kind::Ramp:
+    case Kind::Categories: {
+        const ScalarField* field = points_->field(fieldName_);
+        if (!field) // removed since: the entity's next refresh colours it anew
+            return;
+        if (kind_ == Kind::Ramp)
+            colourise(field->values().data() + begin, end - begin, field->offset(), *table_, how_, rgba + 4 * begin, stride, first);
+        else
+            colourLabels(*field, fieldDisplay_, outside_, label_, rgba, begin, end, stride, first);
+        if (blend_)
+            blendPart(*points_, rgba, begin, end, stride, first);
+        return;
+    }
+    case Kind::Neutral:
+        for (std::size_t i = begin + first; i < end; i += stride)
+            setColour(rgba + 4 * i, kNeutralGrey[0], kNeutralGrey[1], kNeutralGrey[2]);
+        return;
+    case Kind::OwnColours:
+        for (std::size_t i = begin + first; i < end; i += stride) {
+            const Rgb8 c = points_->colors()[i];
+            setColour(rgba + 4 * i, c.r, c.g, c.b);
+        }
+        return;
+    case Kind::Height: {
+        std::vector<float> heights(end - begin);
+        for (std::size_t i = begin; i < end; ++i)
+            heights[i - begin] = points_->positions()[i].z();
+        colourise(heights.data(), heights.size(), 0.0, *table_, how_, rgba + 4 * begin, stride, first);
+        return;
+    }
     }
 }
 
 ColourLegend colourEntity(const PointCloud& points, const DisplayState& display, std::uint8_t* rgba)
 {
-    const std::size_t n = points.size();
-    ColourLegend legend;
-    const ScalarField* field = display.activeField.empty() ? nullptr : points.field(display.activeField);
-    if (field) {
-        const auto it = display.fields.find(field->name());
-        const FieldDisplay fieldDisplay = it == display.fields.end() ? FieldDisplay{} : it->second;
-        if (isCategoricalField(*field)) {
-            colourLabels(*field, fieldDisplay, display.outside, rgba);
-            if (display.blendColours)
-                blendWithOwnColours(points, rgba);
-            return legendOf(points, display);
-        }
-        FieldColouring how;
-        std::tie(how.colourMin, how.colourMax) = colourRange(*field, fieldDisplay);
-        how.visibleMin = fieldDisplay.low;
-        how.visibleMax = fieldDisplay.high;
-        how.outside = display.outside;
-        colourise(field->values().data(), n, field->offset(), fieldDisplay.scale, how, rgba);
-        if (display.blendColours)
-            blendWithOwnColours(points, rgba);
-        legend = {true, field->name(), fieldDisplay.scale, how.colourMin, how.colourMax, {}};
-        return legend;
-    }
-    if (display.neutral) {
-        for (std::size_t i = 0; i < n; ++i) {
-            rgba[4 * i] = kNeutralGrey[0];
-            rgba[4 * i + 1] = kNeutralGrey[1];
-            rgba[4 * i + 2] = kNeutralGrey[2];
-            rgba[4 * i + 3] = 255;
-        }
-        return legend;
-    }
-    if (points.hasColors()) {
-        for (std::size_t i = 0; i < n; ++i) {
-            const Rgb8 c = points.colors()[i];
-            rgba[4 * i] = c.r;
-            rgba[4 * i + 1] = c.g;
-            rgba[4 * i + 2] = c.b;
-            rgba[4 * i + 3] = 255;
-        }
-        return legend;
-    }
-    // Height: what a user expects of a cloud with nothing else to show.
-    std::vector<float> heights(n);
-    for (std::size_t i = 0; i < n; ++i)
-        heights[i] = points.positions()[i].z();
-    float zmin = std::numeric_limits<float>::max(), zmax = -zmin;
-    for (float z : heights)
-        if (std::isfinite(z)) {
-            zmin = std::min(zmin, z);
-            zmax = std::max(zmax, z);
-        }
-    FieldColouring how;
-    how.colourMin = zmin <= zmax ? zmin : 0.0;
-    how.colourMax = zmin < zmax ? zmax : how.colourMin + 1.0;
-    const ColourScale scale = ColourScale::defaultScale();
-    colourise(heights.data(), n, 0.0, scale, how, rgba);
-    legend = {true, "height", scale, how.colourMin + points.origin().z(), how.colourMax + points.origin().z(), {}};
-    return legend;
+    const EntityColourer colourer(points, display);
+    colourer.colourAll(rgba);
+    ColourLegend height = colourer.heightLegend();
+    return height.shown ? height : legendOf(points, display);
 }
 
 } // namespace scandiff::gui

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -74,6 +75,40 @@ ColourLegend legendOf(const PointCloud& points, const DisplayState& display);
 //! so the texture reads and the field's hue stays. Hidden points (alpha 0) are
 //! left alone; a cloud without colours is left as it is.
 void blendWithOwnColours(const PointCloud& points, std::uint8_t* rgba);
+
+//! An entity's colouring, decided once from its display state (which field,
+//! its range and scale's table, labels or a ramp, its own colours, or its
+//! height) and applied to all its points or to a part: every stride-th point
+//! of [begin, end) from begin + first. The view colours a large cloud's
+//! points as its frames draw them, so that a threshold drag on 60 M points
+//! recolours the few the moving frame shows. Holds the cloud by address and
+//! its field by name: valid while the cloud's data is (the view drops it
+//! with the entity's arrays).
+class EntityColourer
+{
+public:
+    EntityColourer(const PointCloud& points, const DisplayState& display);
+    //! rgba is the whole entity's (4 bytes per point, alpha 0 = hidden).
+    void colour(std::uint8_t* rgba, std::size_t begin, std::size_t end, std::size_t stride = 1, std::size_t first = 0) const;
+    void colourAll(std::uint8_t* rgba) const { colour(rgba, 0, points_->size()); }
+    //! Whether colouring a part costs only that part (a field's colours);
+    //! own colours, grey and height are coloured whole.
+    bool colouredInParts() const;
+    //! The legend of a colouring by height (not shown for the others: see legendOf).
+    ColourLegend heightLegend() const;
+
+private:
+    enum class Kind { Ramp, Categories, Neutral, OwnColours, Height };
+    const PointCloud* points_;
+    Kind kind_ = Kind::Height;
+    std::string fieldName_;
+    FieldColouring how_;
+    std::shared_ptr<const ColourTable> table_;
+    FieldColouring::Outside outside_ = FieldColouring::Outside::Hide;
+    FieldDisplay fieldDisplay_;
+    bool label_ = false;
+    bool blend_ = false;
+};
 
 //! Fills rgba (4 bytes per point, alpha 0 = hidden; room for 4 x points.size())
 //! and returns the legend. With display.blendColours, an active field's

@@ -67,6 +67,15 @@ std::size_t CloudView::heldBytes() const
     return bytes;
 }
 
+std::size_t CloudView::pointsAwaitingColour() const
+{
+    std::size_t points = 0;
+    for (const auto& [id, s] : scene_->shown)
+        if (s.pendingColours)
+            points += s.pointCount;
+    return points;
+}
+
 bool CloudView::refinesInSlices() const { return scene_->stride > 1 && !scene_->eyeDomeLighting; }
 
 const CloudView::Refinement& CloudView::refinement() const { return scene_->refinement; }
@@ -133,6 +142,7 @@ void CloudView::drawNextSlice()
                 c.sliceMapper = chunkMapper(c.slice);
             }
             c.sliceMapper->SetClippingPlanes(c.fullMapper->GetClippingPlanes());
+            s.colourForGather(c, r.slices, slice);
             gatherPoints(*c.slice, c.arrays(s), r.slices, slice);
             points += everyStride(c.count, r.slices, slice);
             c.actor->SetMapper(c.sliceMapper);
@@ -164,6 +174,15 @@ void CloudView::drawNextSlice()
     r.pointsDrawn += points;
     r.largestSlice = std::max(r.largestSlice, points);
     r.refining = !last;
+    if (last) // every slice coloured its points: the colours are whole, but a hidden chunk's
+        for (auto& [id, s] : scene_->shown) {
+            if (!s.pendingColours)
+                continue;
+            for (const auto& c : s.chunks)
+                if (!c.actor->GetVisibility())
+                    s.colourForGather(c, 1);
+            s.pendingColours.reset();
+        }
     if (r.refining)
         sliceTimer_->start();
     else if (!refinesInSlices())

@@ -222,6 +222,7 @@ bool CloudView::isPointShown(EntityId id, std::size_t index) const
     const auto it = scene_->shown.find(id);
     if (it == scene_->shown.end() || !it->second.isCloud || index >= it->second.pointCount)
         return false;
+    it->second.settleColours();
     return it->second.rgba[4 * index + 3] != 0;
 }
 
@@ -251,11 +252,11 @@ bool CloudView::pickAtDevicePixel(int x, int y)
     // Points by the point picker; a grid's cells (drawn as quads, whose
     // vertices are corners shared by four cells) by the cell picker, when the
     // point picker finds nothing else.
-    const Shown* pickedEntity = nullptr;
+    Shown* pickedEntity = nullptr;
     EntityId pickedId = kNoEntity;
     std::size_t index = 0;
     auto chunkOf = [&](vtkActor* actor, bool& raster, std::size_t& begin) {
-        for (const auto& [id, s] : scene_->shown)
+        for (auto& [id, s] : scene_->shown)
             for (const auto& c : s.chunks)
                 if (c.actor.Get() == actor) {
                     pickedEntity = &s;
@@ -294,6 +295,8 @@ bool CloudView::pickAtDevicePixel(int x, int y)
         index = begin + static_cast<std::size_t>(scene_->cellPicker->GetCellId());
     }
     // The picker sees every point; one hidden by the thresholds is not an answer.
+    if (pickedEntity->isCloud)
+        pickedEntity->settleColours();
     if (pickedEntity->isCloud && pickedEntity->rgba[4 * index + 3] == 0)
         return false;
     emit pointPicked(pickedId, index);
