@@ -97,17 +97,6 @@ bool isCommentLine(std::string_view trimmed)
     return (!trimmed.empty() && trimmed[0] == '#') || trimmed.substr(0, 2) == "//";
 }
 
-bool parseDouble(std::string_view token, double& value)
-{
-    const char* first = token.data();
-    const char* last = first + token.size();
-    // from_chars rejects the '+' sign that some writers emit.
-    if (first != last && *first == '+')
-        ++first;
-    const auto [ptr, ec] = std::from_chars(first, last, value);
-    return ec == std::errc() && ptr == last && first != last;
-}
-
 bool isInteger(std::string_view token)
 {
     std::int64_t value = 0;
@@ -379,16 +368,6 @@ bool floatKeeps(std::string_view text, double v, double offset)
     double back = 0.0;
     std::from_chars(buffer, printed.ptr, back);
     return back == v;
-}
-
-std::uint8_t colorByte(double v, double scale)
-{
-    v *= scale;
-    if (!(v > 0.0))
-        return 0;
-    if (v >= 255.0)
-        return 255;
-    return static_cast<std::uint8_t>(std::lround(v));
 }
 
 // ---------------------------------------------------------------- reading
@@ -668,9 +647,9 @@ private:
             case Role::X: xyz[0] = v; break;
             case Role::Y: xyz[1] = v; break;
             case Role::Z: xyz[2] = v; break;
-            case Role::Red: rgb.r = colorByte(v, column.colorScale); break;
-            case Role::Green: rgb.g = colorByte(v, column.colorScale); break;
-            case Role::Blue: rgb.b = colorByte(v, column.colorScale); break;
+            case Role::Red: rgb.r = colourByte(v, column.colorScale); break;
+            case Role::Green: rgb.g = colourByte(v, column.colorScale); break;
+            case Role::Blue: rgb.b = colourByte(v, column.colorScale); break;
             case Role::Nx: normal.x() = static_cast<float>(v); break;
             case Role::Ny: normal.y() = static_cast<float>(v); break;
             case Role::Nz: normal.z() = static_cast<float>(v); break;

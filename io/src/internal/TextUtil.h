@@ -1,9 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-//! Small text helpers shared by the text-based readers (internal to io/).
+//! Small helpers shared by the readers (internal to io/): tokens quoted for
+//! messages, numbers parsed from text, colour channels as bytes.
 
+#include <charconv>
+#include <cmath>
+#include <cstdint>
 #include <string>
 #include <string_view>
+#include <system_error>
 
 namespace scandiff::io::detail {
 
@@ -18,6 +23,40 @@ inline std::string quoted(std::string_view s)
     if (s.size() > kMax)
         out += "...";
     return out + "'";
+}
+
+//! A whole token as a number; false when anything is left over. A leading
+//! '+' is accepted (std::from_chars rejects the sign some writers emit).
+inline bool parseDouble(std::string_view token, double& value)
+{
+    const char* first = token.data();
+    const char* last = first + token.size();
+    if (first != last && *first == '+')
+        ++first;
+    const auto [ptr, ec] = std::from_chars(first, last, value);
+    return ec == std::errc() && ptr == last && first != last;
+}
+
+inline bool parseInteger(std::string_view token, std::int64_t& value)
+{
+    const char* first = token.data();
+    const char* last = first + token.size();
+    if (first != last && *first == '+')
+        ++first;
+    const auto [ptr, ec] = std::from_chars(first, last, value);
+    return ec == std::errc() && ptr == last && first != last;
+}
+
+//! A stored colour channel (times `scale` to bring it to 0-255) as a byte:
+//! rounded, clamped, NaN as 0.
+inline std::uint8_t colourByte(double v, double scale)
+{
+    v *= scale;
+    if (!(v > 0.0))
+        return 0;
+    if (v >= 255.0)
+        return 255;
+    return static_cast<std::uint8_t>(std::lround(v));
 }
 
 } // namespace scandiff::io::detail

@@ -5,7 +5,6 @@
 
 #include "internal/TextUtil.h"
 
-#include <charconv>
 #include <cstring>
 
 namespace scandiff::io::detail::ply {
@@ -35,27 +34,6 @@ std::vector<std::string_view> tokenize(std::string_view line)
     while (nextToken(line, token))
         tokens.push_back(token);
     return tokens;
-}
-
-bool parseDouble(std::string_view token, double& value)
-{
-    const char* first = token.data();
-    const char* last = first + token.size();
-    // from_chars rejects the '+' sign that some writers emit.
-    if (first != last && *first == '+')
-        ++first;
-    const auto [ptr, ec] = std::from_chars(first, last, value);
-    return ec == std::errc() && ptr == last && first != last;
-}
-
-bool parseInteger(std::string_view token, std::int64_t& value)
-{
-    const char* first = token.data();
-    const char* last = first + token.size();
-    if (first != last && *first == '+')
-        ++first;
-    const auto [ptr, ec] = std::from_chars(first, last, value);
-    return ec == std::errc() && ptr == last && first != last;
 }
 
 PlyHeader parseHeader(const MappedFile& file, const Context& ctx)

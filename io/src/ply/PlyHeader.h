@@ -5,6 +5,7 @@
 //! (and the line) through Context.
 
 #include "internal/MappedFile.h"
+#include "internal/TextUtil.h"
 #include "ply/PlyCommon.h"
 
 #include <scandiff/core/Error.h>
@@ -63,9 +64,6 @@ inline bool isBlank(char c)
 //! Splits off the next whitespace-separated token of `rest`; false at the end.
 bool nextToken(std::string_view& rest, std::string_view& token);
 std::vector<std::string_view> tokenize(std::string_view line);
-//! A whole token as a number (a leading '+' accepted); false otherwise.
-bool parseDouble(std::string_view token, double& value);
-bool parseInteger(std::string_view token, std::int64_t& value);
 
 class Context
 {

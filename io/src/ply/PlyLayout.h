@@ -76,16 +76,6 @@ struct VertexSink
     double* stagedXyz = nullptr;
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();
 
-    static std::uint8_t colorByte(double v, double scale)
-    {
-        v *= scale;
-        if (!(v > 0.0))
-            return 0;
-        if (v >= 255.0)
-            return 255;
-        return static_cast<std::uint8_t>(std::lround(v));
-    }
-
     //! Turns every slot into a strided destination, so that put() is a small
     //! switch the compiler inlines in the per-value loop.
     void compile(const VertexLayout& layout)
@@ -153,7 +143,7 @@ struct VertexSink
         const Target& t = targets_[s.index];
         switch (t.kind) {
         case Target::Float: t.floats[i * t.stride] = static_cast<float>(v - t.offset); break;
-        case Target::Color: t.bytes[i * t.stride] = colorByte(v, t.colorScale); break;
+        case Target::Color: t.bytes[i * t.stride] = colourByte(v, t.colorScale); break;
         case Target::Staged: t.doubles[i * t.stride] = v; break;
         case Target::FloatAndResidual: {
             const auto f = static_cast<float>(v - t.offset);
