@@ -1,14 +1,68 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Registers the 2.5D Delaunay meshing as the tool "mesh".
+// Registers the 2.5D Delaunay meshing as the tool "mesh", and the height
+// above the ground's TIN as "hag".
+#include <scandiff/core/Error.h>
+#include <scandiff/core/TextLists.h>
 #include <scandiff/plugins/PluginRegistry.h>
 #include <scandiff/plugins/meshing/Delaunay25D.h>
+#include <scandiff/plugins/meshing/HeightAboveGround.h>
 
+#include <cmath>
 #include <sstream>
+
+namespace {
+
+void registerHeightAboveGround(scandiff::PluginRegistry& registry)
+{
+    using namespace scandiff;
+    ToolSpec tool;
+    tool.name = "hag";
+    tool.title = "Height above ground";
+    tool.category = "Classification";
+    tool.description =
+        "Each point's height over the terrain of its ground points (classes 2 by default, as `ground` writes them): "
+        "their Delaunay triangulation in XY (a TIN), interpolated linearly in the triangle under the point, as PDAL's "
+        "filters.hag_delaunay; beyond the TIN's outline, the height over the nearest ground point. Adds the field "
+        "height_above_ground (m): 0 on the ground points, canopy and roof heights above.";
+    tool.outputs = {OutputSpec{"output", "Cloud with heights above ground", DataKind::Cloud, true}};
+    tool.parameters = {
+        ParameterSpec::text("ground-classes", "Ground classes", "The classes the terrain is made of, e.g. 2 or 2,8 (ASPRS: 2 ground, 8 model key points)", "2"),
+        ParameterSpec::text("class-field", "Class field", "The field holding the classes", "classification"),
+    };
+    tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
+        const PointCloud& input = inputs.cloud();
+        plugins::HeightAboveGroundParams params;
+        params.classField = values.text("class-field");
+        params.groundClasses.clear();
+        for (double c : parseNumberWords(values.text("ground-classes"), "ground classes")) {
+            if (c != std::round(c) || c < 0 || c > 255)
+                throw Error(ErrorCode::InvalidArgument, "hag: a ground class is an integer in 0..255, not " + std::to_string(c));
+            params.groundClasses.push_back(static_cast<int>(c));
+        }
+        plugins::HeightAboveGroundResult hag = plugins::heightAboveGround(input, params, progress);
+        PointCloud out = input.clone();
+        if (out.field("height_above_ground"))
+            out.removeField("height_above_ground");
+        ScalarField& field = out.addField("height_above_ground");
+        field.values() = std::move(hag.height);
+        std::ostringstream summary;
+        summary << "heights above a TIN of " << hag.groundPoints << " ground points for " << input.size() << " points";
+        if (hag.outsideHull)
+            summary << "; " << hag.outsideHull << " beyond its outline over their nearest ground point";
+        ToolResult result;
+        result.summary = summary.str();
+        result.add("output", std::move(out));
+        return result;
+    };
+    registry.tools.add(std::move(tool));
+}
+
+} // namespace
 
 void scandiff_register_plugin_meshing(scandiff::PluginRegistry& registry)
 {
     using namespace scandiff;
-    registry.plugins.push_back({"meshing", "2.5D Delaunay meshing of a cloud projected on a plane", "CGAL (2D triangulation)"});
+    registry.plugins.push_back({"meshing", "2.5D Delaunay meshing of a cloud projected on a plane, and heights above the ground's TIN", "CGAL (2D triangulation)"});
 
     ToolSpec tool;
     tool.name = "mesh";
@@ -49,4 +103,5 @@ void scandiff_register_plugin_meshing(scandiff::PluginRegistry& registry)
         return result;
     };
     registry.tools.add(std::move(tool));
+    registerHeightAboveGround(registry);
 }
