@@ -16,6 +16,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <utility>
 
 namespace scandiff::plugins {
@@ -69,16 +70,31 @@ std::vector<std::pair<Point2, double>> groundPoints(const PointCloud& cloud, con
     return ground;
 }
 
-//! Their TIN, inserted in batches (each spatially sorted by CGAL) so that
-//! Cancel is heard while it is built: 16 M points take about 20 s.
-void buildTin(Triangulation& tin, const std::vector<std::pair<Point2, double>>& ground, const std::string& name, ProgressTicker& ticker)
+//! Their TIN. Inserted one by one in a biased randomised order (rounds of
+//! a shuffle, each round Hilbert-sorted, as the mesh tool does), each from
+//! the face of the one before, so that Cancel is heard while it grows (16 M
+//! points take about 20 s); batches of CGAL's range insertion were 10 times
+//! slower at 16 M.
+void buildTin(Triangulation& tin, std::vector<std::pair<Point2, double>> ground, const std::string& name, ProgressTicker& ticker)
 {
-    constexpr std::size_t kBatch = 1 << 18;
-    for (std::size_t begin = 0; begin < ground.size(); begin += kBatch) {
-        const std::size_t end = std::min(ground.size(), begin + kBatch);
-        tin.insert(ground.begin() + static_cast<std::ptrdiff_t>(begin), ground.begin() + static_cast<std::ptrdiff_t>(end));
-        ticker.step(end - begin);
+    using SortTraits = CGAL::Spatial_sort_traits_adapter_2<Kernel, CGAL::First_of_pair_property_map<std::pair<Point2, double>>>;
+    std::mt19937_64 shuffleDraw(0x5eed); // a fixed seed: the same terrain on every run
+    std::shuffle(ground.begin(), ground.end(), shuffleDraw);
+    for (std::size_t end = ground.size(); end > 0;) {
+        const std::size_t begin = end > 64 ? end / 4 : 0;
+        CGAL::hilbert_sort(ground.begin() + static_cast<std::ptrdiff_t>(begin), ground.begin() + static_cast<std::ptrdiff_t>(end),
+                           SortTraits());
+        end = begin;
     }
+    Triangulation::Face_handle hint;
+    for (std::size_t i = 0; i < ground.size(); ++i) {
+        const Triangulation::Vertex_handle vertex = tin.insert(ground[i].first, hint);
+        vertex->info() = ground[i].second; // at one XY place, the last inserted's height
+        hint = vertex->face();
+        if ((i & 8191) == 8191)
+            ticker.step(8192);
+    }
+    ticker.step(ground.size() % 8192);
     if (tin.dimension() < 2)
         throw Error(ErrorCode::InvalidData, "hag: the ground points of '" + name + "' lie on a line");
 }
