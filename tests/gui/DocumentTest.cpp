@@ -403,6 +403,19 @@ private slots:
         }
     }
 
+    // Colour bar titles fit the bar's narrow frame: long field names break
+    // after an underscore, short ones stay on one line.
+    void aLongColourBarTitleIsWrapped()
+    {
+        QCOMPARE(QString::fromStdString(gui::wrappedTitle("c2c_distance")), QString("c2c_distance"));
+        QCOMPARE(QString::fromStdString(gui::wrappedTitle("height_above_ground")), QString("height_above_\nground"));
+        QCOMPARE(QString::fromStdString(gui::wrappedTitle("m3c2_distance_uncertainty")), QString("m3c2_\ndistance_\nuncertainty"));
+        QCOMPARE(QString::fromStdString(gui::wrappedTitle("height")), QString("height"));
+        QCOMPARE(QString::fromStdString(gui::wrappedTitle("a very long title here")), QString("a very long\ntitle here"));
+        QCOMPARE(QString::fromStdString(gui::wrappedTitle("averyveryverylongword")), QString("averyveryverylongword"));
+        QCOMPARE(QString::fromStdString(gui::wrappedTitle("")), QString(""));
+    }
+
     // The view colours a large cloud's points as its frames gather them:
     // every stride-th point of a chunk from some first, in any order. Each
     // part must get the very bytes a whole colouring gives, and leave the

@@ -27,6 +27,40 @@ std::pair<double, double> colourRange(const ScalarField& field, const FieldDispl
     return {lo, hi};
 }
 
+std::string wrappedTitle(const std::string& title, std::size_t width)
+{
+    // Words end after an underscore (kept, so the name reads whole) or at a space (dropped).
+    std::vector<std::string> words;
+    std::string word;
+    for (char c : title) {
+        if (c == ' ') {
+            if (!word.empty())
+                words.push_back(word);
+            word.clear();
+            continue;
+        }
+        word += c;
+        if (c == '_') {
+            words.push_back(word);
+            word.clear();
+        }
+    }
+    if (!word.empty())
+        words.push_back(word);
+    std::string out, line;
+    for (const std::string& w : words) {
+        const bool space = !line.empty() && line.back() != '_';
+        if (!line.empty() && line.size() + (space ? 1 : 0) + w.size() > width) {
+            out += (out.empty() ? "" : "\n") + line;
+            line.clear();
+        }
+        line += (line.empty() || line.back() == '_' ? "" : " ") + w;
+    }
+    if (!line.empty())
+        out += (out.empty() ? "" : "\n") + line;
+    return out;
+}
+
 bool isLabelField(const ScalarField& field)
 {
     static const char* const kLabelNames[] = {"region_id", "primitive_id", "primitive_type", "classification", "class", "label",

@@ -28,6 +28,12 @@ struct ColourLegend
     std::vector<std::pair<long, std::array<std::uint8_t, 3>>> categories;
 };
 
+//! A colour bar's title on lines of at most `width` characters, broken after
+//! an underscore or at a space (a word longer than the line stays whole):
+//! the bar's frame is narrow, and VTK draws a longer title past the view's
+//! edge ("height_above_grou").
+std::string wrappedTitle(const std::string& title, std::size_t width = 13);
+
 //! Whether a field holds labels rather than measures: its name says so
 //! (region_id, primitive_id, primitive_type, classification, label, cluster,
 //! or any name ending in "_id") and every value is an integer. Such a field

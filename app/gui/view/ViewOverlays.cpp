@@ -48,7 +48,7 @@ void CloudView::setLegend(const ColourLegend& legend)
             table->SetTableValue(static_cast<vtkIdType>(i), c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
             table->SetAnnotation(vtkVariant(value), std::to_string(value));
         }
-        scene_->scalarBar->SetTitle(legend.title.c_str());
+        scene_->scalarBar->SetTitle(wrappedTitle(legend.title).c_str());
         scene_->scalarBar->VisibilityOn();
         renderSoon();
         return;
@@ -61,7 +61,7 @@ void CloudView::setLegend(const ColourLegend& legend)
         scene_->scalarBarTable->SetTableValue(i, c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
     }
     scene_->scalarBarTable->SetTableRange(legend.min, legend.max);
-    scene_->scalarBar->SetTitle(legend.title.c_str());
+    scene_->scalarBar->SetTitle(wrappedTitle(legend.title).c_str());
     scene_->scalarBar->VisibilityOn();
     renderSoon();
 }
