@@ -572,6 +572,8 @@ void CloudView::setShownHere(EntityId id, bool shown)
     const auto it = scene_->shown.find(id);
     if (it == scene_->shown.end())
         return;
+    // The slices drawn so far did not colour a cloud hidden then: start them again.
+    stopRefinement();
     for (auto& c : it->second.chunks)
         c.actor->SetVisibility(shown && it->second.documentVisible);
     if (it->second.labels)

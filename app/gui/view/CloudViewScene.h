@@ -87,8 +87,19 @@ struct CloudView::Shown
     {
         if (pendingColours) {
             pendingColours->colourAll(rgba.data());
-            pendingColours.reset();
+            coloursComplete();
         }
+    }
+    //! Every point coloured since the last display change: nothing pending,
+    //! and the chunks' colour arrays (views on rgba) marked changed, so that
+    //! a full frame uploads them again (one may have been drawn, stale, while
+    //! a camera drag held the cloud undecimated).
+    void coloursComplete()
+    {
+        pendingColours.reset();
+        for (Chunk& c : chunks)
+            if (c.colours)
+                c.colours->Modified();
     }
     //! A drawing's texts (stone ids), placed so that they never overlap: as
     //! many as the view has room for, more as one zooms in.

@@ -181,7 +181,7 @@ void CloudView::drawNextSlice()
             for (const auto& c : s.chunks)
                 if (!c.actor->GetVisibility())
                     s.colourForGather(c, 1);
-            s.pendingColours.reset();
+            s.coloursComplete();
         }
     if (r.refining)
         sliceTimer_->start();

@@ -115,14 +115,14 @@ HeightAboveGroundResult heightAboveGround(const PointCloud& cloud, const HeightA
     // face of the one before (in file order, a walk across the TIN each:
     // 240 s for 2 M points of a shuffled file). Locating is a const walk, so
     // both cores share the TIN.
-    std::vector<std::pair<Point2, std::uint32_t>> queries;
+    std::vector<std::pair<Point2, std::size_t>> queries;
     queries.reserve(n);
     for (std::size_t i = 0; i < n; ++i) {
         const Eigen::Vector3f& p = cloud.positions()[i];
         if (p.allFinite())
-            queries.emplace_back(Point2(p.x(), p.y()), static_cast<std::uint32_t>(i));
+            queries.emplace_back(Point2(p.x(), p.y()), i);
     }
-    using SortTraits = CGAL::Spatial_sort_traits_adapter_2<Kernel, CGAL::First_of_pair_property_map<std::pair<Point2, std::uint32_t>>>;
+    using SortTraits = CGAL::Spatial_sort_traits_adapter_2<Kernel, CGAL::First_of_pair_property_map<std::pair<Point2, std::size_t>>>;
     CGAL::hilbert_sort(queries.begin(), queries.end(), SortTraits());
     ticker.step(n - queries.size()); // the points without coordinates
     std::atomic<std::size_t> outside{0};
@@ -131,7 +131,7 @@ HeightAboveGroundResult heightAboveGround(const PointCloud& cloud, const HeightA
         std::size_t beyond = 0;
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
             const Point2& q = queries[k].first;
-            const std::uint32_t i = queries[k].second;
+            const std::size_t i = queries[k].second;
             Triangulation::Locate_type type;
             int index = 0;
             Triangulation::Face_handle face = tin.locate(q, type, index, hint);

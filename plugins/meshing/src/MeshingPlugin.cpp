@@ -23,7 +23,8 @@ void registerHeightAboveGround(scandiff::PluginRegistry& registry)
         "Each point's height over the terrain of its ground points (classes 2 by default, as `ground` writes them): "
         "their Delaunay triangulation in XY (a TIN), interpolated linearly in the triangle under the point, as PDAL's "
         "filters.hag_delaunay; beyond the TIN's outline, the height over the nearest ground point. Adds the field "
-        "height_above_ground (m): 0 on the ground points, canopy and roof heights above.";
+        "height_above_ground (m): 0 on the ground points (where several share one XY place, on the one the terrain "
+        "keeps), canopy and roof heights above.";
     tool.outputs = {OutputSpec{"output", "Cloud with heights above ground", DataKind::Cloud, true}};
     tool.parameters = {
         ParameterSpec::text("ground-classes", "Ground classes", "The classes the terrain is made of, e.g. 2 or 2,8 (ASPRS: 2 ground, 8 model key points)", "2"),
