@@ -27,7 +27,8 @@ inline std::string quoted(std::string_view s)
 
 //! A whole token as a number; false when anything is left over. A leading
 //! '+' is accepted (std::from_chars rejects the sign some writers emit).
-inline bool parseDouble(std::string_view token, double& value)
+template <class Number>
+bool parseNumber(std::string_view token, Number& value)
 {
     const char* first = token.data();
     const char* last = first + token.size();
@@ -37,15 +38,8 @@ inline bool parseDouble(std::string_view token, double& value)
     return ec == std::errc() && ptr == last && first != last;
 }
 
-inline bool parseInteger(std::string_view token, std::int64_t& value)
-{
-    const char* first = token.data();
-    const char* last = first + token.size();
-    if (first != last && *first == '+')
-        ++first;
-    const auto [ptr, ec] = std::from_chars(first, last, value);
-    return ec == std::errc() && ptr == last && first != last;
-}
+inline bool parseDouble(std::string_view token, double& value) { return parseNumber(token, value); }
+inline bool parseInteger(std::string_view token, std::int64_t& value) { return parseNumber(token, value); }
 
 //! A stored colour channel (times `scale` to bring it to 0-255) as a byte:
 //! rounded, clamped, NaN as 0.
