@@ -151,7 +151,7 @@ void colourLabels(const ScalarField& field, const FieldDisplay& display, FieldCo
     }
 }
 
-//! blendWithOwnColours over the same part.
+//! A field's colours shaded by the cloud's own (see colourEntity), over the same part.
 void blendPart(const PointCloud& points, std::uint8_t* rgba, std::size_t begin, std::size_t end, std::size_t stride, std::size_t first)
 {
     if (!points.hasColors())
@@ -193,11 +193,6 @@ ColourLegend legendOf(const PointCloud& points, const DisplayState& display)
         for (long value : labelsPresent(*field, kLegendCategories))
             legend.categories.emplace_back(value, categoryColour(*field, value));
     return legend;
-}
-
-void blendWithOwnColours(const PointCloud& points, std::uint8_t* rgba)
-{
-    blendPart(points, rgba, 0, points.size(), 1, 0);
 }
 
 EntityColourer::EntityColourer(const PointCloud& points, const DisplayState& display)

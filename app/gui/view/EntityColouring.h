@@ -75,13 +75,6 @@ std::pair<double, double> colourRange(const ScalarField& field, const FieldDispl
 //! The legend of the active field (not shown for colours or height).
 ColourLegend legendOf(const PointCloud& points, const DisplayState& display);
 
-//! Shades each shown point's colour by the lightness of the cloud's own colour
-//! there: c x (0.35 + 0.65 L), L the colour's luma (BT.709 weights on its
-//! sRGB values) in [0, 1]; a white point keeps the field's colour, a black one a third of it,
-//! so the texture reads and the field's hue stays. Hidden points (alpha 0) are
-//! left alone; a cloud without colours is left as it is.
-void blendWithOwnColours(const PointCloud& points, std::uint8_t* rgba);
-
 //! An entity's colouring, decided once from its display state (which field,
 //! its range and scale's table, labels or a ramp, its own colours, or its
 //! height) and applied to all its points or to a part: every stride-th point
@@ -118,7 +111,11 @@ private:
 
 //! Fills rgba (4 bytes per point, alpha 0 = hidden; room for 4 x points.size())
 //! and returns the legend. With display.blendColours, an active field's
-//! colours go through blendWithOwnColours.
+//! colours are shaded by the lightness of the cloud's own colour at each
+//! point: c x (0.35 + 0.65 L), L the colour's luma (BT.709 weights on its
+//! sRGB values) in [0, 1]; a white point keeps the field's colour, a black
+//! one a third of it, so the texture reads and the field's hue stays.
+//! Hidden points (alpha 0) and clouds without colours are left as they are.
 ColourLegend colourEntity(const PointCloud& points, const DisplayState& display, std::uint8_t* rgba);
 
 } // namespace scandiff::gui
