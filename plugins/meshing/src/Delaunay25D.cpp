@@ -3,11 +3,11 @@
 
 #include <scandiff/core/Error.h>
 
+#include "BiasedInsertion.h"
+
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Spatial_sort_traits_adapter_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
-#include <CGAL/hilbert_sort.h>
 
 #include <Eigen/Dense>
 
@@ -79,34 +79,10 @@ Delaunay25DResult delaunay25D(const PointCloud& cloud, const Delaunay25DParams& 
         const Eigen::Vector3d p = cloud.positions()[i].cast<double>();
         planar[i] = {Point2(p.dot(axes.u), p.dot(axes.v)), static_cast<std::uint32_t>(i)};
     }
-    // Inserted one by one in CGAL's spatial order (a biased randomised
-    // insertion order: shuffled, then rounds each four times the previous,
-    // each along a Hilbert curve), so that a cancellation is noticed between
-    // points. The rounds are sorted here one by one rather than by
-    // CGAL::spatial_sort in one call, which takes 0.4 s on 2 M points unheard.
-    using SortTraits = CGAL::Spatial_sort_traits_adapter_2<Kernel, CGAL::First_of_pair_property_map<std::pair<Point2, std::uint32_t>>>;
+    // A duplicate keeps the later index: harmless, the earlier is unused.
     ProgressTicker inserting(progress, "Delaunay triangulation", 2 * n);
-    std::mt19937_64 shuffleDraw(0x5eed); // a fixed seed: the same mesh on every run
-    std::shuffle(planar.begin(), planar.end(), shuffleDraw);
-    inserting.step(n / 4);
-    for (std::size_t end = n; end > 0;) {
-        const std::size_t begin = end > 64 ? end / 4 : 0;
-        CGAL::hilbert_sort(planar.begin() + static_cast<std::ptrdiff_t>(begin), planar.begin() + static_cast<std::ptrdiff_t>(end),
-                           SortTraits());
-        inserting.step((end - begin) * 3 / 4);
-        end = begin;
-    }
     Triangulation triangulation;
-    {
-        Triangulation::Face_handle hint;
-        for (std::size_t i = 0; i < n; ++i) {
-            const Triangulation::Vertex_handle vertex = triangulation.insert(planar[i].first, hint);
-            vertex->info() = planar[i].second; // a duplicate keeps the later index: harmless, the earlier is unused
-            hint = vertex->face();
-            if ((i & 8191) == 8191)
-                inserting.step(8192);
-        }
-    }
+    detail::insertInBiasedRandomOrder(triangulation, planar, inserting);
     if (triangulation.dimension() < 2)
         throw Error(ErrorCode::InvalidData, "mesh: the points of '" + cloud.name + "' project onto a line");
 

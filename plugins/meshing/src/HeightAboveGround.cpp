@@ -3,6 +3,8 @@
 
 #include <scandiff/core/Error.h>
 
+#include "BiasedInsertion.h"
+
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Spatial_sort_traits_adapter_2.h>
@@ -16,7 +18,6 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <random>
 #include <utility>
 
 namespace scandiff::plugins {
@@ -70,31 +71,12 @@ std::vector<std::pair<Point2, double>> groundPoints(const PointCloud& cloud, con
     return ground;
 }
 
-//! Their TIN. Inserted one by one in a biased randomised order (rounds of
-//! a shuffle, each round Hilbert-sorted, as the mesh tool does), each from
-//! the face of the one before, so that Cancel is heard while it grows (16 M
-//! points take about 20 s); batches of CGAL's range insertion were 10 times
-//! slower at 16 M.
-void buildTin(Triangulation& tin, std::vector<std::pair<Point2, double>> ground, const std::string& name, ProgressTicker& ticker)
+//! Their TIN (detail::insertInBiasedRandomOrder: Cancel is heard while it
+//! grows, 16 M points take about 20 s). At one XY place, the height of the
+//! last ground point inserted there.
+void buildTin(Triangulation& tin, std::vector<std::pair<Point2, double>>& ground, const std::string& name, ProgressTicker& ticker)
 {
-    using SortTraits = CGAL::Spatial_sort_traits_adapter_2<Kernel, CGAL::First_of_pair_property_map<std::pair<Point2, double>>>;
-    std::mt19937_64 shuffleDraw(0x5eed); // a fixed seed: the same terrain on every run
-    std::shuffle(ground.begin(), ground.end(), shuffleDraw);
-    for (std::size_t end = ground.size(); end > 0;) {
-        const std::size_t begin = end > 64 ? end / 4 : 0;
-        CGAL::hilbert_sort(ground.begin() + static_cast<std::ptrdiff_t>(begin), ground.begin() + static_cast<std::ptrdiff_t>(end),
-                           SortTraits());
-        end = begin;
-    }
-    Triangulation::Face_handle hint;
-    for (std::size_t i = 0; i < ground.size(); ++i) {
-        const Triangulation::Vertex_handle vertex = tin.insert(ground[i].first, hint);
-        vertex->info() = ground[i].second; // at one XY place, the last inserted's height
-        hint = vertex->face();
-        if ((i & 8191) == 8191)
-            ticker.step(8192);
-    }
-    ticker.step(ground.size() % 8192);
+    detail::insertInBiasedRandomOrder(tin, ground, ticker);
     if (tin.dimension() < 2)
         throw Error(ErrorCode::InvalidData, "hag: the ground points of '" + name + "' lie on a line");
 }
@@ -104,10 +86,10 @@ void buildTin(Triangulation& tin, std::vector<std::pair<Point2, double>> ground,
 HeightAboveGroundResult heightAboveGround(const PointCloud& cloud, const HeightAboveGroundParams& params, ProgressObserver* progress)
 {
     HeightAboveGroundResult result;
-    const std::vector<std::pair<Point2, double>> ground = groundPoints(cloud, params);
+    std::vector<std::pair<Point2, double>> ground = groundPoints(cloud, params);
     result.groundPoints = ground.size();
     const std::size_t n = cloud.size();
-    ProgressTicker ticker(progress, "Height above ground", ground.size() + n);
+    ProgressTicker ticker(progress, "Height above ground", 2 * ground.size() + n);
     Triangulation tin;
     buildTin(tin, ground, cloud.name, ticker);
     result.height.assign(n, std::numeric_limits<float>::quiet_NaN());
