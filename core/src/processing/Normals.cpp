@@ -102,7 +102,7 @@ void checkCloud(const PointCloud& cloud, const char* what)
 //! Plane normals of the points `indices` on their `knn` nearest points,
 //! unoriented, with their surface variation when `variation` is given.
 void fitOnNearest(const PointCloud& cloud, const octree::Octree& tree, const std::vector<std::uint32_t>& indices, std::size_t knn,
-                  std::vector<Eigen::Vector3f>& normals, std::vector<float>* variation);
+                  std::vector<Eigen::Vector3f>& normals, std::vector<float>* variation, std::vector<float>* spread = nullptr);
 
 } // namespace
 
@@ -178,13 +178,15 @@ NormalResult computeNormals(const PointCloud& cloud, const NormalParams& params,
 }
 
 void planeNormalsOf(const PointCloud& cloud, const octree::Octree& tree, const std::vector<std::uint32_t>& indices, std::size_t knn,
-                    std::vector<Eigen::Vector3f>& normals)
+                    std::vector<Eigen::Vector3f>& normals, std::vector<float>* spread)
 {
     if (knn < 3)
         throw Error(ErrorCode::InvalidArgument, "normals: at least 3 neighbours");
     if (normals.size() != cloud.size())
         throw Error(ErrorCode::InvalidArgument, "normals: one slot per point of the cloud");
-    fitOnNearest(cloud, tree, indices, knn, normals, nullptr);
+    if (spread && spread->size() != cloud.size())
+        throw Error(ErrorCode::InvalidArgument, "normals: one spread slot per point of the cloud");
+    fitOnNearest(cloud, tree, indices, knn, normals, nullptr, spread);
     for (std::uint32_t i : indices)
         if (normals[i].z() < 0)
             normals[i] = -normals[i];
@@ -193,7 +195,7 @@ void planeNormalsOf(const PointCloud& cloud, const octree::Octree& tree, const s
 namespace {
 
 void fitOnNearest(const PointCloud& cloud, const octree::Octree& tree, const std::vector<std::uint32_t>& indices, std::size_t knn,
-                  std::vector<Eigen::Vector3f>& normals, std::vector<float>* variation)
+                  std::vector<Eigen::Vector3f>& normals, std::vector<float>* variation, std::vector<float>* spread)
 {
     if (indices.empty())
         return;
@@ -215,6 +217,10 @@ void fitOnNearest(const PointCloud& cloud, const octree::Octree& tree, const std
             normal = plane.normal.cast<float>();
             if (variation)
                 (*variation)[indices[q]] = static_cast<float>(surfaceVariationOf(plane));
+            if (spread)
+                (*spread)[indices[q]] = static_cast<float>(std::sqrt(std::max(0.0, plane.values[0]) / static_cast<double>(count)));
+        } else if (spread) {
+            (*spread)[indices[q]] = 0.0f;
         }
         normals[indices[q]] = normal;
     });

@@ -39,6 +39,7 @@ public:
         // overlap), not all of it.
         if (needNormals && !cloud.hasNormals()) {
             normals_.assign(cloud.size(), Eigen::Vector3f::Zero());
+            spread_.assign(cloud.size(), 0.0f);
             fitted_.assign(cloud.size(), 0);
             normalNeighbours_ = normalNeighbours;
         }
@@ -61,11 +62,12 @@ public:
                     fitted_[neighbour.index] = 1;
                     missing.push_back(neighbour.index);
                 }
-            planeNormalsOf(cloud_, tree_, missing, normalNeighbours_, normals_);
+            planeNormalsOf(cloud_, tree_, missing, normalNeighbours_, normals_, &spread_);
         }
         out.points.resize(n);
         out.normals.resize(n);
         out.found.resize(n);
+        out.spread.resize(spread_.empty() ? 0 : n);
         const std::vector<Eigen::Vector3f>& normals = cloud_.hasNormals() ? cloud_.normals() : normals_;
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -75,6 +77,8 @@ public:
                     continue;
                 out.points[i] = cloud_.positions()[j].cast<double>() - shift_;
                 out.normals[i] = normals.empty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(normals[j].cast<double>());
+                if (!spread_.empty())
+                    out.spread[i] = spread_[j];
             }
         });
     }
@@ -86,6 +90,7 @@ private:
     Eigen::Vector3d shift_;
     // Normals fitted so far (zero where not yet, or where no plane fits).
     mutable std::vector<Eigen::Vector3f> normals_;
+    mutable std::vector<float> spread_; // the fitted planes' RMS spread, with the normals
     mutable std::vector<char> fitted_;
     std::size_t normalNeighbours_ = 12;
     // Buffers reused from one iteration to the next (a surface serves one run at a time).
@@ -120,6 +125,7 @@ public:
         out.points.resize(n);
         out.normals.resize(n);
         out.found.resize(n);
+        out.spread.clear();
         const auto& v = mesh_.vertices.positions();
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {

@@ -24,6 +24,10 @@ struct ClosestPoints
     std::vector<Eigen::Vector3d> points;  //!< frame coordinates
     std::vector<Eigen::Vector3d> normals; //!< unit, zero where there is none
     std::vector<char> found;
+    //! How rough the reference is where each closest point lies: its
+    //! neighbours' RMS distance to their fitted plane (m). Empty when the
+    //! surface does not know (a mesh, a cloud with its own normals).
+    std::vector<double> spread;
 };
 
 class ReferenceSurface

@@ -100,9 +100,11 @@ NormalResult computeNormals(const PointCloud& cloud, const NormalParams& params,
 //! their slots of `normals` (one per point of the cloud; a zero vector where
 //! no plane fits): for a caller that needs some of them, in turns, and holds
 //! the cloud's octree (`tree`, built on its positions). The same normals as
-//! computeNormals with the same neighbours and orientation.
+//! computeNormals with the same neighbours and orientation. With `spread`
+//! (one slot per point too), each fitted point's neighbours' RMS distance to
+//! their plane (m; 0 where no plane fits): how rough the surface is there.
 void planeNormalsOf(const PointCloud& cloud, const octree::Octree& tree, const std::vector<std::uint32_t>& indices, std::size_t knn,
-                    std::vector<Eigen::Vector3f>& normals);
+                    std::vector<Eigen::Vector3f>& normals, std::vector<float>* spread = nullptr);
 
 //! Orients `normals` (one per point of `cloud`, zero vectors are left alone)
 //! in place; returns the number of connected parts for the MST orientation
