@@ -603,7 +603,8 @@ IterationRun runIterations(const detail::ReferenceSurface& surface, const Iterat
 
 //! The sample's point-to-plane residuals under a motion, each at most
 //! `cutoff` (a truncated quadratic: what changed does not pull), squared and
-//! summed.
+//! summed; each relative to its tolerance (tolerancesOf), as the iterations
+//! weigh it.
 double truncatedCost(const detail::ReferenceSurface& surface, const IterationPoints& points, const IcpParams& params,
                      const Eigen::Isometry3d& motion, double cutoff)
 {
@@ -613,8 +614,10 @@ double truncatedCost(const detail::ReferenceSurface& surface, const IterationPoi
     Correspondences c;
     correspond(surface, x, params, kInfinity, c, 10 * cutoff, points.roughnessTolerated);
     double cost = 0;
-    for (double r : c.residual)
+    for (std::size_t i = 0; i < c.residual.size(); ++i) {
+        const double r = c.residual[i] / (c.tolerance.empty() ? 1.0 : c.tolerance[i]);
         cost += std::isfinite(r) ? std::min(r * r, cutoff * cutoff) : cutoff * cutoff;
+    }
     return cost;
 }
 
@@ -742,8 +745,12 @@ bool holdOrSolveWeakDirections(const ReferenceSurface& surface, const IterationP
 //! iteration's rules keep it; the magnitudes of those kept.
 std::vector<double> residualsOfEveryPoint(const PointCloud& moving, const ReferenceSurface& surface, const IcpParams& final,
                                           const Eigen::Isometry3d& motion, const Eigen::Vector3d& origin, double finalThreshold,
-                                          bool roughnessTolerated, IcpResult& result, ProgressObserver* progress)
+                                          IcpResult& result, ProgressObserver* progress)
 {
+    // The field and the report judge every moving point, grown crowns
+    // included, by the thesis's threshold: the tolerance of tolerancesOf is
+    // for the classed points the iterations use, and a crown over a rough
+    // crown must not pass as unchanged.
     std::vector<double> magnitudes;
     // In chunks, each a step of its own stage: on a
     // large cloud this pass (closest points and the reference normals they
@@ -762,7 +769,7 @@ std::vector<double> residualsOfEveryPoint(const PointCloud& moving, const Refere
             chunk[i - begin] = moving.positions()[i].allFinite()
                                    ? Eigen::Vector3d(motion * (moving.globalPosition(i) - origin))
                                    : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-        correspond(surface, chunk, final, finalThreshold, last, final.maxDistance.value_or(kInfinity), roughnessTolerated);
+        correspond(surface, chunk, final, finalThreshold, last, final.maxDistance.value_or(kInfinity));
         for (std::size_t i = begin; i < end; ++i) {
             const std::size_t k = i - begin;
             if (std::isfinite(last.residual[k]))
@@ -837,7 +844,7 @@ IcpResult icpOnSurface(const PointCloud& moving, const ReferenceSurface& surface
         return result;
     }
     const std::vector<double> everyMagnitude =
-        residualsOfEveryPoint(moving, surface, final, motion, origin, finalThreshold, used.roughnessTolerated, result, progress);
+        residualsOfEveryPoint(moving, surface, final, motion, origin, finalThreshold, result, progress);
     summarise(everyMagnitude, moving.size(), params, report);
     return result;
 }
