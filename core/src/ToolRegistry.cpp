@@ -2,6 +2,8 @@
 #include <scandiff/core/Error.h>
 #include <scandiff/core/ToolRegistry.h>
 
+#include "ClassRestriction.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -320,6 +322,8 @@ void ToolSpec::checkInputs(const ToolInputs& given) const
 ToolResult ToolSpec::execute(const ToolInputs& given, const ParameterValues& values, ProgressObserver* progress) const
 {
     checkInputs(given);
+    if (detail::restrictsClasses(values))
+        return detail::runOnClasses(*this, given, values, progress);
     return run(given, values, progress);
 }
 
@@ -508,6 +512,7 @@ void ToolRegistry::add(ToolSpec tool)
             throw Error(ErrorCode::Internal, tool.name + ": output '" + o.role + "' goes under '" + o.under +
                                                  "', which must be an earlier repeated output, and be repeated itself");
     }
+    detail::addClassParameters(tool);
     tools_.push_back(std::move(tool));
 }
 
