@@ -12,21 +12,16 @@
 //! - points the tool moved (a registration) are all moved, by the tool's
 //!   matrix output, the points left out with them.
 
+#include <scandiff/core/ClassSelection.h>
 #include <scandiff/core/ToolRegistry.h>
 
 namespace scandiff::detail {
-
-inline constexpr const char* kClassesParameter = "classes";
-inline constexpr const char* kExcludeClassesParameter = "exclude-classes";
 
 //! Adds the two parameters to `tool` when it takes point clouds, has neither
 //! already, and gives no repeated in-place output (the stations of a
 //! multi-station registration: their poses are not one matrix to move the
 //! points left out by).
 void addClassParameters(ToolSpec& tool);
-
-//! True when `values` restricts the run to some classes.
-bool restrictsClasses(const ParameterValues& values);
 
 //! Runs `tool` on its cloud inputs restricted by class (see above). Throws
 //! Error(InvalidArgument) for a bad class list, a cloud without the field

@@ -322,7 +322,7 @@ void ToolSpec::checkInputs(const ToolInputs& given) const
 ToolResult ToolSpec::execute(const ToolInputs& given, const ParameterValues& values, ProgressObserver* progress) const
 {
     checkInputs(given);
-    if (detail::restrictsClasses(values))
+    if (restrictsClasses(values))
         return detail::runOnClasses(*this, given, values, progress);
     return run(given, values, progress);
 }

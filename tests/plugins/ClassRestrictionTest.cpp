@@ -6,6 +6,7 @@
 #include "TestSupport.h"
 
 #include <scandiff/core/Error.h>
+#include <scandiff/core/distance/DistanceParameters.h>
 #include <scandiff/core/processing/CloudEditing.h>
 #include <scandiff/plugins/PluginRegistry.h>
 
@@ -177,6 +178,36 @@ TEST(ClassRestriction, AnInPlaceToolKeepsEveryPointAndWhatItHad)
             EXPECT_EQ(whole.normals()[i], Eigen::Vector3f::Zero()) << i; // no normal there
     }
     EXPECT_EQ(k, ground.size());
+}
+
+// c2c is declared outside the registry (cloudToCloudParameters, shared by
+// the command and the workbench's dialog) and takes the classes the same way.
+TEST(ClassRestriction, CloudToCloudOnGroundOnlyEqualsItOnGroundClouds)
+{
+    const PointCloud earlier = vegetatedGround(20000, 7, 0.0), later = vegetatedGround(20000, 8, 1.5);
+    std::map<std::string, std::string> options{{"model", "quadric"}, {"both-ways", "true"}};
+    const CloudToCloudRun plain = runCloudToCloud(ofClasses(later, {2}), ofClasses(earlier, {2}),
+                                                  resolveParameters(cloudToCloudParameters(), options, "c2c"));
+    options["classes"] = "2";
+    const CloudToCloudRun restricted = runCloudToCloud(later, earlier, resolveParameters(cloudToCloudParameters(), options, "c2c"));
+    auto sameOnGround = [](const PointCloud& whole, const ScalarField& spread, const ScalarField& ground) {
+        ASSERT_EQ(spread.size(), whole.size());
+        std::size_t k = 0;
+        for (std::size_t i = 0; i < whole.size(); ++i) {
+            if (whole.field("classification")->value(i) == 2) {
+                ASSERT_EQ(spread.value(i), ground.value(k++)) << i;
+            } else {
+                ASSERT_TRUE(std::isnan(spread.value(i))) << i;
+            }
+        }
+        EXPECT_EQ(k, ground.size());
+    };
+    sameOnGround(later, restricted.forward.distance, plain.forward.distance);
+    ASSERT_TRUE(restricted.reverse && plain.reverse);
+    sameOnGround(earlier, restricted.reverse->distance, plain.reverse->distance);
+    EXPECT_EQ(restricted.forward.statistics.count, plain.forward.statistics.count);
+    // The grown crowns are out: ground against ground, within the noise and the sampling.
+    EXPECT_LT(restricted.forward.statistics.max, 0.2);
 }
 
 TEST(ClassRestriction, BadClassListsAndCloudsWithoutClassesAreRefused)

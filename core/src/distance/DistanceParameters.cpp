@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include <scandiff/core/ClassSelection.h>
 #include <scandiff/core/Error.h>
 #include <scandiff/core/TextLists.h>
 #include <scandiff/core/distance/DistanceParameters.h>
@@ -74,7 +75,7 @@ const std::vector<ParameterSpec>& cloudToCloudParameters()
 {
     static const std::vector<ParameterSpec> parameters = [] {
         const CloudToCloudParams defaults;
-        return std::vector<ParameterSpec>{
+        std::vector<ParameterSpec> list{
             maxDistanceParameter(),
             clampParameter(),
             ParameterSpec::choice("model", "Local model", "Model of the reference around each nearest neighbour (thesis 000 §2.3.2)",
@@ -112,6 +113,9 @@ const std::vector<ParameterSpec>& cloudToCloudParameters()
                                 1e9, "m"),
             octreeLevelParameter("from the reference's cell populations"),
         };
+        for (ParameterSpec& spec : classParameters())
+            list.push_back(std::move(spec));
+        return list;
     }();
     return parameters;
 }
@@ -180,9 +184,45 @@ CloudToCloudParams cloudToCloudSettings(const ParameterValues& values, const Poi
 
 bool cloudToCloudBothWays(const ParameterValues& values) { return values.boolean("both-ways"); }
 
+namespace {
+
+//! A result computed on the points `kept` of a cloud of `size` points, spread
+//! over all of them: NaN (no value) on the others, reach 0 (none computed).
+void spreadResult(CloudToCloudResult& result, const std::vector<std::size_t>& kept, std::size_t size)
+{
+    result.distance = spreadOver(result.distance, kept, size);
+    for (std::optional<ScalarField>* field : {&result.dx, &result.dy, &result.dz, &result.visibility})
+        if (*field)
+            **field = spreadOver(**field, kept, size);
+    if (!result.reach.empty()) {
+        std::vector<float> reach(size, 0.0f);
+        for (std::size_t k = 0; k < kept.size(); ++k)
+            reach[kept[k]] = result.reach[k];
+        result.reach = std::move(reach);
+    }
+}
+
+} // namespace
+
 CloudToCloudRun runCloudToCloud(const PointCloud& compared, const PointCloud& reference, const ParameterValues& values,
                                 ProgressObserver* progress)
 {
+    // With classes (--classes, --exclude-classes): both clouds restricted to
+    // them, the values spread back over every point (none on the others).
+    const std::optional<std::vector<std::size_t>> comparedKept = pointsOfClasses(compared, values);
+    if (comparedKept) {
+        const std::vector<std::size_t> referenceKept = *pointsOfClasses(reference, values);
+        ParameterValues unrestricted;
+        for (const auto& [name, value] : values.all())
+            if (name != kClassesParameter && name != kExcludeClassesParameter)
+                unrestricted.set(name, value);
+        CloudToCloudRun run =
+            runCloudToCloud(compared.subset(*comparedKept), reference.subset(referenceKept), unrestricted, progress);
+        spreadResult(run.forward, *comparedKept, compared.size());
+        if (run.reverse)
+            spreadResult(*run.reverse, referenceKept, reference.size());
+        return run;
+    }
     CloudToCloudRun run;
     run.params = cloudToCloudSettings(values, reference);
     const bool bothWays = cloudToCloudBothWays(values);
