@@ -11,6 +11,7 @@
 
 #include "CliSupport.h"
 
+#include <scandiff/core/ClassSelection.h>
 #include <scandiff/core/Error.h>
 #include <scandiff/core/distance/DistanceParameters.h>
 #include <scandiff/io/FileIO.h>
@@ -24,6 +25,20 @@
 #include <string>
 
 namespace {
+
+//! c2c's parameters but the classes: the tiles are cut and merged over every
+//! point, and a run on some classes is not there yet (scandiff-cli c2c has it).
+const std::vector<scandiff::ParameterSpec>& tiledCloudToCloudParameters()
+{
+    static const std::vector<scandiff::ParameterSpec> parameters = [] {
+        std::vector<scandiff::ParameterSpec> kept;
+        for (const auto& spec : scandiff::cloudToCloudParameters())
+            if (spec.name != scandiff::kClassesParameter && spec.name != scandiff::kExcludeClassesParameter)
+                kept.push_back(spec);
+        return kept;
+    }();
+    return parameters;
+}
 
 using namespace scandiff;
 
@@ -105,12 +120,12 @@ int run(int argc, char** argv, const mpi::Communicator& world)
     CLI::App* c2c = app.add_subcommand("c2c", "Cloud-to-cloud distance, as scandiff-cli c2c, on tiles over the ranks");
     c2c->add_option("--reference", c2cArgs.reference, "Reference cloud")->required();
     c2c->add_option("--compared", c2cArgs.compared, "Compared cloud (the output keeps its points, in order)")->required();
-    const auto options = cli::addParameterOptions(*c2c, cloudToCloudParameters(), c2cArgs.values);
+    const auto options = cli::addParameterOptions(*c2c, tiledCloudToCloudParameters(), c2cArgs.values);
     options.at("knn")->excludes(options.at("radius"));
     addCommon(*c2c, c2cArgs, "the compared cloud with c2c_distance");
     c2c->callback([&] {
         const cli::ThreadLimit threadLimit(c2cArgs.threads);
-        auto job = c2cArgs.job<mpi::CloudToCloudJob>(cloudToCloudParameters(), "c2c");
+        auto job = c2cArgs.job<mpi::CloudToCloudJob>(tiledCloudToCloudParameters(), "c2c");
         mpi::runTiledCloudToCloud(world, formats, job, out);
     });
 

@@ -13,21 +13,42 @@ namespace scandiff::detail {
 
 namespace {
 
+//! An in-place output that did not move its points is a copy of them: the
+//! same coordinates to the last digit (a registration's correction of a
+//! millimetre is a move, at any distance from the origin).
 bool samePositions(const PointCloud& a, const PointCloud& b)
 {
     if (a.size() != b.size())
         return false;
     for (std::size_t i = 0; i < a.size(); ++i)
-        if ((a.exactGlobalPosition(i) - b.exactGlobalPosition(i)).norm() > 1e-9 * (1 + a.exactGlobalPosition(i).norm()))
+        if (a.exactGlobalPosition(i) != b.exactGlobalPosition(i))
             return false;
     return true;
 }
 
-//! `whole` with what the tool gave for its points `kept` (`part`, in the
-//! same order) laid over it: fields and normals; the tool's new fields empty
-//! elsewhere.
-void layOver(PointCloud& whole, const PointCloud& part, const std::vector<std::size_t>& kept)
+//! Whether `matrix` takes the points of `before` to those of `after` (to a
+//! millimetre: what float coordinates about two origins agree to), so that it
+//! may move the points left out too.
+bool movesOnto(const Eigen::Matrix4d& matrix, const PointCloud& before, const PointCloud& after)
 {
+    for (std::size_t i = 0; i < before.size(); ++i) {
+        const Eigen::Vector3d moved = (matrix * before.exactGlobalPosition(i).homogeneous()).head<3>();
+        if (!((moved - after.exactGlobalPosition(i)).norm() <= 1e-3))
+            return false;
+    }
+    return true;
+}
+
+//! `whole` with what the tool gave for its points `kept` (`part`, in the
+//! same order) laid over it: fields, normals and colours; the tool's new
+//! fields empty elsewhere, normals zero (none) and colours black where the
+//! cloud had none; a field the tool removed (`before` had it, `part` not) is
+//! removed.
+void layOver(PointCloud& whole, const PointCloud& before, const PointCloud& part, const std::vector<std::size_t>& kept)
+{
+    for (const ScalarField& field : before.fields())
+        if (!part.field(field.name()))
+            whole.removeField(field.name());
     for (const ScalarField& field : part.fields()) {
         ScalarField* target = whole.field(field.name());
         if (!target) {
@@ -42,6 +63,11 @@ void layOver(PointCloud& whole, const PointCloud& part, const std::vector<std::s
         for (std::size_t k = 0; k < kept.size(); ++k)
             normals[kept[k]] = part.normals()[k];
     }
+    if (part.hasColors()) {
+        std::vector<Rgb8>& colours = whole.enableColors();
+        for (std::size_t k = 0; k < kept.size(); ++k)
+            colours[kept[k]] = part.colors()[k];
+    }
 }
 
 } // namespace
@@ -52,7 +78,8 @@ void addClassParameters(ToolSpec& tool)
         std::any_of(tool.inputs.begin(), tool.inputs.end(), [](const InputSpec& in) { return in.kind == DataKind::Cloud; });
     const bool repeatedInPlace =
         std::any_of(tool.outputs.begin(), tool.outputs.end(), [](const OutputSpec& out) { return out.updatesInput && out.repeated; });
-    if (!takesClouds || repeatedInPlace || tool.parameter(kClassesParameter) || tool.parameter(kExcludeClassesParameter))
+    if (!tool.runsOnClasses || !takesClouds || repeatedInPlace || tool.parameter(kClassesParameter) ||
+        tool.parameter(kExcludeClassesParameter))
         return;
     for (ParameterSpec& spec : classParameters())
         tool.parameters.push_back(std::move(spec));
@@ -72,6 +99,10 @@ ToolResult runOnClasses(const ToolSpec& tool, const ToolInputs& given, const Par
                 restricted.add(spec.role, *mesh); // a mesh's triangles are not chosen by class
             } else {
                 const PointCloud& cloud = given.cloud(spec.role, i);
+                if (spec.optional && !cloud.field("classification")) {
+                    restricted.add(spec.role, cloud); // core points without classes: all of them
+                    continue;
+                }
                 std::vector<std::size_t> kept = *pointsOfClasses(cloud, values);
                 parts.push_back(cloud.subset(kept));
                 restricted.add(spec.role, parts.back());
@@ -97,14 +128,18 @@ ToolResult runOnClasses(const ToolSpec& tool, const ToolInputs& given, const Par
         if (!part || part->size() != firstKept.size())
             continue;
         PointCloud whole;
-        if (samePositions(*part, firstPart))
+        if (samePositions(*part, firstPart)) {
             whole = first->clone();
-        else if (matrix && std::holds_alternative<Eigen::Matrix4d>(matrix->data))
-            whole = transformCloud(*first, std::get<Eigen::Matrix4d>(matrix->data), "moved as its classes " + spec.role);
-        else
-            continue; // moved without a matrix: the output holds the chosen points only
+        } else {
+            const Eigen::Matrix4d* m = matrix ? std::get_if<Eigen::Matrix4d>(&matrix->data) : nullptr;
+            if (!m || !movesOnto(*m, firstPart, *part))
+                throw Error(ErrorCode::InvalidArgument, tool.name + " moves the points without one motion for all of them: it "
+                                                                    "does not run on some classes only");
+            whole = transformCloud(*first, *m, "");
+            whole.transformHistory() = part->transformHistory(); // the tool's own entry
+        }
         whole.name = part->name;
-        layOver(whole, *part, firstKept);
+        layOver(whole, firstPart, *part, firstKept);
         *part = std::move(whole);
     }
     result.summary += " (on " + std::to_string(firstKept.size()) + " of " + std::to_string(first->size()) +

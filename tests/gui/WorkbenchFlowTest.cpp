@@ -1012,7 +1012,18 @@ private slots:
         QVERIFY(view.pickAt(pickX, pickY));
         QCOMPARE(picked.count(), 2);
         QCOMPARE(picked.at(0).at(0).toInt(), picked.at(1).at(0).toInt());
-        QCOMPARE(picked.at(0).at(1).value<std::size_t>(), picked.at(1).at(1).value<std::size_t>());
+        {
+            // The same point, or one as good: the roof is flat at 5 mm, so two
+            // of its points can share the cursor's pixel (7.5 mm here) at one
+            // depth, and which one the slices met first depends on the budget
+            // the machine's speed set (a loaded machine picked one 1 cm away).
+            const std::size_t atRest = picked.at(0).at(1).value<std::size_t>(), onFullFrame = picked.at(1).at(1).value<std::size_t>();
+            const auto& shown = window.document().item(static_cast<gui::EntityId>(picked.at(0).at(0).toInt())).points().positions();
+            QVERIFY(atRest < shown.size() && onFullFrame < shown.size());
+            QVERIFY2(atRest == onFullFrame || (shown[atRest].z() == shown[onFullFrame].z() &&
+                                               (shown[atRest] - shown[onFullFrame]).head<2>().norm() <= 2 * 0.0075f),
+                     qPrintable(QString("picked %1 at rest, %2 on the full frame").arg(atRest).arg(onFullFrame)));
+        }
         QCOMPARE(refined.size(), full.size());
         const auto apart = [](QRgb f, QRgb g) {
             return std::max({std::abs(qRed(f) - qRed(g)), std::abs(qGreen(f) - qGreen(g)), std::abs(qBlue(f) - qBlue(g))}) > 24;

@@ -73,8 +73,44 @@ TEST(ClassRestriction, EveryToolOnCloudsOffersIt)
         EXPECT_NE(tool.parameter("classes"), nullptr) << name;
         EXPECT_NE(tool.parameter("exclude-classes"), nullptr) << name;
     }
-    // The stations' poses are not one matrix to move left-out points by.
-    EXPECT_EQ(toolNamed(registry, "register-stations").parameter("classes"), nullptr);
+    // The stations' poses are not one matrix to move left-out points by; a
+    // field is renamed or deleted, a cloud moved, on every point.
+    for (const char* name : {"register-stations", "field-rename", "field-delete", "transform", "undo-transform"})
+        EXPECT_EQ(toolNamed(registry, name).parameter("classes"), nullptr) << name;
+}
+
+TEST(ClassRestriction, ColouringTheGroundLeavesTheTreesAsTheyWere)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& tool = toolNamed(registry, "set-colour");
+    PointCloud cloud = vegetatedGround(3000, 9, 0.0);
+    for (auto& colour : cloud.enableColors())
+        colour = {10, 20, 30};
+    const ToolResult result =
+        tool.execute(ToolInputs().add("input", cloud), tool.resolve({{"colour", "255,0,0"}, {"classes", "2"}}), nullptr);
+    const PointCloud& out = result.cloud();
+    ASSERT_EQ(out.size(), cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const bool ground = cloud.field("classification")->value(i) == 2;
+        const Rgb8 expected = ground ? Rgb8{255, 0, 0} : Rgb8{10, 20, 30};
+        EXPECT_EQ(out.colors()[i], expected) << i;
+    }
+}
+
+TEST(ClassRestriction, CorePointsWithoutClassesAreAllUsed)
+{
+    const PluginRegistry registry = makePluginRegistry();
+    const ToolSpec& tool = toolNamed(registry, "m3c2");
+    const PointCloud earlier = vegetatedGround(20000, 10, 0.0), later = vegetatedGround(20000, 11, 1.5);
+    PointCloud cores;
+    for (int i = 0; i < 10; ++i)
+        for (int j = 0; j < 10; ++j)
+            cores.positions().push_back(Eigen::Vector3f(3.0f * i + 1, 3.0f * j + 1, 0.8f * std::sin((3.0f * i + 1) / 4) + 0.5f * std::cos((3.0f * j + 1) / 5)));
+    cores.setOrigin(earlier.origin());
+    const ToolResult result = tool.execute(ToolInputs().add("reference", earlier).add("compared", later).add("core-points", cores),
+                                           tool.resolve({{"normal-scale", "1"}, {"projection-scale", "0.5"}, {"max-depth", "3"}, {"classes", "2"}}),
+                                           nullptr);
+    EXPECT_EQ(result.cloud().size(), cores.size());
 }
 
 TEST(ClassRestriction, M3c2OnGroundOnlyEqualsM3c2OnGroundClouds)

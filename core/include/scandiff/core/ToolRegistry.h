@@ -284,6 +284,10 @@ struct ToolSpec
     //! residual as the pairs are picked). Fast, no progress; throws
     //! Error(InvalidArgument) with the reason while the values cannot give one.
     std::function<Table(const ToolInputs&, const ParameterValues&)> preview;
+    //! The registry gives the tool `--classes` / `--exclude-classes`
+    //! (ClassSelection.h) when it takes clouds; false for a tool where a class
+    //! means nothing (renaming or deleting a field, moving a whole cloud).
+    bool runsOnClasses = true;
 
     const ParameterSpec* parameter(const std::string& name) const;
     const InputSpec* input(const std::string& role) const;

@@ -189,6 +189,7 @@ void addTransformTool(ToolRegistry& registry)
             .withSuggestions({"0,0,0", "centroid", "box-centre"}),
         ParameterSpec::boolean("inverse", "Inverse", "Apply the inverse of the transformation", false),
     };
+    tool.runsOnClasses = false; // the whole cloud is moved
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver* progress) {
         const PointCloud& input = inputs.cloud();
         Eigen::Matrix4d m;
@@ -248,6 +249,7 @@ void addUndoTransformTool(ToolRegistry& registry)
                                  "history (a registration, a transform) and removes it from the history.",
                                  updatedCloud("Moved cloud"));
     tool.outputs.push_back(OutputSpec{"matrix", "Undone matrix", DataKind::Transform, false});
+    tool.runsOnClasses = false; // the whole cloud is moved back
     tool.run = [](const ToolInputs& inputs, const ParameterValues&, ProgressObserver* progress) {
         const PointCloud& input = inputs.cloud();
         const AppliedTransform undone = input.transformHistory().empty() ? AppliedTransform{} : input.transformHistory().back();

@@ -117,6 +117,7 @@ void addRenameTool(ToolRegistry& registry)
     ToolSpec tool = oneCloudTool("field-rename", "Rename a field", "Scalar fields", "Gives a field another name.",
                                  updatedCloud("Cloud with the renamed field"));
     tool.parameters = {fieldParameter("The field to rename"), ParameterSpec::text("to", "New name", "The new name").asRequired()};
+    tool.runsOnClasses = false; // a field is renamed or deleted on every point
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver*) {
         const PointCloud& input = inputs.cloud();
         const std::string &from = values.text("field"), &to = values.text("to");
@@ -140,6 +141,7 @@ void addDeleteTool(ToolRegistry& registry)
     ToolSpec tool = oneCloudTool("field-delete", "Delete fields", "Scalar fields", "Removes fields from the cloud.",
                                  updatedCloud("Cloud without the fields"));
     tool.parameters = {fieldParameter("The fields to delete (NAME;NAME... or the option repeated)")};
+    tool.runsOnClasses = false; // a field is renamed or deleted on every point
     tool.run = [](const ToolInputs& inputs, const ParameterValues& values, ProgressObserver*) {
         const PointCloud& input = inputs.cloud();
         PointCloud out = input.clone();
