@@ -16,21 +16,26 @@ constexpr const char* kClassField = "classification";
 
 std::set<int> classList(const ParameterValues& values, const char* parameter)
 {
-    std::set<int> classes;
     if (!values.has(parameter))
-        return classes;
-    for (double c : parseNumberWords(values.text(parameter), std::string("--") + parameter)) {
-        if (c != std::round(c) || c < 0 || c > 255)
-            throw Error(ErrorCode::InvalidArgument,
-                        std::string("--") + parameter + ": a class is an integer in 0..255 (ASPRS), not " + std::to_string(c));
-        classes.insert(static_cast<int>(c));
-    }
-    if (classes.empty())
-        throw Error(ErrorCode::InvalidArgument, std::string("--") + parameter + ": no class given");
-    return classes;
+        return {};
+    const std::vector<int> classes = parseClassList(values.text(parameter), std::string("--") + parameter);
+    return {classes.begin(), classes.end()};
 }
 
 } // namespace
+
+std::vector<int> parseClassList(const std::string& text, const std::string& what)
+{
+    std::vector<int> classes;
+    for (double c : parseNumberWords(text, what)) {
+        if (c != std::round(c) || c < 0 || c > 255)
+            throw Error(ErrorCode::InvalidArgument, what + ": a class is an integer in 0..255 (ASPRS), not " + std::to_string(c));
+        classes.push_back(static_cast<int>(c));
+    }
+    if (classes.empty())
+        throw Error(ErrorCode::InvalidArgument, what + ": no class given");
+    return classes;
+}
 
 std::vector<ParameterSpec> classParameters()
 {

@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Registers the 2.5D Delaunay meshing as the tool "mesh", and the height
 // above the ground's TIN as "hag".
-#include <scandiff/core/Error.h>
-#include <scandiff/core/TextLists.h>
+#include <scandiff/core/ClassSelection.h>
 #include <scandiff/plugins/PluginRegistry.h>
 #include <scandiff/plugins/meshing/Delaunay25D.h>
 #include <scandiff/plugins/meshing/HeightAboveGround.h>
@@ -34,12 +33,7 @@ void registerHeightAboveGround(scandiff::PluginRegistry& registry)
         const PointCloud& input = inputs.cloud();
         plugins::HeightAboveGroundParams params;
         params.classField = values.text("class-field");
-        params.groundClasses.clear();
-        for (double c : parseNumberWords(values.text("ground-classes"), "ground classes")) {
-            if (c != std::round(c) || c < 0 || c > 255)
-                throw Error(ErrorCode::InvalidArgument, "hag: a ground class is an integer in 0..255, not " + std::to_string(c));
-            params.groundClasses.push_back(static_cast<int>(c));
-        }
+        params.groundClasses = parseClassList(values.text("ground-classes"), "hag: --ground-classes");
         plugins::HeightAboveGroundResult hag = plugins::heightAboveGround(input, params, progress);
         PointCloud out = input.clone();
         if (out.field("height_above_ground"))

@@ -71,6 +71,7 @@ struct Correspondences
     //! In the change-robust mode, on a reference that knows its roughness:
     //! each residual's tolerance relative to the usual one, at least 1 (see correspond).
     std::vector<double> tolerance;
+    double toleranceOf(std::size_t i) const { return tolerance.empty() ? 1.0 : tolerance[i]; }
     std::size_t usedCount = 0;
     double cutoff = kInfinity; //!< the largest |residual| kept (trimming, threshold), in units of tolerance
 };
@@ -134,7 +135,7 @@ void correspond(const detail::ReferenceSurface& surface, const std::vector<Eigen
             continue; // no normal there: no point-to-plane residual
         c.residual[i] = plane ? c.closest.normals[i].dot(d) : c.distance[i];
         const bool near = !params.maxDistance || c.distance[i] <= *params.maxDistance;
-        const double relative = std::abs(c.residual[i]) / (c.tolerance.empty() ? 1.0 : c.tolerance[i]);
+        const double relative = std::abs(c.residual[i]) / c.toleranceOf(i);
         if (near && relative <= threshold) {
             c.used[i] = 1;
             kept.push_back(relative);
@@ -148,7 +149,7 @@ void correspond(const detail::ReferenceSurface& surface, const std::vector<Eigen
         std::nth_element(kept.begin(), at, kept.end());
         c.cutoff = std::min(threshold, *at);
         for (std::size_t i = 0; i < n; ++i)
-            if (c.used[i] && std::abs(c.residual[i]) / (c.tolerance.empty() ? 1.0 : c.tolerance[i]) > c.cutoff)
+            if (c.used[i] && std::abs(c.residual[i]) / c.toleranceOf(i) > c.cutoff)
                 c.used[i] = 0;
     }
     c.usedCount = static_cast<std::size_t>(std::count(c.used.begin(), c.used.end(), 1));
@@ -496,7 +497,7 @@ IterationRun runIterations(const detail::ReferenceSurface& surface, const Iterat
                 ys.push_back(c.closest.points[i]);
                 ns.push_back(c.closest.normals[i]);
                 usedResiduals.push_back(c.residual[i]);
-                usedTolerances.push_back(c.tolerance.empty() ? 1.0 : c.tolerance[i]);
+                usedTolerances.push_back(c.toleranceOf(i));
                 usedDistances.push_back(c.distance[i]);
                 if (plane && !points.sidewaysOnly.empty() && points.sidewaysOnly[i]) {
                     // Horizontal only: a roof's upward normal then weighs nothing, an edge's sideways one holds.
@@ -615,7 +616,7 @@ double truncatedCost(const detail::ReferenceSurface& surface, const IterationPoi
     correspond(surface, x, params, kInfinity, c, 10 * cutoff, points.roughnessTolerated);
     double cost = 0;
     for (std::size_t i = 0; i < c.residual.size(); ++i) {
-        const double r = c.residual[i] / (c.tolerance.empty() ? 1.0 : c.tolerance[i]);
+        const double r = c.residual[i] / c.toleranceOf(i);
         cost += std::isfinite(r) ? std::min(r * r, cutoff * cutoff) : cutoff * cutoff;
     }
     return cost;

@@ -18,6 +18,10 @@ namespace scandiff {
 inline constexpr const char* kClassesParameter = "classes";
 inline constexpr const char* kExcludeClassesParameter = "exclude-classes";
 
+//! ASPRS classes from a list ("2,6", "2 8"): integers in 0..255. Throws
+//! Error(InvalidArgument) naming `what` for another number, or for none.
+std::vector<int> parseClassList(const std::string& text, const std::string& what);
+
 //! The optional parameters `classes` and `exclude-classes`.
 std::vector<ParameterSpec> classParameters();
 
